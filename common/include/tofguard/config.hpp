@@ -1,0 +1,125 @@
+#pragma once
+// The deployment config: one YAML file per deployment (config/sim.yaml is the
+// embedded default). Every process loads and validates the whole file at
+// start, so that a config error stops every process the same way, with one
+// line naming the file, the key and what was expected (ConfigError, exit
+// code 2), before anything is published.
+//
+// Units are in the names: _m metres, _ms milliseconds, _hz hertz, _mm
+// millimetres. Relative paths are resolved against the config file's folder.
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "tofguard/config_error.hpp"
+
+namespace tofguard {
+
+// Where the messages go. Small safety messages and depth images travel on
+// different multicast ports, so that a watchdog's socket is never flooded by
+// depth frames.
+struct LcmConfig {
+  // Safety messages (joint state, risk, status, heartbeats...).
+  std::string url;
+  // Image channels (TOF_DEPTH, TOF_RENDERED, TOF_LABELS); needs a receive
+  // buffer big enough for a whole frame.
+  std::string image_url;
+};
+
+// Channel names; each may be renamed in the config's `channels` section.
+struct ChannelNames {
+  std::string depth = "TOF_DEPTH";
+  std::string joint_state = "JOINT_STATE";
+  std::string camera_pose = "CAMERA_POSE";
+  std::string rendered = "TOF_RENDERED";
+  std::string labels = "TOF_LABELS";
+  std::string discrepancy = "SAFETY_DISCREPANCY";
+  std::string risk = "SAFETY_RISK";
+  std::string status = "SAFETY_STATUS";
+  std::string reset = "SAFETY_RESET";
+  std::string reset_reply = "SAFETY_RESET_REPLY";
+  std::string heartbeat = "SAFETY_HEARTBEAT";
+};
+
+// Pinhole intrinsics, OpenCV convention (pixel (u, v) has its centre at
+// (u, v), u right, v down), in pixels.
+struct Intrinsics {
+  int width = 0;
+  int height = 0;
+  double fx = 0;
+  double fy = 0;
+  double cx = 0;
+  double cy = 0;
+};
+
+// Pose of the camera's optical frame (x right, y down, z forward) in URDF
+// link `frame_id`: p_frame = rotation * p_optical + translation_m.
+struct CameraPose {
+  std::string frame_id;
+  Eigen::Vector3d translation_m = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
+};
+
+struct RobotConfig {
+  std::string id;
+  std::string urdf_path;
+  // Folders searched for package://NAME/... mesh URIs: NAME is looked up as
+  // a sub-folder of each.
+  std::vector<std::string> package_paths;
+};
+
+struct EnvironmentConfig {
+  // Static-environment URDFs (fixed joints only), placed in the same world
+  // frame as the robot's root link.
+  std::vector<std::string> urdf_paths;
+};
+
+struct CameraConfig {
+  std::string id;
+  // "sim" (the simulated ToF camera) or "uvc" (a USB Video Class camera).
+  std::string source;
+  double rate_hz = 0;
+  Intrinsics intrinsics;
+  // Static calibrated pose, used until a CAMERA_POSE message arrives.
+  CameraPose pose;
+};
+
+struct RendererConfig {
+  // Which URDF geometry to render: "visual" or "collision".
+  std::string geometry;
+  // Every shape is inflated by this much, metres.
+  double padding_m = 0;
+  // Clip distances along the optical axis, metres.
+  double near_m = 0;
+  double far_m = 0;
+  // A camera frame whose utime lies further than this beyond the newest
+  // joint state is marked unusable instead of extrapolated, milliseconds.
+  double max_extrapolation_ms = 0;
+};
+
+struct Config {
+  std::string file;
+  LcmConfig lcm;
+  ChannelNames channels;
+  RobotConfig robot;
+  EnvironmentConfig environment;
+  CameraConfig camera;
+  RendererConfig renderer;
+};
+
+// Loads and validates `path`; throws ConfigError. `lcm_default_url_env` is
+// the value of LCM_DEFAULT_URL (nullptr when unset).
+Config load_config(const std::string& path, const char* lcm_default_url_env);
+
+// The safety URL: the config's lcm.url, else LCM_DEFAULT_URL, else
+// kHostLocalLcmUrl.
+constexpr const char* kHostLocalLcmUrl = "udpm://239.255.76.67:7667?ttl=0";
+std::string resolve_lcm_url(const std::string& from_config, const char* lcm_default_url_env);
+
+// The image URL when the config names none: for udpm, the same group on the
+// next port with recv_buf_size=4194304 (a 176x144..640x480 frame must fit in
+// the socket's buffer, or it is silently lost); other providers unchanged.
+std::string derive_image_url(const std::string& safety_url);
+
+}  // namespace tofguard

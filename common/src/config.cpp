@@ -1,0 +1,142 @@
+#include "tofguard/config.hpp"
+
+#include <cmath>
+#include <regex>
+
+#include "tofguard/yaml_reader.hpp"
+
+namespace tofguard {
+namespace {
+
+constexpr double kBig = 1e9;
+
+Intrinsics read_intrinsics(YamlMap& map) {
+  Intrinsics in;
+  in.width = static_cast<int>(map.integer("width", 1, 8192));
+  in.height = static_cast<int>(map.integer("height", 1, 8192));
+  in.fx = map.number("fx", 1e-6, kBig);
+  in.fy = map.number("fy", 1e-6, kBig);
+  in.cx = map.number("cx", -kBig, kBig);
+  in.cy = map.number("cy", -kBig, kBig);
+  return in;
+}
+
+CameraPose read_pose(YamlMap map) {
+  CameraPose pose;
+  pose.frame_id = map.string("frame");
+  const auto t = map.numbers("translation_m", 3);
+  pose.translation_m = Eigen::Vector3d(t[0], t[1], t[2]);
+  const auto q = map.numbers("rotation_wxyz", 4);
+  const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  if (std::abs(norm - 1.0) > 1e-6) {
+    map.fail("rotation_wxyz", "a unit quaternion w, x, y, z (norm 1 within 1e-6)",
+             "norm " + std::to_string(norm));
+  }
+  pose.rotation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]);
+  map.finish();
+  return pose;
+}
+
+void read_channels(YamlMap map, ChannelNames* c) {
+  auto name = [&map](const char* key, std::string* out) {
+    if (auto v = map.optional_string(key)) *out = *v;
+  };
+  name("depth", &c->depth);
+  name("joint_state", &c->joint_state);
+  name("camera_pose", &c->camera_pose);
+  name("rendered", &c->rendered);
+  name("labels", &c->labels);
+  name("discrepancy", &c->discrepancy);
+  name("risk", &c->risk);
+  name("status", &c->status);
+  name("reset", &c->reset);
+  name("reset_reply", &c->reset_reply);
+  name("heartbeat", &c->heartbeat);
+  map.finish();
+}
+
+}  // namespace
+
+std::string resolve_lcm_url(const std::string& from_config, const char* lcm_default_url_env) {
+  if (!from_config.empty()) return from_config;
+  if (lcm_default_url_env != nullptr && lcm_default_url_env[0] != '\0') {
+    return lcm_default_url_env;
+  }
+  return kHostLocalLcmUrl;
+}
+
+std::string derive_image_url(const std::string& safety_url) {
+  static const std::regex udpm(R"(^udpm://([^:/?]+):(\d+)(\?.*)?$)");
+  std::smatch m;
+  if (!std::regex_match(safety_url, m, udpm)) return safety_url;
+  const int port = std::stoi(m[2].str()) + 1;
+  std::string options = m[3].str();
+  if (options.find("recv_buf_size=") == std::string::npos) {
+    options += options.empty() ? "?recv_buf_size=4194304" : "&recv_buf_size=4194304";
+  }
+  return "udpm://" + m[1].str() + ":" + std::to_string(port) + options;
+}
+
+Config load_config(const std::string& path, const char* lcm_default_url_env) {
+  YamlMap root = load_yaml_file(path);
+  Config config;
+  config.file = path;
+
+  std::string url;
+  std::string image_url;
+  if (auto lcm = root.optional_map("lcm")) {
+    url = lcm->optional_string("url").value_or("");
+    image_url = lcm->optional_string("image_url").value_or("");
+    lcm->finish();
+  }
+  config.lcm.url = resolve_lcm_url(url, lcm_default_url_env);
+  config.lcm.image_url = image_url.empty() ? derive_image_url(config.lcm.url) : image_url;
+
+  if (auto channels = root.optional_map("channels")) read_channels(*channels, &config.channels);
+
+  {
+    YamlMap robot = root.map("robot");
+    config.robot.id = robot.string("id");
+    config.robot.urdf_path = robot.existing_path("urdf");
+    if (robot.optional("package_paths")) {
+      config.robot.package_paths = robot.existing_paths("package_paths", /*directory=*/true);
+    }
+    robot.finish();
+  }
+
+  if (auto env = root.optional_map("environment")) {
+    config.environment.urdf_paths = env->existing_paths("urdfs");
+    env->finish();
+  }
+
+  {
+    YamlMap camera = root.map("camera");
+    config.camera.id = camera.string("id");
+    config.camera.source = camera.choice("source", {"sim", "uvc"});
+    config.camera.rate_hz = camera.number("rate_hz", 0.1, 1000);
+    YamlMap intrinsics = camera.map("intrinsics");
+    config.camera.intrinsics = read_intrinsics(intrinsics);
+    intrinsics.finish();
+    config.camera.pose = read_pose(camera.map("pose"));
+    camera.finish();
+  }
+
+  {
+    YamlMap renderer = root.map("renderer");
+    config.renderer.geometry = renderer.choice("geometry", {"visual", "collision"});
+    config.renderer.padding_m = renderer.number("padding_m", 0, 1);
+    config.renderer.near_m = renderer.number("near_m", 1e-3, 100);
+    config.renderer.far_m = renderer.number("far_m", 1e-3, 1000);
+    if (config.renderer.far_m <= config.renderer.near_m) {
+      renderer.fail("far_m", "a distance greater than near_m",
+                    std::to_string(config.renderer.far_m));
+    }
+    config.renderer.max_extrapolation_ms = renderer.number("max_extrapolation_ms", 0, 1000);
+    renderer.finish();
+  }
+
+  root.finish();
+  return config;
+}
+
+}  // namespace tofguard

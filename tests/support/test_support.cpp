@@ -1,0 +1,113 @@
+#include "test_support.hpp"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+namespace tofguard::test {
+
+std::string source_dir() { return TOFGUARD_SOURCE_DIR; }
+std::string binary_dir() { return TOFGUARD_BINARY_DIR; }
+std::string bin_dir() { return std::string(TOFGUARD_BINARY_DIR) + "/bin"; }
+std::string output_dir() { return std::string(TOFGUARD_BINARY_DIR) + "/test-output"; }
+std::string shared_dir() {
+  const auto dir = std::filesystem::path(TOFGUARD_SOURCE_DIR).parent_path() / "shared";
+  return std::filesystem::is_directory(dir) ? dir.string() : std::string();
+}
+
+bool wait_until(const std::function<bool()>& condition, std::chrono::milliseconds deadline,
+                const std::function<void()>& poll) {
+  const auto end = std::chrono::steady_clock::now() + deadline;
+  while (true) {
+    if (condition()) return true;
+    if (std::chrono::steady_clock::now() >= end) return false;
+    if (poll) {
+      poll();
+    } else {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  }
+}
+
+Subprocess::Subprocess(const std::string& name, const std::vector<std::string>& argv) {
+  std::filesystem::create_directories(output_dir());
+  stdout_path_ = output_dir() + "/" + name + ".stdout";
+  stderr_path_ = output_dir() + "/" + name + ".stderr";
+  std::vector<char*> args;
+  for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  args.push_back(nullptr);
+  pid_ = fork();
+  if (pid_ < 0) throw std::runtime_error("fork failed");
+  if (pid_ == 0) {
+    const int out = open(stdout_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int err = open(stderr_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (out < 0 || err < 0) _exit(126);
+    dup2(out, STDOUT_FILENO);
+    dup2(err, STDERR_FILENO);
+    setpgid(0, 0);  // its own process group, so kill() reaches its children
+    execv(args[0], args.data());
+    _exit(127);
+  }
+}
+
+Subprocess::~Subprocess() {
+  if (running()) {
+    kill(-pid_, SIGKILL);
+    kill(pid_, SIGKILL);
+    wait(std::chrono::milliseconds(5000));
+  }
+}
+
+bool Subprocess::running() {
+  if (exit_code_ >= 0 || pid_ <= 0) return false;
+  int status = 0;
+  const pid_t r = waitpid(pid_, &status, WNOHANG);
+  if (r == pid_) {
+    exit_code_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    return false;
+  }
+  return r == 0;
+}
+
+void Subprocess::signal(int signo) {
+  if (running()) kill(pid_, signo);
+}
+
+int Subprocess::wait(std::chrono::milliseconds deadline) {
+  wait_until([this] { return !running(); }, deadline);
+  return exit_code_;
+}
+
+std::string Subprocess::stdout_text() const { return read_file(stdout_path_); }
+std::string Subprocess::stderr_text() const { return read_file(stderr_path_); }
+
+int run_command(const std::string& name, const std::vector<std::string>& argv,
+                std::string* stdout_text, std::string* stderr_text) {
+  Subprocess p(name, argv);
+  const int code = p.wait(std::chrono::seconds(60));
+  if (stdout_text) *stdout_text = p.stdout_text();
+  if (stderr_text) *stderr_text = p.stderr_text();
+  return code;
+}
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void write_file(const std::string& path, const std::string& text) {
+  std::filesystem::create_directories(std::filesystem::path(path).parent_path());
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+}  // namespace tofguard::test

@@ -1,0 +1,60 @@
+#pragma once
+// Shared test helpers: real subprocesses, waiting on a condition with a
+// deadline (never a sleep as synchronisation), and the project's paths.
+#include <chrono>
+#include <functional>
+#include <string>
+#include <sys/types.h>
+#include <vector>
+
+namespace tofguard::test {
+
+// Folders, fixed at build time.
+std::string source_dir();   // the repository root
+std::string binary_dir();   // the CMake build folder
+std::string bin_dir();      // where the tofguard-* executables are
+std::string output_dir();   // scratch space for test outputs
+// ../shared beside the repository (public robot models), "" when absent.
+std::string shared_dir();
+
+// Calls `condition` until it returns true or `deadline` has passed; between
+// calls it runs `poll` (e.g. LCM handleTimeout) or yields for 1 ms. Returns
+// whether the condition became true.
+bool wait_until(const std::function<bool()>& condition, std::chrono::milliseconds deadline,
+                const std::function<void()>& poll = nullptr);
+
+// A child process whose stdout and stderr go to files.
+class Subprocess {
+ public:
+  // Starts argv[0] (a path) with argv; `name` names the output files in
+  // output_dir().
+  Subprocess(const std::string& name, const std::vector<std::string>& argv);
+  ~Subprocess();  // kills the child (SIGKILL) if it still runs
+  Subprocess(const Subprocess&) = delete;
+  Subprocess& operator=(const Subprocess&) = delete;
+
+  pid_t pid() const { return pid_; }
+  bool running();
+  void signal(int signo);
+  // Waits for the child to exit; returns its exit code (128 + signal when
+  // killed), or -1 if it was still running at the deadline.
+  int wait(std::chrono::milliseconds deadline);
+  std::string stdout_text() const;
+  std::string stderr_text() const;
+
+ private:
+  pid_t pid_ = -1;
+  int exit_code_ = -1;
+  std::string stdout_path_;
+  std::string stderr_path_;
+};
+
+// Runs a command to completion (deadline 60 s); returns its exit code and
+// fills the outputs.
+int run_command(const std::string& name, const std::vector<std::string>& argv,
+                std::string* stdout_text = nullptr, std::string* stderr_text = nullptr);
+
+std::string read_file(const std::string& path);
+void write_file(const std::string& path, const std::string& text);
+
+}  // namespace tofguard::test
