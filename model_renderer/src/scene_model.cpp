@@ -1,5 +1,6 @@
 #include "scene_model.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -21,14 +22,16 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// urdfdom reports why a parse failed only through console_bridge; this
-// handler keeps the first error so that ModelError can say it in one line.
+// urdfdom reports problems only through console_bridge, and for some (an
+// unknown geometry type) it logs an error, drops the element and returns a
+// model anyway: a link silently without its geometry. This handler collects
+// the errors so that any of them stops the load, said in one line.
 class CapturingOutputHandler : public console_bridge::OutputHandler {
  public:
   void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
-    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR && first_error.empty()) first_error = text;
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) errors += (errors.empty() ? "" : "; ") + text;
   }
-  std::string first_error;
+  std::string errors;
 };
 
 std::string one_line(std::string text) {
@@ -53,13 +56,12 @@ urdf::ModelInterfaceSharedPtr parse_urdf_file(const std::string& path) {
   try {
     model = urdf::parseURDF(text.str());
   } catch (const std::exception& e) {
-    handler.first_error = e.what();
+    handler.errors += (handler.errors.empty() ? "" : "; ") + std::string(e.what());
   }
   console_bridge::restorePreviousOutputHandler();
-  if (!model) {
+  if (!model || !handler.errors.empty()) {
     throw ModelError(path + ": malformed URDF: " +
-                     (handler.first_error.empty() ? std::string("urdfdom could not parse it")
-                                                  : one_line(handler.first_error)));
+                     (handler.errors.empty() ? std::string("urdfdom could not parse it") : one_line(handler.errors)));
   }
   return model;
 }
@@ -117,9 +119,12 @@ class SceneBuilder {
       }
       scene_.links.push_back(entry);
       add_geometry(*link, link_index, file, urdf_folder);
-      for (auto it = link->child_links.rbegin(); it != link->child_links.rend(); ++it) {
-        stack.emplace_back(*it, link_index);
-      }
+      // Siblings in the order of their names (urdfdom keeps no document
+      // order), pushed in reverse so that the first is visited first.
+      std::vector<urdf::LinkConstSharedPtr> children(link->child_links.begin(), link->child_links.end());
+      std::sort(children.begin(), children.end(),
+                [](const auto& a, const auto& b) { return a->name > b->name; });
+      for (const auto& child : children) stack.emplace_back(child, link_index);
     }
     resolve_mimics(*model, joint_index, path);
     if (!is_environment) scene_.num_robot_links = static_cast<int>(scene_.links.size());

@@ -103,8 +103,9 @@ struct Link {
 };
 
 struct SceneModel {
-  // Robot links first (index 0 is the robot's root), then every
-  // environment's links. Each link comes after its parent.
+  // Robot links first (index 0 is the robot's root), then each
+  // environment's links, each URDF depth-first from its root with siblings
+  // in the order of their names; so every link comes after its parent.
   std::vector<Link> links;
   int num_robot_links = 0;
   // Ordered so that a joint's parent link's pose is known before it.
