@@ -3,6 +3,8 @@
 #include <cstdlib>
 #include <iostream>
 
+#include "tofguard/lcm_node.hpp"
+
 namespace tofguard {
 
 int run_process(int argc, char** argv, const ProcessInfo& info,
@@ -37,6 +39,7 @@ int run_process(int argc, char** argv, const ProcessInfo& info,
     std::cerr << info.name << ": config error: " << e.what() << "\n";
     return kConfigErrorExitCode;
   }
+  install_stop_signal_handlers();
   return body(config, rest);
 }
 
