@@ -108,6 +108,33 @@ InterventionConfig read_intervention(YamlMap map) {
   return in;
 }
 
+LaunchConfig read_launch(YamlMap map) {
+  LaunchConfig launch;
+  launch.present = true;
+  for (auto& p : map.maps("processes")) {
+    LaunchedProcess process;
+    process.name = p.string("name");
+    process.command = p.strings("command");
+    if (process.command.empty()) p.fail("command", "a non-empty list: program and arguments");
+    process.required = p.boolean("required");
+    p.finish();
+    launch.processes.push_back(process);
+  }
+  launch.restart_backoff_initial_ms = map.number("restart_backoff_initial_ms", 1, 60000);
+  launch.restart_backoff_max_ms = map.number("restart_backoff_max_ms", 1, 600000);
+  launch.max_restarts = static_cast<int>(map.integer("max_restarts", 0, 1000));
+  launch.restart_window_s = map.number("restart_window_s", 1, 86400);
+  launch.log_dir = map.path("log_dir");
+  YamlMap recorder = map.map("recorder");
+  launch.recorder.enabled = recorder.boolean("enabled");
+  launch.recorder.max_file_mb = recorder.number("max_file_mb", 0.1, 100000);
+  launch.recorder.max_total_mb = recorder.number("max_total_mb", 0.1, 10000000);
+  launch.recorder.max_age_h = recorder.number("max_age_h", 0.01, 100000);
+  recorder.finish();
+  map.finish();
+  return launch;
+}
+
 }  // namespace
 
 std::string resolve_lcm_url(const std::string& from_config, const char* lcm_default_url_env) {
@@ -198,6 +225,7 @@ Config load_config(const std::string& path, const char* lcm_default_url_env) {
 
   config.joints_sim = read_joints_sim(root.map("joints_sim"));
   config.intervention = read_intervention(root.map("intervention"));
+  if (auto launch = root.optional_map("launch")) config.launch = read_launch(*launch);
 
   root.finish();
   return config;

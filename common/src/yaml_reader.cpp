@@ -190,6 +190,8 @@ std::string YamlMap::existing_path(const std::string& key, bool directory) {
   return resolved;
 }
 
+std::string YamlMap::path(const std::string& key) { return resolve(string(key)); }
+
 std::vector<std::string> YamlMap::existing_paths(const std::string& key, bool directory) {
   std::vector<std::string> result;
   for (const auto& given : strings(key)) {

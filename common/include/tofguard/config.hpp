@@ -153,6 +153,43 @@ struct InterventionConfig {
   std::string relay_serial;
 };
 
+// One process of the group tofguard-launch starts, in start order.
+struct LaunchedProcess {
+  std::string name;
+  // argv; "{config}" in any argument becomes the config file's absolute
+  // path. A bare program name is looked up beside tofguard-launch, then in
+  // PATH.
+  std::vector<std::string> command;
+  // A required process that keeps crashing is reported loudly; the chain
+  // is unsafe without it (the risk classifier sees its heartbeat missing).
+  bool required = true;
+};
+
+// The black-box recorder: lcm-logger on both LCM URLs into rotating files.
+struct RecorderConfig {
+  bool enabled = false;
+  // A new file every max_file_mb; the oldest files are deleted when all
+  // together exceed max_total_mb or are older than max_age_h.
+  double max_file_mb = 0;
+  double max_total_mb = 0;
+  double max_age_h = 0;
+};
+
+struct LaunchConfig {
+  bool present = false;
+  std::vector<LaunchedProcess> processes;
+  // Restart back-off: doubles from initial to max.
+  double restart_backoff_initial_ms = 0;
+  double restart_backoff_max_ms = 0;
+  // More restarts than this within restart_window_s -> left stopped.
+  int max_restarts = 0;
+  double restart_window_s = 0;
+  // Each process's stdout/stderr (<name>.log) and the recordings go here;
+  // relative to the config file's folder; created when missing.
+  std::string log_dir;
+  RecorderConfig recorder;
+};
+
 struct Config {
   std::string file;
   LcmConfig lcm;
@@ -163,6 +200,8 @@ struct Config {
   RendererConfig renderer;
   JointsSimConfig joints_sim;
   InterventionConfig intervention;
+  // Optional: only tofguard-launch needs it.
+  LaunchConfig launch;
 };
 
 // Loads and validates `path`; throws ConfigError. `lcm_default_url_env` is
