@@ -99,7 +99,7 @@ class SceneBuilder {
     const urdf::ModelInterfaceSharedPtr model = parse_urdf_file(path);
     const urdf::LinkConstSharedPtr root = model->getRoot();
     if (!root) throw ModelError(path + ": malformed URDF: no root link");
-    const std::string file = fs::path(path).filename().string();
+    const std::string& file = path;  // as given, in every message
     const fs::path urdf_folder = fs::absolute(fs::path(path)).parent_path();
     std::map<std::string, int> joint_index;  // this file's joints, for mimic
     // Depth first from the root: every link after its parent, every joint
