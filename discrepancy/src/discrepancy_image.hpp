@@ -69,7 +69,8 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
 
 // The summary of a camera frame that cannot be compared (`kind` is one of
 // discrepancy_t::UNUSABLE_*): identity, calibrated flag and invalid pixels
-// filled in, everything else zero.
+// filled in, everything else zero (depth_hash and repeat_count are the
+// caller's).
 discrepancy_t unusable_summary(const depth_image_t& camera, int8_t kind, const std::string& reason);
 
 // FNV-1a 64-bit hash of a depth array's bytes (little-endian int16).

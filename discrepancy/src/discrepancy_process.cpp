@@ -61,6 +61,7 @@ int run_discrepancy(const Config& config) {
       node.errors().report("unpaired", "camera frame " + lost.reason);
       discrepancy_t summary =
           unusable_summary(lost.camera.image, discrepancy_t::UNUSABLE_NO_RENDERING, lost.reason);
+      summary.depth_hash = lost.camera.depth_hash;
       summary.repeat_count = lost.camera.repeat_count;
       publish(summary);
     }
