@@ -33,26 +33,24 @@ void FramePairer::add_camera(CameraFrame frame, int64_t now_us, PairingOutput* o
   complete_if_ready(seq, out);
 }
 
-void FramePairer::add_rendered(depth_image_t rendered, int64_t now_us, PairingOutput* out) {
-  const int64_t seq = rendered.seq;
+template <class Part>
+void FramePairer::add_partner(std::optional<Part> Pending::*slot, Part part, int64_t now_us, PairingOutput* out) {
+  const int64_t seq = part.seq;
   Pending* p = entry(seq, now_us, out);
-  if (p == nullptr || p->rendered) {
+  if (p == nullptr || (p->*slot).has_value()) {
     out->dropped_partners++;
     return;
   }
-  p->rendered = std::move(rendered);
+  p->*slot = std::move(part);
   complete_if_ready(seq, out);
 }
 
+void FramePairer::add_rendered(depth_image_t rendered, int64_t now_us, PairingOutput* out) {
+  add_partner(&Pending::rendered, std::move(rendered), now_us, out);
+}
+
 void FramePairer::add_labels(link_labels_t labels, int64_t now_us, PairingOutput* out) {
-  const int64_t seq = labels.seq;
-  Pending* p = entry(seq, now_us, out);
-  if (p == nullptr || p->labels) {
-    out->dropped_partners++;
-    return;
-  }
-  p->labels = std::move(labels);
-  complete_if_ready(seq, out);
+  add_partner(&Pending::labels, std::move(labels), now_us, out);
 }
 
 void FramePairer::complete_if_ready(int64_t seq, PairingOutput* out) {

@@ -70,6 +70,10 @@ class FramePairer {
     std::optional<link_labels_t> labels;
   };
 
+  // Stores a rendered frame or labels (`slot`) unless its seq is finished or
+  // already has one (then it is dropped).
+  template <class Part>
+  void add_partner(std::optional<Part> Pending::*slot, Part part, int64_t now_us, PairingOutput* out);
   // nullptr when `seq` was already finished (a late partner).
   Pending* entry(int64_t seq, int64_t now_us, PairingOutput* out);
   void complete_if_ready(int64_t seq, PairingOutput* out);

@@ -81,61 +81,54 @@ std::optional<FrameFinding> RiskMonitor::expired(int64_t now_us) const {
   return std::nullopt;
 }
 
+namespace {
+
+// A verdict of `level` with `finding`'s cause, suspect, score and detail.
+risk_t verdict(int64_t utime, int64_t seq, int8_t level, const FrameFinding& finding, const std::string& detail) {
+  risk_t r;
+  r.utime = utime;
+  r.seq = seq;
+  r.level = level;
+  r.cause = finding.cause;
+  r.suspect = finding.suspect;
+  r.score = finding.score;
+  r.threshold = finding.threshold;
+  r.detail = detail;
+  return r;
+}
+
+}  // namespace
+
 std::optional<risk_t> RiskMonitor::check_deadlines(int64_t now_us) const {
   const std::optional<FrameFinding> f = expired(now_us);
   if (!f) return std::nullopt;
-  risk_t r;
-  r.utime = last_frame_utime_;
-  r.seq = -1;
-  r.level = risk_t::DANGEROUS;
-  r.cause = f->cause;
-  r.suspect = f->suspect;
-  r.score = f->score;
-  r.threshold = f->threshold;
-  r.detail = "timeout: " + f->detail;
-  return r;
+  return verdict(last_frame_utime_, -1, risk_t::DANGEROUS, *f, "timeout: " + f->detail);
 }
 
 risk_t RiskMonitor::on_discrepancy(const discrepancy_t& frame, int64_t now_us) {
   touch(&discrepancy_, now_us);
   last_frame_utime_ = frame.utime;
-  risk_t r;
-  r.utime = frame.utime;
-  r.seq = frame.seq;
 
   ClassifierContext context;
   context.depth_channel = config_.channels.depth;
   context.labels_channel = config_.channels.labels;
   context.arm_moving = arm_moving_;
-  const FrameFinding finding = classify_frame(frame, robot_, config_.risk, context);
+  FrameFinding finding = classify_frame(frame, robot_, config_.risk, context);
   consecutive_ = finding.cause == risk_t::CAUSE_NONE ? 0 : consecutive_ + 1;
 
   if (const std::optional<FrameFinding> stale = expired(now_us)) {
-    r.level = risk_t::DANGEROUS;
-    r.cause = stale->cause;
-    r.suspect = stale->suspect;
-    r.score = stale->score;
-    r.threshold = stale->threshold;
-    r.detail = "timeout: " + stale->detail;
-    return r;
+    return verdict(frame.utime, frame.seq, risk_t::DANGEROUS, *stale, "timeout: " + stale->detail);
   }
-  r.cause = finding.cause;
-  r.suspect = finding.suspect;
-  r.score = finding.score;
-  r.threshold = finding.threshold;
   if (finding.cause == risk_t::CAUSE_NONE) {
-    r.level = risk_t::SAFE;
-    r.score = frame.mismatch_fraction;
-    r.threshold = 0;
-    r.detail = "model and camera agree (mismatch fraction): " + std::to_string(frame.num_compared - frame.num_match) +
-               " of " + std::to_string(frame.num_compared) + " compared pixels differ";
-    return r;
+    finding.score = frame.mismatch_fraction;
+    return verdict(frame.utime, frame.seq, risk_t::SAFE, finding,
+                   "model and camera agree (mismatch fraction): " + std::to_string(frame.num_compared - frame.num_match) +
+                       " of " + std::to_string(frame.num_compared) + " compared pixels differ");
   }
   const int needed = is_fault_cause(finding.cause) ? config_.risk.sensor_debounce_frames : config_.risk.debounce_frames;
-  r.level = consecutive_ >= needed ? risk_t::DANGEROUS : risk_t::WARNING;
-  r.detail = finding.detail + " [" + std::to_string(std::min(consecutive_, needed)) + "/" + std::to_string(needed) +
-             " frames]";
-  return r;
+  return verdict(frame.utime, frame.seq, consecutive_ >= needed ? risk_t::DANGEROUS : risk_t::WARNING, finding,
+                 finding.detail + " [" + std::to_string(std::min(consecutive_, needed)) + "/" +
+                     std::to_string(needed) + " frames]");
 }
 
 }  // namespace tofguard::risk
