@@ -52,6 +52,9 @@ void read_channels(YamlMap map, ChannelNames* c) {
   name("reset", &c->reset);
   name("reset_reply", &c->reset_reply);
   name("heartbeat", &c->heartbeat);
+  name("power", &c->power);
+  name("sim_true_joint_state", &c->sim_true_joint_state);
+  name("sim_joint_fault", &c->sim_joint_fault);
   map.finish();
 }
 
@@ -131,6 +134,83 @@ RiskConfig read_risk(YamlMap map) {
   return r;
 }
 
+JointsSimConfig read_joints_sim(YamlMap map) {
+  JointsSimConfig sim;
+  sim.rate_hz = map.number("rate_hz", 1, 1000);
+  sim.status_deadline_ms = map.number("status_deadline_ms", 1, 10000);
+  YamlMap motion = map.map("motion");
+  for (const auto& joint : motion.keys()) {
+    YamlMap m = motion.map(joint);
+    JointMotion jm;
+    jm.joint = joint;
+    jm.center = m.number("center", -100, 100);
+    jm.amplitude = m.number("amplitude", 0, 100);
+    jm.period_s = m.number("period_s", 0.01, 1e6);
+    jm.phase_rad = m.optional_number("phase_rad", 0, -100, 100);
+    m.finish();
+    sim.motion.push_back(jm);
+  }
+  motion.finish();
+  if (map.optional("faults")) {
+    for (auto& f : map.maps("faults")) {
+      EncoderFault fault;
+      fault.joint = f.string("joint");
+      fault.offset = f.number("offset", -100, 100);
+      fault.at_s = f.number("at_s", 0, 1e9);
+      f.finish();
+      sim.faults.push_back(fault);
+    }
+  }
+  map.finish();
+  return sim;
+}
+
+InterventionConfig read_intervention(YamlMap map) {
+  InterventionConfig in;
+  in.publish_rate_hz = map.number("publish_rate_hz", 10, 1000);
+  in.risk_deadline_ms = map.number("risk_deadline_ms", 1, 10000);
+  in.stop_deadline_ms = map.number("stop_deadline_ms", 1, 10000);
+  in.joint_state_deadline_ms = map.number("joint_state_deadline_ms", 1, 10000);
+  in.stopped_velocity = map.number("stopped_velocity", 0, 10);
+  in.power_cut = map.choice("power_cut", {"lcm", "usb_hid_relay"});
+  if (auto relay = map.optional_map("usb_hid_relay")) {
+    in.relay_channel = static_cast<int>(relay->integer("channel", 1, 8));
+    in.relay_serial = relay->optional_string("serial").value_or("");
+    relay->finish();
+  } else if (in.power_cut == "usb_hid_relay") {
+    map.fail("usb_hid_relay", "a mapping with channel (and serial) when power_cut is usb_hid_relay");
+  }
+  map.finish();
+  return in;
+}
+
+LaunchConfig read_launch(YamlMap map) {
+  LaunchConfig launch;
+  launch.present = true;
+  for (auto& p : map.maps("processes")) {
+    LaunchedProcess process;
+    process.name = p.string("name");
+    process.command = p.strings("command");
+    if (process.command.empty()) p.fail("command", "a non-empty list: program and arguments");
+    process.required = p.boolean("required");
+    p.finish();
+    launch.processes.push_back(process);
+  }
+  launch.restart_backoff_initial_ms = map.number("restart_backoff_initial_ms", 1, 60000);
+  launch.restart_backoff_max_ms = map.number("restart_backoff_max_ms", 1, 600000);
+  launch.max_restarts = static_cast<int>(map.integer("max_restarts", 0, 1000));
+  launch.restart_window_s = map.number("restart_window_s", 1, 86400);
+  launch.log_dir = map.path("log_dir");
+  YamlMap recorder = map.map("recorder");
+  launch.recorder.enabled = recorder.boolean("enabled");
+  launch.recorder.max_file_mb = recorder.number("max_file_mb", 0.1, 100000);
+  launch.recorder.max_total_mb = recorder.number("max_total_mb", 0.1, 10000000);
+  launch.recorder.max_age_h = recorder.number("max_age_h", 0.01, 100000);
+  recorder.finish();
+  map.finish();
+  return launch;
+}
+
 }  // namespace
 
 std::string resolve_lcm_url(const std::string& from_config, const char* lcm_default_url_env) {
@@ -151,6 +231,14 @@ std::string derive_image_url(const std::string& safety_url) {
     options += options.empty() ? "?recv_buf_size=4194304" : "&recv_buf_size=4194304";
   }
   return "udpm://" + m[1].str() + ":" + std::to_string(port) + options;
+}
+
+Config default_wire_config(const char* lcm_default_url_env) {
+  Config config;
+  config.file = "(no config: defaults)";
+  config.lcm.url = resolve_lcm_url("", lcm_default_url_env);
+  config.lcm.image_url = derive_image_url(config.lcm.url);
+  return config;
 }
 
 Config load_config(const std::string& path, const char* lcm_default_url_env) {
@@ -214,6 +302,9 @@ Config load_config(const std::string& path, const char* lcm_default_url_env) {
   // Safety chain sections (required: no silent defaults for thresholds).
   config.discrepancy = read_discrepancy(root.map("discrepancy"));
   config.risk = read_risk(root.map("risk"));
+  config.joints_sim = read_joints_sim(root.map("joints_sim"));
+  config.intervention = read_intervention(root.map("intervention"));
+  if (auto launch = root.optional_map("launch")) config.launch = read_launch(*launch);
 
   root.finish();
   return config;

@@ -104,4 +104,16 @@ std::string check_link_labels(const link_labels_t& labels) {
   return "";
 }
 
+std::string check_risk(const risk_t& risk) {
+  if (risk.level < risk_t::SAFE || risk.level > risk_t::DANGEROUS) {
+    return expected("level", "SAFE (0), WARNING (1) or DANGEROUS (2)", risk.level);
+  }
+  if (risk.cause < risk_t::CAUSE_NONE || risk.cause > risk_t::CAUSE_UNCLASSIFIED) {
+    return expected("cause", "one of risk_t's CAUSE_ constants (0..6)", risk.cause);
+  }
+  if (!std::isfinite(risk.score)) return expected("score", "a finite number", risk.score);
+  if (!std::isfinite(risk.threshold)) return expected("threshold", "a finite number", risk.threshold);
+  return "";
+}
+
 }  // namespace tofguard

@@ -190,6 +190,8 @@ std::string YamlMap::existing_path(const std::string& key, bool directory) {
   return resolved;
 }
 
+std::string YamlMap::path(const std::string& key) { return resolve(string(key)); }
+
 std::vector<std::string> YamlMap::existing_paths(const std::string& key, bool directory) {
   std::vector<std::string> result;
   for (const auto& given : strings(key)) {
@@ -224,6 +226,15 @@ std::vector<YamlMap> YamlMap::maps(const std::string& key) {
   for (size_t i = 0; i < value.size(); ++i) {
     if (!value[i].IsMap()) fail(key, "a list of mappings", "the entry " + describe(value[i]));
     result.emplace_back(value[i], file_, base_dir_, key_path(key) + "[" + std::to_string(i) + "]");
+  }
+  return result;
+}
+
+std::vector<std::string> YamlMap::keys() {
+  std::vector<std::string> result;
+  for (const auto& entry : node_) {
+    result.push_back(entry.first.Scalar());
+    read_keys_.insert(result.back());
   }
   return result;
 }

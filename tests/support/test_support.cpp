@@ -97,6 +97,26 @@ int run_command(const std::string& name, const std::vector<std::string>& argv,
   return code;
 }
 
+std::string sim_config_variant(const std::string& name,
+                               const std::vector<std::pair<std::string, std::string>>& replacements,
+                               const std::string& appended) {
+  std::string text = read_file(source_dir() + "/config/sim.yaml");
+  for (const auto& [from, to] : replacements) {
+    const auto at = text.find(from);
+    if (at == std::string::npos) throw std::runtime_error("sim.yaml no longer contains: " + from);
+    text.replace(at, from.size(), to);
+  }
+  const std::string models = source_dir() + "/config/models/";
+  for (size_t p = text.find("models/"); p != std::string::npos; p = text.find("models/", p + models.size() + 1)) {
+    if (p > 0 && text[p - 1] == '/') continue;
+    text.replace(p, 7, models);
+  }
+  text += appended;
+  const std::string path = output_dir() + "/" + name + ".yaml";
+  write_file(path, text);
+  return path;
+}
+
 std::string read_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::ostringstream s;

@@ -9,6 +9,7 @@
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/link_labels_t.hpp"
+#include "tofguard/risk_t.hpp"
 
 namespace tofguard {
 
@@ -20,5 +21,7 @@ std::string check_joint_state(const joint_state_t& state);
 // The rotation must be a unit quaternion within 1e-3.
 std::string check_camera_pose(const camera_pose_t& pose);
 std::string check_link_labels(const link_labels_t& labels);
+// level and cause must be one of risk_t's constants.
+std::string check_risk(const risk_t& risk);
 
 }  // namespace tofguard

@@ -42,12 +42,18 @@ class YamlMap {
   // A path to an existing file (or directory when `directory`), resolved
   // against the config file's directory when relative.
   std::string existing_path(const std::string& key, bool directory = false);
+  // A path that need not exist yet, resolved like existing_path.
+  std::string path(const std::string& key);
   std::vector<std::string> existing_paths(const std::string& key, bool directory = false);
 
   YamlMap map(const std::string& key);
   std::optional<YamlMap> optional_map(const std::string& key);
   // A sequence of mappings.
   std::vector<YamlMap> maps(const std::string& key);
+
+  // Every key of this mapping, in file order (for maps keyed by name, such
+  // as joints); each is marked as known.
+  std::vector<std::string> keys();
 
   // Throws for every key of this mapping that was not read.
   void finish() const;
