@@ -398,7 +398,8 @@ discrepancy_image_t colour_image(const DiscrepancyFrame& frame, double full_scal
     if (c == discrepancy_t::PIXEL_MATCH || c == discrepancy_t::PIXEL_INVALID || dis[i] == 0) continue;
     const double level = std::min(255.0, 255.0 * std::abs(dis[i]) / full_scale_mm);
     const auto value = static_cast<uint8_t>(std::max(1.0, level));
-    image.rgb[3 * i + (dis[i] > 0 ? 2 : 0)] = value;
+    // Red (channel 0) where the camera sees nearer, blue (2) farther.
+    image.rgb[3 * i + (dis[i] > 0 ? 0 : 2)] = value;
   }
   return image;
 }

@@ -88,9 +88,13 @@ class RepeatCounter {
   int32_t repeats_ = 0;
 };
 
-// The seed's colour image: blue where I_dis > 0 (camera nearer than the
-// model), red where I_dis < 0, black where the pixel matches or is not
-// compared; brightness |I_dis| / full_scale_mm, saturating at 255.
+// The colour discrepancy image: red where I_dis > 0 (the camera sees
+// nearer than the model: something is there that the model does not
+// have), blue where I_dis < 0 (the camera sees farther: the model's surface
+// is missing), black where the pixel matches or is not compared;
+// brightness |I_dis| / full_scale_mm, saturating at 255. (The tofguard
+// issues disagree on the sign convention; this follows the one with a
+// physical definition and a test: "nearer in the camera is red".)
 discrepancy_image_t colour_image(const DiscrepancyFrame& frame, double full_scale_mm);
 
 }  // namespace tofguard::discrepancy

@@ -228,18 +228,19 @@ TEST(Discrepancy, FramesThatDoNotFitAreUnusableAndSayWhy) {
   EXPECT_EQ(s.unusable_reason, "label[179]: expected 0, 1..3 or 1000..1000, got 500");
 }
 
-TEST(Discrepancy, ColourImageIsBlueForNearerRedForFartherBlackForMatch) {
+TEST(Discrepancy, ColourImageIsRedForNearerBlueForFartherBlackForMatch) {
   const SyntheticImage model = draw(default_arm());
   const DiscrepancyFrame f = compare(model, draw(default_arm(10)).depth_mm);
   const discrepancy_image_t image = discrepancy::colour_image(f, /*full_scale_mm=*/1000);
   ASSERT_EQ(image.num_bytes, 3 * kPixels);
   auto rgb = [&](int v, int u, int c) { return image.rgb[3 * (v * kWidth + u) + c]; };
-  // Robot missing: I_dis = -500 -> red at half brightness.
-  EXPECT_EQ(rgb(70, 65, 0), 127);
-  EXPECT_EQ(rgb(70, 65, 2), 0);
-  // Unexpected surface: I_dis = +500 -> blue.
-  EXPECT_EQ(rgb(70, 105, 2), 127);
-  EXPECT_EQ(rgb(70, 105, 0), 0);
+  // Robot missing (the camera sees farther): I_dis = -500 -> blue at half
+  // brightness.
+  EXPECT_EQ(rgb(70, 65, 2), 127);
+  EXPECT_EQ(rgb(70, 65, 0), 0);
+  // Unexpected surface (the camera sees nearer): I_dis = +500 -> red.
+  EXPECT_EQ(rgb(70, 105, 0), 127);
+  EXPECT_EQ(rgb(70, 105, 2), 0);
   // Match -> black.
   EXPECT_EQ(rgb(10, 10, 0) + rgb(10, 10, 1) + rgb(10, 10, 2), 0);
 }
