@@ -63,6 +63,10 @@ int run(const Config& config, const std::vector<std::string>& args) {
   }
   safety.subscribe(".*", &Receiver::on_message, &receiver);
   if (config.lcm.image_url != config.lcm.url) images.subscribe(".*", &Receiver::on_message, &receiver);
+  // LCM 1.3 joins the multicast group lazily, on the first getFileno() or
+  // handle(): do it now, so "listening" is true when it is printed.
+  safety.getFileno();
+  images.getFileno();
   std::cout << "tofguard-spy: listening on " << config.lcm.url << " and " << config.lcm.image_url << std::endl;
 
   int64_t next_draw_us = 0;
