@@ -1,13 +1,96 @@
-// tofguard-joints-sim: wires config + LCM + the library in src/.
+// tofguard-joints-sim: the simulated arm. Publishes JOINT_STATE (what the
+// encoders report, faults included) and SIM_TRUE_JOINT_STATE (the truth, for
+// the simulated camera) at joints_sim.rate_hz; halts while SAFETY_STATUS
+// withdraws permission or is older than joints_sim.status_deadline_ms;
+// takes encoder faults from the config and from SIM_JOINT_FAULT.
 #include <iostream>
 
-#include "joints_sim_process.hpp"
+#include "simulated_arm.hpp"
+#include "tofguard/clock.hpp"
+#include "tofguard/joint_state_t.hpp"
+#include "tofguard/lcm_node.hpp"
+#include "tofguard/process.hpp"
+#include "tofguard/safety_status_t.hpp"
+#include "tofguard/sim_joint_fault_t.hpp"
+
+namespace tofguard::joints_sim {
+namespace {
+
+joint_state_t to_message(const ArmState& state, const std::string& robot_id, int64_t utime) {
+  joint_state_t m;
+  m.utime = utime;
+  m.robot_id = robot_id;
+  m.num_joints = static_cast<int32_t>(state.name.size());
+  m.name = state.name;
+  m.position = state.position;
+  m.velocity = state.velocity;
+  return m;
+}
+
+int run(const Config& config, const std::vector<std::string>& rest) {
+  if (!rest.empty()) {
+    std::cerr << "tofguard-joints-sim: unknown argument '" << rest[0] << "'\n";
+    return kConfigErrorExitCode;
+  }
+  std::unique_ptr<SimulatedArm> arm;
+  try {
+    arm = std::make_unique<SimulatedArm>(config.joints_sim, movable_joints(config.robot.urdf_path),
+                                         config.file);
+  } catch (const ConfigError& e) {
+    std::cerr << "tofguard-joints-sim: config error: " << e.what() << "\n";
+    return kConfigErrorExitCode;
+  }
+  LcmNode node(config, "tofguard-joints-sim");
+
+  bool status_allows = false;
+  int64_t status_arrival_us = -1;
+  node.subscribe<safety_status_t>(node.safety(), config.channels.status, [&](const safety_status_t& s) {
+    status_allows = s.motion_allowed;
+    status_arrival_us = monotonic_us();
+  });
+  node.subscribe<sim_joint_fault_t>(node.safety(), config.channels.sim_joint_fault,
+                                    [&](const sim_joint_fault_t& fault) {
+    if (!arm->set_encoder_offset(fault.joint, fault.offset)) {
+      node.counters().validation_errors++;
+      node.errors().report(config.channels.sim_joint_fault,
+                           config.channels.sim_joint_fault + ": joint: expected a joint of the arm, got '" +
+                               fault.joint + "'");
+      return;
+    }
+    std::cerr << "tofguard-joints-sim: encoder fault on " << fault.joint << ": offset " << fault.offset
+              << std::endl;
+  });
+
+  const int64_t period_us = static_cast<int64_t>(1e6 / config.joints_sim.rate_hz);
+  int64_t last_step_us = monotonic_us();
+  node.add_timer(period_us, [&] {
+    const int64_t now_us = monotonic_us();
+    const bool allowed = status_allows && status_arrival_us >= 0 &&
+                         now_us - status_arrival_us <= config.joints_sim.status_deadline_ms * 1000;
+    arm->step((now_us - last_step_us) * 1e-6, allowed);
+    last_step_us = now_us;
+    const int64_t utime = wall_utime();
+    const joint_state_t reported = to_message(arm->reported_state(), config.robot.id, utime);
+    const joint_state_t truth = to_message(arm->true_state(), config.robot.id, utime);
+    node.safety().publish(config.channels.joint_state, &reported);
+    node.safety().publish(config.channels.sim_true_joint_state, &truth);
+    node.counters().frames_out++;
+    node.heartbeat().set_status(allowed ? "moving" : "halted: no permission to move");
+  });
+  node.run();
+  return 0;
+}
+
+}  // namespace
+}  // namespace tofguard::joints_sim
 
 int main(int argc, char** argv) {
-  const tofguard::ProcessInfo info = tofguard::joints_sim::process_info();
-  return tofguard::run_process(argc, argv, info,
-                               [&](const tofguard::Config&, const std::vector<std::string>&) {
-                                 std::cerr << info.name << ": not implemented yet (issue 5)\n";
-                                 return 1;
-                               });
+  return tofguard::run_process(
+      argc, argv,
+      {"tofguard-joints-sim",
+       "The simulated arm: publishes JOINT_STATE (reported, with encoder faults) and\n"
+       "SIM_TRUE_JOINT_STATE (the truth) at joints_sim.rate_hz, following the periodic\n"
+       "motion of the config; halts while SAFETY_STATUS withdraws permission or is stale.\n"
+       "Encoder faults: joints_sim.faults in the config, or sim_joint_fault_t on SIM_JOINT_FAULT."},
+      tofguard::joints_sim::run);
 }

@@ -150,7 +150,60 @@ void read_channels(YamlMap map, ChannelNames* c) {
   name("reset", &c->reset);
   name("reset_reply", &c->reset_reply);
   name("heartbeat", &c->heartbeat);
+  name("power", &c->power);
+  name("sim_true_joint_state", &c->sim_true_joint_state);
+  name("sim_joint_fault", &c->sim_joint_fault);
   map.finish();
+}
+
+JointsSimConfig read_joints_sim(YamlMap map) {
+  JointsSimConfig sim;
+  sim.rate_hz = map.number("rate_hz", 1, 1000);
+  sim.status_deadline_ms = map.number("status_deadline_ms", 1, 10000);
+  YamlMap motion = map.map("motion");
+  for (const auto& joint : motion.keys()) {
+    YamlMap m = motion.map(joint);
+    JointMotion jm;
+    jm.joint = joint;
+    jm.center = m.number("center", -100, 100);
+    jm.amplitude = m.number("amplitude", 0, 100);
+    jm.period_s = m.number("period_s", 0.01, 1e6);
+    jm.phase_rad = m.optional_number("phase_rad", 0, -100, 100);
+    m.finish();
+    sim.motion.push_back(jm);
+  }
+  motion.finish();
+  if (map.optional("faults")) {
+    for (auto& f : map.maps("faults")) {
+      EncoderFault fault;
+      fault.joint = f.string("joint");
+      fault.offset = f.number("offset", -100, 100);
+      fault.at_s = f.number("at_s", 0, 1e9);
+      f.finish();
+      sim.faults.push_back(fault);
+    }
+  }
+  map.finish();
+  return sim;
+}
+
+InterventionConfig read_intervention(YamlMap map) {
+  InterventionConfig in;
+  in.publish_rate_hz = map.number("publish_rate_hz", 10, 1000);
+  in.risk_deadline_ms = map.number("risk_deadline_ms", 1, 10000);
+  in.stop_deadline_ms = map.number("stop_deadline_ms", 1, 10000);
+  in.joint_state_deadline_ms = map.number("joint_state_deadline_ms", 1, 10000);
+  in.stopped_velocity = map.number("stopped_velocity", 0, 10);
+  in.power_cut = map.choice("power_cut", {"lcm", "usb_hid_relay"});
+  if (auto relay = map.optional_map("usb_hid_relay")) {
+    in.relay_channel = static_cast<int>(relay->integer("channel", 1, 8));
+    in.relay_serial = relay->optional_string("serial").value_or("");
+    relay->finish();
+  } else if (in.power_cut == "usb_hid_relay") {
+    map.fail("usb_hid_relay", "a mapping with channel (and serial) when power_cut is usb_hid_relay");
+  }
+  map.finish();
+  return in;
 }
 
 }  // namespace
@@ -173,6 +226,14 @@ std::string derive_image_url(const std::string& safety_url) {
     options += options.empty() ? "?recv_buf_size=4194304" : "&recv_buf_size=4194304";
   }
   return "udpm://" + m[1].str() + ":" + std::to_string(port) + options;
+}
+
+Config default_wire_config(const char* lcm_default_url_env) {
+  Config config;
+  config.file = "(no config: defaults)";
+  config.lcm.url = resolve_lcm_url("", lcm_default_url_env);
+  config.lcm.image_url = derive_image_url(config.lcm.url);
+  return config;
 }
 
 Config load_config(const std::string& path, const char* lcm_default_url_env) {
@@ -241,6 +302,9 @@ Config load_config(const std::string& path, const char* lcm_default_url_env) {
     config.renderer.max_extrapolation_ms = renderer.number("max_extrapolation_ms", 0, 1000);
     renderer.finish();
   }
+
+  config.joints_sim = read_joints_sim(root.map("joints_sim"));
+  config.intervention = read_intervention(root.map("intervention"));
 
   root.finish();
   return config;

@@ -3,6 +3,8 @@
 #include <cstdlib>
 #include <iostream>
 
+#include "tofguard/lcm_node.hpp"
+
 namespace tofguard {
 
 int run_process(int argc, char** argv, const ProcessInfo& info,
@@ -12,7 +14,7 @@ int run_process(int argc, char** argv, const ProcessInfo& info,
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--help" || arg == "-h") {
-      std::cout << "usage: " << info.name << " --config FILE [options]\n\n"
+      std::cout << "usage: " << info.name << (info.config_required ? " --config FILE" : " [--config FILE]") << " [options]\n\n"
                 << info.summary << "\n";
       return 0;
     }
@@ -26,6 +28,10 @@ int run_process(int argc, char** argv, const ProcessInfo& info,
       rest.push_back(arg);
     }
   }
+  if (config_path.empty() && !info.config_required) {
+    install_stop_signal_handlers();
+    return body(default_wire_config(std::getenv("LCM_DEFAULT_URL")), rest);
+  }
   if (config_path.empty()) {
     std::cerr << info.name << ": no --config FILE given (config/sim.yaml is the simulated default)\n";
     return kConfigErrorExitCode;
@@ -37,6 +43,7 @@ int run_process(int argc, char** argv, const ProcessInfo& info,
     std::cerr << info.name << ": config error: " << e.what() << "\n";
     return kConfigErrorExitCode;
   }
+  install_stop_signal_handlers();
   return body(config, rest);
 }
 

@@ -228,6 +228,15 @@ std::vector<YamlMap> YamlMap::maps(const std::string& key) {
   return result;
 }
 
+std::vector<std::string> YamlMap::keys() {
+  std::vector<std::string> result;
+  for (const auto& entry : node_) {
+    result.push_back(entry.first.Scalar());
+    read_keys_.insert(result.back());
+  }
+  return result;
+}
+
 void YamlMap::finish() const {
   for (const auto& entry : node_) {
     const std::string key = entry.first.Scalar();

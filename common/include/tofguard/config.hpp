@@ -41,6 +41,12 @@ struct ChannelNames {
   std::string reset = "SAFETY_RESET";
   std::string reset_reply = "SAFETY_RESET_REPLY";
   std::string heartbeat = "SAFETY_HEARTBEAT";
+  // The power-cut actuator `lcm` (power_relay_t, positive logic).
+  std::string power = "SAFETY_POWER";
+  // Simulation only: the simulated arm's true joint state (for the simulated
+  // camera) and run-time encoder fault injection.
+  std::string sim_true_joint_state = "SIM_TRUE_JOINT_STATE";
+  std::string sim_joint_fault = "SIM_JOINT_FAULT";
 };
 
 // Pinhole intrinsics, OpenCV convention (pixel (u, v) has its centre at
@@ -177,6 +183,55 @@ struct RendererConfig {
   double max_extrapolation_ms = 0;
 };
 
+// One joint's periodic motion in the simulated arm:
+// position = center + amplitude * sin(2*pi*t/period_s + phase), radians (or
+// metres for a prismatic joint); t is the arm's motion time, which stands
+// still while the arm is halted.
+struct JointMotion {
+  std::string joint;
+  double center = 0;
+  double amplitude = 0;
+  double period_s = 1;
+  double phase_rad = 0;
+};
+
+// An encoder fault of the simulated arm: from `at_s` seconds after start,
+// joint `joint` reports `offset` (rad or m) more than its true position.
+struct EncoderFault {
+  std::string joint;
+  double offset = 0;
+  double at_s = 0;
+};
+
+struct JointsSimConfig {
+  double rate_hz = 0;
+  // The arm halts when the newest SAFETY_STATUS withdraws permission or
+  // arrived longer ago than this (monotonic clock), milliseconds.
+  double status_deadline_ms = 0;
+  // Every movable joint of the URDF, in the order published.
+  std::vector<JointMotion> motion;
+  std::vector<EncoderFault> faults;
+};
+
+struct InterventionConfig {
+  // SAFETY_STATUS rate; a change is published at once as well.
+  double publish_rate_hz = 0;
+  // No SAFETY_RISK for this long (monotonic) -> power cut, milliseconds.
+  double risk_deadline_ms = 0;
+  // After a software stop the arm must be still (every |velocity| below
+  // stopped_velocity) within stop_deadline_ms, else power cut. A joint state
+  // older than joint_state_deadline_ms cannot show that.
+  double stop_deadline_ms = 0;
+  double joint_state_deadline_ms = 0;
+  double stopped_velocity = 0;  // rad/s (or m/s)
+  // "lcm" (power_relay_t on channels.power) or "usb_hid_relay".
+  std::string power_cut;
+  // USB HID relay board (16c0:05df): which relay (1-based) switches the
+  // arm's power, wired normally open; serial "" takes the only board.
+  int relay_channel = 1;
+  std::string relay_serial;
+};
+
 struct Config {
   std::string file;
   LcmConfig lcm;
@@ -185,11 +240,17 @@ struct Config {
   EnvironmentConfig environment;
   CameraConfig camera;
   RendererConfig renderer;
+  JointsSimConfig joints_sim;
+  InterventionConfig intervention;
 };
 
 // Loads and validates `path`; throws ConfigError. `lcm_default_url_env` is
 // the value of LCM_DEFAULT_URL (nullptr when unset).
 Config load_config(const std::string& path, const char* lcm_default_url_env);
+
+// Only the LCM URLs (from LCM_DEFAULT_URL or the host-local default) and the
+// default channel names: for tools that need no deployment config.
+Config default_wire_config(const char* lcm_default_url_env);
 
 // The safety URL: the config's lcm.url, else LCM_DEFAULT_URL, else
 // kHostLocalLcmUrl.

@@ -15,6 +15,9 @@ struct ProcessInfo {
   std::string name;
   // One paragraph: what the process does, its channels in and out.
   std::string summary;
+  // Tools that only need LCM (e.g. tofguard-reset) may run without --config:
+  // they then get default_wire_config().
+  bool config_required = true;
 };
 
 // Parses the command line: `--config FILE` (required), `--help`. Loads the

@@ -49,6 +49,10 @@ class YamlMap {
   // A sequence of mappings.
   std::vector<YamlMap> maps(const std::string& key);
 
+  // Every key of this mapping, in file order (for maps keyed by name, such
+  // as joints); each is marked as known.
+  std::vector<std::string> keys();
+
   // Throws for every key of this mapping that was not read.
   void finish() const;
 

@@ -1,0 +1,89 @@
+#include "tofguard/lcm_node.hpp"
+
+#include <poll.h>
+#include <signal.h>
+
+#include <algorithm>
+#include <atomic>
+#include <stdexcept>
+
+#include "tofguard/clock.hpp"
+
+namespace tofguard {
+namespace {
+
+std::atomic<bool> g_stop_requested{false};
+
+void on_stop_signal(int) { g_stop_requested = true; }
+
+std::unique_ptr<lcm::LCM> open_lcm(const std::string& url) {
+  auto lcm = std::make_unique<lcm::LCM>(url);
+  if (!lcm->good()) {
+    throw std::runtime_error("cannot open LCM at '" + url +
+                             "' (for udpm: is there a multicast route? "
+                             "ip route add 224.0.0.0/4 dev lo)");
+  }
+  return lcm;
+}
+
+}  // namespace
+
+void install_stop_signal_handlers() {
+  struct sigaction action = {};
+  action.sa_handler = on_stop_signal;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+}
+
+bool stop_requested() { return g_stop_requested; }
+
+LcmNode::LcmNode(const Config& config, const std::string& process_name, double heartbeat_rate_hz)
+    : process_name_(process_name),
+      safety_(open_lcm(config.lcm.url)),
+      images_(config.lcm.image_url == config.lcm.url ? nullptr : open_lcm(config.lcm.image_url)),
+      errors_(process_name),
+      heartbeat_(safety_.get(), config.channels.heartbeat, process_name, heartbeat_rate_hz) {}
+
+LcmNode::~LcmNode() = default;
+
+void LcmNode::add_timer(int64_t period_us, std::function<void()> tick) {
+  timers_.push_back(Timer{period_us, monotonic_us() + period_us, std::move(tick)});
+}
+
+bool LcmNode::spin_once(int max_wait_ms) {
+  if (stop_requested()) return false;
+  int64_t wait_us = std::min<int64_t>(int64_t{max_wait_ms} * 1000, heartbeat_.us_until_due());
+  const int64_t now_us = monotonic_us();
+  for (const auto& timer : timers_) wait_us = std::min(wait_us, timer.next_us - now_us);
+  wait_us = std::max<int64_t>(0, wait_us);
+
+  pollfd fds[2] = {{safety_->getFileno(), POLLIN, 0}, {-1, POLLIN, 0}};
+  const nfds_t nfds = images_ ? 2 : 1;
+  if (images_) fds[1].fd = images_->getFileno();
+  // Round up so that a wait never ends just before a timer is due.
+  const int ready = poll(fds, nfds, static_cast<int>((wait_us + 999) / 1000));
+  if (ready > 0) {
+    if (fds[0].revents & POLLIN) safety_->handle();
+    if (images_ && (fds[1].revents & POLLIN)) images_->handle();
+  }
+
+  const int64_t after_us = monotonic_us();
+  for (auto& timer : timers_) {
+    if (after_us >= timer.next_us) {
+      timer.tick();
+      // Never burst to catch up: the next tick is one period from now at
+      // the latest.
+      timer.next_us = std::max(timer.next_us + timer.period_us, after_us + timer.period_us / 2);
+    }
+  }
+  heartbeat_.publish_if_due();
+  return !stop_requested();
+}
+
+void LcmNode::run() {
+  while (spin_once(100)) {
+  }
+}
+
+}  // namespace tofguard

@@ -1,0 +1,119 @@
+#include "tofguard/wire_checks.hpp"
+
+#include <cmath>
+#include <set>
+#include <sstream>
+
+namespace tofguard {
+namespace {
+
+std::string expected(const std::string& field, const std::string& what, double got) {
+  std::ostringstream s;
+  s << field << ": expected " << what << ", got " << got;
+  return s.str();
+}
+
+std::string check_size(int32_t width, int32_t height) {
+  if (width <= 0 || width > kMaxImageSide) {
+    return expected("width", "1.." + std::to_string(kMaxImageSide), width);
+  }
+  if (height <= 0 || height > kMaxImageSide) {
+    return expected("height", "1.." + std::to_string(kMaxImageSide), height);
+  }
+  return "";
+}
+
+}  // namespace
+
+std::string check_depth_image(const depth_image_t& image) {
+  if (image.camera_id.empty()) return "camera_id: expected a camera name, got an empty string";
+  if (image.utime <= 0) return expected("utime", "a capture time > 0", static_cast<double>(image.utime));
+  if (image.seq < 0) return expected("seq", "a frame number >= 0", static_cast<double>(image.seq));
+  if (auto problem = check_size(image.width, image.height); !problem.empty()) return problem;
+  const int64_t pixels = int64_t{image.width} * image.height;
+  if (image.num_pixels != pixels) {
+    return expected("num_pixels", "width*height = " + std::to_string(pixels), image.num_pixels);
+  }
+  if (image.num_amplitude != 0 && image.num_amplitude != pixels) {
+    return expected("num_amplitude", "0 or width*height = " + std::to_string(pixels),
+                    image.num_amplitude);
+  }
+  if (!std::isfinite(image.fx) || image.fx <= 0) return expected("fx", "a focal length > 0 px", image.fx);
+  if (!std::isfinite(image.fy) || image.fy <= 0) return expected("fy", "a focal length > 0 px", image.fy);
+  if (!std::isfinite(image.cx)) return expected("cx", "a finite principal point", image.cx);
+  if (!std::isfinite(image.cy)) return expected("cy", "a finite principal point", image.cy);
+  return "";
+}
+
+std::string check_joint_state(const joint_state_t& state) {
+  if (state.num_joints < 0) return expected("num_joints", "a count >= 0", state.num_joints);
+  std::set<std::string> seen;
+  for (int i = 0; i < state.num_joints; ++i) {
+    const std::string at = "[" + std::to_string(i) + "]";
+    if (state.name[i].empty()) return "name" + at + ": expected a joint name, got an empty string";
+    if (!seen.insert(state.name[i]).second) {
+      return "name" + at + ": expected unique joint names, got '" + state.name[i] + "' twice";
+    }
+    if (!std::isfinite(state.position[i])) {
+      return expected("position" + at + " (" + state.name[i] + ")", "a finite number", state.position[i]);
+    }
+    if (!std::isfinite(state.velocity[i])) {
+      return expected("velocity" + at + " (" + state.name[i] + ")", "a finite number", state.velocity[i]);
+    }
+  }
+  return "";
+}
+
+std::string check_camera_pose(const camera_pose_t& pose) {
+  if (pose.frame_id.empty()) return "frame_id: expected a URDF link name, got an empty string";
+  for (int i = 0; i < 3; ++i) {
+    if (!std::isfinite(pose.translation[i])) {
+      return expected("translation[" + std::to_string(i) + "]", "a finite number of metres",
+                      pose.translation[i]);
+    }
+  }
+  double norm2 = 0;
+  for (int i = 0; i < 4; ++i) {
+    if (!std::isfinite(pose.rotation[i])) {
+      return expected("rotation[" + std::to_string(i) + "]", "a finite number", pose.rotation[i]);
+    }
+    norm2 += pose.rotation[i] * pose.rotation[i];
+  }
+  if (std::abs(std::sqrt(norm2) - 1.0) > 1e-3) {
+    return expected("rotation", "a unit quaternion w,x,y,z (norm 1 within 1e-3), norm", std::sqrt(norm2));
+  }
+  return "";
+}
+
+std::string check_link_labels(const link_labels_t& labels) {
+  if (labels.utime <= 0) return expected("utime", "a capture time > 0", static_cast<double>(labels.utime));
+  if (labels.num_robot_links < 0 || labels.num_robot_links > labels.num_links) {
+    return expected("num_robot_links", "0..num_links", labels.num_robot_links);
+  }
+  if (!labels.usable) {
+    if (labels.unusable_reason.empty()) {
+      return "unusable_reason: expected a reason for an unusable frame, got an empty string";
+    }
+    return "";
+  }
+  if (auto problem = check_size(labels.width, labels.height); !problem.empty()) return problem;
+  const int64_t pixels = int64_t{labels.width} * labels.height;
+  if (labels.num_pixels != pixels) {
+    return expected("num_pixels", "width*height = " + std::to_string(pixels), labels.num_pixels);
+  }
+  return "";
+}
+
+std::string check_risk(const risk_t& risk) {
+  if (risk.level < risk_t::SAFE || risk.level > risk_t::DANGEROUS) {
+    return expected("level", "SAFE (0), WARNING (1) or DANGEROUS (2)", risk.level);
+  }
+  if (risk.cause < risk_t::CAUSE_NONE || risk.cause > risk_t::CAUSE_UNCLASSIFIED) {
+    return expected("cause", "one of risk_t's CAUSE_ constants (0..6)", risk.cause);
+  }
+  if (!std::isfinite(risk.score)) return expected("score", "a finite number", risk.score);
+  if (!std::isfinite(risk.threshold)) return expected("threshold", "a finite number", risk.threshold);
+  return "";
+}
+
+}  // namespace tofguard

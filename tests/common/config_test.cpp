@@ -1,0 +1,147 @@
+// The deployment config: the embedded default loads, and every kind of
+// mistake gives one line naming the file, the key and what was expected.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "test_support.hpp"
+#include "tofguard/config.hpp"
+
+namespace tofguard::test {
+namespace {
+
+std::string sim_yaml_path() { return source_dir() + "/config/sim.yaml"; }
+
+// sim.yaml with `from` replaced by `to` (which must occur), written next to
+// the test outputs; relative model paths are made absolute.
+std::string sim_variant(const std::string& name, const std::string& from, const std::string& to) {
+  std::string text = read_file(sim_yaml_path());
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << "sim.yaml no longer contains: " << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  for (size_t p = text.find(" models/"); p != std::string::npos; p = text.find(" models/", p + 1)) {
+    text.replace(p + 1, 0, source_dir() + "/config/");
+  }
+  for (size_t p = text.find("[models/"); p != std::string::npos; p = text.find("[models/", p + 1)) {
+    text.replace(p + 1, 0, source_dir() + "/config/");
+  }
+  const std::string path = output_dir() + "/config-" + name + ".yaml";
+  write_file(path, text);
+  return path;
+}
+
+std::string config_error(const std::string& path) {
+  try {
+    load_config(path, nullptr);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(Config, EmbeddedDefaultLoads) {
+  const Config config = load_config(sim_yaml_path(), nullptr);
+  EXPECT_EQ(config.robot.id, "friend-sim");
+  EXPECT_EQ(config.camera.source, "sim");
+  EXPECT_EQ(config.camera.intrinsics.width, 176);
+  EXPECT_EQ(config.camera.intrinsics.height, 144);
+  EXPECT_DOUBLE_EQ(config.camera.intrinsics.fx, 221.0);
+  EXPECT_DOUBLE_EQ(config.camera.intrinsics.cy, 71.8);
+  EXPECT_EQ(config.camera.pose.frame_id, "world");
+  EXPECT_NEAR(config.camera.pose.rotation.norm(), 1.0, 1e-6);
+  // The optical axis (z) looks forward (+x) and down: 40 degrees below the
+  // horizon.
+  const Eigen::Vector3d optical_axis = config.camera.pose.rotation * Eigen::Vector3d::UnitZ();
+  EXPECT_NEAR(optical_axis.x(), std::cos(40 * M_PI / 180), 1e-6);
+  EXPECT_NEAR(optical_axis.z(), -std::sin(40 * M_PI / 180), 1e-6);
+  EXPECT_EQ(config.lcm.url, "udpm://239.255.76.67:7667?ttl=0");
+  EXPECT_EQ(config.lcm.image_url, "udpm://239.255.76.67:7668?ttl=0&recv_buf_size=4194304");
+  EXPECT_EQ(config.channels.depth, "TOF_DEPTH");
+  EXPECT_EQ(config.channels.status, "SAFETY_STATUS");
+  EXPECT_EQ(config.robot.urdf_path, source_dir() + "/config/models/friend_arm.urdf");
+  ASSERT_EQ(config.environment.urdf_paths.size(), 1u);
+  EXPECT_DOUBLE_EQ(config.renderer.max_extrapolation_ms, 20);
+}
+
+TEST(Config, LcmUrlComesFromConfigThenEnvironmentThenHostLocalDefault) {
+  EXPECT_EQ(resolve_lcm_url("udpm://239.1.1.1:7000", "udpm://239.2.2.2:7000"), "udpm://239.1.1.1:7000");
+  EXPECT_EQ(resolve_lcm_url("", "udpm://239.2.2.2:7000"), "udpm://239.2.2.2:7000");
+  EXPECT_EQ(resolve_lcm_url("", nullptr), "udpm://239.255.76.67:7667?ttl=0");
+  EXPECT_EQ(resolve_lcm_url("", ""), "udpm://239.255.76.67:7667?ttl=0");
+
+  const std::string path = sim_variant("no-lcm-section",
+                                       "  url: \"udpm://239.255.76.67:7667?ttl=0\"\n", "");
+  // With lcm.url removed, LCM_DEFAULT_URL decides; the image URL names its
+  // own port with a big receive buffer.
+  const Config config = load_config(path, "udpm://239.9.9.9:9000?ttl=1");
+  EXPECT_EQ(config.lcm.url, "udpm://239.9.9.9:9000?ttl=1");
+}
+
+TEST(Config, ImageUrlIsDerivedOnTheNextPortWithABigBuffer) {
+  EXPECT_EQ(derive_image_url("udpm://239.255.76.67:7667?ttl=0"),
+            "udpm://239.255.76.67:7668?ttl=0&recv_buf_size=4194304");
+  EXPECT_EQ(derive_image_url("udpm://239.255.76.67:7667"),
+            "udpm://239.255.76.67:7668?recv_buf_size=4194304");
+  EXPECT_EQ(derive_image_url("udpm://239.1.2.3:100?recv_buf_size=100"),
+            "udpm://239.1.2.3:101?recv_buf_size=100");
+  EXPECT_EQ(derive_image_url("memq://"), "memq://");
+}
+
+struct BadConfig {
+  std::string name;
+  std::string from;
+  std::string to;
+  // Every one of these must appear in the one-line message.
+  std::vector<std::string> expected;
+};
+
+class ConfigErrors : public ::testing::TestWithParam<BadConfig> {};
+
+TEST_P(ConfigErrors, NameFileKeyAndExpectation) {
+  const BadConfig& bad = GetParam();
+  const std::string path = sim_variant(bad.name, bad.from, bad.to);
+  const std::string message = config_error(path);
+  EXPECT_EQ(message.find('\n'), std::string::npos) << "not one line: " << message;
+  EXPECT_NE(message.find(path), std::string::npos) << message;
+  for (const auto& part : bad.expected) {
+    EXPECT_NE(message.find(part), std::string::npos) << "'" << part << "' missing from: " << message;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Mistakes, ConfigErrors,
+    ::testing::Values(
+        BadConfig{"missing-key", "  id: friend-sim\n", "", {"robot.id", "missing key", "expected a string"}},
+        BadConfig{"unknown-key", "  rate_hz: 30\n", "  rate_hz: 30\n  exposure_us: 300\n",
+                  {"camera.exposure_us", "unknown key", "expected one of", "rate_hz"}},
+        BadConfig{"unknown-section", "renderer:\n", "rendering:\n  x: 1\nrenderer:\n",
+                  {"rendering", "unknown key"}},
+        BadConfig{"wrong-type", "rate_hz: 30", "rate_hz: fast",
+                  {"camera.rate_hz", "expected a number in", "'fast'"}},
+        BadConfig{"wrong-type-int", "width: 176", "width: 176.5",
+                  {"camera.intrinsics.width", "expected an integer", "'176.5'"}},
+        BadConfig{"out-of-range", "far_m: 8.0", "far_m: 0.05",
+                  {"renderer.far_m", "expected a distance greater than near_m"}},
+        BadConfig{"bad-choice", "source: sim", "source: kinect",
+                  {"camera.source", "expected one of sim, uvc", "'kinect'"}},
+        BadConfig{"missing-path", "models/friend_arm.urdf", "models/no_such_arm.urdf",
+                  {"robot.urdf", "expected an existing file", "no_such_arm.urdf", "does not exist"}},
+        BadConfig{"not-unit-quaternion", "[0.298836239, -0.640856382", "[0.6, -0.640856382",
+                  {"camera.pose.rotation_wxyz", "expected a unit quaternion"}},
+        BadConfig{"short-list", "translation_m: [-0.35, -0.20, 1.55]", "translation_m: [-0.35, 1.55]",
+                  {"camera.pose.translation_m", "expected a list of 3 numbers", "2 entries"}},
+        BadConfig{"not-yaml", "robot:\n", "robot: [\n", {"not valid YAML"}}),
+    [](const ::testing::TestParamInfo<BadConfig>& info) {
+      std::string name = info.param.name;
+      for (auto& c : name) if (c == '-') c = '_';
+      return name;
+    });
+
+TEST(Config, MissingFileIsNamed) {
+  const std::string message = config_error("/nonexistent/tofguard.yaml");
+  EXPECT_NE(message.find("/nonexistent/tofguard.yaml"), std::string::npos) << message;
+  EXPECT_NE(message.find("no such file"), std::string::npos) << message;
+}
+
+}  // namespace
+}  // namespace tofguard::test

@@ -1,0 +1,108 @@
+// LcmNode over real UDP multicast (private network namespace): malformed
+// messages are dropped and counted, never handed on; the heartbeat carries
+// the counters; timers fire by themselves.
+#include <gtest/gtest.h>
+
+#include "../lcmtypes/sample_messages.hpp"
+#include "test_support.hpp"
+#include "tofguard/clock.hpp"
+#include "tofguard/config.hpp"
+#include "tofguard/lcm_node.hpp"
+#include "tofguard/wire_checks.hpp"
+
+namespace tofguard::test {
+namespace {
+
+Config test_config() {
+  Config config;
+  config.lcm.url = "udpm://239.255.76.67:7667?ttl=0";
+  config.lcm.image_url = derive_image_url(config.lcm.url);
+  return config;
+}
+
+struct HeartbeatListener {
+  heartbeat_t last;
+  int count = 0;
+  void on_message(const lcm::ReceiveBuffer*, const std::string&, const heartbeat_t* hb) {
+    last = *hb;
+    ++count;
+  }
+};
+
+TEST(LcmNode, MalformedMessagesAreCountedAndNeverHandedOn) {
+  const Config config = test_config();
+  LcmNode node(config, "node-under-test");
+  std::vector<depth_image_t> handled;
+  node.subscribe<depth_image_t>(
+      node.images(), "TOF_DEPTH", [&](const depth_image_t& m) { handled.push_back(m); },
+      check_depth_image);
+
+  lcm::LCM publisher(config.lcm.image_url);
+  ASSERT_TRUE(publisher.good());
+  lcm::LCM safety(config.lcm.url);
+  HeartbeatListener heartbeats;
+  safety.subscribe("SAFETY_HEARTBEAT", &HeartbeatListener::on_message, &heartbeats);
+
+  depth_image_t good = sample_depth_image();
+  depth_image_t wrong_size = good;
+  wrong_size.num_pixels = 5;
+  wrong_size.depth_mm.resize(5);
+  joint_state_t other_type = sample_joint_state();  // wrong fingerprint
+  std::vector<uint8_t> truncated(good.getEncodedSize());
+  good.encode(truncated.data(), 0, static_cast<int>(truncated.size()));
+  truncated.resize(truncated.size() / 2);
+
+  publisher.publish("TOF_DEPTH", &wrong_size);
+  publisher.publish("TOF_DEPTH", &other_type);
+  publisher.publish("TOF_DEPTH", truncated.data(), static_cast<unsigned>(truncated.size()));
+  publisher.publish("TOF_DEPTH", &good);
+
+  ASSERT_TRUE(wait_until([&] { return handled.size() == 1 && node.counters().decode_errors == 2; },
+                         std::chrono::seconds(5), [&] { node.spin_once(10); }));
+  EXPECT_EQ(handled[0].seq, good.seq);
+  EXPECT_EQ(handled[0].depth_mm, good.depth_mm);
+  EXPECT_EQ(node.counters().frames_in, 1);
+  EXPECT_EQ(node.counters().validation_errors, 1);
+  EXPECT_NE(node.errors().last().find("TOF_DEPTH"), std::string::npos);
+
+  // The heartbeat reports the same counters.
+  ASSERT_TRUE(wait_until(
+      [&] { return heartbeats.count > 0 && heartbeats.last.decode_errors == 2; }, std::chrono::seconds(5),
+      [&] {
+        node.spin_once(10);
+        safety.handleTimeout(0);
+      }));
+  EXPECT_EQ(heartbeats.last.process, "node-under-test");
+  EXPECT_EQ(heartbeats.last.frames_in, 1);
+  EXPECT_EQ(heartbeats.last.validation_errors, 1);
+  EXPECT_GT(heartbeats.last.pid, 0);
+}
+
+TEST(LcmNode, HeartbeatsComeAtTheirRateWithoutAnyTraffic) {
+  const Config config = test_config();
+  LcmNode node(config, "quiet-node", /*heartbeat_rate_hz=*/20);
+  lcm::LCM safety(config.lcm.url);
+  HeartbeatListener heartbeats;
+  safety.subscribe("SAFETY_HEARTBEAT", &HeartbeatListener::on_message, &heartbeats);
+  const int64_t start_us = monotonic_us();
+  ASSERT_TRUE(wait_until([&] { return heartbeats.count >= 10; }, std::chrono::seconds(5), [&] {
+    node.spin_once(10);
+    safety.handleTimeout(0);
+  }));
+  // 10 heartbeats at 20 Hz take about 450 ms; consecutive seq numbers.
+  EXPECT_GE(monotonic_us() - start_us, 400'000);
+  EXPECT_EQ(heartbeats.last.seq, heartbeats.count - 1);
+}
+
+TEST(LcmNode, TimersFireWhileNothingArrives) {
+  LcmNode node(test_config(), "timer-node");
+  int ticks = 0;
+  node.add_timer(10'000, [&] { ++ticks; });
+  const int64_t start_us = monotonic_us();
+  ASSERT_TRUE(wait_until([&] { return ticks >= 10; }, std::chrono::seconds(5), [&] { node.spin_once(100); }));
+  // Ten ticks of a 10 ms timer cannot come sooner than 100 ms.
+  EXPECT_GE(monotonic_us() - start_us, 100'000);
+}
+
+}  // namespace
+}  // namespace tofguard::test

@@ -1,0 +1,79 @@
+// Every tofguard process validates the whole config at start: a config error
+// is one line on stderr naming the file and the key, exit code 2, and
+// nothing is published before it. Runs in a private network namespace with a
+// listener on both of the config's LCM URLs.
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+
+#include "test_support.hpp"
+
+namespace tofguard::test {
+namespace {
+
+const char* const kProcesses[] = {"tofguard-camera",      "tofguard-joints-sim", "tofguard-renderer",
+                                  "tofguard-discrepancy", "tofguard-risk",       "tofguard-intervene"};
+
+struct Counter {
+  int messages = 0;
+  void on_message(const lcm::ReceiveBuffer*, const std::string&) { ++messages; }
+};
+
+std::string bad_config() {
+  std::string text = read_file(source_dir() + "/config/sim.yaml");
+  const std::string from = "rate_hz: 30";
+  text.replace(text.find(from), from.size(), "rate_hz: -5");
+  for (size_t p = text.find("models/"); p != std::string::npos; p = text.find("models/", p + 40)) {
+    text.replace(p, 0, source_dir() + "/config/");
+  }
+  const std::string path = output_dir() + "/process-bad-config.yaml";
+  write_file(path, text);
+  return path;
+}
+
+TEST(ProcessConfig, EveryProcessRejectsABadConfigWithExitCode2AndPublishesNothing) {
+  const std::string path = bad_config();
+  lcm::LCM safety("udpm://239.255.76.67:7667?ttl=0");
+  lcm::LCM images("udpm://239.255.76.67:7668?ttl=0&recv_buf_size=4194304");
+  ASSERT_TRUE(safety.good());
+  ASSERT_TRUE(images.good());
+  Counter counter;
+  safety.subscribe(".*", &Counter::on_message, &counter);
+  images.subscribe(".*", &Counter::on_message, &counter);
+
+  for (const char* process : kProcesses) {
+    std::string out, err;
+    const int code = run_command(std::string("config-") + process,
+                                 {bin_dir() + "/" + process, "--config", path}, &out, &err);
+    EXPECT_EQ(code, 2) << process << ": " << err;
+    // Exactly one line, naming the process, the file, the key and the range.
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << process << ": " << err;
+    EXPECT_NE(err.find(process), std::string::npos) << err;
+    EXPECT_NE(err.find(path), std::string::npos) << err;
+    EXPECT_NE(err.find("camera.rate_hz"), std::string::npos) << err;
+    EXPECT_NE(err.find("expected a number in [0.1, 1000]"), std::string::npos) << err;
+  }
+  // Drain whatever might have been sent: nothing may have been.
+  while (safety.handleTimeout(50) > 0 || images.handleTimeout(0) > 0) {
+  }
+  EXPECT_EQ(counter.messages, 0);
+}
+
+TEST(ProcessConfig, MissingConfigArgumentIsAUsageError) {
+  for (const char* process : kProcesses) {
+    std::string out, err;
+    EXPECT_EQ(run_command(std::string("noconfig-") + process, {bin_dir() + "/" + process}, &out, &err), 2)
+        << process;
+    EXPECT_NE(err.find("--config"), std::string::npos) << err;
+  }
+}
+
+TEST(ProcessConfig, HelpExitsZero) {
+  for (const char* process : kProcesses) {
+    std::string out, err;
+    EXPECT_EQ(run_command(std::string("help-") + process, {bin_dir() + "/" + process, "--help"}, &out, &err), 0);
+    EXPECT_NE(out.find(std::string("usage: ") + process), std::string::npos) << out;
+  }
+}
+
+}  // namespace
+}  // namespace tofguard::test
