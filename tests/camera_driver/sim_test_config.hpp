@@ -3,7 +3,7 @@
 // default's 176x144 camera and an error model like config/sim.yaml's.
 #include "tofguard/config.hpp"
 
-namespace tofguard::camera::test {
+namespace tofguard::camera::sim_test {
 
 inline Intrinsics test_intrinsics() {
   Intrinsics in;
@@ -35,4 +35,4 @@ inline SimCameraConfig test_sim_config() {
   return c;
 }
 
-}  // namespace tofguard::camera::test
+}  // namespace tofguard::camera::sim_test

@@ -10,8 +10,8 @@
 namespace tofguard::camera {
 namespace {
 
-using test::test_intrinsics;
-using test::test_sim_config;
+using sim_test::test_intrinsics;
+using sim_test::test_sim_config;
 
 std::vector<float> wall(float z_m) {
   const Intrinsics in = test_intrinsics();
