@@ -14,8 +14,6 @@ int main(int argc, char** argv) {
           return 2;
         }
         if (config.camera.source == "uvc") return tofguard::camera::run_uvc_camera(config);
-        std::cerr << info.name << ": the sim source is not wired into this process yet "
-                  << "(it needs the renderer library)\n";
-        return 1;
+        return tofguard::camera::run_sim_camera(config);
       });
 }

@@ -153,6 +153,7 @@ void read_channels(YamlMap map, ChannelNames* c) {
   name("power", &c->power);
   name("sim_true_joint_state", &c->sim_true_joint_state);
   name("sim_joint_fault", &c->sim_joint_fault);
+  name("sim_camera_fault", &c->sim_camera_fault);
   map.finish();
 }
 

@@ -47,6 +47,8 @@ struct ChannelNames {
   // camera) and run-time encoder fault injection.
   std::string sim_true_joint_state = "SIM_TRUE_JOINT_STATE";
   std::string sim_joint_fault = "SIM_JOINT_FAULT";
+  // Simulation only: run-time fault injection into the simulated camera.
+  std::string sim_camera_fault = "SIM_CAMERA_FAULT";
 };
 
 // Pinhole intrinsics, OpenCV convention (pixel (u, v) has its centre at
@@ -124,8 +126,8 @@ struct SimCameraFaultConfig {
   // m/s, and rotation rate about the optical frame's axes, rad/s.
   Eigen::Vector3d drift_translation_m_per_s = Eigen::Vector3d::Zero();
   Eigen::Vector3d drift_rotation_rad_per_s = Eigen::Vector3d::Zero();
-  // intruding_object: an axis-aligned box in the pose's frame, its size,
-  // its centre at the fault's start and its velocity.
+  // intruding_object: an axis-aligned box in the world frame (the robot's
+  // root link), its size, its centre at the fault's start and its velocity.
   Eigen::Vector3d object_size_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d object_position_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d object_velocity_m_per_s = Eigen::Vector3d::Zero();
