@@ -47,7 +47,7 @@ std::optional<std::map<std::string, double>> TrueJointHistory::at(int64_t utime,
     return out;
   }
   if (utime < states_.front().utime) {
-    *why = "frame older than the oldest true joint state kept";
+    *why = "capture time before the oldest true joint state kept";
     return std::nullopt;
   }
   for (size_t i = states_.size() - 1; i > 0; --i) {

@@ -2,30 +2,16 @@
 // camera.sim): strict, range-checked, one-line errors.
 #include <gtest/gtest.h>
 
+#include "config_variant.hpp"
 #include "test_support.hpp"
 #include "tofguard/config.hpp"
 
 namespace tofguard {
 namespace {
 
-// config/sim.yaml with the model paths made absolute and `replace` ->
-// `with` applied, written to the test output folder.
 std::string variant(const std::string& name, const std::string& replace = "",
                     const std::string& with = "") {
-  std::string text = test::read_file(test::source_dir() + "/config/sim.yaml");
-  const std::string prefix = test::source_dir() + "/config/";
-  for (size_t at = 0; (at = text.find("models/", at)) != std::string::npos;
-       at += prefix.size() + 7) {
-    text.insert(at, prefix);
-  }
-  if (!replace.empty()) {
-    const size_t at = text.find(replace);
-    EXPECT_NE(at, std::string::npos) << replace;
-    text.replace(at, replace.size(), with);
-  }
-  const std::string path = test::output_dir() + "/" + name + ".yaml";
-  test::write_file(path, text);
-  return path;
+  return camera_test::sim_config_variant(name, replace, with);
 }
 
 std::string error_of(const std::string& path) {

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "camera_sources.hpp"
+#include "config_variant.hpp"
 #include "test_support.hpp"
 
 namespace tofguard::camera {
@@ -15,19 +16,10 @@ namespace {
 
 // config/sim.yaml turned into a uvc camera config for ids nobody uses.
 std::string uvc_config() {
-  std::string text = test::read_file(test::source_dir() + "/config/sim.yaml");
-  const std::string prefix = test::source_dir() + "/config/";
-  for (size_t at = 0; (at = text.find("models/", at)) != std::string::npos;
-       at += prefix.size() + 7) {
-    text.insert(at, prefix);
-  }
-  const std::string source = "source: sim";
-  text.replace(text.find(source), source.size(),
-               "source: uvc\n  uvc: {vendor_id: \"fffe\", product_id: \"fffd\", serial: \"X1\", "
-               "format: z16, depth_unit_mm: 0.125, distance: radial}");
-  const std::string path = test::output_dir() + "/uvc_camera.yaml";
-  test::write_file(path, text);
-  return path;
+  return camera_test::sim_config_variant(
+      "uvc_camera", "source: sim",
+      "source: uvc\n  uvc: {vendor_id: \"fffe\", product_id: \"fffd\", serial: \"X1\", "
+      "format: z16, depth_unit_mm: 0.125, distance: radial}");
 }
 
 TEST(UvcCamera, ListsUsbDevicesInOneLine) {
