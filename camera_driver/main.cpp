@@ -1,13 +1,19 @@
-// tofguard-camera: wires config + LCM + the library in src/.
+// tofguard-camera: publishes depth_image_t on TOF_DEPTH from the source the
+// config names (camera.source: uvc or sim); see src/camera_sources.hpp.
 #include <iostream>
 
 #include "camera_process.hpp"
+#include "camera_sources.hpp"
 
 int main(int argc, char** argv) {
   const tofguard::ProcessInfo info = tofguard::camera::process_info();
-  return tofguard::run_process(argc, argv, info,
-                               [&](const tofguard::Config&, const std::vector<std::string>&) {
-                                 std::cerr << info.name << ": not implemented yet (issue 4)\n";
-                                 return 1;
-                               });
+  return tofguard::run_process(
+      argc, argv, info, [&](const tofguard::Config& config, const std::vector<std::string>& rest) {
+        if (!rest.empty()) {
+          std::cerr << info.name << ": unknown argument '" << rest[0] << "'\n";
+          return 2;
+        }
+        if (config.camera.source == "uvc") return tofguard::camera::run_uvc_camera(config);
+        return tofguard::camera::run_sim_camera(config);
+      });
 }

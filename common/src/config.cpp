@@ -1,6 +1,7 @@
 #include "tofguard/config.hpp"
 
 #include <cmath>
+#include <cstdint>
 #include <regex>
 
 #include "tofguard/yaml_reader.hpp"
@@ -37,6 +38,103 @@ CameraPose read_pose(YamlMap map) {
   return pose;
 }
 
+DepthCalibrationConfig read_depth_calibration(YamlMap map) {
+  DepthCalibrationConfig c;
+  c.enabled = true;
+  c.degree = static_cast<int>(map.integer("degree", 0, 9));
+  c.coefficients_m = map.numbers("coefficients_m", c.degree + 1);
+  map.finish();
+  return c;
+}
+
+int read_usb_id(YamlMap& map, const std::string& key) {
+  static const std::regex hex4("^[0-9a-fA-F]{4}$");
+  const std::string text = map.string(key);
+  if (!std::regex_match(text, hex4)) {
+    map.fail(key, "a USB id as 4 hex digits in quotes, as lsusb shows it (e.g. \"2bc5\")",
+             "\"" + text + "\"");
+  }
+  return std::stoi(text, nullptr, 16);
+}
+
+UvcCameraConfig read_uvc(YamlMap map) {
+  UvcCameraConfig c;
+  c.vendor_id = read_usb_id(map, "vendor_id");
+  c.product_id = read_usb_id(map, "product_id");
+  c.serial = map.optional_string("serial").value_or("");
+  c.format = map.choice("format", {"z16", "y16", "gray16"});
+  c.depth_unit_mm = map.number("depth_unit_mm", 1e-3, 100);
+  c.radial_distance = map.choice("distance", {"z", "radial"}) == "radial";
+  map.finish();
+  return c;
+}
+
+Eigen::Vector3d vector3(YamlMap& map, const std::string& key, double limit) {
+  const auto v = map.numbers(key, 3);
+  for (double x : v) {
+    if (std::abs(x) > limit) {
+      map.fail(key, "3 numbers each in [-" + std::to_string(limit) + ", " +
+                        std::to_string(limit) + "]",
+               std::to_string(x));
+    }
+  }
+  return Eigen::Vector3d(v[0], v[1], v[2]);
+}
+
+SimCameraFaultConfig read_sim_fault(YamlMap map) {
+  SimCameraFaultConfig f;
+  f.kind = map.choice("kind", {"frozen_image", "stall", "pose_drift", "intruding_object"});
+  f.start_s = map.number("start_s", 0, 1e6);
+  f.duration_s = map.number("duration_s", 0, 1e6);
+  if (f.kind == "pose_drift") {
+    f.drift_translation_m_per_s = vector3(map, "translation_m_per_s", 10);
+    f.drift_rotation_rad_per_s = vector3(map, "rotation_rad_per_s", 10);
+  } else if (f.kind == "intruding_object") {
+    f.object_size_m = vector3(map, "size_m", 10);
+    if (f.object_size_m.minCoeff() <= 0) map.fail("size_m", "3 sizes > 0");
+    f.object_position_m = vector3(map, "position_m", 100);
+    if (map.optional("velocity_m_per_s")) {
+      f.object_velocity_m_per_s = vector3(map, "velocity_m_per_s", 10);
+    }
+  }
+  map.finish();
+  return f;
+}
+
+SimCameraConfig read_sim(YamlMap map) {
+  SimCameraConfig c;
+  c.seed = static_cast<uint64_t>(map.integer("seed", 0, INT64_MAX));
+  c.systematic_error_m = map.numbers("systematic_error_m", -1);
+  if (c.systematic_error_m.empty() || c.systematic_error_m.size() > 10) {
+    map.fail("systematic_error_m", "1 to 10 polynomial coefficients (ascending powers, metres)",
+             std::to_string(c.systematic_error_m.size()) + " coefficients");
+  }
+  {
+    YamlMap noise = map.map("noise");
+    c.noise_sigma0_mm = noise.number("sigma0_mm", 0, 1000);
+    c.noise_sigma_per_m2_mm = noise.number("sigma_per_m2_mm", 0, 1000);
+    noise.finish();
+  }
+  {
+    YamlMap amplitude = map.map("amplitude");
+    c.amplitude_at_1m = amplitude.number("at_1m", 1, 32767);
+    c.min_valid_amplitude = amplitude.number("min_valid", 0, 32767);
+    c.dark_pixel_probability = amplitude.number("dark_pixel_probability", 0, 1);
+    amplitude.finish();
+  }
+  {
+    YamlMap mixed = map.map("mixed_pixels");
+    c.mixed_pixel_jump_m = mixed.number("jump_m", 1e-3, 100);
+    c.mixed_pixel_probability = mixed.number("probability", 0, 1);
+    mixed.finish();
+  }
+  if (map.optional("faults")) {
+    for (YamlMap& fault : map.maps("faults")) c.faults.push_back(read_sim_fault(fault));
+  }
+  map.finish();
+  return c;
+}
+
 void read_channels(YamlMap map, ChannelNames* c) {
   auto name = [&map](const char* key, std::string* out) {
     if (auto v = map.optional_string(key)) *out = *v;
@@ -55,6 +153,7 @@ void read_channels(YamlMap map, ChannelNames* c) {
   name("power", &c->power);
   name("sim_true_joint_state", &c->sim_true_joint_state);
   name("sim_joint_fault", &c->sim_joint_fault);
+  name("sim_camera_fault", &c->sim_camera_fault);
   map.finish();
 }
 
@@ -282,6 +381,15 @@ Config load_config(const std::string& path, const char* lcm_default_url_env) {
     config.camera.intrinsics = read_intrinsics(intrinsics);
     intrinsics.finish();
     config.camera.pose = read_pose(camera.map("pose"));
+    if (camera.optional("depth_calibration")) {
+      config.camera.depth_calibration = read_depth_calibration(camera.map("depth_calibration"));
+    }
+    if (config.camera.source == "uvc" || camera.optional("uvc")) {
+      config.camera.uvc = read_uvc(camera.map("uvc"));
+    }
+    if (config.camera.source == "sim" || camera.optional("sim")) {
+      config.camera.sim = read_sim(camera.map("sim"));
+    }
     camera.finish();
   }
 

@@ -7,6 +7,7 @@
 //
 // Units are in the names: _m metres, _ms milliseconds, _hz hertz, _mm
 // millimetres. Relative paths are resolved against the config file's folder.
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,8 @@ struct ChannelNames {
   // camera) and run-time encoder fault injection.
   std::string sim_true_joint_state = "SIM_TRUE_JOINT_STATE";
   std::string sim_joint_fault = "SIM_JOINT_FAULT";
+  // Simulation only: run-time fault injection into the simulated camera.
+  std::string sim_camera_fault = "SIM_CAMERA_FAULT";
 };
 
 // Pinhole intrinsics, OpenCV convention (pixel (u, v) has its centre at
@@ -81,6 +84,79 @@ struct EnvironmentConfig {
   std::vector<std::string> urdf_paths;
 };
 
+// Distance calibration applied by tofguard-camera before publishing:
+//   d_calibrated = d - p(d),  p(d) = sum_i coefficients_m[i] * d^i,
+// with d the measured Z (along the optical axis) in metres and p(d) in
+// metres. Fitted by tofguard-calibrate-depth.
+struct DepthCalibrationConfig {
+  // false when the config has no camera.depth_calibration: frames are then
+  // published with calibrated = false.
+  bool enabled = false;
+  int degree = 0;
+  // degree + 1 coefficients, ascending powers of d.
+  std::vector<double> coefficients_m;
+};
+
+// A USB Video Class depth camera (camera.uvc, required when source is uvc).
+struct UvcCameraConfig {
+  int vendor_id = 0;   // USB idVendor (written as 4 hex digits in the YAML)
+  int product_id = 0;  // USB idProduct
+  // The camera's USB serial number; "" accepts any camera with these ids.
+  std::string serial;
+  // Stream format, one little-endian 16-bit count per pixel: "z16", "y16"
+  // or "gray16" (y16 and gray16 are the same UVC format GUID).
+  std::string format;
+  // Millimetres per count (e.g. 1.0, 0.25, 0.125).
+  double depth_unit_mm = 0;
+  // true when the camera reports radial distance along each pixel's ray
+  // (converted to Z with the intrinsics), false when it reports Z.
+  bool radial_distance = false;
+};
+
+// One fault the simulated camera injects (camera.sim.faults), at
+// start_s..start_s+duration_s seconds after the camera started.
+struct SimCameraFaultConfig {
+  // "frozen_image" (the last image repeats), "stall" (no frames),
+  // "pose_drift" (the true camera pose moves away from the calibrated one),
+  // "intruding_object" (a box appears in the scene).
+  std::string kind;
+  double start_s = 0;
+  double duration_s = 0;
+  // pose_drift: velocity of the optical frame's origin in the pose's frame,
+  // m/s, and rotation rate about the optical frame's axes, rad/s.
+  Eigen::Vector3d drift_translation_m_per_s = Eigen::Vector3d::Zero();
+  Eigen::Vector3d drift_rotation_rad_per_s = Eigen::Vector3d::Zero();
+  // intruding_object: an axis-aligned box in the world frame (the robot's
+  // root link), its size, its centre at the fault's start and its velocity.
+  Eigen::Vector3d object_size_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d object_position_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d object_velocity_m_per_s = Eigen::Vector3d::Zero();
+};
+
+// The simulated ToF camera's error model (camera.sim, required when source
+// is sim). Distances r are radial (along the pixel's ray), metres.
+struct SimCameraConfig {
+  uint64_t seed = 0;
+  // Systematic error e(r) = sum_i systematic_error_m[i] * r^i, metres; the
+  // camera measures r + e(r).
+  std::vector<double> systematic_error_m;
+  // Gaussian noise: sigma(r) = noise_sigma0_mm + noise_sigma_per_m2_mm * r^2.
+  double noise_sigma0_mm = 0;
+  double noise_sigma_per_m2_mm = 0;
+  // Amplitude of a surface seen perpendicularly at 1 m (camera units); it
+  // falls with 1/r^2 and the cosine of the incidence angle.
+  double amplitude_at_1m = 0;
+  // Pixels whose amplitude is below this are invalid (depth 0).
+  double min_valid_amplitude = 0;
+  // Chance per pixel and frame of an invalid pixel from dark noise.
+  double dark_pixel_probability = 0;
+  // A depth step larger than this between 4-neighbours is a silhouette;
+  // silhouette pixels mix both surfaces with this probability.
+  double mixed_pixel_jump_m = 0;
+  double mixed_pixel_probability = 0;
+  std::vector<SimCameraFaultConfig> faults;
+};
+
 struct CameraConfig {
   std::string id;
   // "sim" (the simulated ToF camera) or "uvc" (a USB Video Class camera).
@@ -89,6 +165,11 @@ struct CameraConfig {
   Intrinsics intrinsics;
   // Static calibrated pose, used until a CAMERA_POSE message arrives.
   CameraPose pose;
+  DepthCalibrationConfig depth_calibration;
+  // The section named by `source` is required; the other one is validated
+  // and filled when present.
+  UvcCameraConfig uvc;
+  SimCameraConfig sim;
 };
 
 struct RendererConfig {

@@ -1,0 +1,131 @@
+#pragma once
+// The simulated ToF camera's logic, apart from the renderer and LCM: which
+// scene to render for a frame (the arm at its true joint angles interpolated
+// at the capture time, the camera pose with any drift, intruding objects),
+// the ToF error model, and the injected faults.
+//
+// Frames: the camera pose is the optical frame's pose in the config's
+// camera.pose.frame_id; intruding boxes are given in the world frame (the
+// robot's root link).
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "tof_error_model.hpp"
+#include "tofguard/config.hpp"
+
+namespace tofguard::camera {
+
+// An axis-aligned box in the world frame.
+struct SimBox {
+  Eigen::Vector3d size_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d center_m = Eigen::Vector3d::Zero();
+};
+
+struct RenderedDepth {
+  bool usable = false;
+  std::string unusable_reason;  // one line when !usable
+  // Z along the optical axis, metres, row-major; 0 = nothing in range.
+  std::vector<float> depth_m;
+};
+
+// What the simulated camera needs from the renderer (the real one renders
+// the URDF scene with tofguard::renderer::DepthRenderer; tests use fakes).
+class SceneRenderer {
+ public:
+  virtual ~SceneRenderer() = default;
+  virtual RenderedDepth render(const std::map<std::string, double>& joint_positions,
+                               const CameraPose& camera_pose, const Intrinsics& intrinsics,
+                               const std::vector<SimBox>& boxes) = 0;
+};
+
+// The simulated arm's true joint states (SIM_TRUE_JOINT_STATE), a short
+// history to interpolate in.
+class TrueJointHistory {
+ public:
+  // States older than `keep_us` behind the newest are forgotten.
+  explicit TrueJointHistory(int64_t keep_us = 2000000) : keep_us_(keep_us) {}
+  // Adds a state; out-of-order states (utime not after the newest) are
+  // ignored and return false.
+  bool add(int64_t utime, const std::vector<std::string>& names,
+           const std::vector<double>& positions, const std::vector<double>& velocities);
+  // Positions at `utime`: linear between the two states around it; beyond
+  // the newest state by at most `max_extrapolation_us`, the newest state
+  // moved on with its velocities. Otherwise nullopt and `*why` says why.
+  std::optional<std::map<std::string, double>> at(int64_t utime, int64_t max_extrapolation_us,
+                                                  std::string* why) const;
+
+ private:
+  struct State {
+    int64_t utime;
+    std::map<std::string, double> position;
+    std::map<std::string, double> velocity;
+  };
+  int64_t keep_us_;
+  std::deque<State> states_;
+};
+
+// One injected fault with absolute times (microseconds since the epoch).
+struct ActiveSimFault {
+  SimCameraFaultConfig fault;
+  int64_t start_utime = 0;
+  int64_t end_utime = 0;
+};
+
+class SimulatedCamera {
+ public:
+  // `start_utime`: when the camera started (config faults count from it).
+  SimulatedCamera(const CameraConfig& config, SceneRenderer* renderer, int64_t start_utime);
+
+  void add_true_joint_state(int64_t utime, const std::vector<std::string>& names,
+                            const std::vector<double>& positions,
+                            const std::vector<double>& velocities) {
+    joints_.add(utime, names, positions, velocities);
+  }
+  // A run-time fault, starting at `fault.start_utime`.
+  void inject(const ActiveSimFault& fault) { faults_.push_back(fault); }
+  // Ends every fault active or pending at `utime`.
+  void clear_faults(int64_t utime);
+
+  struct Frame {
+    enum class Outcome {
+      kImage,        // image is valid
+      kStalled,      // stall fault: no frame
+      kNoJointState, // no true joint state near the capture time
+      kRenderFailed, // the renderer said the image is unusable
+    };
+    Outcome outcome = Outcome::kImage;
+    std::string why;  // one line unless kImage
+    TofImage image;   // uncalibrated ToF image when kImage
+    bool frozen = false;
+  };
+  // The frame whose mid-exposure time is `capture_utime`; `frame_index`
+  // selects the noise (the same index gives the same noise).
+  Frame capture(int64_t capture_utime, uint64_t frame_index);
+
+  // The camera pose the scene is rendered from at `utime` (the config's
+  // pose plus any pose drift).
+  CameraPose true_pose(int64_t utime) const;
+  // Intruding boxes at `utime`.
+  std::vector<SimBox> boxes(int64_t utime) const;
+
+ private:
+  bool active(const ActiveSimFault& f, int64_t utime) const {
+    return utime >= f.start_utime && utime < f.end_utime;
+  }
+
+  CameraConfig config_;
+  SceneRenderer* renderer_;
+  TofErrorModel model_;
+  TrueJointHistory joints_;
+  std::vector<ActiveSimFault> faults_;
+  std::optional<TofImage> last_image_;
+};
+
+}  // namespace tofguard::camera

@@ -1,0 +1,138 @@
+// tofguard-camera with the simulated camera as a real process over real LCM
+// (private network namespace) and real EGL rendering: frames at the
+// embedded default's camera with seq +1, calibrated, amplitude; a run-time
+// stall fault stops the frames and is counted as dropped; an intruding box
+// in front of the lens shows up at its distance.
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+
+#include <algorithm>
+
+#include "test_support.hpp"
+#include "tofguard/clock.hpp"
+#include "tofguard/config.hpp"
+#include "tofguard/depth_image_t.hpp"
+#include "tofguard/heartbeat_t.hpp"
+#include "tofguard/joint_state_t.hpp"
+#include "tofguard/sim_camera_fault_t.hpp"
+
+namespace tofguard::test {
+namespace {
+
+struct Rig {
+  Config config = load_config(source_dir() + "/config/sim.yaml", nullptr);
+  lcm::LCM safety{config.lcm.url};
+  lcm::LCM images{config.lcm.image_url};
+  std::vector<depth_image_t> frames;
+  heartbeat_t heartbeat;
+  int heartbeats = 0;
+  int64_t last_truth_us = 0;
+
+  Rig() {
+    images.subscribe("TOF_DEPTH", &Rig::on_depth, this);
+    safety.subscribe("SAFETY_HEARTBEAT", &Rig::on_heartbeat, this);
+  }
+  void on_depth(const lcm::ReceiveBuffer*, const std::string&, const depth_image_t* m) {
+    frames.push_back(*m);
+  }
+  void on_heartbeat(const lcm::ReceiveBuffer*, const std::string&, const heartbeat_t* m) {
+    if (m->process != "tofguard-camera") return;
+    heartbeat = *m;
+    ++heartbeats;
+  }
+  // The simulated arm's truth at 100 Hz (what tofguard-joints-sim sends).
+  void pump() {
+    if (monotonic_us() - last_truth_us >= 10000) {
+      last_truth_us = monotonic_us();
+      joint_state_t s;
+      s.utime = wall_utime();
+      s.robot_id = "friend-sim";
+      s.num_joints = 7;
+      s.name = {"a1", "a2", "a3", "a4", "a5", "a6", "a7"};
+      s.position = {-0.3, 0.7, 0.0, 1.1, 0.0, 0.6, 0.0};
+      s.velocity.assign(7, 0.0);
+      safety.publish("SIM_TRUE_JOINT_STATE", &s);
+    }
+    safety.handleTimeout(1);
+    images.handleTimeout(1);
+  }
+  void fault(int32_t kind, double duration_s, const Eigen::Vector3d& position = Eigen::Vector3d::Zero()) {
+    sim_camera_fault_t f{};
+    f.utime = wall_utime();
+    f.camera_id = config.camera.id;
+    f.kind = kind;
+    f.duration_s = duration_s;
+    for (int i = 0; i < 3; ++i) {
+      f.drift_translation_m_per_s[i] = f.drift_rotation_rad_per_s[i] = 0;
+      f.object_size_m[i] = 0.3;
+      f.object_position_m[i] = position[i];
+      f.object_velocity_m_per_s[i] = 0;
+    }
+    safety.publish("SIM_CAMERA_FAULT", &f);
+  }
+};
+
+// Median valid depth of the 9x9 pixels around the principal point, mm.
+int centre_depth_mm(const depth_image_t& f) {
+  std::vector<int16_t> d;
+  for (int v = static_cast<int>(f.cy) - 4; v <= static_cast<int>(f.cy) + 4; ++v)
+    for (int u = static_cast<int>(f.cx) - 4; u <= static_cast<int>(f.cx) + 4; ++u)
+      if (f.depth_mm[v * f.width + u] > 0) d.push_back(f.depth_mm[v * f.width + u]);
+  if (d.size() < 20) return 0;
+  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+  return d[d.size() / 2];
+}
+
+TEST(SimCameraProcess, PublishesFaultsAndRendersIntruders) {
+  Rig rig;
+  Subprocess camera("sim-camera",
+                    {bin_dir() + "/tofguard-camera", "--config", source_dir() + "/config/sim.yaml"});
+  ASSERT_TRUE(wait_until([&] { return rig.frames.size() >= 10; }, std::chrono::seconds(30),
+                         [&] { rig.pump(); }))
+      << camera.stderr_text();
+  for (size_t i = 1; i < rig.frames.size(); ++i) {
+    EXPECT_EQ(rig.frames[i].seq, rig.frames[i - 1].seq + 1) << "a frame slot was missed";
+    EXPECT_GT(rig.frames[i].utime, rig.frames[i - 1].utime);
+  }
+  const depth_image_t& f = rig.frames.back();
+  EXPECT_EQ(f.camera_id, "tof-mast");
+  EXPECT_EQ(f.width, 176);
+  EXPECT_EQ(f.height, 144);
+  EXPECT_TRUE(f.calibrated);
+  EXPECT_EQ(f.num_pixels, 176 * 144);
+  EXPECT_EQ(f.num_amplitude, 176 * 144);
+  const auto valid = std::count_if(f.depth_mm.begin(), f.depth_mm.end(), [](int16_t d) { return d > 0; });
+  EXPECT_GT(valid, 176 * 144 / 20) << "the arm and the environment are in view";
+  EXPECT_LT(std::abs(wall_utime() - f.utime), 500000);
+
+  // A 0.3 m box 0.6 m in front of the lens (its centre 0.75 m away).
+  const Eigen::Vector3d optical_axis = rig.config.camera.pose.rotation * Eigen::Vector3d::UnitZ();
+  rig.fault(sim_camera_fault_t::INTRUDING_OBJECT, 30.0,
+            rig.config.camera.pose.translation_m + 0.75 * optical_axis);
+  ASSERT_TRUE(wait_until(
+      [&] {
+        const int d = centre_depth_mm(rig.frames.back());
+        return d > 450 && d < 750;
+      },
+      std::chrono::seconds(10), [&] { rig.pump(); }))
+      << "centre depth " << centre_depth_mm(rig.frames.back()) << " mm\n" << camera.stderr_text();
+
+  // Stall: no frames for 1 s, each lost slot counted as dropped.
+  ASSERT_TRUE(wait_until([&] { return rig.heartbeats > 0; }, std::chrono::seconds(5), [&] { rig.pump(); }));
+  const int64_t dropped_before = rig.heartbeat.frames_dropped;
+  rig.fault(sim_camera_fault_t::STALL, 1.0);
+  ASSERT_TRUE(wait_until([&] { return rig.heartbeat.frames_dropped >= dropped_before + 10; },
+                         std::chrono::seconds(5), [&] { rig.pump(); }))
+      << camera.stderr_text();
+  const size_t frames_in_stall = rig.frames.size();
+  const int64_t seq_before = rig.frames.back().seq;
+  ASSERT_TRUE(wait_until([&] { return rig.frames.size() >= frames_in_stall + 3; },
+                         std::chrono::seconds(5), [&] { rig.pump(); }));
+  EXPECT_GE(rig.frames.back().seq - seq_before, 10) << "lost slots leave a gap in seq";
+
+  camera.signal(SIGTERM);
+  EXPECT_EQ(camera.wait(std::chrono::seconds(5)), 0) << camera.stderr_text();
+}
+
+}  // namespace
+}  // namespace tofguard::test
