@@ -219,6 +219,8 @@ RiskConfig read_risk(YamlMap map) {
     r.min_link_pixels = static_cast<int>(joint.integer("min_link_pixels", 1, 1000000));
     r.link_mismatch_fraction = joint.number("link_mismatch_fraction", 0.01, 1);
     r.joint_link_missing_fraction = joint.number("link_missing_fraction", 0.01, 1);
+    r.joint_link_affected_fraction = joint.number("link_affected_fraction", 0.001, 1);
+    r.joint_link_affected_min_pixels = static_cast<int>(joint.integer("link_affected_min_pixels", 1, 100000));
     joint.finish();
   }
   {

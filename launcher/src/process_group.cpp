@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -88,6 +89,7 @@ void ProcessGroup::start(Managed& p, int64_t) {
   sigaddset(&stop_signals, SIGINT);
   sigaddset(&stop_signals, SIGTERM);
   sigprocmask(SIG_BLOCK, &stop_signals, &old_mask);
+  const pid_t parent = getpid();
   const pid_t pid = fork();
   if (pid != 0) sigprocmask(SIG_SETMASK, &old_mask, nullptr);
   if (pid < 0) {
@@ -97,6 +99,12 @@ void ProcessGroup::start(Managed& p, int64_t) {
   }
   if (pid == 0) {
     setpgid(0, 0);  // its own group: a stop reaches its children too
+    // If tofguard-launch itself dies (even by SIGKILL), its processes stop
+    // too, so that a restarted launcher (systemd) never runs a second chain
+    // beside an orphaned one. The arm then stops on the controller's
+    // SAFETY_STATUS deadline.
+    prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (getppid() != parent) _exit(126);  // the launcher died before prctl
     signal(SIGINT, SIG_DFL);
     signal(SIGTERM, SIG_DFL);
     sigprocmask(SIG_SETMASK, &old_mask, nullptr);

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include "frame_classifier.hpp"
 
 #include <cmath>
@@ -94,14 +95,29 @@ FrameFinding classify_frame(const discrepancy_t& f, const RobotTree& robot, cons
     for (const LinkView& link : visible) mismatching_links += link.mismatch >= config.link_mismatch_fraction ? 1 : 0;
     const double robot_fraction =
         visible.empty() ? 1.0 : static_cast<double>(mismatching_links) / static_cast<double>(visible.size());
-    if (environment_mismatch >= config.calibration_environment_mismatch_fraction &&
-        robot_fraction >= config.calibration_robot_link_fraction) {
+    // A link fixed to the robot's root (its base) cannot be moved by any
+    // joint: when it mismatches together with most of the arm, the camera
+    // pose is off. (A camera moved by a few centimetres shifts the near arm
+    // far more than a distant floor, which may stay within tolerance.)
+    std::string fixed_link_mismatching;
+    for (const LinkView& link : visible) {
+      if (link.mismatch >= config.link_mismatch_fraction && robot.has_link(link.name) &&
+          robot.nearest_movable_joint_above(link.name).empty()) {
+        fixed_link_mismatching = link.name;
+      }
+    }
+    if (robot_fraction >= config.calibration_robot_link_fraction &&
+        (environment_mismatch >= config.calibration_environment_mismatch_fraction ||
+         !fixed_link_mismatching.empty())) {
       return finding(risk_t::CAUSE_CALIBRATION_ERROR, "", environment_mismatch,
                      config.calibration_environment_mismatch_fraction,
                      "camera pose or calibration off (environment mismatch fraction): " +
                          fixed(100.0 * environment_mismatch, 1) + " % of the environment and " +
                          std::to_string(mismatching_links) + "/" + std::to_string(visible.size()) +
-                         " visible links mismatch; median I_dis environment " +
+                         " visible links mismatch" +
+                         (fixed_link_mismatching.empty() ? std::string()
+                                                         : ", the fixed " + fixed_link_mismatching + " among them") +
+                         "; median I_dis environment " +
                          fixed(f.environment_median_dis_mm, 0) + " mm, arm " + fixed(f.robot_median_dis_mm, 0) +
                          " mm");
     }
@@ -115,24 +131,39 @@ FrameFinding classify_frame(const discrepancy_t& f, const RobotTree& robot, cons
     int64_t compared_pixels = 0;
     std::string unknown;
     for (const LinkView& link : visible) {
+      // Only a displaced arm is missing where the model has it: an object
+      // can hide a link (nearer) but never make the camera see farther.
       if (link.missing < config.joint_link_missing_fraction) continue;
       if (!robot.has_link(link.name)) {
         unknown = link.name;
         continue;
       }
       missing_links.push_back(link.name);
-      missing_pixels += static_cast<int64_t>(std::lround(link.missing * link.compared));
+      missing_pixels += static_cast<int64_t>(std::lround(link.mismatch * link.compared));
       compared_pixels += link.compared;
     }
     if (!missing_links.empty()) {
-      const std::string common = robot.lowest_common_ancestor(missing_links);
+      std::string common = robot.lowest_common_ancestor(missing_links);
+      // The joint's own link moves least (it turns about the joint), so it
+      // may mismatch only slightly while its distal links are missing: blame
+      // the most proximal link on the way down to `common` that is visibly
+      // affected, when all above it match.
+      for (const std::string& link : robot.chain_from_root(common)) {
+        const auto view = std::find_if(visible.begin(), visible.end(),
+                                       [&](const LinkView& v) { return v.name == link; });
+        if (view != visible.end() && view->mismatch >= config.joint_link_affected_fraction &&
+            view->mismatch * view->compared >= config.joint_link_affected_min_pixels) {
+          common = link;
+          break;
+        }
+      }
       const std::string joint = robot.nearest_movable_joint_above(common);
       if (!joint.empty()) {
         const double score = static_cast<double>(missing_pixels) / static_cast<double>(compared_pixels);
         std::string links;
         for (const std::string& l : missing_links) links += (links.empty() ? "" : ", ") + l;
         return finding(risk_t::CAUSE_JOINT_ERROR, joint, score, config.joint_link_missing_fraction,
-                       "joint " + joint + " reads other than seen (missing fraction): the arm is missing at " +
+                       "joint " + joint + " reads other than seen (mismatch fraction): the arm mismatches at " +
                            fixed(100.0 * score, 1) + " % of the modelled pixels of " + links +
                            ", all distal to " + joint);
       }
@@ -140,6 +171,42 @@ FrameFinding classify_frame(const discrepancy_t& f, const RobotTree& robot, cons
     if (!unknown.empty()) {
       return finding(risk_t::CAUSE_UNCLASSIFIED, unknown, 1, 0,
                      "link '" + unknown + "' of the discrepancy is not in the robot's URDF");
+    }
+  }
+
+  // JOINT_ERROR, second chance: no link is missing enough, yet the arm's
+  // own links mismatch (a link moved towards the camera is seen nearer, and
+  // the surfaces beside it look like an object near the arm). When every
+  // visibly affected link hangs below one moving joint and the links above
+  // it match, that joint is the suspect. (An object that hides part of a
+  // link lands here too: either way the arm stops.)
+  if (f.near_arm_area_m2 >= config.unknown_object_min_area_m2) {
+    std::vector<std::string> affected;
+    int64_t mismatching = 0;
+    int64_t compared = 0;
+    for (const LinkView& link : visible) {
+      if (!robot.has_link(link.name)) continue;
+      if (link.mismatch < config.joint_link_affected_fraction ||
+          link.mismatch * link.compared < config.joint_link_affected_min_pixels) {
+        continue;
+      }
+      affected.push_back(link.name);
+      mismatching += static_cast<int64_t>(std::lround(link.mismatch * link.compared));
+      compared += link.compared;
+    }
+    if (!affected.empty()) {
+      const std::string common = robot.lowest_common_ancestor(affected);
+      const std::string joint = robot.nearest_movable_joint_above(common);
+      // The affected links must be the common link and links below it.
+      if (!joint.empty() && std::find(affected.begin(), affected.end(), common) != affected.end()) {
+        const double score = static_cast<double>(mismatching) / static_cast<double>(compared);
+        std::string links;
+        for (const std::string& l : affected) links += (links.empty() ? "" : ", ") + l;
+        return finding(risk_t::CAUSE_JOINT_ERROR, joint, score, config.joint_link_affected_fraction,
+                       "joint " + joint + " reads other than seen (mismatch fraction): " + links +
+                           " mismatch at " + fixed(100.0 * score, 1) + " % and surfaces beside them are " +
+                           "unexplained; the links above " + joint + " match");
+      }
     }
   }
 

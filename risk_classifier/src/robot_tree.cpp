@@ -88,3 +88,13 @@ std::string RobotTree::child_link(const std::string& joint) const {
 }
 
 }  // namespace tofguard::risk
+
+namespace tofguard::risk {
+
+std::vector<std::string> RobotTree::chain_from_root(const std::string& link) const {
+  std::vector<std::string> chain = chain_to_root(link);
+  std::reverse(chain.begin(), chain.end());
+  return chain;
+}
+
+}  // namespace tofguard::risk

@@ -29,6 +29,8 @@ class RobotTree {
   // moves, else the first moving joint further up; "" when there is none
   // (the link is fixed to the root).
   std::string nearest_movable_joint_above(const std::string& link) const;
+  // The links from the root down to `link` (root first, `link` last).
+  std::vector<std::string> chain_from_root(const std::string& link) const;
   // The link a joint moves (its child link); "" for an unknown joint.
   std::string child_link(const std::string& joint) const;
 

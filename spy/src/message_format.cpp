@@ -9,6 +9,7 @@
 
 #include "tofguard/camera_pose_t.hpp"
 #include "tofguard/depth_image_t.hpp"
+#include "tofguard/discrepancy_t.hpp"
 #include "tofguard/heartbeat_t.hpp"
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/link_labels_t.hpp"
@@ -96,6 +97,24 @@ std::string format(const power_relay_t& m) {
   return "seq=" + std::to_string(m.seq) + " power_enabled=" + yes_no(m.power_enabled) + " | " + m.reason;
 }
 
+std::string format(const discrepancy_t& m) {
+  std::ostringstream s;
+  s << "utime=" << m.utime << " seq=" << m.seq << " usable=" << yes_no(m.usable);
+  if (!m.usable) return s.str() + " (" + m.unusable_reason + ")";
+  s << std::fixed << std::setprecision(1) << " match=" << m.num_match << " robot_missing=" << m.num_robot_missing
+    << " occluded=" << m.num_occluded << " unexpected=" << m.num_unexpected_surface
+    << " env_missing=" << m.num_environment_missing << " invalid=" << m.num_invalid
+    << " median_abs_dis_mm=" << m.median_abs_dis_mm << " robot_median_mm=" << m.robot_median_dis_mm
+    << " env_median_mm=" << m.environment_median_dis_mm << " blob_px=" << m.largest_blob_pixels
+    << " near_arm_px=" << m.near_arm_pixels << " |";
+  for (int i = 0; i < m.num_links; ++i) {
+    if (m.link_compared[i] == 0) continue;
+    s << " " << m.link_name[i] << "=" << m.link_match[i] << "/" << m.link_compared[i] << "(far "
+      << m.link_farther[i] << ", near " << m.link_nearer[i] << ")";
+  }
+  return s.str();
+}
+
 std::string format(const sim_joint_fault_t& m) {
   std::ostringstream s;
   s << "joint=" << m.joint << " offset=" << m.offset;
@@ -123,6 +142,7 @@ const std::map<int64_t, std::pair<std::string, Formatter>>& formatters() {
       entry<depth_image_t>(),   entry<joint_state_t>(),     entry<camera_pose_t>(), entry<risk_t>(),
       entry<safety_status_t>(), entry<heartbeat_t>(),       entry<link_labels_t>(), entry<reset_request_t>(),
       entry<reset_reply_t>(),   entry<power_relay_t>(),     entry<sim_joint_fault_t>(),
+      entry<discrepancy_t>(),
   };
   return table;
 }

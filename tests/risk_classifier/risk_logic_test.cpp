@@ -78,7 +78,7 @@ TEST(FrameClassifier, ShiftedLinkIsAJointErrorOfTheJointAboveIt) {
   EXPECT_EQ(f.cause, risk_t::CAUSE_JOINT_ERROR) << f.detail;
   EXPECT_EQ(f.suspect, "a2");
   EXPECT_NEAR(f.score, 16.0 / 39.0, 1e-9);
-  EXPECT_DOUBLE_EQ(f.threshold, 0.2);
+  EXPECT_DOUBLE_EQ(f.threshold, sim_config().risk.joint_link_missing_fraction);
   EXPECT_NE(f.detail.find("link2"), std::string::npos) << f.detail;
 }
 
@@ -88,6 +88,34 @@ TEST(FrameClassifier, MismatchOnSeveralLinksBlamesTheJointAboveAllOfThem) {
   const FrameFinding f = classify(summary_of(scene));
   EXPECT_EQ(f.cause, risk_t::CAUSE_JOINT_ERROR) << f.detail;
   EXPECT_EQ(f.suspect, "a1");
+}
+
+TEST(FrameClassifier, WholeArmShiftedWithTheFixedBaseIsACalibrationError) {
+  // The camera a few centimetres off: the near arm (base_link included,
+  // which no joint can move) shifts 8 px, the distant floor stays within
+  // tolerance.
+  std::vector<Box> scene = default_arm();
+  for (Box& b : scene) {
+    b.u0 += 8;
+    b.u1 += 8;
+  }
+  const FrameFinding f = classify(summary_of(scene));
+  EXPECT_EQ(f.cause, risk_t::CAUSE_CALIBRATION_ERROR) << f.detail;
+  EXPECT_NE(f.detail.find("the fixed base_link among them"), std::string::npos) << f.detail;
+}
+
+TEST(FrameClassifier, LinkSeenNearerWithSurfacesBesideItIsAJointErrorNotAnObject) {
+  // link2 moved towards the camera (1.3 m instead of 1.5 m): it is seen
+  // nearer, never missing, and its end shows up beside the model.
+  std::vector<Box> scene = default_arm();
+  scene[2].depth_mm = 1300;
+  scene.push_back({100, 60, 110, 80, 1300, 0});
+  const discrepancy_t d = summary_of(scene);
+  ASSERT_GE(d.near_arm_area_m2, sim_config().risk.unknown_object_min_area_m2);
+  const FrameFinding f = classify(d);
+  EXPECT_EQ(f.cause, risk_t::CAUSE_JOINT_ERROR) << f.detail;
+  EXPECT_EQ(f.suspect, "a2");
+  EXPECT_NE(f.detail.find("link2 mismatch"), std::string::npos) << f.detail;
 }
 
 TEST(FrameClassifier, ObjectInFrontOfTheArmIsAnUnknownObject) {

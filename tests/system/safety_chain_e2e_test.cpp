@@ -17,7 +17,10 @@
 #include <memory>
 #include <thread>
 
+#include "kinematics.hpp"
+#include "scene_model.hpp"
 #include "test_support.hpp"
+#include "tofguard/joint_state_t.hpp"
 #include "tofguard/camera_pose_t.hpp"
 #include "tofguard/clock.hpp"
 #include "tofguard/config.hpp"
@@ -42,6 +45,7 @@ class Chain {
     safety_.subscribe(config_.channels.status, &Chain::on_status, this);
     safety_.subscribe(config_.channels.risk, &Chain::on_risk, this);
     images_.subscribe(config_.channels.depth, &Chain::on_depth, this);
+    safety_.subscribe(config_.channels.joint_state, &Chain::on_joints, this);
     safety_.getFileno();
     images_.getFileno();
     for (const char* name : {"tofguard-intervene", "tofguard-risk", "tofguard-discrepancy", "tofguard-renderer",
@@ -99,6 +103,7 @@ class Chain {
   // fills the stop's status.
   int64_t stop_latency_after_frame(const std::function<void()>& inject, safety_status_t* stop) {
     const int64_t injected_utime = wall_utime();
+    risk_log_.clear();
     inject();
     first_affected_arrival_us_ = -1;
     affected_after_utime_ = injected_utime;
@@ -106,6 +111,7 @@ class Chain {
     EXPECT_TRUE(wait([&] { return stopped_at_us_ > 0; }, std::chrono::seconds(3)))
         << "no stop; last risk " << describe_last_risk();
     *stop = stop_status_;
+    std::cout << "risk verdicts after the fault:\n" << risk_log_ << std::flush;
     if (first_affected_arrival_us_ < 0) return stopped_at_us_ - injected_utime;  // should not happen
     return stopped_at_us_ - first_affected_arrival_us_;
   }
@@ -114,6 +120,7 @@ class Chain {
   // permission was withdrawn.
   int64_t stop_latency_since(int64_t since_us, safety_status_t* stop) {
     stopped_at_us_ = -1;
+    risk_log_.clear();
     EXPECT_TRUE(wait([&] { return stopped_at_us_ > 0; }, std::chrono::seconds(3)))
         << "no stop; last risk " << describe_last_risk();
     *stop = stop_status_;
@@ -127,11 +134,12 @@ class Chain {
     f.kind = kind;
     f.duration_s = duration_s;
     if (kind == sim_camera_fault_t::INTRUDING_OBJECT) {
-      // A 12 cm box (a hand) 10 cm in front of the arm's elbow region,
-      // standing still.
-      const Eigen::Vector3d at = object_near_arm_m_;
+      // A 10 cm box (a hand) standing still 15 cm beside the forearm's
+      // joint (link5's origin), to the image's left (the arm stands in the
+      // image's right half): within 0.2 m of the arm, not in front of it.
+      const Eigen::Vector3d at = object_beside_forearm_m(-0.15);
       for (int i = 0; i < 3; ++i) {
-        f.object_size_m[i] = 0.12;
+        f.object_size_m[i] = 0.10;
         f.object_position_m[i] = at[i];
       }
     }
@@ -167,7 +175,19 @@ class Chain {
            last_risk_.suspect + "' seq " + std::to_string(last_risk_.seq) + " | " + last_risk_.detail;
   }
   const Config& config() const { return config_; }
-  void set_object_near_arm(const Eigen::Vector3d& at) { object_near_arm_m_ = at; }
+  // A point `distance_m` from link5's origin along the camera's x axis
+  // (image right), at the latest joint state (world frame, metres).
+  Eigen::Vector3d object_beside_forearm_m(double distance_m) {
+    const renderer::SceneModel scene = renderer::load_scene(config_.robot.urdf_path, {}, renderer::SceneOptions{});
+    const renderer::LinkPoses poses = renderer::forward_kinematics(scene, latest_joints_);
+    EXPECT_TRUE(poses.usable) << poses.unusable_reason;
+    const auto names = scene.link_names();
+    const size_t link5 = std::find(names.begin(), names.end(), "link5") - names.begin();
+    EXPECT_LT(link5, names.size());
+    const Eigen::Vector3d forearm = poses.world_from_link.at(link5).translation();
+    const Eigen::Vector3d image_right = config_.camera.pose.rotation * Eigen::Vector3d::UnitX();
+    return forearm + distance_m * image_right;
+  }
 
  private:
   void on_status(const lcm::ReceiveBuffer*, const std::string&, const safety_status_t* s) {
@@ -182,8 +202,15 @@ class Chain {
   }
   void on_risk(const lcm::ReceiveBuffer*, const std::string&, const risk_t* r) {
     last_risk_ = *r;
+    if (r->seq >= 0 && std::count(risk_log_.begin(), risk_log_.end(), '\n') < 12) {
+      risk_log_ += "  seq " + std::to_string(r->seq) + " " + risk_level_name(r->level) + " " +
+                   risk_cause_name(r->cause) + " '" + r->suspect + "': " + r->detail + "\n";
+    }
     if (r->seq < 0) return;
     safe_streak_ = r->level == risk_t::SAFE ? safe_streak_ + 1 : 0;
+  }
+  void on_joints(const lcm::ReceiveBuffer*, const std::string&, const joint_state_t* j) {
+    for (int i = 0; i < j->num_joints; ++i) latest_joints_[j->name[i]] = j->position[i];
   }
   void on_depth(const lcm::ReceiveBuffer*, const std::string&, const depth_image_t* d) {
     last_depth_arrival_us_ = monotonic_us();
@@ -209,7 +236,8 @@ class Chain {
   int64_t last_depth_arrival_us_ = 0;
   std::optional<camera_pose_t> camera_pose_;
   int64_t last_pose_us_ = 0;
-  Eigen::Vector3d object_near_arm_m_{0.25, -0.35, 1.05};
+  renderer::JointPositions latest_joints_;
+  std::string risk_log_;
 };
 
 #define EXPECT_STOP(latency_us, status, expected_cause)                                            \

@@ -251,6 +251,11 @@ struct RiskConfig {
   int min_link_pixels = 0;
   double link_mismatch_fraction = 0;
   double joint_link_missing_fraction = 0;
+  // A link on the way down to the missing links counts as moved (and the
+  // joint above it is blamed) when this fraction of it, and at least this
+  // many pixels, mismatch.
+  double joint_link_affected_fraction = 0;
+  int joint_link_affected_min_pixels = 0;
   int min_environment_pixels = 0;
   double calibration_environment_mismatch_fraction = 0;
   double calibration_robot_link_fraction = 0;
