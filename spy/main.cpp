@@ -5,6 +5,8 @@
 // Listens on both the safety URL and the image URL; decodes by fingerprint.
 #include <poll.h>
 
+#include <deque>
+#include <fstream>
 #include <iostream>
 #include <regex>
 
@@ -17,8 +19,22 @@
 namespace tofguard::spy {
 namespace {
 
+// The last `count` lines of a text file ("" when it cannot be read).
+std::string last_lines(const std::string& path, size_t count) {
+  std::ifstream in(path);
+  std::deque<std::string> lines;
+  for (std::string line; std::getline(in, line);) {
+    lines.push_back(line);
+    if (lines.size() > count) lines.pop_front();
+  }
+  std::string text;
+  for (const auto& line : lines) text += line + "\n";
+  return text;
+}
+
 struct Receiver {
   bool lines = false;
+  std::string footer_file;
   std::vector<std::regex> filters;
   StatusBoard board;
   void on_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
@@ -43,6 +59,8 @@ int run(const Config& config, const std::vector<std::string>& args) {
       receiver.lines = true;
     } else if (args[i] == "--board") {
       receiver.lines = false;
+    } else if (args[i] == "--footer" && i + 1 < args.size()) {
+      receiver.footer_file = args[++i];
     } else if (args[i] == "--channel" && i + 1 < args.size()) {
       try {
         receiver.filters.emplace_back(args[++i]);
@@ -80,7 +98,9 @@ int run(const Config& config, const std::vector<std::string>& args) {
       next_draw_us = monotonic_us() + 250'000;
       // Clear the screen and draw from the top.
       std::cout << "\033[H\033[2J" << "tofguard-spy  " << config.lcm.url << "  (Ctrl-C to quit)\n\n"
-                << receiver.board.render(monotonic_us(), wall_utime()) << std::flush;
+                << receiver.board.render(monotonic_us(), wall_utime());
+      if (!receiver.footer_file.empty()) std::cout << "\n" << last_lines(receiver.footer_file, 6);
+      std::cout << std::flush;
     }
   }
   return 0;
@@ -94,7 +114,8 @@ int main(int argc, char** argv) {
       "tofguard-spy",
       "Watches the live tofguard channels: a refreshing status board (default: permission to\n"
       "move and why, latest risk, heartbeats with counters, channel rates, latency from the\n"
-      "camera frame), or --lines: one decoded line per message, filtered by --channel REGEX.",
+      "camera frame), or --lines: one decoded line per message, filtered by --channel REGEX.\n"
+      "--footer FILE shows the last lines of FILE under the board (e.g. a demo's narration).",
       /*config_required=*/false};
   return tofguard::run_process(argc, argv, info, tofguard::spy::run);
 }
