@@ -1,4 +1,5 @@
 // tofguard-discrepancy: wires config + LCM + the library in src/.
+#include <exception>
 #include <iostream>
 
 #include "discrepancy_process.hpp"
@@ -6,8 +7,12 @@
 int main(int argc, char** argv) {
   const tofguard::ProcessInfo info = tofguard::discrepancy::process_info();
   return tofguard::run_process(argc, argv, info,
-                               [&](const tofguard::Config&, const std::vector<std::string>&) {
-                                 std::cerr << info.name << ": not implemented yet (issue 5)\n";
-                                 return 1;
+                               [&](const tofguard::Config& config, const std::vector<std::string>&) {
+                                 try {
+                                   return tofguard::discrepancy::run_discrepancy(config);
+                                 } catch (const std::exception& e) {
+                                   std::cerr << info.name << ": " << e.what() << "\n";
+                                   return 1;
+                                 }
                                });
 }

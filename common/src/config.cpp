@@ -157,6 +157,82 @@ void read_channels(YamlMap map, ChannelNames* c) {
   map.finish();
 }
 
+// ---- Safety chain: discrepancy and risk (docs/safety-chain.md) ----
+
+DiscrepancyConfig read_discrepancy(YamlMap map) {
+  DiscrepancyConfig d;
+  {
+    YamlMap noise = map.map("noise");
+    d.noise_sigma_at_0m_mm = noise.number("sigma_at_0m_mm", 0, 1000);
+    d.noise_sigma_per_m2_mm = noise.number("sigma_per_m2_mm", 0, 1000);
+    noise.finish();
+  }
+  d.tolerance_sigmas = map.number("tolerance_sigmas", 0.5, 100);
+  d.model_tolerance_mm = map.number("model_tolerance_mm", 0, 1000);
+  d.pair_timeout_ms = map.number("pair_timeout_ms", 1, 10000);
+  d.max_pending_frames = static_cast<int>(map.integer("max_pending_frames", 1, 1000));
+  d.opening_radius_px = static_cast<int>(map.integer("opening_radius_px", 0, 10));
+  d.near_arm_m = map.number("near_arm_m", 0, 10);
+  d.max_depth_mm = map.number("max_depth_mm", 1, 32767);
+  {
+    YamlMap colour = map.map("colour_image");
+    d.colour_image_enabled = colour.boolean("enabled");
+    d.colour_image_channel = colour.string("channel");
+    d.colour_image_full_scale_mm = colour.number("full_scale_mm", 1, 32767);
+    colour.finish();
+  }
+  map.finish();
+  return d;
+}
+
+RiskConfig read_risk(YamlMap map) {
+  RiskConfig r;
+  r.check_period_ms = map.number("check_period_ms", 1, 1000);
+  r.debounce_frames = static_cast<int>(map.integer("debounce_frames", 1, 1000));
+  r.sensor_debounce_frames = static_cast<int>(map.integer("sensor_debounce_frames", 1, 1000));
+  {
+    YamlMap deadlines = map.map("deadlines_ms");
+    r.depth_deadline_ms = deadlines.number("depth", 1, 60000);
+    r.discrepancy_deadline_ms = deadlines.number("discrepancy", 1, 60000);
+    r.joint_state_deadline_ms = deadlines.number("joint_state", 1, 60000);
+    r.heartbeat_deadline_ms = deadlines.number("heartbeat", 1, 60000);
+    deadlines.finish();
+  }
+  {
+    YamlMap pose = map.map("camera_pose");
+    r.camera_pose_required = pose.boolean("required");
+    r.camera_pose_deadline_ms = pose.number("deadline_ms", 1, 600000);
+    pose.finish();
+  }
+  r.required_heartbeats = map.strings("required_heartbeats");
+  {
+    YamlMap sensor = map.map("sensor");
+    r.max_invalid_fraction = sensor.number("max_invalid_fraction", 0, 1);
+    r.calibrated_required = sensor.boolean("calibrated_required");
+    r.frozen_repeat_frames = static_cast<int>(sensor.integer("frozen_repeat_frames", 1, 1000));
+    r.moving_joint_speed_rad_s = sensor.number("moving_joint_speed_rad_s", 0, 100);
+    sensor.finish();
+  }
+  {
+    YamlMap joint = map.map("joint_error");
+    r.min_link_pixels = static_cast<int>(joint.integer("min_link_pixels", 1, 1000000));
+    r.link_mismatch_fraction = joint.number("link_mismatch_fraction", 0.01, 1);
+    r.joint_link_missing_fraction = joint.number("link_missing_fraction", 0.01, 1);
+    joint.finish();
+  }
+  {
+    YamlMap calibration = map.map("calibration_error");
+    r.min_environment_pixels = static_cast<int>(calibration.integer("min_environment_pixels", 1, 100000000));
+    r.calibration_environment_mismatch_fraction = calibration.number("environment_mismatch_fraction", 0.01, 1);
+    r.calibration_robot_link_fraction = calibration.number("robot_link_fraction", 0, 1);
+    calibration.finish();
+  }
+  r.unknown_object_min_area_m2 = map.number("unknown_object_min_area_m2", 1e-6, 100);
+  r.unclassified_blob_area_m2 = map.number("unclassified_blob_area_m2", 1e-6, 100);
+  map.finish();
+  return r;
+}
+
 JointsSimConfig read_joints_sim(YamlMap map) {
   JointsSimConfig sim;
   sim.rate_hz = map.number("rate_hz", 1, 1000);
@@ -205,6 +281,33 @@ InterventionConfig read_intervention(YamlMap map) {
   }
   map.finish();
   return in;
+}
+
+LaunchConfig read_launch(YamlMap map) {
+  LaunchConfig launch;
+  launch.present = true;
+  for (auto& p : map.maps("processes")) {
+    LaunchedProcess process;
+    process.name = p.string("name");
+    process.command = p.strings("command");
+    if (process.command.empty()) p.fail("command", "a non-empty list: program and arguments");
+    process.required = p.boolean("required");
+    p.finish();
+    launch.processes.push_back(process);
+  }
+  launch.restart_backoff_initial_ms = map.number("restart_backoff_initial_ms", 1, 60000);
+  launch.restart_backoff_max_ms = map.number("restart_backoff_max_ms", 1, 600000);
+  launch.max_restarts = static_cast<int>(map.integer("max_restarts", 0, 1000));
+  launch.restart_window_s = map.number("restart_window_s", 1, 86400);
+  launch.log_dir = map.path("log_dir");
+  YamlMap recorder = map.map("recorder");
+  launch.recorder.enabled = recorder.boolean("enabled");
+  launch.recorder.max_file_mb = recorder.number("max_file_mb", 0.1, 100000);
+  launch.recorder.max_total_mb = recorder.number("max_total_mb", 0.1, 10000000);
+  launch.recorder.max_age_h = recorder.number("max_age_h", 0.01, 100000);
+  recorder.finish();
+  map.finish();
+  return launch;
 }
 
 }  // namespace
@@ -304,8 +407,12 @@ Config load_config(const std::string& path, const char* lcm_default_url_env) {
     renderer.finish();
   }
 
+  // Safety chain sections (required: no silent defaults for thresholds).
+  config.discrepancy = read_discrepancy(root.map("discrepancy"));
+  config.risk = read_risk(root.map("risk"));
   config.joints_sim = read_joints_sim(root.map("joints_sim"));
   config.intervention = read_intervention(root.map("intervention"));
+  if (auto launch = root.optional_map("launch")) config.launch = read_launch(*launch);
 
   root.finish();
   return config;

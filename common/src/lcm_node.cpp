@@ -43,7 +43,12 @@ LcmNode::LcmNode(const Config& config, const std::string& process_name, double h
       safety_(open_lcm(config.lcm.url)),
       images_(config.lcm.image_url == config.lcm.url ? nullptr : open_lcm(config.lcm.image_url)),
       errors_(process_name),
-      heartbeat_(safety_.get(), config.channels.heartbeat, process_name, heartbeat_rate_hz) {}
+      heartbeat_(safety_.get(), config.channels.heartbeat, process_name, heartbeat_rate_hz) {
+  // LCM 1.3 joins the multicast groups lazily (first getFileno()/handle()):
+  // join now, so nothing sent after construction is missed.
+  safety_->getFileno();
+  if (images_) images_->getFileno();
+}
 
 LcmNode::~LcmNode() = default;
 

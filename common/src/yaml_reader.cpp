@@ -190,6 +190,8 @@ std::string YamlMap::existing_path(const std::string& key, bool directory) {
   return resolved;
 }
 
+std::string YamlMap::path(const std::string& key) { return resolve(string(key)); }
+
 std::vector<std::string> YamlMap::existing_paths(const std::string& key, bool directory) {
   std::vector<std::string> result;
   for (const auto& given : strings(key)) {
@@ -238,8 +240,15 @@ std::vector<std::string> YamlMap::keys() {
 }
 
 void YamlMap::finish() const {
+  std::set<std::string> seen;
   for (const auto& entry : node_) {
     const std::string key = entry.first.Scalar();
+    // yaml-cpp keeps both entries of a duplicated key and lookups see only
+    // the first: a silently ignored setting, so it is an error.
+    if (!seen.insert(key).second) {
+      throw ConfigError(location(file_, entry.first) + ": " + key_path(key) +
+                        ": duplicate key, expected each key once");
+    }
     if (read_keys_.count(key) == 0) {
       std::string known;
       for (const auto& k : read_keys_) known += (known.empty() ? "" : ", ") + k;

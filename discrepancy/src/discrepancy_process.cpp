@@ -1,10 +1,117 @@
 #include "discrepancy_process.hpp"
 
+#include <algorithm>
+
+#include "discrepancy_image.hpp"
+#include "frame_pairer.hpp"
+#include "tofguard/clock.hpp"
+#include "tofguard/lcm_node.hpp"
+#include "tofguard/wire_checks.hpp"
+
 namespace tofguard::discrepancy {
 
 ProcessInfo process_info() {
   return {"tofguard-discrepancy",
-          "Pairs camera and rendered frames and computes I_dis = I_gen - I_ToF: TOF_DEPTH, TOF_RENDERED, TOF_LABELS -> SAFETY_DISCREPANCY."};
+          "Pairs camera and rendered frames by seq and computes I_dis = I_gen - I_ToF: TOF_DEPTH, "
+          "TOF_RENDERED, TOF_LABELS -> SAFETY_DISCREPANCY (discrepancy_t), and optionally the colour "
+          "image (discrepancy_image_t)."};
+}
+
+int run_discrepancy(const Config& config) {
+  install_stop_signal_handlers();
+  LcmNode node(config, process_info().name);
+  const DiscrepancyConfig& dc = config.discrepancy;
+  const Parameters parameters = parameters_from(dc);
+  FramePairer pairer(static_cast<int64_t>(dc.pair_timeout_ms * 1000), dc.max_pending_frames);
+  RepeatCounter repeats;
+  int64_t judged = 0;
+  int64_t unusable = 0;
+
+  auto publish = [&](const discrepancy_t& summary) {
+    node.safety().publish(config.channels.discrepancy, &summary);
+    node.counters().frames_out++;
+    node.heartbeat().set_last_frame_utime(summary.utime);
+    (summary.usable ? judged : unusable)++;
+    node.heartbeat().set_status("ok: " + std::to_string(judged) + " frames compared, " +
+                                std::to_string(unusable) + " unusable" +
+                                (node.errors().last().empty() ? "" : "; last error: " + node.errors().last()));
+  };
+
+  auto handle = [&](PairingOutput& out) {
+    for (PairedFrame& pair : out.paired) {
+      const int64_t start_us = monotonic_us();
+      const depth_image_t empty{};
+      DiscrepancyFrame frame =
+          compute_discrepancy(pair.camera.image, pair.rendered ? *pair.rendered : empty, pair.labels, parameters);
+      frame.summary.depth_hash = pair.camera.depth_hash;
+      frame.summary.repeat_count = pair.camera.repeat_count;
+      frame.summary.compute_us = static_cast<int32_t>(monotonic_us() - start_us);
+      if (!frame.summary.usable && frame.summary.unusable_kind == discrepancy_t::UNUSABLE_MISMATCHED) {
+        node.errors().report("pair", "seq " + std::to_string(frame.summary.seq) + ": " +
+                                         frame.summary.unusable_reason);
+      }
+      publish(frame.summary);
+      if (dc.colour_image_enabled) {
+        const discrepancy_image_t colour = colour_image(frame, dc.colour_image_full_scale_mm);
+        node.images().publish(dc.colour_image_channel, &colour);
+      }
+    }
+    for (UnpairedFrame& lost : out.unpaired) {
+      node.counters().frames_dropped++;
+      node.errors().report("unpaired", "camera frame " + lost.reason);
+      discrepancy_t summary =
+          unusable_summary(lost.camera.image, discrepancy_t::UNUSABLE_NO_RENDERING, lost.reason);
+      summary.depth_hash = lost.camera.depth_hash;
+      summary.repeat_count = lost.camera.repeat_count;
+      publish(summary);
+    }
+    node.counters().frames_dropped += out.dropped_partners;
+  };
+
+  const std::string camera_id = config.camera.id;
+  auto check_camera = [camera_id](const depth_image_t& image) {
+    std::string problem = check_depth_image(image);
+    if (problem.empty() && image.camera_id != camera_id) {
+      problem = "camera_id: expected '" + camera_id + "', got '" + image.camera_id + "'";
+    }
+    return problem;
+  };
+
+  node.subscribe<depth_image_t>(
+      node.images(), config.channels.depth,
+      [&](const depth_image_t& image) {
+        PairingOutput out;
+        CameraFrame frame{image, depth_hash(image.depth_mm), 0};
+        frame.repeat_count = repeats.update(frame.depth_hash);
+        pairer.add_camera(std::move(frame), monotonic_us(), &out);
+        handle(out);
+      },
+      check_camera);
+  node.subscribe<depth_image_t>(
+      node.images(), config.channels.rendered,
+      [&](const depth_image_t& rendered) {
+        PairingOutput out;
+        pairer.add_rendered(rendered, monotonic_us(), &out);
+        handle(out);
+      },
+      check_depth_image);
+  node.subscribe<link_labels_t>(
+      node.images(), config.channels.labels,
+      [&](const link_labels_t& labels) {
+        PairingOutput out;
+        pairer.add_labels(labels, monotonic_us(), &out);
+        handle(out);
+      },
+      check_link_labels);
+  // Expire waiting frames at a tenth of the pairing timeout (at least 1 ms).
+  node.add_timer(std::max<int64_t>(1000, static_cast<int64_t>(dc.pair_timeout_ms * 100)), [&] {
+    PairingOutput out;
+    pairer.expire(monotonic_us(), &out);
+    handle(out);
+  });
+  node.heartbeat().set_status("ok: waiting for frames");
+  node.run();
+  return 0;
 }
 
 }  // namespace tofguard::discrepancy

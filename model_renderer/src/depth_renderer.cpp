@@ -118,6 +118,7 @@ struct DepthRenderer::Impl {
   struct DrawRange {
     GLsizei index_count = 0;
     size_t first_index_byte = 0;
+    bool cull_back_faces = false;
   };
 
   Impl(const SceneModel& scene_in, double near, double far, EglPlatform platform)
@@ -161,7 +162,8 @@ struct DepthRenderer::Impl {
     std::vector<uint32_t> indices;
     for (const TriangleMesh& mesh : scene.meshes) {
       const uint32_t base = static_cast<uint32_t>(vertices.size() / 3);
-      ranges.push_back({static_cast<GLsizei>(mesh.indices.size()), indices.size() * sizeof(uint32_t)});
+      ranges.push_back(
+          {static_cast<GLsizei>(mesh.indices.size()), indices.size() * sizeof(uint32_t), mesh.closed_outward});
       for (const Eigen::Vector3f& v : mesh.vertices) vertices.insert(vertices.end(), {v.x(), v.y(), v.z()});
       for (uint32_t i : mesh.indices) indices.push_back(base + i);
     }
@@ -179,6 +181,13 @@ struct DepthRenderer::Impl {
 
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
+    // Back faces are skipped only for closed, outward-wound meshes
+    // (TriangleMesh::closed_outward). clip_from_optical() keeps image rows
+    // in GL window rows (v down = window y up), which mirrors the image
+    // against GL's usual camera; so outward faces, counter-clockwise seen
+    // from outside, arrive clockwise in window coordinates.
+    glFrontFace(GL_CW);
+    glCullFace(GL_BACK);
     glDisable(GL_CULL_FACE);
     glDisable(GL_BLEND);
     glDisable(GL_DITHER);
@@ -221,6 +230,10 @@ struct DepthRenderer::Impl {
     glUniformMatrix4fv(optical_from_mesh_location, 1, GL_FALSE, m.data());  // column-major, as GL wants
     glUniform1i(label_location, label);
     const DrawRange& range = ranges[mesh_index];
+    if (range.cull_back_faces != culling) {
+      culling = range.cull_back_faces;
+      culling ? glEnable(GL_CULL_FACE) : glDisable(GL_CULL_FACE);
+    }
     glDrawElements(GL_TRIANGLES, range.index_count, GL_UNSIGNED_INT,
                    reinterpret_cast<const void*>(range.first_index_byte));
   }
@@ -323,6 +336,7 @@ struct DepthRenderer::Impl {
   int fb_height = 0;
   int read_channels = 4;
   std::vector<uint32_t> readback;
+  bool culling = false;
 };
 
 DepthRenderer::DepthRenderer(const SceneModel& scene, double near_m, double far_m)

@@ -22,14 +22,15 @@ TriangleMesh unit_box() {
   for (int i = 0; i < 8; ++i) {
     add_vertex(mesh, (i & 1) ? 0.5 : -0.5, (i & 2) ? 0.5 : -0.5, (i & 4) ? 0.5 : -0.5);
   }
-  // Two triangles per face; corner index bits are (x, y, z). Winding does
-  // not matter: the renderer does not cull.
-  const uint32_t faces[6][4] = {{0, 2, 6, 4}, {1, 3, 7, 5}, {0, 1, 5, 4},
-                                {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 5, 7, 6}};
+  // Corner index = x + 2y + 4z (bits). Each face as a quad a, b, c, d
+  // counter-clockwise seen from outside, so that (b - a) x (c - a) points out.
+  const uint32_t faces[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
+                                {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
   for (const auto& f : faces) {
     add_triangle(mesh, f[0], f[1], f[2]);
     add_triangle(mesh, f[0], f[2], f[3]);
   }
+  mesh.closed_outward = true;
   return mesh;
 }
 
@@ -59,6 +60,7 @@ TriangleMesh unit_sphere() {
       add_triangle(mesh, at(i, j), at(i + 1, j + 1), at(i, j + 1));
     }
   }
+  mesh.closed_outward = true;
   return mesh;
 }
 
@@ -81,6 +83,7 @@ TriangleMesh unit_cylinder() {
     add_triangle(mesh, top(j), bottom(j), bottom(j + 1));
     add_triangle(mesh, top(j), bottom(j + 1), top(j + 1));
   }
+  mesh.closed_outward = true;
   return mesh;
 }
 

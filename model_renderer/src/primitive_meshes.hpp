@@ -8,8 +8,8 @@
 
 namespace tofguard::renderer {
 
-constexpr int kSphereSegments = 96;     // around the z axis; 48 rings pole to pole
-constexpr int kCylinderSegments = 128;  // around the z axis
+constexpr int kSphereSegments = 80;    // around the z axis; 40 rings pole to pole
+constexpr int kCylinderSegments = 80;  // around the z axis
 
 TriangleMesh unit_box();       // edge 1, centred on the origin
 TriangleMesh unit_sphere();    // radius 1, centred on the origin

@@ -99,7 +99,7 @@ class SceneBuilder {
     const urdf::ModelInterfaceSharedPtr model = parse_urdf_file(path);
     const urdf::LinkConstSharedPtr root = model->getRoot();
     if (!root) throw ModelError(path + ": malformed URDF: no root link");
-    const std::string file = fs::path(path).filename().string();
+    const std::string& file = path;  // as given, in every message
     const fs::path urdf_folder = fs::absolute(fs::path(path)).parent_path();
     std::map<std::string, int> joint_index;  // this file's joints, for mimic
     // Depth first from the root: every link after its parent, every joint
@@ -300,11 +300,17 @@ class SceneBuilder {
                          const std::string& where) const {
     Assimp::Importer importer;
     importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, true);
-    // Points and lines are dropped; normals are recomputed here after scaling.
+    // Points and lines are dropped. Only positions matter: without normals,
+    // texture coordinates and colours, vertices that share a position are
+    // joined, so a closed surface is seen to be closed (see orient()).
     importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+    importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
+                                                            aiComponent_COLORS | aiComponent_TEXCOORDS |
+                                                            aiComponent_BONEWEIGHTS | aiComponent_ANIMATIONS |
+                                                            aiComponent_TEXTURES | aiComponent_MATERIALS);
     const aiScene* scene = importer.ReadFile(
-        path.string(), aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices |
-                           aiProcess_SortByPType | aiProcess_DropNormals);
+        path.string(), aiProcess_RemoveComponent | aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                           aiProcess_PreTransformVertices | aiProcess_SortByPType);
     if (scene == nullptr) {
       throw ModelError(where + "mesh '" + uri + "' (" + path.string() +
                        ") could not be read: " + one_line(importer.GetErrorString()));
@@ -329,14 +335,41 @@ class SceneBuilder {
     if (mesh.num_triangles() == 0) {
       throw ModelError(where + "mesh '" + uri + "' (" + path.string() + ") has no triangles");
     }
+    orient(mesh);
     if (options_.padding_m > 0) pad_along_normals(mesh, options_.padding_m);
     return mesh;
   }
 
+  // Sets closed_outward, flipping a closed, consistently wound mesh that is
+  // wound inside out (e.g. mirrored by a negative scale).
+  static void orient(TriangleMesh& mesh) {
+    std::map<std::pair<uint32_t, uint32_t>, int> directed_edges;
+    for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+      for (int k = 0; k < 3; ++k) ++directed_edges[{mesh.indices[t + k], mesh.indices[t + (k + 1) % 3]}];
+    }
+    for (const auto& [edge, count] : directed_edges) {
+      const auto reverse = directed_edges.find({edge.second, edge.first});
+      if (count != 1 || reverse == directed_edges.end() || reverse->second != 1) return;  // open or inconsistent
+    }
+    // Signed volume by the divergence theorem: positive when wound outward.
+    double volume6 = 0;
+    for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+      const Eigen::Vector3d a = mesh.vertices[mesh.indices[t]].cast<double>();
+      const Eigen::Vector3d b = mesh.vertices[mesh.indices[t + 1]].cast<double>();
+      const Eigen::Vector3d c = mesh.vertices[mesh.indices[t + 2]].cast<double>();
+      volume6 += a.dot(b.cross(c));
+    }
+    if (volume6 == 0) return;
+    if (volume6 < 0) {
+      for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) std::swap(mesh.indices[t + 1], mesh.indices[t + 2]);
+    }
+    mesh.closed_outward = true;
+  }
+
   static void pad_along_normals(TriangleMesh& mesh, double padding_m) {
     // Area-weighted vertex normals (the cross product's length is twice the
-    // area); a mirroring scale flips every normal alike, so orientation is
-    // taken from the mesh as written.
+    // area). Closed meshes are wound outward by now (orient()); an open mesh
+    // is padded towards the side its winding calls outside.
     std::vector<Eigen::Vector3d> normals(mesh.vertices.size(), Eigen::Vector3d::Zero());
     for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
       const Eigen::Vector3d a = mesh.vertices[mesh.indices[t]].cast<double>();

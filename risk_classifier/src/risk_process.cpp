@@ -1,10 +1,102 @@
 #include "risk_process.hpp"
 
+#include <algorithm>
+#include <cmath>
+
+#include "risk_monitor.hpp"
+#include "tofguard/camera_pose_t.hpp"
+#include "tofguard/clock.hpp"
+#include "tofguard/lcm_node.hpp"
+#include "tofguard/wire_checks.hpp"
+
 namespace tofguard::risk {
+namespace {
+
+// The summary's own consistency (the decoder already sized the arrays).
+std::string check_discrepancy(const discrepancy_t& d) {
+  if (d.utime <= 0) return "utime: expected a capture time > 0, got " + std::to_string(d.utime);
+  if (d.seq < 0) return "seq: expected a frame number >= 0, got " + std::to_string(d.seq);
+  if (d.num_robot_links < 0 || d.num_robot_links > d.num_links) {
+    return "num_robot_links: expected 0..num_links = " + std::to_string(d.num_links) + ", got " +
+           std::to_string(d.num_robot_links);
+  }
+  if (!(d.invalid_fraction >= 0 && d.invalid_fraction <= 1)) {
+    return "invalid_fraction: expected a fraction in [0, 1], got " + std::to_string(d.invalid_fraction);
+  }
+  for (int i = 0; i < d.num_links; ++i) {
+    if (d.link_compared[i] < 0 || d.link_match[i] < 0 || d.link_farther[i] < 0 || d.link_match[i] > d.link_compared[i] ||
+        d.link_farther[i] > d.link_compared[i]) {
+      return "link_compared[" + std::to_string(i) + "]: expected counts with 0 <= match, farther <= compared";
+    }
+  }
+  if (!std::isfinite(d.near_arm_area_m2) || !std::isfinite(d.largest_blob_area_m2)) {
+    return "near_arm_area_m2 / largest_blob_area_m2: expected finite areas";
+  }
+  return "";
+}
+
+std::string check_heartbeat(const heartbeat_t& hb) {
+  if (hb.process.empty()) return "process: expected a process name, got an empty string";
+  return "";
+}
+
+}  // namespace
 
 ProcessInfo process_info() {
   return {"tofguard-risk",
-          "Classifies the risk of every frame and fires deadlines: SAFETY_DISCREPANCY, SAFETY_HEARTBEAT -> SAFETY_RISK."};
+          "Classifies the risk of every frame and fires deadlines: SAFETY_DISCREPANCY, TOF_DEPTH, JOINT_STATE, "
+          "CAMERA_POSE, SAFETY_HEARTBEAT -> SAFETY_RISK (risk_t)."};
+}
+
+int run_risk(const Config& config) {
+  install_stop_signal_handlers();
+  RiskMonitor monitor(config, RobotTree::from_urdf_file(config.robot.urdf_path), monotonic_us());
+  LcmNode node(config, process_info().name);
+  int64_t dangerous = 0;
+
+  auto publish = [&](const risk_t& r) {
+    node.safety().publish(config.channels.risk, &r);
+    node.counters().frames_out++;
+    if (r.seq >= 0) node.heartbeat().set_last_frame_utime(r.utime);
+    if (r.level == risk_t::DANGEROUS) ++dangerous;
+    node.heartbeat().set_status("last verdict: level " + std::to_string(r.level) + " cause " +
+                                std::to_string(r.cause) + " (" + r.detail + "); " + std::to_string(dangerous) +
+                                " dangerous so far");
+  };
+
+  node.subscribe<discrepancy_t>(
+      node.safety(), config.channels.discrepancy,
+      [&](const discrepancy_t& d) { publish(monitor.on_discrepancy(d, monotonic_us())); }, check_discrepancy);
+  const std::string camera_id = config.camera.id;
+  node.subscribe<depth_image_t>(
+      node.images(), config.channels.depth, [&](const depth_image_t&) { monitor.on_depth(monotonic_us()); },
+      [camera_id](const depth_image_t& image) {
+        std::string problem = check_depth_image(image);
+        if (problem.empty() && image.camera_id != camera_id) {
+          problem = "camera_id: expected '" + camera_id + "', got '" + image.camera_id + "'";
+        }
+        return problem;
+      });
+  node.subscribe<joint_state_t>(
+      node.safety(), config.channels.joint_state,
+      [&](const joint_state_t& s) { monitor.on_joint_state(s, monotonic_us()); },
+      [&](const joint_state_t& s) {
+        std::string problem = check_joint_state(s);
+        if (problem.empty()) problem = monitor.check_joint_names(s);
+        return problem;
+      });
+  node.subscribe<camera_pose_t>(
+      node.safety(), config.channels.camera_pose, [&](const camera_pose_t&) { monitor.on_camera_pose(monotonic_us()); },
+      check_camera_pose);
+  node.subscribe<heartbeat_t>(
+      node.safety(), config.channels.heartbeat,
+      [&](const heartbeat_t& hb) { monitor.on_heartbeat(hb, monotonic_us()); }, check_heartbeat);
+  node.add_timer(static_cast<int64_t>(config.risk.check_period_ms * 1000), [&] {
+    if (const auto timeout = monitor.check_deadlines(monotonic_us())) publish(*timeout);
+  });
+  node.heartbeat().set_status("ok: waiting for frames");
+  node.run();
+  return 0;
 }
 
 }  // namespace tofguard::risk

@@ -49,11 +49,14 @@ TEST(Config, EmbeddedDefaultLoads) {
   EXPECT_DOUBLE_EQ(config.camera.intrinsics.cy, 71.8);
   EXPECT_EQ(config.camera.pose.frame_id, "world");
   EXPECT_NEAR(config.camera.pose.rotation.norm(), 1.0, 1e-6);
-  // The optical axis (z) looks forward (+x) and down: 40 degrees below the
-  // horizon.
+  // The optical axis (z) looks forward (+x), 8 degrees to the right (-y)
+  // and 35 degrees below the horizon; image right (x) is level.
   const Eigen::Vector3d optical_axis = config.camera.pose.rotation * Eigen::Vector3d::UnitZ();
-  EXPECT_NEAR(optical_axis.x(), std::cos(40 * M_PI / 180), 1e-6);
-  EXPECT_NEAR(optical_axis.z(), -std::sin(40 * M_PI / 180), 1e-6);
+  const double pitch = 35 * M_PI / 180, yaw = -8 * M_PI / 180;
+  EXPECT_NEAR(optical_axis.x(), std::cos(pitch) * std::cos(yaw), 1e-6);
+  EXPECT_NEAR(optical_axis.y(), std::cos(pitch) * std::sin(yaw), 1e-6);
+  EXPECT_NEAR(optical_axis.z(), -std::sin(pitch), 1e-6);
+  EXPECT_NEAR((config.camera.pose.rotation * Eigen::Vector3d::UnitX()).z(), 0.0, 1e-6);
   EXPECT_EQ(config.lcm.url, "udpm://239.255.76.67:7667?ttl=0");
   EXPECT_EQ(config.lcm.image_url, "udpm://239.255.76.67:7668?ttl=0&recv_buf_size=4194304");
   EXPECT_EQ(config.channels.depth, "TOF_DEPTH");
@@ -126,9 +129,9 @@ INSTANTIATE_TEST_SUITE_P(
                   {"camera.source", "expected one of sim, uvc", "'kinect'"}},
         BadConfig{"missing-path", "models/friend_arm.urdf", "models/no_such_arm.urdf",
                   {"robot.urdf", "expected an existing file", "no_such_arm.urdf", "does not exist"}},
-        BadConfig{"not-unit-quaternion", "[0.298836239, -0.640856382", "[0.6, -0.640856382",
+        BadConfig{"not-unit-quaternion", "[0.302934347, -0.581931466", "[0.6, -0.581931466",
                   {"camera.pose.rotation_wxyz", "expected a unit quaternion"}},
-        BadConfig{"short-list", "translation_m: [-0.35, -0.20, 1.55]", "translation_m: [-0.35, 1.55]",
+        BadConfig{"short-list", "translation_m: [-0.90, -0.20, 1.80]", "translation_m: [-0.90, 1.80]",
                   {"camera.pose.translation_m", "expected a list of 3 numbers", "2 entries"}},
         BadConfig{"not-yaml", "robot:\n", "robot: [\n", {"not valid YAML"}}),
     [](const ::testing::TestParamInfo<BadConfig>& info) {

@@ -390,22 +390,22 @@ TEST(SceneModelErrors, MalformedUrdf) {
 TEST(SceneModelErrors, MissingMeshNamesLinkAndFile) {
   const std::string path = write_test_file("bad/missing_mesh.urdf", one_link_urdf("<mesh filename=\"meshes/missing.stl\"/>"));
   const std::string error = model_error(path);
-  EXPECT_EQ(error, "missing_mesh.urdf: link 'thing': mesh 'meshes/missing.stl' not found (resolved to " +
+  EXPECT_EQ(error, path + ": link 'thing': mesh 'meshes/missing.stl' not found (resolved to " +
                        (fs::path(path).parent_path() / "meshes/missing.stl").string() + ")");
   const std::string package = write_test_file("bad/missing_package.urdf", one_link_urdf("<mesh filename=\"package://nopkg/m.stl\"/>"));
-  EXPECT_EQ(model_error(package), "missing_package.urdf: link 'thing': mesh 'package://nopkg/m.stl' not found "
-                                  "(searched: no package_paths configured)");
+  EXPECT_EQ(model_error(package), package + ": link 'thing': mesh 'package://nopkg/m.stl' not found "
+                                            "(searched: no package_paths configured)");
   SceneOptions options;
   options.package_paths = {"/tmp/a"};
   EXPECT_EQ(model_error(package, {}, options),
-            "missing_package.urdf: link 'thing': mesh 'package://nopkg/m.stl' not found (searched: /tmp/a/nopkg/m.stl)");
+            package + ": link 'thing': mesh 'package://nopkg/m.stl' not found (searched: /tmp/a/nopkg/m.stl)");
 }
 
 TEST(SceneModelErrors, UnreadableMeshNamesLinkAndFile) {
   write_test_file("bad/meshes/garbage.stl", "this is not a mesh\n");
   const std::string path = write_test_file("bad/garbage_mesh.urdf", one_link_urdf("<mesh filename=\"meshes/garbage.stl\"/>"));
   const std::string error = model_error(path);
-  EXPECT_EQ(error.rfind("garbage_mesh.urdf: link 'thing': mesh 'meshes/garbage.stl' (", 0), 0u) << error;
+  EXPECT_EQ(error.rfind(path + ": link 'thing': mesh 'meshes/garbage.stl' (", 0), 0u) << error;
   EXPECT_NE(error.find("could not be read"), std::string::npos) << error;
 }
 
@@ -429,7 +429,7 @@ TEST(SceneModelErrors, MovingJointInTheEnvironment) {
 
 TEST(SceneModelErrors, BadSizesAndPadding) {
   const std::string path = write_test_file("bad/zero_box.urdf", one_link_urdf("<box size=\"0.1 0 0.1\"/>"));
-  EXPECT_EQ(model_error(path), "zero_box.urdf: link 'thing': box size must be three positive lengths");
+  EXPECT_EQ(model_error(path), path + ": link 'thing': box size must be three positive lengths");
   SceneOptions options;
   options.padding_m = -0.01;
   EXPECT_NE(model_error(write_test_file("bad/ok.urdf", one_link_urdf("<sphere radius=\"0.1\"/>")), {}, options)

@@ -97,6 +97,40 @@ int run_command(const std::string& name, const std::vector<std::string>& argv,
   return code;
 }
 
+std::string sim_config_variant(const std::string& name,
+                               const std::vector<std::pair<std::string, std::string>>& replacements,
+                               const std::string& appended) {
+  std::string text = read_file(source_dir() + "/config/sim.yaml");
+  for (const auto& [from, to] : replacements) {
+    const auto at = text.find(from);
+    if (at == std::string::npos) throw std::runtime_error("sim.yaml no longer contains: " + from);
+    text.replace(at, from.size(), to);
+  }
+  const std::string models = source_dir() + "/config/models/";
+  for (size_t p = text.find("models/"); p != std::string::npos; p = text.find("models/", p + models.size() + 1)) {
+    if (p > 0 && text[p - 1] == '/') continue;
+    text.replace(p, 7, models);
+  }
+  // A top-level section in `appended` replaces sim.yaml's own.
+  std::stringstream added(appended);
+  for (std::string line; std::getline(added, line);) {
+    if (line.empty() || line[0] == ' ' || line[0] == '#' || line.find(':') == std::string::npos) continue;
+    const std::string key = "\n" + line.substr(0, line.find(':') + 1);
+    const auto start = text.find(key);
+    if (start == std::string::npos) continue;
+    size_t end = start + 1;
+    while ((end = text.find('\n', end)) != std::string::npos && end + 1 < text.size() &&
+           (text[end + 1] == ' ' || text[end + 1] == '\n' || text[end + 1] == '#')) {
+      ++end;
+    }
+    text.erase(start, end == std::string::npos ? std::string::npos : end - start);
+  }
+  text += appended;
+  const std::string path = output_dir() + "/" + name + ".yaml";
+  write_file(path, text);
+  return path;
+}
+
 std::string read_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::ostringstream s;

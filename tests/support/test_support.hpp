@@ -54,6 +54,14 @@ class Subprocess {
 int run_command(const std::string& name, const std::vector<std::string>& argv,
                 std::string* stdout_text = nullptr, std::string* stderr_text = nullptr);
 
+// config/sim.yaml copied to output_dir()/<name>.yaml with `replacements`
+// (each `from` must occur) applied and `appended` added at the end; the
+// model paths are made absolute so the copy works from anywhere. Returns
+// the copy's path.
+std::string sim_config_variant(const std::string& name,
+                               const std::vector<std::pair<std::string, std::string>>& replacements = {},
+                               const std::string& appended = "");
+
 std::string read_file(const std::string& path);
 void write_file(const std::string& path, const std::string& text);
 

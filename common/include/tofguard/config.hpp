@@ -185,6 +185,74 @@ struct RendererConfig {
   double max_extrapolation_ms = 0;
 };
 
+// ---- Safety chain: discrepancy and risk (docs/safety-chain.md) ----
+
+// tofguard-discrepancy: how camera and rendered frames are paired and
+// compared.
+struct DiscrepancyConfig {
+  // Camera noise model: sigma(d) = noise_sigma_at_0m_mm +
+  // noise_sigma_per_m2_mm * d^2, d the camera's depth in metres, sigma in mm.
+  double noise_sigma_at_0m_mm = 0;
+  double noise_sigma_per_m2_mm = 0;
+  // A pixel matches when |I_dis| <= tolerance_sigmas * sigma(d) +
+  // model_tolerance_mm (the model's own inaccuracy), millimetres.
+  double tolerance_sigmas = 0;
+  double model_tolerance_mm = 0;
+  // A camera frame waits this long (monotonic) for its rendered frame and
+  // labels before it is published as unusable, milliseconds.
+  double pair_timeout_ms = 0;
+  // At most this many frames of each kind wait for their partners.
+  int max_pending_frames = 0;
+  // Radius of the morphological opening applied to the mismatch mask
+  // before blobs and near-arm surfaces are measured, pixels (0 = none).
+  int opening_radius_px = 0;
+  // Surfaces nearer than the model within this distance of the modelled
+  // arm count as near the arm, metres.
+  double near_arm_m = 0;
+  // The seed score's logical maximum per pixel, millimetres.
+  double max_depth_mm = 0;
+  // Optional colour discrepancy image for viewers.
+  bool colour_image_enabled = false;
+  std::string colour_image_channel;
+  double colour_image_full_scale_mm = 0;
+};
+
+// tofguard-risk: deadlines, thresholds and debouncing.
+struct RiskConfig {
+  // How often deadlines are checked (and timeouts re-published), ms.
+  double check_period_ms = 0;
+  // Staleness deadlines on the receiver's monotonic clock (time since the
+  // last valid arrival), milliseconds.
+  double depth_deadline_ms = 0;
+  double discrepancy_deadline_ms = 0;
+  double joint_state_deadline_ms = 0;
+  bool camera_pose_required = false;
+  double camera_pose_deadline_ms = 0;
+  double heartbeat_deadline_ms = 0;
+  // Processes (heartbeat_t.process) whose heartbeat must keep coming.
+  std::vector<std::string> required_heartbeats;
+  // A model mismatch (joint, calibration, object, unclassified) is WARNING
+  // until it has held for this many consecutive frames, then DANGEROUS.
+  int debounce_frames = 0;
+  // The same for per-frame sensor faults (unusable frame, invalid pixels,
+  // uncalibrated, frozen).
+  int sensor_debounce_frames = 0;
+  // Sensor faults.
+  double max_invalid_fraction = 0;
+  bool calibrated_required = true;
+  int frozen_repeat_frames = 0;
+  double moving_joint_speed_rad_s = 0;
+  // Classification (docs/safety-chain.md).
+  int min_link_pixels = 0;
+  double link_mismatch_fraction = 0;
+  double joint_link_missing_fraction = 0;
+  int min_environment_pixels = 0;
+  double calibration_environment_mismatch_fraction = 0;
+  double calibration_robot_link_fraction = 0;
+  double unknown_object_min_area_m2 = 0;
+  double unclassified_blob_area_m2 = 0;
+};
+
 // One joint's periodic motion in the simulated arm:
 // position = center + amplitude * sin(2*pi*t/period_s + phase), radians (or
 // metres for a prismatic joint); t is the arm's motion time, which stands
@@ -234,6 +302,43 @@ struct InterventionConfig {
   std::string relay_serial;
 };
 
+// One process of the group tofguard-launch starts, in start order.
+struct LaunchedProcess {
+  std::string name;
+  // argv; "{config}" in any argument becomes the config file's absolute
+  // path. A bare program name is looked up beside tofguard-launch, then in
+  // PATH.
+  std::vector<std::string> command;
+  // A required process that keeps crashing is reported loudly; the chain
+  // is unsafe without it (the risk classifier sees its heartbeat missing).
+  bool required = true;
+};
+
+// The black-box recorder: lcm-logger on both LCM URLs into rotating files.
+struct RecorderConfig {
+  bool enabled = false;
+  // A new file every max_file_mb; the oldest files are deleted when all
+  // together exceed max_total_mb or are older than max_age_h.
+  double max_file_mb = 0;
+  double max_total_mb = 0;
+  double max_age_h = 0;
+};
+
+struct LaunchConfig {
+  bool present = false;
+  std::vector<LaunchedProcess> processes;
+  // Restart back-off: doubles from initial to max.
+  double restart_backoff_initial_ms = 0;
+  double restart_backoff_max_ms = 0;
+  // More restarts than this within restart_window_s -> left stopped.
+  int max_restarts = 0;
+  double restart_window_s = 0;
+  // Each process's stdout/stderr (<name>.log) and the recordings go here;
+  // relative to the config file's folder; created when missing.
+  std::string log_dir;
+  RecorderConfig recorder;
+};
+
 struct Config {
   std::string file;
   LcmConfig lcm;
@@ -242,8 +347,12 @@ struct Config {
   EnvironmentConfig environment;
   CameraConfig camera;
   RendererConfig renderer;
+  DiscrepancyConfig discrepancy;
+  RiskConfig risk;
   JointsSimConfig joints_sim;
   InterventionConfig intervention;
+  // Optional: only tofguard-launch needs it.
+  LaunchConfig launch;
 };
 
 // Loads and validates `path`; throws ConfigError. `lcm_default_url_env` is

@@ -42,6 +42,8 @@ class YamlMap {
   // A path to an existing file (or directory when `directory`), resolved
   // against the config file's directory when relative.
   std::string existing_path(const std::string& key, bool directory = false);
+  // A path that need not exist yet, resolved like existing_path.
+  std::string path(const std::string& key);
   std::vector<std::string> existing_paths(const std::string& key, bool directory = false);
 
   YamlMap map(const std::string& key);

@@ -1,0 +1,407 @@
+#include "discrepancy_image.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include <opencv2/imgproc.hpp>
+
+namespace tofguard::discrepancy {
+namespace {
+
+// Counts of I_dis values in whole millimetres, clamped to +-kHistogramMm
+// (medians and percentiles of larger discrepancies saturate there): a
+// median from counts costs one pass over 8191 bins instead of sorting.
+constexpr int kHistogramMm = 4095;
+
+class Histogram {
+ public:
+  Histogram() : bins_(2 * kHistogramMm + 1, 0) {}
+  void add(int value_mm) {
+    bins_[std::clamp(value_mm, -kHistogramMm, kHistogramMm) + kHistogramMm]++;
+    ++count_;
+  }
+  void add(const Histogram& other) {
+    for (size_t i = 0; i < bins_.size(); ++i) bins_[i] += other.bins_[i];
+    count_ += other.count_;
+  }
+  int64_t count() const { return count_; }
+  // The value of rank `k` (0-based) in ascending order.
+  int value_at_rank(int64_t k) const {
+    int64_t seen = 0;
+    for (size_t i = 0; i < bins_.size(); ++i) {
+      seen += bins_[i];
+      if (seen > k) return static_cast<int>(i) - kHistogramMm;
+    }
+    return kHistogramMm;
+  }
+  // The element at index size/2 of the sorted values (0 for none).
+  float median() const { return count_ == 0 ? 0.0f : static_cast<float>(value_at_rank(count_ / 2)); }
+  // The element at index floor(q*(size-1)).
+  float quantile(double q) const {
+    if (count_ == 0) return 0.0f;
+    return static_cast<float>(value_at_rank(static_cast<int64_t>(std::floor(q * static_cast<double>(count_ - 1)))));
+  }
+  // The histogram of |value|.
+  Histogram folded() const {
+    Histogram abs;
+    for (int v = -kHistogramMm; v <= kHistogramMm; ++v) abs.bins_[std::abs(v) + kHistogramMm] += bins_[v + kHistogramMm];
+    abs.count_ = count_;
+    return abs;
+  }
+
+ private:
+  std::vector<int64_t> bins_;
+  int64_t count_ = 0;
+};
+
+bool same_intrinsics(const depth_image_t& a, const depth_image_t& b) {
+  constexpr double kTolerancePx = 1e-3;
+  return std::abs(a.fx - b.fx) <= kTolerancePx && std::abs(a.fy - b.fy) <= kTolerancePx &&
+         std::abs(a.cx - b.cx) <= kTolerancePx && std::abs(a.cy - b.cy) <= kTolerancePx;
+}
+
+// "" when the three messages describe the same frame, else why not.
+std::string mismatch_reason(const depth_image_t& camera, const depth_image_t& rendered,
+                            const link_labels_t& labels) {
+  std::ostringstream why;
+  if (rendered.width != camera.width || rendered.height != camera.height) {
+    why << "rendered frame is " << rendered.width << "x" << rendered.height << ", camera frame "
+        << camera.width << "x" << camera.height;
+  } else if (labels.width != camera.width || labels.height != camera.height) {
+    why << "labels are " << labels.width << "x" << labels.height << ", camera frame " << camera.width
+        << "x" << camera.height;
+  } else if (rendered.camera_id != camera.camera_id || labels.camera_id != camera.camera_id) {
+    why << "camera_id: rendered '" << rendered.camera_id << "', labels '" << labels.camera_id
+        << "', camera '" << camera.camera_id << "'";
+  } else if (!same_intrinsics(camera, rendered)) {
+    why << "rendered intrinsics fx " << rendered.fx << " fy " << rendered.fy << " cx " << rendered.cx
+        << " cy " << rendered.cy << " differ from the camera's fx " << camera.fx << " fy " << camera.fy
+        << " cx " << camera.cx << " cy " << camera.cy;
+  }
+  return why.str();
+}
+
+cv::Mat1b opened(const cv::Mat1b& mask, int radius_px) {
+  if (radius_px <= 0) return mask;
+  cv::Mat1b out;
+  const cv::Mat kernel =
+      cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * radius_px + 1, 2 * radius_px + 1));
+  cv::morphologyEx(mask, out, cv::MORPH_OPEN, kernel);
+  return out;
+}
+
+}  // namespace
+
+Parameters parameters_from(const DiscrepancyConfig& config) {
+  Parameters p;
+  p.tolerance.sigma_at_0m_mm = config.noise_sigma_at_0m_mm;
+  p.tolerance.sigma_per_m2_mm = config.noise_sigma_per_m2_mm;
+  p.tolerance.sigmas = config.tolerance_sigmas;
+  p.tolerance.model_mm = config.model_tolerance_mm;
+  p.opening_radius_px = config.opening_radius_px;
+  p.near_arm_m = config.near_arm_m;
+  p.max_depth_mm = config.max_depth_mm;
+  return p;
+}
+
+discrepancy_t unusable_summary(const depth_image_t& camera, int8_t kind, const std::string& reason) {
+  discrepancy_t s{};
+  s.utime = camera.utime;
+  s.seq = camera.seq;
+  s.camera_id = camera.camera_id;
+  s.usable = false;
+  s.unusable_kind = kind;
+  s.unusable_reason = reason;
+  s.calibrated = camera.calibrated;
+  s.width = camera.width;
+  s.height = camera.height;
+  s.num_pixels = camera.num_pixels;
+  for (int16_t d : camera.depth_mm) s.num_invalid += d <= 0 ? 1 : 0;
+  s.invalid_fraction = s.num_pixels > 0 ? static_cast<float>(s.num_invalid) / s.num_pixels : 1.0f;
+  s.near_arm_min_distance_m = -1;
+  return s;
+}
+
+DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_image_t& rendered,
+                                     const link_labels_t& labels, const Parameters& parameters) {
+  DiscrepancyFrame frame;
+  if (!labels.usable) {
+    frame.summary = unusable_summary(camera, discrepancy_t::UNUSABLE_RENDERER,
+                                     "renderer: " + labels.unusable_reason);
+    return frame;
+  }
+  if (const std::string why = mismatch_reason(camera, rendered, labels); !why.empty()) {
+    frame.summary = unusable_summary(camera, discrepancy_t::UNUSABLE_MISMATCHED, why);
+    return frame;
+  }
+
+  const int width = camera.width;
+  const int height = camera.height;
+  const int num_pixels = width * height;
+  const int num_links = labels.num_links;
+  const int num_robot_links = labels.num_robot_links;
+  const int num_environment_links = num_links - num_robot_links;
+
+  discrepancy_t& s = frame.summary;
+  s = unusable_summary(camera, discrepancy_t::UNUSABLE_NONE, "");
+  s.usable = true;
+  s.num_invalid = 0;
+  s.num_robot_links = num_robot_links;
+  s.num_links = num_links;
+  s.link_name = labels.link_name;
+  s.link_compared.assign(num_links, 0);
+  s.link_match.assign(num_links, 0);
+  s.link_farther.assign(num_links, 0);
+  s.link_nearer.assign(num_links, 0);
+  s.link_invalid.assign(num_links, 0);
+  s.link_median_dis_mm.assign(num_links, 0.0f);
+
+  frame.pixel_class.create(height, width);
+  frame.dis_mm.create(height, width);
+  // Mismatches between modelled surfaces (for blobs), and nearer surfaces
+  // (occluded or unexpected, for near-arm objects).
+  cv::Mat1b mismatch_mask(height, width, uint8_t{0});
+  cv::Mat1b nearer_mask(height, width, uint8_t{0});
+  // 0 where the model has a robot link, 255 elsewhere (distance transform).
+  cv::Mat1b not_robot(height, width, uint8_t{255});
+
+  // Per link, plus one for modelled pixels without a link label.
+  std::vector<Histogram> link_dis(num_links + 1);
+  double sum_abs = 0;
+  int num_compared = 0;
+  int counts[6] = {0, 0, 0, 0, 0, 0};
+  bool any_robot = false;
+
+  const int16_t* tof = camera.depth_mm.data();
+  const int16_t* gen = rendered.depth_mm.data();
+  const int16_t* label = labels.label.data();
+  uint8_t* pixel_class = frame.pixel_class.ptr<uint8_t>();
+  int32_t* dis = frame.dis_mm.ptr<int32_t>();
+  uint8_t* mismatch = mismatch_mask.ptr<uint8_t>();
+  uint8_t* nearer = nearer_mask.ptr<uint8_t>();
+  uint8_t* robot_free = not_robot.ptr<uint8_t>();
+
+  for (int i = 0; i < num_pixels; ++i) {
+    const int l = label[i];
+    int link = -1;
+    if (l >= link_labels_t::ROBOT_FIRST && l < link_labels_t::ROBOT_FIRST + num_robot_links) {
+      link = l - link_labels_t::ROBOT_FIRST;
+    } else if (l >= link_labels_t::ENVIRONMENT_FIRST &&
+               l < link_labels_t::ENVIRONMENT_FIRST + num_environment_links) {
+      link = num_robot_links + l - link_labels_t::ENVIRONMENT_FIRST;
+    } else if (l != link_labels_t::NOTHING) {
+      std::ostringstream why;
+      why << "label[" << i << "]: expected 0, 1.." << num_robot_links << " or 1000.."
+          << 999 + num_environment_links << ", got " << l;
+      frame = DiscrepancyFrame{};
+      frame.summary = unusable_summary(camera, discrepancy_t::UNUSABLE_MISMATCHED, why.str());
+      return frame;
+    }
+    const int t = tof[i];
+    const int g = gen[i];
+    const bool modelled = g > 0;
+    const bool robot = modelled && link >= 0 && link < num_robot_links;
+    if (robot) {
+      robot_free[i] = 0;
+      any_robot = true;
+    }
+    dis[i] = 0;
+    int8_t c;
+    if (t <= 0) {
+      c = discrepancy_t::PIXEL_INVALID;
+      if (link >= 0 && modelled) s.link_invalid[link]++;
+    } else if (!modelled) {
+      // The camera sees a surface where the model has none.
+      c = discrepancy_t::PIXEL_UNEXPECTED_SURFACE;
+      nearer[i] = 255;
+    } else {
+      const int d = g - t;
+      dis[i] = d;
+      const int magnitude = std::abs(d);
+      sum_abs += magnitude;
+      ++num_compared;
+      link_dis[link >= 0 ? link : num_links].add(d);
+      if (magnitude <= parameters.tolerance.at(t)) {
+        c = discrepancy_t::PIXEL_MATCH;
+      } else if (d > 0) {
+        c = robot ? discrepancy_t::PIXEL_OCCLUDED : discrepancy_t::PIXEL_UNEXPECTED_SURFACE;
+        nearer[i] = 255;
+        mismatch[i] = 255;
+      } else {
+        c = robot ? discrepancy_t::PIXEL_ROBOT_MISSING : discrepancy_t::PIXEL_ENVIRONMENT_MISSING;
+        mismatch[i] = 255;
+      }
+      if (link >= 0) {
+        s.link_compared[link]++;
+        if (c == discrepancy_t::PIXEL_MATCH) {
+          s.link_match[link]++;
+        } else if (d > 0) {
+          s.link_nearer[link]++;
+        } else {
+          s.link_farther[link]++;
+        }
+      }
+    }
+    pixel_class[i] = static_cast<uint8_t>(c);
+    counts[c]++;
+  }
+
+  s.num_match = counts[discrepancy_t::PIXEL_MATCH];
+  s.num_robot_missing = counts[discrepancy_t::PIXEL_ROBOT_MISSING];
+  s.num_occluded = counts[discrepancy_t::PIXEL_OCCLUDED];
+  s.num_unexpected_surface = counts[discrepancy_t::PIXEL_UNEXPECTED_SURFACE];
+  s.num_environment_missing = counts[discrepancy_t::PIXEL_ENVIRONMENT_MISSING];
+  s.num_invalid = counts[discrepancy_t::PIXEL_INVALID];
+  s.invalid_fraction = static_cast<float>(s.num_invalid) / static_cast<float>(num_pixels);
+  s.num_compared = num_compared;
+  s.sum_abs_dis_mm = sum_abs;
+  s.normalized_sum_abs_dis =
+      s.num_compared > 0 ? sum_abs / (s.num_compared * parameters.max_depth_mm) : 0.0;
+  s.mismatch_fraction =
+      s.num_compared > 0 ? static_cast<float>(s.num_compared - s.num_match) / s.num_compared : 0.0f;
+  Histogram robot_dis;
+  Histogram environment_dis;
+  for (int link = 0; link < num_links; ++link) {
+    s.link_median_dis_mm[link] = link_dis[link].median();
+    (link < num_robot_links ? robot_dis : environment_dis).add(link_dis[link]);
+  }
+  Histogram all_dis = robot_dis;
+  all_dis.add(environment_dis);
+  all_dis.add(link_dis[num_links]);
+  const Histogram abs_dis = all_dis.folded();
+  s.median_abs_dis_mm = abs_dis.median();
+  s.p95_abs_dis_mm = abs_dis.quantile(0.95);
+  s.robot_median_dis_mm = robot_dis.median();
+  s.environment_median_dis_mm = environment_dis.median();
+
+  // Metric footprint of pixel i at the camera's depth (else the model's),
+  // square metres.
+  const double inv_fx_fy = 1.0 / (camera.fx * camera.fy);
+  auto footprint_m2 = [&](int i) {
+    const double z_m = (tof[i] > 0 ? tof[i] : gen[i]) * 1e-3;
+    return z_m * z_m * inv_fx_fy;
+  };
+
+  // Largest blob of mismatching modelled pixels.
+  {
+    const cv::Mat1b blobs = opened(mismatch_mask, parameters.opening_radius_px);
+    cv::Mat1i component;
+    cv::Mat stats;
+    cv::Mat centroids;
+    const int n = cv::connectedComponentsWithStats(blobs, component, stats, centroids, 8, CV_32S);
+    int largest = 0;
+    for (int k = 1; k < n; ++k) {
+      if (largest == 0 ||
+          stats.at<int>(k, cv::CC_STAT_AREA) > stats.at<int>(largest, cv::CC_STAT_AREA)) {
+        largest = k;
+      }
+    }
+    if (largest > 0) {
+      s.largest_blob_pixels = stats.at<int>(largest, cv::CC_STAT_AREA);
+      double area = 0;
+      const int* comp = component.ptr<int>();
+      for (int i = 0; i < num_pixels; ++i) {
+        if (comp[i] == largest) area += footprint_m2(i);
+      }
+      s.largest_blob_area_m2 = static_cast<float>(area);
+    }
+  }
+
+  // Nearer surfaces close to the modelled arm. For an occluded pixel the
+  // distance is how far in front of the arm the surface is; for an
+  // unexpected surface it is the 3-D distance to the modelled arm point at
+  // the nearest robot pixel in the image (an approximation of the distance
+  // to the arm's visible surface).
+  {
+    const cv::Mat1b candidates = opened(nearer_mask, parameters.opening_radius_px);
+    s.near_arm_min_distance_m = -1;
+    if (any_robot && cv::countNonZero(candidates) > 0) {
+      cv::Mat1f distance_px;
+      cv::Mat1i nearest;
+      cv::distanceTransform(not_robot, distance_px, nearest, cv::DIST_L2, cv::DIST_MASK_5,
+                            cv::DIST_LABEL_PIXEL);
+      // Each robot pixel carries its own label: label -> pixel index.
+      std::vector<int> pixel_of_label;
+      const int* nearest_label = nearest.ptr<int>();
+      for (int i = 0; i < num_pixels; ++i) {
+        if (robot_free[i] == 0) {
+          const int k = nearest_label[i];
+          if (k >= static_cast<int>(pixel_of_label.size())) pixel_of_label.resize(k + 1, -1);
+          pixel_of_label[k] = i;
+        }
+      }
+      auto point_m = [&](int i, int depth_mm) {
+        const double z = depth_mm * 1e-3;
+        return cv::Point3d((i % width - camera.cx) * z / camera.fx, (i / width - camera.cy) * z / camera.fy, z);
+      };
+      const uint8_t* candidate = candidates.ptr<uint8_t>();
+      double min_distance = std::numeric_limits<double>::infinity();
+      double area = 0;
+      for (int i = 0; i < num_pixels; ++i) {
+        if (candidate[i] == 0) continue;
+        double distance_m;
+        if (pixel_class[i] == discrepancy_t::PIXEL_OCCLUDED) {
+          distance_m = (gen[i] - tof[i]) * 1e-3;
+        } else {
+          const int k = nearest_label[i];
+          const int arm = k < static_cast<int>(pixel_of_label.size()) ? pixel_of_label[k] : -1;
+          if (arm < 0) continue;
+          distance_m = cv::norm(point_m(i, tof[i]) - point_m(arm, gen[arm]));
+        }
+        if (distance_m <= parameters.near_arm_m) {
+          s.near_arm_pixels++;
+          area += footprint_m2(i);
+          min_distance = std::min(min_distance, distance_m);
+        }
+      }
+      s.near_arm_area_m2 = static_cast<float>(area);
+      if (s.near_arm_pixels > 0) s.near_arm_min_distance_m = static_cast<float>(min_distance);
+    }
+  }
+  return frame;
+}
+
+int64_t depth_hash(const std::vector<int16_t>& depth_mm) {
+  uint64_t hash = 0xcbf29ce484222325ULL;
+  for (int16_t d : depth_mm) {
+    const auto bits = static_cast<uint16_t>(d);
+    hash = (hash ^ (bits & 0xffu)) * 0x100000001b3ULL;
+    hash = (hash ^ (bits >> 8)) * 0x100000001b3ULL;
+  }
+  return static_cast<int64_t>(hash);
+}
+
+int32_t RepeatCounter::update(int64_t hash) {
+  repeats_ = (has_previous_ && hash == previous_) ? repeats_ + 1 : 0;
+  has_previous_ = true;
+  previous_ = hash;
+  return repeats_;
+}
+
+discrepancy_image_t colour_image(const DiscrepancyFrame& frame, double full_scale_mm) {
+  discrepancy_image_t image;
+  image.utime = frame.summary.utime;
+  image.seq = frame.summary.seq;
+  image.camera_id = frame.summary.camera_id;
+  image.width = frame.summary.width;
+  image.height = frame.summary.height;
+  const int num_pixels = image.width * image.height;
+  image.num_bytes = 3 * num_pixels;
+  image.rgb.assign(image.num_bytes, 0);
+  if (frame.pixel_class.empty()) return image;
+  const uint8_t* pixel_class = frame.pixel_class.ptr<uint8_t>();
+  const int32_t* dis = frame.dis_mm.ptr<int32_t>();
+  for (int i = 0; i < num_pixels; ++i) {
+    const uint8_t c = pixel_class[i];
+    if (c == discrepancy_t::PIXEL_MATCH || c == discrepancy_t::PIXEL_INVALID || dis[i] == 0) continue;
+    const double level = std::min(255.0, 255.0 * std::abs(dis[i]) / full_scale_mm);
+    const auto value = static_cast<uint8_t>(std::max(1.0, level));
+    // Red (channel 0) where the camera sees nearer, blue (2) farther.
+    image.rgb[3 * i + (dis[i] > 0 ? 0 : 2)] = value;
+  }
+  return image;
+}
+
+}  // namespace tofguard::discrepancy

@@ -1,0 +1,100 @@
+// tofguard-spy: watch the live tofguard channels in a terminal.
+//   tofguard-spy [--config FILE]                  refreshing status board
+//   tofguard-spy [--config FILE] --lines [--channel REGEX]...
+//                                                 one decoded line per message
+// Listens on both the safety URL and the image URL; decodes by fingerprint.
+#include <poll.h>
+
+#include <iostream>
+#include <regex>
+
+#include "message_format.hpp"
+#include "status_board.hpp"
+#include "tofguard/clock.hpp"
+#include "tofguard/lcm_node.hpp"
+#include "tofguard/process.hpp"
+
+namespace tofguard::spy {
+namespace {
+
+struct Receiver {
+  bool lines = false;
+  std::vector<std::regex> filters;
+  StatusBoard board;
+  void on_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    const int size = static_cast<int>(rbuf->data_size);
+    if (lines) {
+      if (!filters.empty()) {
+        bool match = false;
+        for (const auto& f : filters) match = match || std::regex_match(channel, f);
+        if (!match) return;
+      }
+      std::cout << format_message(channel, rbuf->data, size) << std::endl;
+    } else {
+      board.on_message(channel, rbuf->data, size, monotonic_us(), wall_utime());
+    }
+  }
+};
+
+int run(const Config& config, const std::vector<std::string>& args) {
+  Receiver receiver;
+  for (size_t i = 0; i < args.size(); ++i) {
+    if (args[i] == "--lines") {
+      receiver.lines = true;
+    } else if (args[i] == "--board") {
+      receiver.lines = false;
+    } else if (args[i] == "--channel" && i + 1 < args.size()) {
+      try {
+        receiver.filters.emplace_back(args[++i]);
+      } catch (const std::regex_error&) {
+        std::cerr << "tofguard-spy: --channel: expected a regular expression, got '" << args[i] << "'\n";
+        return kConfigErrorExitCode;
+      }
+    } else {
+      std::cerr << "tofguard-spy: unknown argument '" << args[i] << "'\n";
+      return kConfigErrorExitCode;
+    }
+  }
+  lcm::LCM safety(config.lcm.url);
+  lcm::LCM images(config.lcm.image_url);
+  if (!safety.good() || !images.good()) {
+    std::cerr << "tofguard-spy: cannot open LCM at " << config.lcm.url << " / " << config.lcm.image_url << "\n";
+    return 3;
+  }
+  safety.subscribe(".*", &Receiver::on_message, &receiver);
+  if (config.lcm.image_url != config.lcm.url) images.subscribe(".*", &Receiver::on_message, &receiver);
+  // LCM 1.3 joins the multicast group lazily, on the first getFileno() or
+  // handle(): do it now, so "listening" is true when it is printed.
+  safety.getFileno();
+  images.getFileno();
+  std::cout << "tofguard-spy: listening on " << config.lcm.url << " and " << config.lcm.image_url << std::endl;
+
+  int64_t next_draw_us = 0;
+  while (!stop_requested()) {
+    pollfd fds[2] = {{safety.getFileno(), POLLIN, 0}, {images.getFileno(), POLLIN, 0}};
+    if (poll(fds, 2, 50) > 0) {
+      if (fds[0].revents & POLLIN) safety.handle();
+      if (fds[1].revents & POLLIN) images.handle();
+    }
+    if (!receiver.lines && monotonic_us() >= next_draw_us) {
+      next_draw_us = monotonic_us() + 250'000;
+      // Clear the screen and draw from the top.
+      std::cout << "\033[H\033[2J" << "tofguard-spy  " << config.lcm.url << "  (Ctrl-C to quit)\n\n"
+                << receiver.board.render(monotonic_us(), wall_utime()) << std::flush;
+    }
+  }
+  return 0;
+}
+
+}  // namespace
+}  // namespace tofguard::spy
+
+int main(int argc, char** argv) {
+  tofguard::ProcessInfo info{
+      "tofguard-spy",
+      "Watches the live tofguard channels: a refreshing status board (default: permission to\n"
+      "move and why, latest risk, heartbeats with counters, channel rates, latency from the\n"
+      "camera frame), or --lines: one decoded line per message, filtered by --channel REGEX.",
+      /*config_required=*/false};
+  return tofguard::run_process(argc, argv, info, tofguard::spy::run);
+}

@@ -1,0 +1,157 @@
+#include "message_format.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <functional>
+#include <iomanip>
+#include <map>
+#include <sstream>
+
+#include "tofguard/camera_pose_t.hpp"
+#include "tofguard/depth_image_t.hpp"
+#include "tofguard/heartbeat_t.hpp"
+#include "tofguard/joint_state_t.hpp"
+#include "tofguard/link_labels_t.hpp"
+#include "tofguard/power_relay_t.hpp"
+#include "tofguard/reset_reply_t.hpp"
+#include "tofguard/reset_request_t.hpp"
+#include "tofguard/risk_names.hpp"
+#include "tofguard/risk_t.hpp"
+#include "tofguard/safety_status_t.hpp"
+#include "tofguard/sim_joint_fault_t.hpp"
+
+namespace tofguard::spy {
+namespace {
+
+std::string yes_no(bool b) { return b ? "true" : "false"; }
+
+std::string format(const depth_image_t& m) {
+  int valid = 0;
+  for (int16_t d : m.depth_mm) valid += d > 0;
+  std::ostringstream s;
+  s << "utime=" << m.utime << " seq=" << m.seq << " camera=" << m.camera_id << " " << m.width << "x" << m.height
+    << " valid=" << std::fixed << std::setprecision(1)
+    << (m.num_pixels > 0 ? 100.0 * valid / m.num_pixels : 0.0) << "% calibrated=" << yes_no(m.calibrated);
+  return s.str();
+}
+
+std::string format(const joint_state_t& m) {
+  std::ostringstream s;
+  s << "utime=" << m.utime << " robot=" << m.robot_id << std::fixed << std::setprecision(4);
+  for (int i = 0; i < m.num_joints; ++i) s << " " << m.name[i] << "=" << m.position[i];
+  return s.str();
+}
+
+std::string format(const camera_pose_t& m) {
+  std::ostringstream s;
+  s << "utime=" << m.utime << " camera=" << m.camera_id << " frame=" << m.frame_id << std::fixed
+    << std::setprecision(4) << " t=[" << m.translation[0] << "," << m.translation[1] << "," << m.translation[2]
+    << "] q_wxyz=[" << m.rotation[0] << "," << m.rotation[1] << "," << m.rotation[2] << "," << m.rotation[3]
+    << "]";
+  return s.str();
+}
+
+std::string format(const risk_t& m) {
+  std::ostringstream s;
+  s << "utime=" << m.utime << " seq=" << m.seq << " " << risk_level_name(m.level) << " "
+    << risk_cause_name(m.cause);
+  if (!m.suspect.empty()) s << " suspect=" << m.suspect;
+  s << " score=" << m.score << " threshold=" << m.threshold;
+  if (!m.detail.empty()) s << " | " << m.detail;
+  return s.str();
+}
+
+std::string format(const safety_status_t& m) {
+  std::ostringstream s;
+  s << "seq=" << m.seq << " motion_allowed=" << yes_no(m.motion_allowed) << " stop=" << stop_name(m.stop)
+    << " latched=" << yes_no(m.latched) << " cause=" << risk_cause_name(m.cause) << " | " << m.reason;
+  return s.str();
+}
+
+std::string format(const heartbeat_t& m) {
+  std::ostringstream s;
+  s << m.process << " pid=" << m.pid << " seq=" << m.seq << " in=" << m.frames_in << " out=" << m.frames_out
+    << " dropped=" << m.frames_dropped << " decode_errors=" << m.decode_errors
+    << " validation_errors=" << m.validation_errors << " | " << m.status;
+  return s.str();
+}
+
+std::string format(const link_labels_t& m) {
+  std::ostringstream s;
+  s << "utime=" << m.utime << " seq=" << m.seq << " camera=" << m.camera_id << " usable=" << yes_no(m.usable);
+  if (!m.usable) s << " (" << m.unusable_reason << ")";
+  s << " " << m.width << "x" << m.height << " links=" << m.num_links;
+  return s.str();
+}
+
+std::string format(const reset_request_t& m) {
+  return "request_id=" + std::to_string(m.request_id) + " who=" + m.who + " | " + m.why;
+}
+
+std::string format(const reset_reply_t& m) {
+  return "request_id=" + std::to_string(m.request_id) + " accepted=" + yes_no(m.accepted) + " | " + m.reason;
+}
+
+std::string format(const power_relay_t& m) {
+  return "seq=" + std::to_string(m.seq) + " power_enabled=" + yes_no(m.power_enabled) + " | " + m.reason;
+}
+
+std::string format(const sim_joint_fault_t& m) {
+  std::ostringstream s;
+  s << "joint=" << m.joint << " offset=" << m.offset;
+  return s.str();
+}
+
+using Formatter = std::function<std::optional<std::string>(const void*, int)>;
+
+template <class T>
+std::pair<int64_t, std::pair<std::string, Formatter>> entry() {
+  Formatter f = [](const void* data, int size) -> std::optional<std::string> {
+    T m;
+    try {
+      if (m.decode(data, 0, size) < 0) return std::nullopt;
+    } catch (const std::exception&) {
+      return std::nullopt;
+    }
+    return format(m);
+  };
+  return {T::getHash(), {T::getTypeName(), f}};
+}
+
+const std::map<int64_t, std::pair<std::string, Formatter>>& formatters() {
+  static const std::map<int64_t, std::pair<std::string, Formatter>> table = {
+      entry<depth_image_t>(),   entry<joint_state_t>(),     entry<camera_pose_t>(), entry<risk_t>(),
+      entry<safety_status_t>(), entry<heartbeat_t>(),       entry<link_labels_t>(), entry<reset_request_t>(),
+      entry<reset_reply_t>(),   entry<power_relay_t>(),     entry<sim_joint_fault_t>(),
+  };
+  return table;
+}
+
+int64_t fingerprint(const void* data, int size) {
+  if (size < 8) return 0;
+  const auto* b = static_cast<const uint8_t*>(data);
+  uint64_t hash = 0;
+  for (int i = 0; i < 8; ++i) hash = (hash << 8) | b[i];  // big-endian on the wire
+  return static_cast<int64_t>(hash);
+}
+
+}  // namespace
+
+std::string type_of(const void* data, int size) {
+  const auto it = formatters().find(fingerprint(data, size));
+  return it == formatters().end() ? "" : it->second.first;
+}
+
+std::string format_message(const std::string& channel, const void* data, int size) {
+  const int64_t hash = fingerprint(data, size);
+  const auto it = formatters().find(hash);
+  if (it != formatters().end()) {
+    if (auto text = it->second.second(data, size)) return channel + " " + it->second.first + " " + *text;
+  }
+  std::ostringstream s;
+  s << channel << " ? fingerprint 0x" << std::hex << std::setw(16) << std::setfill('0') << static_cast<uint64_t>(hash)
+    << std::dec << " (" << size << " bytes)";
+  return s.str();
+}
+
+}  // namespace tofguard::spy

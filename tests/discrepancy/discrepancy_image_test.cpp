@@ -1,0 +1,260 @@
+// The discrepancy image on synthetic frames whose every count is known.
+#include <gtest/gtest.h>
+
+#include "discrepancy_image.hpp"
+#include "synthetic_frames.hpp"
+
+namespace tofguard::test {
+namespace {
+
+using discrepancy::compute_discrepancy;
+using discrepancy::DiscrepancyFrame;
+using discrepancy::Parameters;
+
+// The simulated camera's noise, 4 sigma + 15 mm, 3x3 opening, 0.2 m.
+Parameters sim_parameters() { return Parameters{}; }
+
+DiscrepancyFrame compare(const SyntheticImage& model, const std::vector<int16_t>& camera_depth,
+                         const Parameters& parameters = sim_parameters()) {
+  return compute_discrepancy(depth_frame(camera_depth, 7), depth_frame(model.depth_mm, 7),
+                             labels_frame(model.label, 7), parameters);
+}
+
+constexpr int kPixels = kWidth * kHeight;
+
+TEST(Tolerance, GrowsWithTheSquareOfTheDepth) {
+  const discrepancy::Tolerance t;
+  // 4 * (4 + 1.2 * d^2) + 15
+  EXPECT_DOUBLE_EQ(t.at(500), 4 * (4 + 1.2 * 0.25) + 15);
+  EXPECT_DOUBLE_EQ(t.at(5000), 4 * (4 + 1.2 * 25) + 15);
+}
+
+TEST(Discrepancy, IdenticalFramesMatchEverywhere) {
+  const SyntheticImage model = draw(default_arm());
+  const DiscrepancyFrame f = compare(model, model.depth_mm);
+  const discrepancy_t& s = f.summary;
+  ASSERT_TRUE(s.usable) << s.unusable_reason;
+  EXPECT_EQ(s.seq, 7);
+  EXPECT_EQ(s.num_pixels, kPixels);
+  EXPECT_EQ(s.num_compared, kPixels);
+  EXPECT_EQ(s.num_match, kPixels);
+  EXPECT_EQ(s.sum_abs_dis_mm, 0);
+  EXPECT_EQ(s.largest_blob_pixels, 0);
+  EXPECT_EQ(s.near_arm_pixels, 0);
+  EXPECT_FLOAT_EQ(s.near_arm_min_distance_m, -1);
+  ASSERT_EQ(s.num_links, 4);
+  EXPECT_EQ(s.link_name[2], "link2");
+  // base_link 20x40, link1 20x40, link2 40x20 pixels; the floor the rest.
+  EXPECT_EQ(s.link_compared[0], 800);
+  EXPECT_EQ(s.link_compared[1], 800);
+  EXPECT_EQ(s.link_compared[2], 800);
+  EXPECT_EQ(s.link_compared[3], kPixels - 2400);
+  EXPECT_EQ(s.link_match[2], 800);
+}
+
+TEST(Discrepancy, NoiseOnlyFramesMatchAndScoreAsNoise) {
+  const SyntheticImage model = draw(default_arm());
+  for (uint32_t seed = 1; seed <= 5; ++seed) {
+    const discrepancy_t s = compare(model, with_noise(model.depth_mm, seed)).summary;
+    ASSERT_TRUE(s.usable);
+    EXPECT_EQ(s.num_match, kPixels) << "seed " << seed;
+    EXPECT_EQ(s.largest_blob_pixels, 0);
+    EXPECT_EQ(s.near_arm_pixels, 0);
+    // Most pixels see the floor at 2 m: sigma = 8.8 mm, median |noise| =
+    // 0.674 sigma = 5.9 mm.
+    EXPECT_NEAR(s.median_abs_dis_mm, 5.9, 1.0);
+    EXPECT_NEAR(s.p95_abs_dis_mm, 1.96 * 8.8, 2.0);
+    EXPECT_NEAR(s.environment_median_dis_mm, 0, 1.0);
+  }
+}
+
+TEST(Discrepancy, ShiftedLinkIsMissingWhereModelledAndUnexpectedBesideIt) {
+  const SyntheticImage model = draw(default_arm());
+  const SyntheticImage seen = draw(default_arm(/*link2_shift_px=*/10));
+  const DiscrepancyFrame f = compare(model, seen.depth_mm);
+  const discrepancy_t& s = f.summary;
+  ASSERT_TRUE(s.usable);
+  // u 60..69 x v 60..79: the model's link2, the camera sees the floor.
+  EXPECT_EQ(s.num_robot_missing, 200);
+  // u 100..109 x v 60..79: the camera sees the arm where the model has floor.
+  EXPECT_EQ(s.num_unexpected_surface, 200);
+  EXPECT_EQ(s.num_occluded, 0);
+  EXPECT_EQ(s.num_match, kPixels - 400);
+  EXPECT_EQ(s.link_farther[2], 200);
+  EXPECT_EQ(s.link_match[2], 600);
+  EXPECT_EQ(s.link_farther[0] + s.link_farther[1], 0);
+  EXPECT_EQ(s.link_nearer[3], 200);
+  EXPECT_FLOAT_EQ(s.link_median_dis_mm[2], 0);
+  // The seed's score: 400 pixels 500 mm off.
+  EXPECT_DOUBLE_EQ(s.sum_abs_dis_mm, 400 * 500.0);
+  EXPECT_DOUBLE_EQ(s.normalized_sum_abs_dis, 400 * 500.0 / (kPixels * 8000.0));
+  EXPECT_NEAR(s.mismatch_fraction, 400.0 / kPixels, 1e-6);
+  // Two separate 10x20 blobs.
+  EXPECT_EQ(s.largest_blob_pixels, 200);
+  // The unexpected surface lies beside the arm: all of it near the arm; the
+  // closest pixel is one column (1.5 m / 200 px = 7.5 mm) from it.
+  EXPECT_EQ(s.near_arm_pixels, 200);
+  EXPECT_NEAR(s.near_arm_area_m2, 200 * (1.5 / 200) * (1.5 / 200), 1e-7);
+  EXPECT_NEAR(s.near_arm_min_distance_m, 0.0075, 1e-6);
+  EXPECT_EQ(f.pixel_class(70, 65), discrepancy_t::PIXEL_ROBOT_MISSING);
+  EXPECT_EQ(f.pixel_class(70, 105), discrepancy_t::PIXEL_UNEXPECTED_SURFACE);
+  EXPECT_EQ(f.dis_mm(70, 65), -500);
+  EXPECT_EQ(f.dis_mm(70, 105), 500);
+}
+
+TEST(Discrepancy, ObjectInFrontOfTheArmIsOccludedAndNearTheArm) {
+  const SyntheticImage model = draw(default_arm());
+  std::vector<Box> scene = default_arm();
+  // 20x20 box 0.1 m in front of base_link, half over it, half over floor.
+  scene.push_back({30, 110, 50, 130, 1400, 0});
+  const discrepancy_t s = compare(model, with_noise(draw(scene).depth_mm, 3)).summary;
+  EXPECT_EQ(s.num_occluded, 200);
+  EXPECT_EQ(s.num_unexpected_surface, 200);
+  EXPECT_EQ(s.num_robot_missing, 0);
+  EXPECT_EQ(s.link_nearer[0], 200);
+  EXPECT_EQ(s.largest_blob_pixels, 400);
+  EXPECT_NEAR(s.largest_blob_area_m2, 400 * (1.4 / 200) * (1.4 / 200), 2e-5);
+  EXPECT_EQ(s.near_arm_pixels, 400);
+  EXPECT_NEAR(s.near_arm_min_distance_m, 0.1, 0.02);
+}
+
+TEST(Discrepancy, ObjectFarFromTheArmIsNotNearTheArm) {
+  const SyntheticImage model = draw(default_arm());
+  std::vector<Box> scene = default_arm();
+  scene.push_back({140, 10, 160, 30, 1900, 0});  // 0.5 m from the arm
+  const discrepancy_t s = compare(model, draw(scene).depth_mm).summary;
+  EXPECT_EQ(s.num_unexpected_surface, 400);
+  EXPECT_EQ(s.largest_blob_pixels, 400);
+  EXPECT_NEAR(s.largest_blob_area_m2, 400 * (1.9 / 200) * (1.9 / 200), 1e-6);
+  EXPECT_EQ(s.near_arm_pixels, 0);
+  EXPECT_FLOAT_EQ(s.near_arm_min_distance_m, -1);
+}
+
+TEST(Discrepancy, ThinSilhouetteSliversAreNotBlobs) {
+  const SyntheticImage model = draw(default_arm());
+  // The camera's link2 one pixel wider: a one-pixel column of mismatch.
+  std::vector<Box> scene = default_arm();
+  scene.push_back({100, 60, 101, 80, kArmMm, 3});
+  const discrepancy_t s = compare(model, draw(scene).depth_mm).summary;
+  EXPECT_EQ(s.num_unexpected_surface, 20);
+  EXPECT_EQ(s.largest_blob_pixels, 0);
+  EXPECT_EQ(s.near_arm_pixels, 0);
+  // Without the opening the sliver counts.
+  Parameters raw = sim_parameters();
+  raw.opening_radius_px = 0;
+  EXPECT_EQ(compare(model, draw(scene).depth_mm, raw).summary.largest_blob_pixels, 20);
+}
+
+TEST(Discrepancy, ConstantOffsetScoresAsTheSeedDefines) {
+  const SyntheticImage model = draw(default_arm());
+  std::vector<int16_t> camera = model.depth_mm;
+  for (int16_t& d : camera) d = static_cast<int16_t>(d - 100);  // 100 mm nearer
+  const discrepancy_t s = compare(model, camera).summary;
+  EXPECT_DOUBLE_EQ(s.sum_abs_dis_mm, 100.0 * kPixels);
+  EXPECT_DOUBLE_EQ(s.normalized_sum_abs_dis, 100.0 / 8000.0);
+  EXPECT_FLOAT_EQ(s.median_abs_dis_mm, 100);
+  EXPECT_FLOAT_EQ(s.robot_median_dis_mm, 100);
+  EXPECT_FLOAT_EQ(s.environment_median_dis_mm, 100);
+  EXPECT_EQ(s.num_occluded, 2400);
+  EXPECT_EQ(s.num_unexpected_surface, kPixels - 2400);
+  EXPECT_EQ(s.largest_blob_pixels, kPixels);
+}
+
+TEST(Discrepancy, InvalidPixelsAreCountedAndNotCompared) {
+  const SyntheticImage model = draw(default_arm());
+  std::vector<int16_t> camera = model.depth_mm;
+  for (int v = 100; v < 110; ++v) {
+    for (int u = 40; u < 50; ++u) camera[v * kWidth + u] = 0;  // on base_link
+  }
+  camera[0] = -1;
+  const discrepancy_t s = compare(model, camera).summary;
+  EXPECT_EQ(s.num_invalid, 101);
+  EXPECT_NEAR(s.invalid_fraction, 101.0 / kPixels, 1e-7);
+  EXPECT_EQ(s.num_compared, kPixels - 101);
+  EXPECT_EQ(s.link_invalid[0], 100);
+  EXPECT_EQ(s.link_compared[0], 700);
+  EXPECT_EQ(s.num_match + s.num_invalid, kPixels);
+}
+
+TEST(Discrepancy, NothingModelledButSomethingSeenIsUnexpectedNotCompared) {
+  SyntheticImage model = draw(default_arm());
+  for (int i = 0; i < kWidth * 10; ++i) {
+    model.depth_mm[i] = 0;
+    model.label[i] = link_labels_t::NOTHING;
+  }
+  const discrepancy_t s = compare(model, draw(default_arm()).depth_mm).summary;
+  EXPECT_EQ(s.num_unexpected_surface, kWidth * 10);
+  EXPECT_EQ(s.num_compared, kPixels - kWidth * 10);
+  // Far from the arm, and not modelled: neither near the arm nor a blob.
+  EXPECT_EQ(s.near_arm_pixels, 0);
+  EXPECT_EQ(s.largest_blob_pixels, 0);
+}
+
+TEST(Discrepancy, UnusableLabelsMakeAnUnusableFrame) {
+  const SyntheticImage model = draw(default_arm());
+  const depth_image_t camera = depth_frame(model.depth_mm, 9);
+  const discrepancy_t s =
+      compute_discrepancy(camera, depth_image_t{}, unusable_labels(9, "joint 'a3' missing"), sim_parameters())
+          .summary;
+  EXPECT_FALSE(s.usable);
+  EXPECT_EQ(s.unusable_kind, discrepancy_t::UNUSABLE_RENDERER);
+  EXPECT_EQ(s.unusable_reason, "renderer: joint 'a3' missing");
+  EXPECT_EQ(s.seq, 9);
+  EXPECT_EQ(s.utime, camera.utime);
+  EXPECT_TRUE(s.calibrated);
+}
+
+TEST(Discrepancy, FramesThatDoNotFitAreUnusableAndSayWhy) {
+  const SyntheticImage model = draw(default_arm());
+  const depth_image_t camera = depth_frame(model.depth_mm, 4);
+  const link_labels_t labels = labels_frame(model.label, 4);
+
+  const SyntheticImage small = draw({}, 88, 72);
+  auto s = compute_discrepancy(camera, depth_frame(small.depth_mm, 4, 88, 72), labels, sim_parameters()).summary;
+  EXPECT_FALSE(s.usable);
+  EXPECT_EQ(s.unusable_kind, discrepancy_t::UNUSABLE_MISMATCHED);
+  EXPECT_EQ(s.unusable_reason, "rendered frame is 88x72, camera frame 176x144");
+
+  depth_image_t other_focal = depth_frame(model.depth_mm, 4);
+  other_focal.fx = 210;
+  s = compute_discrepancy(camera, other_focal, labels, sim_parameters()).summary;
+  EXPECT_FALSE(s.usable);
+  EXPECT_NE(s.unusable_reason.find("intrinsics"), std::string::npos) << s.unusable_reason;
+
+  link_labels_t bad_label = labels;
+  bad_label.label[kWidth + 3] = 500;
+  s = compute_discrepancy(camera, depth_frame(model.depth_mm, 4), bad_label, sim_parameters()).summary;
+  EXPECT_FALSE(s.usable);
+  EXPECT_EQ(s.unusable_reason, "label[179]: expected 0, 1..3 or 1000..1000, got 500");
+}
+
+TEST(Discrepancy, ColourImageIsRedForNearerBlueForFartherBlackForMatch) {
+  const SyntheticImage model = draw(default_arm());
+  const DiscrepancyFrame f = compare(model, draw(default_arm(10)).depth_mm);
+  const discrepancy_image_t image = discrepancy::colour_image(f, /*full_scale_mm=*/1000);
+  ASSERT_EQ(image.num_bytes, 3 * kPixels);
+  auto rgb = [&](int v, int u, int c) { return image.rgb[3 * (v * kWidth + u) + c]; };
+  // Robot missing (the camera sees farther): I_dis = -500 -> blue at half
+  // brightness.
+  EXPECT_EQ(rgb(70, 65, 2), 127);
+  EXPECT_EQ(rgb(70, 65, 0), 0);
+  // Unexpected surface (the camera sees nearer): I_dis = +500 -> red.
+  EXPECT_EQ(rgb(70, 105, 0), 127);
+  EXPECT_EQ(rgb(70, 105, 2), 0);
+  // Match -> black.
+  EXPECT_EQ(rgb(10, 10, 0) + rgb(10, 10, 1) + rgb(10, 10, 2), 0);
+}
+
+TEST(DepthHash, RepeatsAreCountedInARow) {
+  const std::vector<int16_t> a = {1, 2, 3};
+  const std::vector<int16_t> b = {1, 2, 4};
+  EXPECT_NE(discrepancy::depth_hash(a), discrepancy::depth_hash(b));
+  discrepancy::RepeatCounter repeats;
+  EXPECT_EQ(repeats.update(discrepancy::depth_hash(a)), 0);
+  EXPECT_EQ(repeats.update(discrepancy::depth_hash(a)), 1);
+  EXPECT_EQ(repeats.update(discrepancy::depth_hash(a)), 2);
+  EXPECT_EQ(repeats.update(discrepancy::depth_hash(b)), 0);
+}
+
+}  // namespace
+}  // namespace tofguard::test

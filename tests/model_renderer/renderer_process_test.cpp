@@ -1,0 +1,188 @@
+// tofguard-renderer as a real process over real LCM (private network
+// namespace): joint states and a depth frame in, the rendered frame and its
+// labels out, with the numbers the library gives for the interpolated
+// joints; unusable frames carry their reason and no TOF_RENDERED.
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+
+#include <iostream>
+#include <map>
+
+#include "depth_renderer.hpp"
+#include "renderer_process.hpp"
+#include "test_support.hpp"
+#include "tofguard/clock.hpp"
+#include "tofguard/heartbeat_t.hpp"
+
+namespace tofguard::renderer {
+namespace {
+
+using tofguard::test::wait_until;
+
+// Joint values that change linearly in time, so that interpolation between
+// any two messages is exact: a_i(t) = 0.1*i + 0.5*i*(t - t0) [s].
+JointPositions arm_at(int64_t utime, int64_t t0) {
+  JointPositions q;
+  for (int i = 1; i <= 7; ++i) q["a" + std::to_string(i)] = 0.1 * i + 0.5 * i * (utime - t0) * 1e-6;
+  return q;
+}
+
+struct Bench {
+  Config config = load_config(tofguard::test::source_dir() + "/config/sim.yaml", nullptr);
+  lcm::LCM safety{config.lcm.url};
+  lcm::LCM images{config.lcm.image_url};
+  std::map<int64_t, depth_image_t> rendered;  // by seq
+  std::map<int64_t, link_labels_t> labels;
+  heartbeat_t heartbeat;
+  int64_t t0 = wall_utime();
+  int64_t next_joint_utime = t0;
+  int64_t seq = 0;
+
+  Bench() {
+    images.subscribe(config.channels.rendered, &Bench::on_rendered, this);
+    images.subscribe(config.channels.labels, &Bench::on_labels, this);
+    safety.subscribe(config.channels.heartbeat, &Bench::on_heartbeat, this);
+  }
+  void on_rendered(const lcm::ReceiveBuffer*, const std::string&, const depth_image_t* m) { rendered[m->seq] = *m; }
+  void on_labels(const lcm::ReceiveBuffer*, const std::string&, const link_labels_t* m) { labels[m->seq] = *m; }
+  void on_heartbeat(const lcm::ReceiveBuffer*, const std::string&, const heartbeat_t* m) {
+    if (m->process == "tofguard-renderer") heartbeat = *m;
+  }
+  void pump() {
+    images.handleTimeout(2);
+    safety.handleTimeout(2);
+  }
+  void publish_joints(int64_t utime, const JointPositions& q) {
+    joint_state_t m;
+    m.utime = utime;
+    m.robot_id = config.robot.id;
+    for (const auto& [name, value] : q) {
+      m.name.push_back(name);
+      m.position.push_back(value);
+      m.velocity.push_back(0);
+    }
+    m.num_joints = static_cast<int32_t>(m.name.size());
+    safety.publish(config.channels.joint_state, &m);
+  }
+  // Joint states every 10 ms of utime up to `until`.
+  void publish_joints_until(int64_t until) {
+    for (; next_joint_utime <= until; next_joint_utime += 10'000) {
+      publish_joints(next_joint_utime, arm_at(next_joint_utime, t0));
+    }
+  }
+  int64_t publish_frame(int64_t utime) {
+    const Intrinsics& k = config.camera.intrinsics;
+    depth_image_t f;
+    f.utime = utime;
+    f.seq = ++seq;
+    f.camera_id = config.camera.id;
+    f.width = k.width;
+    f.height = k.height;
+    f.fx = k.fx;
+    f.fy = k.fy;
+    f.cx = k.cx;
+    f.cy = k.cy;
+    f.calibrated = true;
+    f.num_pixels = k.width * k.height;
+    f.depth_mm.assign(f.num_pixels, 1500);
+    f.num_amplitude = 0;
+    images.publish(config.channels.depth, &f);
+    return f.seq;
+  }
+};
+
+TEST(RendererProcess, RendersFramesAtInterpolatedJointsAndMarksUnusableOnes) {
+  tofguard::test::Subprocess process(
+      "renderer-process",
+      {tofguard::test::bin_dir() + "/tofguard-renderer", "--config", tofguard::test::source_dir() + "/config/sim.yaml"});
+  Bench bench;
+
+  // Until the process is up, keep sending joint states and a frame between
+  // the last two of them.
+  int64_t first_seq = 0;
+  ASSERT_TRUE(wait_until(
+      [&] { return first_seq != 0 && bench.rendered.count(first_seq) > 0; }, std::chrono::seconds(20),
+      [&] {
+        if (bench.rendered.empty()) {
+          bench.publish_joints_until(bench.next_joint_utime + 10'000);
+          first_seq = bench.publish_frame(bench.next_joint_utime - 10'000 - 3'700);  // between the last two
+        }
+        bench.pump();
+      }))
+      << process.stderr_text();
+  // Whichever frame came through first: its utime is what it was sent with.
+  const depth_image_t& out = bench.rendered.begin()->second;
+  ASSERT_EQ(bench.labels.count(out.seq), 1u);
+  const link_labels_t& labels = bench.labels.at(out.seq);
+  EXPECT_TRUE(labels.usable) << labels.unusable_reason;
+  EXPECT_EQ(out.camera_id, bench.config.camera.id);
+  EXPECT_EQ(out.width, 176);
+  EXPECT_EQ(out.height, 144);
+  EXPECT_EQ(out.fx, 221.0);
+  EXPECT_EQ(out.num_pixels, 176 * 144);
+  EXPECT_EQ(labels.utime, out.utime);
+  EXPECT_EQ(labels.num_robot_links, 10);
+
+  // The numbers: the library at the joints interpolated at the frame's utime.
+  const Config& config = bench.config;
+  const SceneModel scene = load_scene(config.robot.urdf_path, config.environment.urdf_paths, scene_options(config));
+  DepthRenderer renderer(scene, config.renderer.near_m, config.renderer.far_m);
+  const RenderResult expected = renderer.render(arm_at(out.utime, bench.t0), config.camera.pose, config.camera.intrinsics);
+  ASSERT_TRUE(expected.usable);
+  int differing = 0, robot_pixels = 0;
+  for (size_t i = 0; i < expected.depth_m.size(); ++i) {
+    differing += std::abs(out.depth_mm[i] - std::lround(expected.depth_m[i] * 1000)) > 1 ||
+                 labels.label[i] != expected.labels[i];
+    robot_pixels += expected.labels[i] > 0 && expected.labels[i] < kLabelEnvironmentFirst;
+  }
+  EXPECT_GT(robot_pixels, 1000);
+  EXPECT_EQ(differing, 0);
+
+  // A frame 50 ms beyond the newest joint state: unusable, labels only.
+  const int64_t late_seq = bench.publish_frame(bench.next_joint_utime - 10'000 + 50'000);
+  // A frame whose joint state lacks a4.
+  JointPositions without_a4 = arm_at(bench.next_joint_utime, bench.t0);
+  without_a4.erase("a4");
+  bench.publish_joints(bench.next_joint_utime, without_a4);
+  const int64_t missing_seq = bench.publish_frame(bench.next_joint_utime);
+  bench.next_joint_utime += 10'000;
+  // Then a good one, which arrives after them (LCM keeps a publisher's order).
+  bench.publish_joints_until(bench.next_joint_utime + 10'000);
+  const int64_t good_seq = bench.publish_frame(bench.next_joint_utime - 15'000);
+  ASSERT_TRUE(wait_until([&] { return bench.labels.count(good_seq) > 0; }, std::chrono::seconds(10),
+                         [&] { bench.pump(); }))
+      << process.stderr_text();
+  // The frames before it may have been dropped as stale (only the newest
+  // pending one is rendered); those that were rendered say why not usable.
+  if (bench.labels.count(late_seq)) {
+    EXPECT_FALSE(bench.labels.at(late_seq).usable);
+    EXPECT_NE(bench.labels.at(late_seq).unusable_reason.find("older than the frame"), std::string::npos)
+        << bench.labels.at(late_seq).unusable_reason;
+    EXPECT_EQ(bench.labels.at(late_seq).num_pixels, 0);
+  }
+  if (bench.labels.count(missing_seq)) {
+    EXPECT_FALSE(bench.labels.at(missing_seq).usable);
+    EXPECT_EQ(bench.labels.at(missing_seq).unusable_reason, "joint 'a4' missing from the joint state");
+  }
+  std::cout << "late frame " << (bench.labels.count(late_seq) ? "labelled" : "dropped") << ", missing-joint frame "
+            << (bench.labels.count(missing_seq) ? "labelled" : "dropped") << "\n";
+  EXPECT_EQ(bench.rendered.count(late_seq), 0u);
+  EXPECT_EQ(bench.rendered.count(missing_seq), 0u);
+  EXPECT_TRUE(bench.labels.at(good_seq).usable) << bench.labels.at(good_seq).unusable_reason;
+  ASSERT_TRUE(wait_until([&] { return bench.rendered.count(good_seq) > 0; }, std::chrono::seconds(5),
+                         [&] { bench.pump(); }));
+
+  // Every frame the process took in was either rendered or dropped.
+  ASSERT_TRUE(wait_until([&] { return bench.heartbeat.last_frame_utime == bench.labels.at(good_seq).utime; },
+                         std::chrono::seconds(5), [&] { bench.pump(); }));
+  const int64_t frames_sent = bench.seq;
+  EXPECT_LE(bench.heartbeat.frames_out + bench.heartbeat.frames_dropped, frames_sent);
+  EXPECT_EQ(bench.heartbeat.validation_errors, 0);
+  EXPECT_EQ(bench.heartbeat.decode_errors, 0);
+
+  process.signal(SIGTERM);
+  EXPECT_EQ(process.wait(std::chrono::seconds(5)), 0) << process.stderr_text();
+}
+
+}  // namespace
+}  // namespace tofguard::renderer

@@ -1,0 +1,153 @@
+// tofguard-spy: the decoded lines of a log replayed into it with
+// lcm-logplayer (private network namespace), its channel filter, and the
+// status board's content.
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+#include <signal.h>
+
+#include <filesystem>
+#include <thread>
+
+#include "../lcmtypes/sample_messages.hpp"
+#include "message_format.hpp"
+#include "status_board.hpp"
+#include "test_support.hpp"
+
+namespace tofguard::test {
+namespace {
+
+template <class T>
+std::vector<uint8_t> encoded(const T& message) {
+  std::vector<uint8_t> bytes(message.getEncodedSize());
+  message.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  return bytes;
+}
+
+const std::vector<std::pair<std::string, std::vector<uint8_t>>>& log_events() {
+  static const std::vector<std::pair<std::string, std::vector<uint8_t>>> events = {
+      {"TOF_DEPTH", encoded(sample_depth_image())},
+      {"JOINT_STATE", encoded(sample_joint_state())},
+      {"SAFETY_RISK", encoded(sample_risk())},
+      {"SAFETY_STATUS", encoded(sample_safety_status())},
+      {"SAFETY_HEARTBEAT", encoded(sample_heartbeat())},
+      {"JUNK", {1, 2, 3}},
+  };
+  return events;
+}
+
+const std::vector<std::string> kExpectedLines = {
+    "TOF_DEPTH depth_image_t utime=1700000000123456 seq=42 camera=tof-test 4x3 valid=91.7% calibrated=true",
+    "JOINT_STATE joint_state_t utime=1700000000200000 robot=friend-test a1=0.5000 a2=-1.2500 a3=3.0000",
+    "SAFETY_RISK risk_t utime=1700000000123456 seq=42 DANGEROUS joint error suspect=a4 score=123.5 threshold=50 | "
+    "joint a4 reads 10.0 deg less than seen",
+    "SAFETY_STATUS safety_status_t seq=7 motion_allowed=false stop=software stop latched=true cause=joint error | "
+    "DANGEROUS: joint error, suspect a4",
+    "SAFETY_HEARTBEAT heartbeat_t tofguard-renderer pid=4242 seq=99 in=1000 out=998 dropped=2 decode_errors=3 "
+    "validation_errors=4 | running",
+    "JUNK ? fingerprint 0x0000000000000000 (3 bytes)",
+};
+
+std::string write_log(const std::string& name) {
+  const std::string path = output_dir() + "/" + name + ".lcmlog";
+  std::filesystem::remove(path);
+  lcm::LogFile log(path, "w");
+  int64_t t = 1700000000000000;
+  // lcm-logplayer 1.3.1 may start reading before it has subscribed its
+  // republisher and then drops the first events: a lead-in event 500 ms
+  // ahead of the real ones takes that loss.
+  static const uint8_t lead_in = 0;
+  lcm::LogEvent first;
+  first.eventnum = 0;
+  first.timestamp = t - 500'000;
+  first.channel = "LOG_LEAD_IN";
+  first.datalen = 1;
+  first.data = const_cast<uint8_t*>(&lead_in);
+  log.writeEvent(&first);
+  for (const auto& [channel, bytes] : log_events()) {
+    lcm::LogEvent event;
+    event.eventnum = 0;
+    event.timestamp = t += 1000;
+    event.channel = channel;
+    event.datalen = static_cast<int32_t>(bytes.size());
+    event.data = const_cast<uint8_t*>(bytes.data());
+    log.writeEvent(&event);
+  }
+  return path;
+}
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> lines;
+  std::stringstream s(text);
+  for (std::string line; std::getline(s, line);) {
+    if (line.rfind("tofguard-spy:", 0) != 0 && line.rfind("SPY_PROBE", 0) != 0 &&
+        line.rfind("LOG_LEAD_IN", 0) != 0) lines.push_back(line);
+  }
+  return lines;
+}
+
+// Replays `log` into a running `tofguard-spy --lines` with `extra` args;
+// returns the decoded lines once `expected_count` have arrived.
+std::vector<std::string> spy_on_replay(const std::string& name, const std::string& log,
+                                       const std::vector<std::string>& extra, size_t expected_count) {
+  std::vector<std::string> argv = {bin_dir() + "/tofguard-spy", "--lines"};
+  // (SPY_PROBE lines are the readiness handshake, not part of the result.)
+  argv.insert(argv.end(), extra.begin(), extra.end());
+  Subprocess spy(name, argv);
+  EXPECT_TRUE(wait_until([&] { return spy.stdout_text().find("listening on") != std::string::npos; },
+                         std::chrono::seconds(5)));
+  // The spy is surely receiving once it has printed a probe of ours.
+  lcm::LCM probe_sender("udpm://239.255.76.67:7667?ttl=0");
+  const uint8_t probe = 0;
+  EXPECT_TRUE(wait_until(
+      [&] {
+        probe_sender.publish("SPY_PROBE", &probe, 1);
+        return spy.stdout_text().find("SPY_PROBE") != std::string::npos;
+      },
+      std::chrono::seconds(5), [] { std::this_thread::sleep_for(std::chrono::milliseconds(20)); }));
+  Subprocess player(name + "-player", {"/usr/bin/lcm-logplayer", "--lcm-url=udpm://239.255.76.67:7667?ttl=0",
+                                       "-s", "1", log});
+  EXPECT_EQ(player.wait(std::chrono::seconds(10)), 0);
+  EXPECT_TRUE(wait_until([&] { return lines_of(spy.stdout_text()).size() >= expected_count; },
+                         std::chrono::seconds(5)))
+      << spy.stdout_text();
+  spy.signal(SIGINT);
+  EXPECT_EQ(spy.wait(std::chrono::seconds(5)), 0);
+  return lines_of(spy.stdout_text());
+}
+
+TEST(Spy, PrintsOneDecodedLinePerReplayedMessage) {
+  const std::string log = write_log("spy-replay");
+  EXPECT_EQ(spy_on_replay("spy-lines", log, {}, kExpectedLines.size()), kExpectedLines);
+}
+
+TEST(Spy, ChannelFilterKeepsOnlyMatchingChannels) {
+  const std::string log = write_log("spy-filter");
+  const auto lines = spy_on_replay("spy-filtered", log, {"--channel", "SAFETY_(RISK|STATUS)", "--channel", "SPY_PROBE"}, 2);
+  EXPECT_EQ(lines, (std::vector<std::string>{kExpectedLines[2], kExpectedLines[3]}));
+}
+
+TEST(Spy, StatusBoardShowsPermissionRiskHeartbeatsRatesAndLatency) {
+  spy::StatusBoard board;
+  const int64_t t0_us = 5'000'000;
+  const int64_t utime0 = 1700000000123456;
+  for (const auto& [channel, bytes] : log_events()) {
+    board.on_message(channel, bytes.data(), static_cast<int>(bytes.size()), t0_us, utime0 + 25'000);
+  }
+  const std::string text = board.render(t0_us + 100'000, utime0 + 125'000);
+  EXPECT_NE(text.find("PERMISSION TO MOVE: NO (software stop, latched, cause joint error)"), std::string::npos)
+      << text;
+  EXPECT_NE(text.find("DANGEROUS: joint error, suspect a4"), std::string::npos) << text;
+  EXPECT_NE(text.find("RISK: DANGEROUS joint error, suspect a4  (frame seq 42"), std::string::npos) << text;
+  EXPECT_NE(text.find("tofguard-renderer"), std::string::npos) << text;
+  EXPECT_NE(text.find("dropped 2 decode_err 3 invalid 4 | running"), std::string::npos) << text;
+  // One TOF_DEPTH in the 2 s window: 0.5 Hz; captured 25 ms before arrival.
+  EXPECT_NE(text.find("TOF_DEPTH                 0.5 Hz   latency 25.0 ms"), std::string::npos) << text;
+
+  // Without a fresh status the board says so.
+  const std::string later = board.render(t0_us + 1'000'000, utime0);
+  EXPECT_NE(later.find("STALE"), std::string::npos) << later;
+  EXPECT_NE(later.find("MISSING"), std::string::npos) << later;
+}
+
+}  // namespace
+}  // namespace tofguard::test
