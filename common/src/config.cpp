@@ -172,6 +172,7 @@ DiscrepancyConfig read_discrepancy(YamlMap map) {
   d.pair_timeout_ms = map.number("pair_timeout_ms", 1, 10000);
   d.max_pending_frames = static_cast<int>(map.integer("max_pending_frames", 1, 1000));
   d.opening_radius_px = static_cast<int>(map.integer("opening_radius_px", 0, 10));
+  d.silhouette_jump_mm = map.number("silhouette_jump_mm", 1, 10000);
   d.near_arm_m = map.number("near_arm_m", 0, 10);
   d.max_depth_mm = map.number("max_depth_mm", 1, 32767);
   {

@@ -101,6 +101,7 @@ Parameters parameters_from(const DiscrepancyConfig& config) {
   p.tolerance.sigmas = config.tolerance_sigmas;
   p.tolerance.model_mm = config.model_tolerance_mm;
   p.opening_radius_px = config.opening_radius_px;
+  p.silhouette_jump_mm = config.silhouette_jump_mm;
   p.near_arm_m = config.near_arm_m;
   p.max_depth_mm = config.max_depth_mm;
   return p;
@@ -183,6 +184,27 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
   uint8_t* nearer = nearer_mask.ptr<uint8_t>();
   uint8_t* robot_free = not_robot.ptr<uint8_t>();
 
+  // Silhouette pixels: beside a rendered depth step (or the model's
+  // outline). A ToF pixel there mixes both surfaces, so its I_dis says
+  // nothing about a link's pose; on a thin link (a finger three pixels
+  // wide) it would otherwise be most of the link.
+  std::vector<uint8_t> silhouette(num_pixels, 0);
+  for (int v = 0; v < height && parameters.silhouette_jump_mm > 0; ++v) {
+    for (int u = 0; u < width; ++u) {
+      const int i = v * width + u;
+      const int neighbours[2] = {u + 1 < width ? i + 1 : -1, v + 1 < height ? i + width : -1};
+      for (int n : neighbours) {
+        if (n < 0) continue;
+        const int a = gen[i] > 0 ? gen[i] : 0;
+        const int b = gen[n] > 0 ? gen[n] : 0;
+        if ((a > 0) != (b > 0) || std::abs(a - b) > parameters.silhouette_jump_mm) {
+          silhouette[i] = 1;
+          silhouette[n] = 1;
+        }
+      }
+    }
+  }
+
   for (int i = 0; i < num_pixels; ++i) {
     const int l = label[i];
     int link = -1;
@@ -227,13 +249,13 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
         c = discrepancy_t::PIXEL_MATCH;
       } else if (d > 0) {
         c = robot ? discrepancy_t::PIXEL_OCCLUDED : discrepancy_t::PIXEL_UNEXPECTED_SURFACE;
-        nearer[i] = 255;
-        mismatch[i] = 255;
+        nearer[i] = silhouette[i] ? 0 : 255;
+        mismatch[i] = silhouette[i] ? 0 : 255;
       } else {
         c = robot ? discrepancy_t::PIXEL_ROBOT_MISSING : discrepancy_t::PIXEL_ENVIRONMENT_MISSING;
-        mismatch[i] = 255;
+        mismatch[i] = silhouette[i] ? 0 : 255;
       }
-      if (link >= 0) {
+      if (link >= 0 && !silhouette[i]) {
         s.link_compared[link]++;
         if (c == discrepancy_t::PIXEL_MATCH) {
           s.link_match[link]++;

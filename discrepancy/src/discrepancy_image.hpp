@@ -41,6 +41,10 @@ struct Parameters {
   Tolerance tolerance;
   // Radius of the square opening of the mismatch masks, pixels (0 = none).
   int opening_radius_px = 1;
+  // Rendered depth steps over this (and the model's outline) are
+  // silhouettes, where ToF pixels mix both surfaces: the pixels beside them
+  // are left out of link counts and blobs, mm. 0 = no silhouettes.
+  double silhouette_jump_mm = 0;
   // Distance from the modelled arm within which nearer surfaces count, m.
   double near_arm_m = 0.2;
   // Logical maximum of |I_dis| per pixel for the normalised seed score, mm.

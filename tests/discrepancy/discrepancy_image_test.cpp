@@ -258,3 +258,39 @@ TEST(DepthHash, RepeatsAreCountedInARow) {
 
 }  // namespace
 }  // namespace tofguard::test
+
+namespace tofguard::test {
+namespace {
+
+TEST(Discrepancy, MixedPixelsOnAThinLinksSilhouetteDoNotCountAgainstIt) {
+  // A finger 3 px wide at 1.5 m in front of the floor at 2 m; the camera
+  // mixes both surfaces on its two edge columns (1750 mm: 250 mm off).
+  const std::vector<Box> finger = {{80, 40, 83, 100, kArmMm, 1}};
+  const SyntheticImage model = draw(finger);
+  std::vector<int16_t> camera = model.depth_mm;
+  for (int v = 40; v < 100; ++v) {
+    camera[v * kWidth + 80] = 1750;
+    camera[v * kWidth + 82] = 1750;
+  }
+  discrepancy::Parameters with_silhouettes;
+  with_silhouettes.silhouette_jump_mm = 50;
+  const auto raw = compute_discrepancy(depth_frame(camera, 1), depth_frame(model.depth_mm, 1),
+                                       labels_frame(model.label, 1), discrepancy::Parameters{})
+                       .summary;
+  const auto seen = compute_discrepancy(depth_frame(camera, 1), depth_frame(model.depth_mm, 1),
+                                        labels_frame(model.label, 1), with_silhouettes)
+                        .summary;
+  // Without silhouettes two thirds of the finger look missing.
+  EXPECT_EQ(raw.link_farther[0], 2 * 60);
+  EXPECT_EQ(raw.link_compared[0], 3 * 60);
+  // With them, only its middle column's inner rows count, and they match.
+  EXPECT_EQ(seen.link_farther[0], 0);
+  EXPECT_EQ(seen.link_compared[0], 58);
+  EXPECT_EQ(seen.link_match[0], 58);
+  // The pixel classes themselves are unchanged (the colour image shows them).
+  EXPECT_EQ(seen.num_robot_missing, raw.num_robot_missing);
+  EXPECT_EQ(seen.largest_blob_pixels, 0);
+}
+
+}  // namespace
+}  // namespace tofguard::test

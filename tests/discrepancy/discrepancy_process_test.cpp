@@ -70,7 +70,9 @@ TEST_F(DiscrepancyProcess, PairedFramesAreComparedAndKeepTheirUtimeAndSeq) {
   EXPECT_NE(good.depth_hash, 0);
   const discrepancy_t& shifted = *find(2);
   EXPECT_EQ(shifted.num_robot_missing, 320);
-  EXPECT_EQ(shifted.link_farther[2], 320);
+  // Per link, the silhouette rows (link2's top and bottom row border the
+  // floor) are left out: 16 columns x 18 rows.
+  EXPECT_EQ(shifted.link_farther[2], 16 * 18);
   EXPECT_EQ(shifted.num_unexpected_surface, 320);
 }
 

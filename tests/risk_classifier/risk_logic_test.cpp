@@ -70,11 +70,14 @@ TEST(FrameClassifier, NoiseOnlyFramesAreSafe) {
 }
 
 TEST(FrameClassifier, ShiftedLinkIsAJointErrorOfTheJointAboveIt) {
-  // link2 seen 16 of its 40 px off: missing on 40 % of its pixels; a2 moves it.
+  // link2 (40 x 20 px) seen 16 px off. Its silhouette pixels do not count
+  // (top and bottom rows and its right column border the floor; its left
+  // column borders link1 at the same depth): missing on 16 x 18 of 39 x 18
+  // counted pixels. a2 moves it.
   const FrameFinding f = classify(summary_of(default_arm(16)));
   EXPECT_EQ(f.cause, risk_t::CAUSE_JOINT_ERROR) << f.detail;
   EXPECT_EQ(f.suspect, "a2");
-  EXPECT_NEAR(f.score, 0.4, 1e-9);
+  EXPECT_NEAR(f.score, 16.0 / 39.0, 1e-9);
   EXPECT_DOUBLE_EQ(f.threshold, 0.2);
   EXPECT_NE(f.detail.find("link2"), std::string::npos) << f.detail;
 }
@@ -94,7 +97,9 @@ TEST(FrameClassifier, ObjectInFrontOfTheArmIsAnUnknownObject) {
   const FrameFinding f = classify(d);
   EXPECT_EQ(f.cause, risk_t::CAUSE_UNKNOWN_OBJECT) << f.detail;
   EXPECT_NEAR(f.score, d.near_arm_area_m2, 1e-9);
-  EXPECT_NEAR(f.score, 400 * (1.4 / 200) * (1.4 / 200), 1e-4);
+  // 20 x 20 px at 1.4 m, less the two columns beside base_link's modelled
+  // outline (u = 39, 40: silhouette pixels).
+  EXPECT_NEAR(f.score, (400 - 2 * 20) * (1.4 / 200) * (1.4 / 200), 1e-4);
   EXPECT_DOUBLE_EQ(f.threshold, 0.0015);
 }
 

@@ -206,6 +206,11 @@ struct DiscrepancyConfig {
   // Radius of the morphological opening applied to the mismatch mask
   // before blobs and near-arm surfaces are measured, pixels (0 = none).
   int opening_radius_px = 0;
+  // Rendered depth steps larger than this (and the model's outline) are
+  // silhouettes, where a ToF camera mixes foreground and background (mixed
+  // pixels): the pixels on either side of one are left out of the per-link
+  // counts and the blobs, millimetres.
+  double silhouette_jump_mm = 0;
   // Surfaces nearer than the model within this distance of the modelled
   // arm count as near the arm, metres.
   double near_arm_m = 0;

@@ -1,0 +1,314 @@
+// The whole safety chain as its users run it: the simulated arm and the
+// simulated ToF camera (with its noise), tofguard-renderer,
+// tofguard-discrepancy, tofguard-risk and tofguard-intervene as real
+// processes over real LCM in a private network namespace.
+//
+// Every fault must withdraw the permission to move within 200 ms of the
+// first camera frame it affects (for stalls: of the deadline), with the
+// right cause. Times are taken on this test's monotonic clock when the
+// messages arrive here.
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+#include <signal.h>
+
+#include <cmath>
+#include <deque>
+#include <map>
+#include <memory>
+#include <thread>
+
+#include "test_support.hpp"
+#include "tofguard/camera_pose_t.hpp"
+#include "tofguard/clock.hpp"
+#include "tofguard/config.hpp"
+#include "tofguard/depth_image_t.hpp"
+#include "tofguard/risk_names.hpp"
+#include "tofguard/risk_t.hpp"
+#include "tofguard/safety_status_t.hpp"
+#include "tofguard/sim_camera_fault_t.hpp"
+#include "tofguard/sim_joint_fault_t.hpp"
+
+namespace tofguard::test {
+namespace {
+
+constexpr int64_t kStopBudgetUs = 200'000;
+
+class Chain {
+ public:
+  Chain() : config_path_(sim_config_variant("e2e-chain")),
+            config_(load_config(config_path_, nullptr)),
+            safety_(config_.lcm.url),
+            images_(config_.lcm.image_url) {
+    safety_.subscribe(config_.channels.status, &Chain::on_status, this);
+    safety_.subscribe(config_.channels.risk, &Chain::on_risk, this);
+    images_.subscribe(config_.channels.depth, &Chain::on_depth, this);
+    safety_.getFileno();
+    images_.getFileno();
+    for (const char* name : {"tofguard-intervene", "tofguard-risk", "tofguard-discrepancy", "tofguard-renderer",
+                             "tofguard-joints-sim", "tofguard-camera"}) {
+      start(name);
+    }
+  }
+
+  void start(const std::string& name) {
+    processes_[name] = std::make_unique<Subprocess>(
+        "e2e-" + name + "-" + std::to_string(++starts_), std::vector<std::string>{bin_dir() + "/" + name, "--config", config_path_});
+  }
+  Subprocess& process(const std::string& name) { return *processes_.at(name); }
+  std::string stderr_of_all() {
+    std::string text;
+    for (auto& [name, p] : processes_) text += "--- " + name + ":\n" + p->stderr_text();
+    return text;
+  }
+
+  // Handles what arrives (and keeps a published camera pose going).
+  void pump() {
+    if (camera_pose_ && monotonic_us() - last_pose_us_ > 100'000) {
+      last_pose_us_ = monotonic_us();
+      camera_pose_->utime = wall_utime();
+      safety_.publish(config_.channels.camera_pose, &*camera_pose_);
+    }
+    images_.handleTimeout(2);
+    while (safety_.handleTimeout(0) > 0) {
+    }
+  }
+  bool wait(const std::function<bool()>& condition, std::chrono::milliseconds deadline) {
+    return wait_until(condition, deadline, [this] { pump(); });
+  }
+
+  // Waits for `frames` SAFE verdicts in a row, then resets until accepted.
+  void bring_to_motion(const std::string& why) {
+    safe_streak_ = 0;
+    ASSERT_TRUE(wait([&] { return safe_streak_ >= 15; }, std::chrono::seconds(30)))
+        << "never SAFE: last risk " << describe_last_risk() << "\n" << stderr_of_all();
+    std::string out;
+    int code = -1;
+    for (int attempt = 0; attempt < 5 && code != 0; ++attempt) {
+      // tofguard-reset blocks; the chain keeps running on its own.
+      code = run_command("e2e-reset", {bin_dir() + "/tofguard-reset", "--config", config_path_, "--who", "e2e",
+                                       "--why", why},
+                         &out);
+      pump();
+    }
+    ASSERT_EQ(code, 0) << out << " last risk " << describe_last_risk();
+    ASSERT_TRUE(wait([&] { return motion_allowed_; }, std::chrono::seconds(2)));
+  }
+
+  // Runs `inject` and returns how long after the first affected camera
+  // frame (the first captured after it) the permission was withdrawn;
+  // fills the stop's status.
+  int64_t stop_latency_after_frame(const std::function<void()>& inject, safety_status_t* stop) {
+    const int64_t injected_utime = wall_utime();
+    inject();
+    first_affected_arrival_us_ = -1;
+    affected_after_utime_ = injected_utime;
+    stopped_at_us_ = -1;
+    EXPECT_TRUE(wait([&] { return stopped_at_us_ > 0; }, std::chrono::seconds(3)))
+        << "no stop; last risk " << describe_last_risk();
+    *stop = stop_status_;
+    if (first_affected_arrival_us_ < 0) return stopped_at_us_ - injected_utime;  // should not happen
+    return stopped_at_us_ - first_affected_arrival_us_;
+  }
+
+  // For stalls: returns how long after `since_us` (monotonic) the
+  // permission was withdrawn.
+  int64_t stop_latency_since(int64_t since_us, safety_status_t* stop) {
+    stopped_at_us_ = -1;
+    EXPECT_TRUE(wait([&] { return stopped_at_us_ > 0; }, std::chrono::seconds(3)))
+        << "no stop; last risk " << describe_last_risk();
+    *stop = stop_status_;
+    return stopped_at_us_ - since_us;
+  }
+
+  void camera_fault(int32_t kind, double duration_s = 1000) {
+    sim_camera_fault_t f{};
+    f.utime = wall_utime();
+    f.camera_id = config_.camera.id;
+    f.kind = kind;
+    f.duration_s = duration_s;
+    if (kind == sim_camera_fault_t::INTRUDING_OBJECT) {
+      // A 12 cm box (a hand) 10 cm in front of the arm's elbow region,
+      // standing still.
+      const Eigen::Vector3d at = object_near_arm_m_;
+      for (int i = 0; i < 3; ++i) {
+        f.object_size_m[i] = 0.12;
+        f.object_position_m[i] = at[i];
+      }
+    }
+    safety_.publish(config_.channels.sim_camera_fault, &f);
+  }
+  void joint_fault(const std::string& joint, double offset_rad) {
+    sim_joint_fault_t f;
+    f.utime = wall_utime();
+    f.joint = joint;
+    f.offset = offset_rad;
+    safety_.publish(config_.channels.sim_joint_fault, &f);
+  }
+  void publish_camera_pose(const Eigen::Vector3d& offset_m) {
+    camera_pose_t pose;
+    pose.camera_id = config_.camera.id;
+    pose.frame_id = config_.camera.pose.frame_id;
+    const Eigen::Vector3d t = config_.camera.pose.translation_m + offset_m;
+    const Eigen::Quaterniond& q = config_.camera.pose.rotation;
+    for (int i = 0; i < 3; ++i) pose.translation[i] = t[i];
+    pose.rotation[0] = q.w();
+    pose.rotation[1] = q.x();
+    pose.rotation[2] = q.y();
+    pose.rotation[3] = q.z();
+    camera_pose_ = pose;
+    last_pose_us_ = 0;
+  }
+
+  int64_t last_depth_arrival_us() const { return last_depth_arrival_us_; }
+  bool motion_allowed() const { return motion_allowed_; }
+  int stops_seen() const { return stops_seen_; }
+  std::string describe_last_risk() const {
+    return risk_level_name(last_risk_.level) + " " + risk_cause_name(last_risk_.cause) + " suspect '" +
+           last_risk_.suspect + "' seq " + std::to_string(last_risk_.seq) + " | " + last_risk_.detail;
+  }
+  const Config& config() const { return config_; }
+  void set_object_near_arm(const Eigen::Vector3d& at) { object_near_arm_m_ = at; }
+
+ private:
+  void on_status(const lcm::ReceiveBuffer*, const std::string&, const safety_status_t* s) {
+    if (motion_allowed_ && !s->motion_allowed) {
+      ++stops_seen_;
+      if (stopped_at_us_ < 0) {
+        stopped_at_us_ = monotonic_us();
+        stop_status_ = *s;
+      }
+    }
+    motion_allowed_ = s->motion_allowed;
+  }
+  void on_risk(const lcm::ReceiveBuffer*, const std::string&, const risk_t* r) {
+    last_risk_ = *r;
+    if (r->seq < 0) return;
+    safe_streak_ = r->level == risk_t::SAFE ? safe_streak_ + 1 : 0;
+  }
+  void on_depth(const lcm::ReceiveBuffer*, const std::string&, const depth_image_t* d) {
+    last_depth_arrival_us_ = monotonic_us();
+    if (first_affected_arrival_us_ < 0 && affected_after_utime_ > 0 && d->utime >= affected_after_utime_) {
+      first_affected_arrival_us_ = last_depth_arrival_us_;
+    }
+  }
+
+  std::string config_path_;
+  Config config_;
+  lcm::LCM safety_;
+  lcm::LCM images_;
+  std::map<std::string, std::unique_ptr<Subprocess>> processes_;
+  int starts_ = 0;
+  bool motion_allowed_ = false;
+  int stops_seen_ = 0;
+  int safe_streak_ = 0;
+  risk_t last_risk_{};
+  int64_t stopped_at_us_ = -1;
+  safety_status_t stop_status_{};
+  int64_t affected_after_utime_ = 0;
+  int64_t first_affected_arrival_us_ = -1;
+  int64_t last_depth_arrival_us_ = 0;
+  std::optional<camera_pose_t> camera_pose_;
+  int64_t last_pose_us_ = 0;
+  Eigen::Vector3d object_near_arm_m_{0.25, -0.35, 1.05};
+};
+
+#define EXPECT_STOP(latency_us, status, expected_cause)                                            \
+  do {                                                                                             \
+    EXPECT_LE(latency_us, kStopBudgetUs) << "stop took " << (latency_us) / 1000 << " ms";         \
+    EXPECT_EQ(risk_cause_name((status).cause), risk_cause_name(expected_cause)) << (status).reason; \
+    EXPECT_FALSE((status).motion_allowed);                                                         \
+    EXPECT_TRUE((status).latched);                                                                 \
+  } while (0)
+
+TEST(SafetyChainE2E, NominalMotionThenEveryFaultStopsTheArmWithItsCause) {
+  Chain chain;
+  chain.bring_to_motion("start of the test");
+  if (HasFatalFailure()) return;
+
+  {
+    SCOPED_TRACE("nominal: 20 s of motion without a stop");
+    const int64_t start_us = monotonic_us();
+    const int stops_before = chain.stops_seen();
+    chain.wait([&] { return monotonic_us() - start_us > 20'000'000 || chain.stops_seen() > stops_before; },
+               std::chrono::seconds(25));
+    EXPECT_EQ(chain.stops_seen(), stops_before) << chain.describe_last_risk();
+    EXPECT_TRUE(chain.motion_allowed());
+  }
+
+  safety_status_t stop;
+  {
+    SCOPED_TRACE("a 10 degree encoder offset on a4");
+    const int64_t latency = chain.stop_latency_after_frame([&] { chain.joint_fault("a4", 10 * M_PI / 180); }, &stop);
+    EXPECT_STOP(latency, stop, risk_t::CAUSE_JOINT_ERROR);
+    EXPECT_NE(stop.reason.find("suspect a4"), std::string::npos) << stop.reason;
+    chain.joint_fault("a4", 0);
+    chain.bring_to_motion("encoder fixed");
+    if (HasFatalFailure()) return;
+  }
+  {
+    SCOPED_TRACE("the camera pose off by 5 cm");
+    const int64_t latency =
+        chain.stop_latency_after_frame([&] { chain.publish_camera_pose(Eigen::Vector3d(0.05, 0, 0)); }, &stop);
+    EXPECT_STOP(latency, stop, risk_t::CAUSE_CALIBRATION_ERROR);
+    chain.publish_camera_pose(Eigen::Vector3d::Zero());
+    chain.bring_to_motion("calibration fixed");
+    if (HasFatalFailure()) return;
+  }
+  {
+    SCOPED_TRACE("an object within 0.2 m of the arm");
+    const int64_t latency =
+        chain.stop_latency_after_frame([&] { chain.camera_fault(sim_camera_fault_t::INTRUDING_OBJECT); }, &stop);
+    EXPECT_STOP(latency, stop, risk_t::CAUSE_UNKNOWN_OBJECT);
+    chain.camera_fault(sim_camera_fault_t::CLEAR);
+    chain.bring_to_motion("object gone");
+    if (HasFatalFailure()) return;
+  }
+  {
+    SCOPED_TRACE("a frozen camera");
+    const int64_t latency =
+        chain.stop_latency_after_frame([&] { chain.camera_fault(sim_camera_fault_t::FROZEN_IMAGE); }, &stop);
+    EXPECT_STOP(latency, stop, risk_t::CAUSE_SENSOR_FAULT);
+    chain.camera_fault(sim_camera_fault_t::CLEAR);
+    chain.bring_to_motion("camera unfrozen");
+    if (HasFatalFailure()) return;
+  }
+  const double depth_deadline_us = chain.config().risk.depth_deadline_ms * 1000;
+  {
+    SCOPED_TRACE("a camera stall");
+    chain.camera_fault(sim_camera_fault_t::STALL);
+    // The deadline runs from the last frame that arrived.
+    chain.wait([&] { return monotonic_us() - chain.last_depth_arrival_us() > 50'000; }, std::chrono::seconds(2));
+    const int64_t latency = chain.stop_latency_since(chain.last_depth_arrival_us(), &stop);
+    EXPECT_LE(latency, depth_deadline_us + kStopBudgetUs);
+    EXPECT_EQ(risk_cause_name(stop.cause), risk_cause_name(risk_t::CAUSE_SENSOR_FAULT)) << stop.reason;
+    chain.camera_fault(sim_camera_fault_t::CLEAR);
+    chain.bring_to_motion("camera back");
+    if (HasFatalFailure()) return;
+  }
+  {
+    SCOPED_TRACE("a joint-state stall");
+    const int64_t stalled_us = monotonic_us();
+    chain.process("tofguard-joints-sim").signal(SIGSTOP);
+    const int64_t latency = chain.stop_latency_since(stalled_us, &stop);
+    EXPECT_LE(latency, chain.config().risk.joint_state_deadline_ms * 1000 + kStopBudgetUs);
+    EXPECT_EQ(risk_cause_name(stop.cause), risk_cause_name(risk_t::CAUSE_SENSOR_FAULT)) << stop.reason;
+    chain.process("tofguard-joints-sim").signal(SIGCONT);
+    chain.bring_to_motion("arm driver back");
+    if (HasFatalFailure()) return;
+  }
+  {
+    SCOPED_TRACE("the renderer killed");
+    const int64_t killed_us = monotonic_us();
+    chain.process("tofguard-renderer").signal(SIGKILL);
+    const int64_t latency = chain.stop_latency_since(killed_us, &stop);
+    // Frames without a rendering go out unusable after pair_timeout_ms.
+    EXPECT_LE(latency, chain.config().discrepancy.pair_timeout_ms * 1000 + depth_deadline_us + kStopBudgetUs);
+    EXPECT_TRUE(stop.cause == risk_t::CAUSE_COMPONENT_FAULT || stop.cause == risk_t::CAUSE_SENSOR_FAULT)
+        << risk_cause_name(stop.cause) << ": " << stop.reason;
+    chain.start("tofguard-renderer");
+    chain.bring_to_motion("renderer restarted");
+  }
+}
+
+}  // namespace
+}  // namespace tofguard::test
