@@ -11,66 +11,19 @@ int64_t seconds_to_us(double s) { return static_cast<int64_t>(std::llround(s * 1
 
 }  // namespace
 
-bool TrueJointHistory::add(int64_t utime, const std::vector<std::string>& names,
-                           const std::vector<double>& positions,
-                           const std::vector<double>& velocities) {
-  if (!states_.empty() && utime <= states_.back().utime) return false;
-  State s;
-  s.utime = utime;
-  for (size_t i = 0; i < names.size() && i < positions.size(); ++i) {
-    s.position[names[i]] = positions[i];
-    s.velocity[names[i]] = i < velocities.size() ? velocities[i] : 0.0;
-  }
-  states_.push_back(std::move(s));
-  while (states_.size() > 2 && states_.front().utime < utime - keep_us_) states_.pop_front();
-  return true;
-}
-
-std::optional<std::map<std::string, double>> TrueJointHistory::at(int64_t utime,
-                                                                   int64_t max_extrapolation_us,
-                                                                   std::string* why) const {
-  if (states_.empty()) {
-    *why = "no true joint state received yet";
-    return std::nullopt;
-  }
-  const State& newest = states_.back();
-  if (utime >= newest.utime) {
-    const int64_t ahead_us = utime - newest.utime;
-    if (ahead_us > max_extrapolation_us) {
-      *why = "newest true joint state is " + std::to_string(ahead_us / 1000) +
-             " ms older than the frame (more than " + std::to_string(max_extrapolation_us / 1000) +
-             " ms)";
-      return std::nullopt;
-    }
-    std::map<std::string, double> out = newest.position;
-    for (auto& [name, q] : out) q += newest.velocity.at(name) * ahead_us * 1e-6;
-    return out;
-  }
-  if (utime < states_.front().utime) {
-    *why = "capture time before the oldest true joint state kept";
-    return std::nullopt;
-  }
-  for (size_t i = states_.size() - 1; i > 0; --i) {
-    const State& a = states_[i - 1];
-    const State& b = states_[i];
-    if (utime < a.utime) continue;
-    const double t = static_cast<double>(utime - a.utime) / static_cast<double>(b.utime - a.utime);
-    std::map<std::string, double> out;
-    for (const auto& [name, qa] : a.position) {
-      const auto it = b.position.find(name);
-      // A joint missing from one state stays missing: the renderer then
-      // refuses the frame instead of drawing the arm wrong.
-      if (it != b.position.end()) out[name] = qa + t * (it->second - qa);
-    }
-    return out;
-  }
-  *why = "no true joint states around the frame";
-  return std::nullopt;
+bool SimulatedCamera::add_true_joint_state(int64_t utime, const std::vector<std::string>& names,
+                                           const std::vector<double>& positions) {
+  renderer::JointPositions joints;
+  for (size_t i = 0; i < names.size() && i < positions.size(); ++i) joints[names[i]] = positions[i];
+  return joints_.add(utime, joints);
 }
 
 SimulatedCamera::SimulatedCamera(const CameraConfig& config, SceneRenderer* renderer,
                                  int64_t start_utime)
-    : config_(config), renderer_(renderer), model_(config.sim, config.intrinsics) {
+    : config_(config),
+      renderer_(renderer),
+      model_(config.sim, config.intrinsics),
+      joints_(kMaxExtrapolationUs) {
   for (const SimCameraFaultConfig& f : config.sim.faults) {
     const int64_t start = start_utime + seconds_to_us(f.start_s);
     faults_.push_back({f, start, start + seconds_to_us(f.duration_s)});
@@ -128,13 +81,14 @@ SimulatedCamera::Frame SimulatedCamera::capture(int64_t utime, uint64_t frame_in
       return frame;
     }
   }
-  const auto joints = joints_.at(utime, kMaxExtrapolationUs, &frame.why);
-  if (!joints) {
+  const renderer::JointsAtTime joints = joints_.at(utime);
+  if (!joints.usable) {
     frame.outcome = Frame::Outcome::kNoJointState;
+    frame.why = "true joint state: " + joints.unusable_reason;
     return frame;
   }
-  const RenderedDepth rendered = renderer_->render(*joints, true_pose(utime), config_.intrinsics,
-                                                   boxes(utime));
+  const RenderedDepth rendered = renderer_->render(joints.joints, true_pose(utime),
+                                                   config_.intrinsics, boxes(utime));
   if (!rendered.usable) {
     frame.outcome = Frame::Outcome::kRenderFailed;
     frame.why = "render failed: " + rendered.unusable_reason;

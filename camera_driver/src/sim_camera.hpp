@@ -8,8 +8,6 @@
 // camera.pose.frame_id; intruding boxes are given in the world frame (the
 // robot's root link).
 #include <cstdint>
-#include <deque>
-#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -17,6 +15,7 @@
 
 #include <Eigen/Geometry>
 
+#include "joint_history.hpp"
 #include "tof_error_model.hpp"
 #include "tofguard/config.hpp"
 
@@ -45,32 +44,6 @@ class SceneRenderer {
                                const std::vector<SimBox>& boxes) = 0;
 };
 
-// The simulated arm's true joint states (SIM_TRUE_JOINT_STATE), a short
-// history to interpolate in.
-class TrueJointHistory {
- public:
-  // States older than `keep_us` behind the newest are forgotten.
-  explicit TrueJointHistory(int64_t keep_us = 2000000) : keep_us_(keep_us) {}
-  // Adds a state; out-of-order states (utime not after the newest) are
-  // ignored and return false.
-  bool add(int64_t utime, const std::vector<std::string>& names,
-           const std::vector<double>& positions, const std::vector<double>& velocities);
-  // Positions at `utime`: linear between the two states around it; beyond
-  // the newest state by at most `max_extrapolation_us`, the newest state
-  // moved on with its velocities. Otherwise nullopt and `*why` says why.
-  std::optional<std::map<std::string, double>> at(int64_t utime, int64_t max_extrapolation_us,
-                                                  std::string* why) const;
-
- private:
-  struct State {
-    int64_t utime;
-    std::map<std::string, double> position;
-    std::map<std::string, double> velocity;
-  };
-  int64_t keep_us_;
-  std::deque<State> states_;
-};
-
 // One injected fault with absolute times (microseconds since the epoch).
 struct ActiveSimFault {
   SimCameraFaultConfig fault;
@@ -83,11 +56,12 @@ class SimulatedCamera {
   // `start_utime`: when the camera started (config faults count from it).
   SimulatedCamera(const CameraConfig& config, SceneRenderer* renderer, int64_t start_utime);
 
-  void add_true_joint_state(int64_t utime, const std::vector<std::string>& names,
-                            const std::vector<double>& positions,
-                            const std::vector<double>& velocities) {
-    joints_.add(utime, names, positions, velocities);
-  }
+  // A true joint state of the simulated arm (SIM_TRUE_JOINT_STATE). The
+  // frame's joints are interpolated between the states around its capture
+  // time, extrapolated at most 50 ms past the newest (renderer's
+  // JointHistory). Returns false for a state not newer than the newest.
+  bool add_true_joint_state(int64_t utime, const std::vector<std::string>& names,
+                            const std::vector<double>& positions);
   // A run-time fault, starting at `fault.start_utime`.
   void inject(const ActiveSimFault& fault) { faults_.push_back(fault); }
   // Ends every fault active or pending at `utime`.
@@ -123,7 +97,7 @@ class SimulatedCamera {
   CameraConfig config_;
   SceneRenderer* renderer_;
   TofErrorModel model_;
-  TrueJointHistory joints_;
+  renderer::JointHistory joints_;
   std::vector<ActiveSimFault> faults_;
   std::optional<TofImage> last_image_;
 };

@@ -114,7 +114,12 @@ int run_sim_camera(const Config& config) {
 
   node.subscribe<joint_state_t>(
       node.safety(), config.channels.sim_true_joint_state,
-      [&](const joint_state_t& s) { sim.add_true_joint_state(s.utime, s.name, s.position, s.velocity); },
+      [&](const joint_state_t& s) {
+        if (!sim.add_true_joint_state(s.utime, s.name, s.position)) {
+          node.errors().report("truth", config.channels.sim_true_joint_state +
+                                            ": utime not newer than the last state; ignored");
+        }
+      },
       check_joint_state);
   node.subscribe<sim_camera_fault_t>(
       node.safety(), config.channels.sim_camera_fault,

@@ -1,5 +1,6 @@
 // The simulated camera's logic with a fake renderer: true joint states
 // interpolated at the capture time, determinism, and the injected faults.
+// (The interpolation itself is renderer::JointHistory's, tested there.)
 #include "sim_camera.hpp"
 
 #include <gtest/gtest.h>
@@ -52,34 +53,14 @@ CameraConfig camera_config() {
   return c;
 }
 
-TEST(TrueJointHistory, InterpolatesAndExtrapolatesBriefly) {
-  TrueJointHistory h;
-  std::string why;
-  EXPECT_FALSE(h.at(kT0, 50000, &why));
-  EXPECT_EQ(why, "no true joint state received yet");
-  h.add(kT0, {"a1", "a2"}, {0.0, 1.0}, {0.0, 0.0});
-  h.add(kT0 + 10000, {"a1", "a2"}, {1.0, 1.0}, {2.0, 0.0});
-  EXPECT_FALSE(h.add(kT0 + 5000, {"a1"}, {5.0}, {0.0})) << "out of order";
-  auto q = h.at(kT0 + 2500, 50000, &why);
-  ASSERT_TRUE(q) << why;
-  EXPECT_DOUBLE_EQ(q->at("a1"), 0.25);
-  EXPECT_DOUBLE_EQ(q->at("a2"), 1.0);
-  // 20 ms past the newest state: moved on with its velocity 2 rad/s.
-  q = h.at(kT0 + 30000, 50000, &why);
-  ASSERT_TRUE(q) << why;
-  EXPECT_NEAR(q->at("a1"), 1.04, 1e-12);
-  EXPECT_FALSE(h.at(kT0 + 70000, 50000, &why));
-  EXPECT_EQ(why, "newest true joint state is 60 ms older than the frame (more than 50 ms)");
-}
-
 TEST(SimulatedCamera, RendersAtTheTrueJointsOfTheCaptureTime) {
   FakeRenderer renderer;
   SimulatedCamera sim(camera_config(), &renderer, kT0);
   auto frame = sim.capture(kT0, 0);
   EXPECT_EQ(frame.outcome, SimulatedCamera::Frame::Outcome::kNoJointState);
   EXPECT_EQ(renderer.calls, 0);
-  sim.add_true_joint_state(kT0, {"a1"}, {0.0}, {0.0});
-  sim.add_true_joint_state(kT0 + 10000, {"a1"}, {0.5}, {0.0});
+  sim.add_true_joint_state(kT0, {"a1"}, {0.0});
+  sim.add_true_joint_state(kT0 + 10000, {"a1"}, {0.5});
   frame = sim.capture(kT0 + 4000, 1);
   ASSERT_EQ(frame.outcome, SimulatedCamera::Frame::Outcome::kImage) << frame.why;
   EXPECT_DOUBLE_EQ(renderer.last_joints.at("a1"), 0.2);
@@ -99,7 +80,7 @@ TEST(SimulatedCamera, RendersAtTheTrueJointsOfTheCaptureTime) {
 TEST(SimulatedCamera, SameSeedSameFrames) {
   FakeRenderer r1, r2;
   SimulatedCamera a(camera_config(), &r1, kT0), b(camera_config(), &r2, kT0);
-  for (SimulatedCamera* s : {&a, &b}) s->add_true_joint_state(kT0, {"a1"}, {0.3}, {0.0});
+  for (SimulatedCamera* s : {&a, &b}) s->add_true_joint_state(kT0, {"a1"}, {0.3});
   const auto fa = a.capture(kT0 + 1000, 7);
   const auto fb = b.capture(kT0 + 1000, 7);
   ASSERT_EQ(fa.outcome, SimulatedCamera::Frame::Outcome::kImage);
@@ -136,7 +117,7 @@ TEST(SimulatedCamera, ConfigFaultsStallFreezeDriftAndIntrude) {
   double joints_until_s = 0;
   auto capture = [&](double s, uint64_t index) {
     for (; joints_until_s <= s + 0.01; joints_until_s += 0.01) {
-      sim.add_true_joint_state(at(joints_until_s), {"a1"}, {joints_until_s / 10}, {0.1});
+      sim.add_true_joint_state(at(joints_until_s), {"a1"}, {joints_until_s / 10});
     }
     return sim.capture(at(s), index);
   };
@@ -171,7 +152,7 @@ TEST(SimulatedCamera, ConfigFaultsStallFreezeDriftAndIntrude) {
 TEST(SimulatedCamera, RunTimeFaultsAndClear) {
   FakeRenderer renderer;
   SimulatedCamera sim(camera_config(), &renderer, kT0);
-  sim.add_true_joint_state(kT0, {"a1"}, {0.0}, {0.0});
+  sim.add_true_joint_state(kT0, {"a1"}, {0.0});
   ActiveSimFault stall;
   stall.fault.kind = "stall";
   stall.start_utime = kT0 + 1000;
