@@ -12,6 +12,7 @@
 #include "tofguard/process.hpp"
 #include "tofguard/safety_status_t.hpp"
 #include "tofguard/sim_joint_fault_t.hpp"
+#include "tofguard/wire_checks.hpp"
 
 namespace tofguard::joints_sim {
 namespace {
@@ -47,7 +48,7 @@ int run(const Config& config, const std::vector<std::string>& rest) {
   node.subscribe<safety_status_t>(node.safety(), config.channels.status, [&](const safety_status_t& s) {
     status_allows = s.motion_allowed;
     status_arrival_us = monotonic_us();
-  });
+  }, check_safety_status);
   node.subscribe<sim_joint_fault_t>(node.safety(), config.channels.sim_joint_fault,
                                     [&](const sim_joint_fault_t& fault) {
     if (!arm->set_encoder_offset(fault.joint, fault.offset)) {

@@ -116,4 +116,17 @@ std::string check_risk(const risk_t& risk) {
   return "";
 }
 
+std::string check_safety_status(const safety_status_t& status) {
+  if (status.stop < safety_status_t::STOP_NONE || status.stop > safety_status_t::STOP_POWER_CUT) {
+    return expected("stop", "one of safety_status_t's STOP_ constants (0..2)", status.stop);
+  }
+  if (status.cause < risk_t::CAUSE_NONE || status.cause > risk_t::CAUSE_UNCLASSIFIED) {
+    return expected("cause", "one of risk_t's CAUSE_ constants (0..6)", status.cause);
+  }
+  if (status.motion_allowed && status.stop != safety_status_t::STOP_NONE) {
+    return expected("stop", "STOP_NONE while motion_allowed is true", status.stop);
+  }
+  return "";
+}
+
 }  // namespace tofguard

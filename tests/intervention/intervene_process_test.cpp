@@ -5,11 +5,13 @@
 #include <signal.h>
 
 #include <atomic>
+#include <cmath>
 #include <filesystem>
 #include <thread>
 
 #include "test_support.hpp"
 #include "tofguard/clock.hpp"
+#include "tofguard/heartbeat_t.hpp"
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/power_relay_t.hpp"
 #include "tofguard/risk_t.hpp"
@@ -171,6 +173,83 @@ TEST(InterveneProcess, LatchedStopResetAndRestart) {
   // SIGTERM: a last "stopped" status, exit code 0.
   intervene->signal(SIGTERM);
   EXPECT_EQ(intervene->wait(std::chrono::seconds(5)), 0);
+}
+
+}  // namespace
+}  // namespace tofguard::test
+
+namespace tofguard::test {
+namespace {
+
+struct HeartbeatOf {
+  std::string process;
+  heartbeat_t last;
+  bool seen = false;
+  void on(const lcm::ReceiveBuffer*, const std::string&, const heartbeat_t* hb) {
+    if (hb->process == process) {
+      last = *hb;
+      seen = true;
+    }
+  }
+};
+
+TEST(InterveneProcess, MalformedInputIsDroppedCountedAndTheGoodRisksStillJudged) {
+  Bench bench;
+  HeartbeatOf heartbeat;
+  heartbeat.process = "tofguard-intervene";
+  bench.lcm.subscribe("SAFETY_HEARTBEAT", &HeartbeatOf::on, &heartbeat);
+  Subprocess intervene("intervene-malformed", intervene_argv());
+  ASSERT_TRUE(wait_until([&] { return heartbeat.seen; }, std::chrono::seconds(5), [&] { bench.pump(); }))
+      << intervene.stderr_text();
+
+  // Wrong fingerprint and truncated bytes on SAFETY_RISK; a risk level that
+  // does not exist; a joint state with NaN; a reset that is not one.
+  joint_state_t wrong_type;
+  wrong_type.num_joints = 0;
+  bench.lcm.publish("SAFETY_RISK", &wrong_type);
+  const uint8_t truncated[5] = {1, 2, 3, 4, 5};
+  bench.lcm.publish("SAFETY_RISK", truncated, sizeof truncated);
+  risk_t impossible{};
+  impossible.utime = wall_utime();
+  impossible.level = 9;
+  bench.lcm.publish("SAFETY_RISK", &impossible);
+  joint_state_t nan_joint;
+  nan_joint.utime = wall_utime();
+  nan_joint.num_joints = 1;
+  nan_joint.name = {"a1"};
+  nan_joint.position = {std::nan("")};
+  nan_joint.velocity = {0};
+  bench.lcm.publish("JOINT_STATE", &nan_joint);
+  bench.lcm.publish("SAFETY_RESET", truncated, sizeof truncated);
+
+  ASSERT_TRUE(wait_until(
+      [&] { return heartbeat.last.decode_errors >= 3 && heartbeat.last.validation_errors >= 2; },
+      std::chrono::seconds(5), [&] { bench.pump(); }))
+      << "decode " << heartbeat.last.decode_errors << " validation " << heartbeat.last.validation_errors;
+  EXPECT_EQ(heartbeat.last.decode_errors, 3);
+  EXPECT_EQ(heartbeat.last.validation_errors, 2);
+  EXPECT_TRUE(intervene.running());
+
+  // The good SAFE risks keep coming (pump): a reset is accepted, and a
+  // DANGEROUS one still stops the arm.
+  std::string out;
+  std::atomic<bool> feeding{true};
+  std::thread feeder([&] {
+    lcm::LCM lcm(kSafetyUrl);
+    while (feeding) {
+      risk_t r{};
+      r.utime = wall_utime();
+      r.level = risk_t::SAFE;
+      lcm.publish("SAFETY_RISK", &r);
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));  // the feed's period
+    }
+  });
+  EXPECT_EQ(reset("reset-after-malformed", &out), 0) << out;
+  feeding = false;
+  feeder.join();
+  bench.risk_level = risk_t::DANGEROUS;
+  bench.risk_cause = risk_t::CAUSE_UNKNOWN_OBJECT;
+  EXPECT_TRUE(bench.wait_for([](const safety_status_t& s) { return !s.motion_allowed; }, std::chrono::seconds(2)));
 }
 
 }  // namespace

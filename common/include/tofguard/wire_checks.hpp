@@ -10,6 +10,7 @@
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/link_labels_t.hpp"
 #include "tofguard/risk_t.hpp"
+#include "tofguard/safety_status_t.hpp"
 
 namespace tofguard {
 
@@ -23,5 +24,7 @@ std::string check_camera_pose(const camera_pose_t& pose);
 std::string check_link_labels(const link_labels_t& labels);
 // level and cause must be one of risk_t's constants.
 std::string check_risk(const risk_t& risk);
+// stop and cause must be one of the constants.
+std::string check_safety_status(const safety_status_t& status);
 
 }  // namespace tofguard
