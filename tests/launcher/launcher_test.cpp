@@ -166,25 +166,3 @@ TEST(Launcher, RecorderWritesEveryChannelToRotatingFiles) {
 }  // namespace
 }  // namespace tofguard::test
 
-namespace tofguard::test {
-namespace {
-
-TEST(Launcher, ItsProcessesStopWhenTheLauncherIsKilled) {
-  const std::string log_dir = output_dir() + "/launch-killed";
-  std::filesystem::remove_all(log_dir);
-  const std::string config = sim_config_variant(
-      "launch-killed", {},
-      launch_section(log_dir, "    - {name: sleeper, command: [/bin/sleep, '1000'], required: true}\n"));
-  Subprocess launch("launch-killed", {bin_dir() + "/tofguard-launch", config});
-  ASSERT_TRUE(wait_until([&] { return pids_in(launch.stdout_text(), "sleeper").size() == 1; },
-                         std::chrono::seconds(5)))
-      << launch.stdout_text();
-  const pid_t sleeper = pids_in(launch.stdout_text(), "sleeper")[0];
-  kill(launch.pid(), SIGKILL);  // no chance to clean up
-  launch.wait(std::chrono::seconds(5));
-  EXPECT_TRUE(wait_until([&] { return !process_group_alive(sleeper); }, std::chrono::seconds(5)))
-      << "an orphaned process would run beside the next launcher's";
-}
-
-}  // namespace
-}  // namespace tofguard::test

@@ -138,8 +138,10 @@ TEST(RendererProcess, RendersFramesAtInterpolatedJointsAndMarksUnusableOnes) {
   EXPECT_GT(robot_pixels, 1000);
   EXPECT_EQ(differing, 0);
 
-  // A frame 50 ms beyond the newest joint state: unusable, labels only.
-  const int64_t late_seq = bench.publish_frame(bench.next_joint_utime - 10'000 + 50'000);
+  // A frame far beyond the newest joint state: unusable, labels only.
+  // (200 ms beyond: still beyond every joint state sent below, whichever
+  // arrives first.)
+  const int64_t late_seq = bench.publish_frame(bench.next_joint_utime - 10'000 + 200'000);
   // A frame whose joint state lacks a4.
   JointPositions without_a4 = arm_at(bench.next_joint_utime, bench.t0);
   without_a4.erase("a4");
