@@ -2,7 +2,6 @@
 // camera.sim): strict, range-checked, one-line errors.
 #include <gtest/gtest.h>
 
-#include "config_variant.hpp"
 #include "test_support.hpp"
 #include "tofguard/config.hpp"
 
@@ -11,7 +10,8 @@ namespace {
 
 std::string variant(const std::string& name, const std::string& replace = "",
                     const std::string& with = "") {
-  return camera_test::sim_config_variant(name, replace, with);
+  if (replace.empty()) return test::sim_config_variant(name);
+  return test::sim_config_variant(name, {{replace, with}});
 }
 
 std::string error_of(const std::string& path) {

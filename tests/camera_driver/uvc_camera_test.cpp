@@ -8,7 +8,6 @@
 #include <gtest/gtest.h>
 
 #include "camera_sources.hpp"
-#include "config_variant.hpp"
 #include "test_support.hpp"
 
 namespace tofguard::camera {
@@ -16,10 +15,10 @@ namespace {
 
 // config/sim.yaml turned into a uvc camera config for ids nobody uses.
 std::string uvc_config() {
-  return camera_test::sim_config_variant(
-      "uvc_camera", "source: sim",
-      "source: uvc\n  uvc: {vendor_id: \"fffe\", product_id: \"fffd\", serial: \"X1\", "
-      "format: z16, depth_unit_mm: 0.125, distance: radial}");
+  return test::sim_config_variant(
+      "uvc_camera", {{"source: sim",
+                      "source: uvc\n  uvc: {vendor_id: \"fffe\", product_id: \"fffd\", serial: \"X1\", "
+                      "format: z16, depth_unit_mm: 0.125, distance: radial}"}});
 }
 
 TEST(UvcCamera, ListsUsbDevicesInOneLine) {

@@ -12,22 +12,10 @@ namespace {
 
 std::string sim_yaml_path() { return source_dir() + "/config/sim.yaml"; }
 
-// sim.yaml with `from` replaced by `to` (which must occur), written next to
-// the test outputs; relative model paths are made absolute.
+// sim.yaml with `from` replaced by `to` (which must occur), in the test
+// output folder.
 std::string sim_variant(const std::string& name, const std::string& from, const std::string& to) {
-  std::string text = read_file(sim_yaml_path());
-  const auto at = text.find(from);
-  EXPECT_NE(at, std::string::npos) << "sim.yaml no longer contains: " << from;
-  if (at != std::string::npos) text.replace(at, from.size(), to);
-  for (size_t p = text.find(" models/"); p != std::string::npos; p = text.find(" models/", p + 1)) {
-    text.replace(p + 1, 0, source_dir() + "/config/");
-  }
-  for (size_t p = text.find("[models/"); p != std::string::npos; p = text.find("[models/", p + 1)) {
-    text.replace(p + 1, 0, source_dir() + "/config/");
-  }
-  const std::string path = output_dir() + "/config-" + name + ".yaml";
-  write_file(path, text);
-  return path;
+  return sim_config_variant("config-" + name, {{from, to}});
 }
 
 std::string config_error(const std::string& path) {

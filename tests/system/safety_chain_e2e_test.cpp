@@ -20,6 +20,7 @@
 #include "kinematics.hpp"
 #include "scene_model.hpp"
 #include "test_support.hpp"
+#include "tofguard/heartbeat_t.hpp"
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/camera_pose_t.hpp"
 #include "tofguard/clock.hpp"
@@ -46,6 +47,7 @@ class Chain {
     safety_.subscribe(config_.channels.risk, &Chain::on_risk, this);
     images_.subscribe(config_.channels.depth, &Chain::on_depth, this);
     safety_.subscribe(config_.channels.joint_state, &Chain::on_joints, this);
+    safety_.subscribe(config_.channels.heartbeat, &Chain::on_heartbeat, this);
     safety_.getFileno();
     images_.getFileno();
     for (const char* name : {"tofguard-intervene", "tofguard-risk", "tofguard-discrepancy", "tofguard-renderer",
@@ -65,8 +67,62 @@ class Chain {
     return text;
   }
 
+  // While on, sends malformed messages on every channel the chain
+  // subscribes to, a few times a second: wrong fingerprints, truncated
+  // bytes, sizes that do not fit, NaN, a non-unit quaternion.
+  bool send_malformed = false;
+  int malformed_rounds = 0;
+
+  void send_malformed_round() {
+    const uint8_t junk[7] = {9, 8, 7, 6, 5, 4, 3};
+    joint_state_t nan_joints;
+    nan_joints.utime = wall_utime();
+    nan_joints.robot_id = config_.robot.id;
+    nan_joints.num_joints = 1;
+    nan_joints.name = {"a1"};
+    nan_joints.position = {std::nan("")};
+    nan_joints.velocity = {0};
+    depth_image_t bad_size;
+    bad_size.utime = wall_utime();
+    bad_size.seq = 1;
+    bad_size.camera_id = config_.camera.id;
+    bad_size.width = 176;
+    bad_size.height = 144;
+    bad_size.fx = bad_size.fy = 200;
+    bad_size.cx = bad_size.cy = 80;
+    bad_size.num_pixels = 10;
+    bad_size.depth_mm.assign(10, 1000);
+    bad_size.num_amplitude = 0;
+    camera_pose_t bad_pose;
+    bad_pose.utime = wall_utime();
+    bad_pose.camera_id = config_.camera.id;
+    bad_pose.frame_id = "world";
+    for (int i = 0; i < 3; ++i) bad_pose.translation[i] = 0;
+    for (int i = 0; i < 4; ++i) bad_pose.rotation[i] = 0.9;
+    images_.publish(config_.channels.depth, &bad_size);
+    images_.publish(config_.channels.depth, junk, sizeof junk);
+    images_.publish(config_.channels.rendered, &nan_joints);
+    images_.publish(config_.channels.labels, junk, sizeof junk);
+    safety_.publish(config_.channels.joint_state, &nan_joints);
+    safety_.publish(config_.channels.joint_state, junk, sizeof junk);
+    safety_.publish(config_.channels.sim_true_joint_state, &nan_joints);
+    safety_.publish(config_.channels.camera_pose, &bad_pose);
+    safety_.publish(config_.channels.discrepancy, junk, sizeof junk);
+    safety_.publish(config_.channels.risk, &nan_joints);
+    safety_.publish(config_.channels.status, junk, sizeof junk);
+    safety_.publish(config_.channels.heartbeat, junk, sizeof junk);
+    safety_.publish(config_.channels.reset, junk, sizeof junk);
+    safety_.publish(config_.channels.sim_joint_fault, junk, sizeof junk);
+    safety_.publish(config_.channels.sim_camera_fault, junk, sizeof junk);
+    ++malformed_rounds;
+  }
+
   // Handles what arrives (and keeps a published camera pose going).
   void pump() {
+    if (send_malformed && monotonic_us() - last_malformed_us_ > 250'000) {
+      last_malformed_us_ = monotonic_us();
+      send_malformed_round();
+    }
     if (camera_pose_ && monotonic_us() - last_pose_us_ > 100'000) {
       last_pose_us_ = monotonic_us();
       camera_pose_->utime = wall_utime();
@@ -235,6 +291,16 @@ class Chain {
   int64_t first_affected_arrival_us_ = -1;
   int64_t last_depth_arrival_us_ = 0;
   std::optional<camera_pose_t> camera_pose_;
+  int64_t last_malformed_us_ = 0;
+  std::map<std::string, heartbeat_t> heartbeats_;
+
+ public:
+  const std::map<std::string, heartbeat_t>& heartbeats() const { return heartbeats_; }
+  void on_heartbeat(const lcm::ReceiveBuffer*, const std::string&, const heartbeat_t* hb) {
+    heartbeats_[hb->process] = *hb;
+  }
+
+ private:
   int64_t last_pose_us_ = 0;
   renderer::JointPositions latest_joints_;
   std::string risk_log_;
@@ -242,6 +308,8 @@ class Chain {
 
 #define EXPECT_STOP(latency_us, status, expected_cause)                                            \
   do {                                                                                             \
+    std::cout << "stop " << (latency_us) / 1000.0 << " ms after the first affected frame, cause "  \
+              << risk_cause_name((status).cause) << ": " << (status).reason << std::endl;         \
     EXPECT_LE(latency_us, kStopBudgetUs) << "stop took " << (latency_us) / 1000 << " ms";         \
     EXPECT_EQ(risk_cause_name((status).cause), risk_cause_name(expected_cause)) << (status).reason; \
     EXPECT_FALSE((status).motion_allowed);                                                         \
@@ -254,13 +322,27 @@ TEST(SafetyChainE2E, NominalMotionThenEveryFaultStopsTheArmWithItsCause) {
   if (HasFatalFailure()) return;
 
   {
-    SCOPED_TRACE("nominal: 20 s of motion without a stop");
+    SCOPED_TRACE("nominal: 20 s of motion without a stop, with malformed input on every channel");
+    std::map<std::string, heartbeat_t> before = chain.heartbeats();
+    chain.send_malformed = true;
     const int64_t start_us = monotonic_us();
     const int stops_before = chain.stops_seen();
     chain.wait([&] { return monotonic_us() - start_us > 20'000'000 || chain.stops_seen() > stops_before; },
                std::chrono::seconds(25));
+    chain.send_malformed = false;
     EXPECT_EQ(chain.stops_seen(), stops_before) << chain.describe_last_risk();
     EXPECT_TRUE(chain.motion_allowed());
+    EXPECT_GE(chain.malformed_rounds, 50);
+    // Every process dropped and counted what it could not use, and lives.
+    for (const char* name : {"tofguard-intervene", "tofguard-risk", "tofguard-discrepancy", "tofguard-renderer",
+                             "tofguard-joints-sim", "tofguard-camera"}) {
+      ASSERT_TRUE(chain.heartbeats().count(name)) << name;
+      const heartbeat_t& hb = chain.heartbeats().at(name);
+      const int64_t errors = hb.decode_errors + hb.validation_errors -
+                             (before.count(name) ? before[name].decode_errors + before[name].validation_errors : 0);
+      EXPECT_GE(errors, 50) << name << ": decode " << hb.decode_errors << ", validation " << hb.validation_errors;
+      EXPECT_TRUE(chain.process(name).running()) << name;
+    }
   }
 
   safety_status_t stop;
@@ -307,6 +389,7 @@ TEST(SafetyChainE2E, NominalMotionThenEveryFaultStopsTheArmWithItsCause) {
     // The deadline runs from the last frame that arrived.
     chain.wait([&] { return monotonic_us() - chain.last_depth_arrival_us() > 50'000; }, std::chrono::seconds(2));
     const int64_t latency = chain.stop_latency_since(chain.last_depth_arrival_us(), &stop);
+    std::cout << "camera stall: stop " << latency / 1000.0 << " ms after the last frame" << std::endl;
     EXPECT_LE(latency, depth_deadline_us + kStopBudgetUs);
     EXPECT_EQ(risk_cause_name(stop.cause), risk_cause_name(risk_t::CAUSE_SENSOR_FAULT)) << stop.reason;
     chain.camera_fault(sim_camera_fault_t::CLEAR);
@@ -318,6 +401,7 @@ TEST(SafetyChainE2E, NominalMotionThenEveryFaultStopsTheArmWithItsCause) {
     const int64_t stalled_us = monotonic_us();
     chain.process("tofguard-joints-sim").signal(SIGSTOP);
     const int64_t latency = chain.stop_latency_since(stalled_us, &stop);
+    std::cout << "joint-state stall: stop " << latency / 1000.0 << " ms after the stall" << std::endl;
     EXPECT_LE(latency, chain.config().risk.joint_state_deadline_ms * 1000 + kStopBudgetUs);
     EXPECT_EQ(risk_cause_name(stop.cause), risk_cause_name(risk_t::CAUSE_SENSOR_FAULT)) << stop.reason;
     chain.process("tofguard-joints-sim").signal(SIGCONT);
@@ -329,6 +413,8 @@ TEST(SafetyChainE2E, NominalMotionThenEveryFaultStopsTheArmWithItsCause) {
     const int64_t killed_us = monotonic_us();
     chain.process("tofguard-renderer").signal(SIGKILL);
     const int64_t latency = chain.stop_latency_since(killed_us, &stop);
+    std::cout << "renderer killed: stop " << latency / 1000.0 << " ms after the kill, cause "
+              << risk_cause_name(stop.cause) << std::endl;
     // Frames without a rendering go out unusable after pair_timeout_ms.
     EXPECT_LE(latency, chain.config().discrepancy.pair_timeout_ms * 1000 + depth_deadline_us + kStopBudgetUs);
     EXPECT_TRUE(stop.cause == risk_t::CAUSE_COMPONENT_FAULT || stop.cause == risk_t::CAUSE_SENSOR_FAULT)
