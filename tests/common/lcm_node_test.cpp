@@ -3,7 +3,7 @@
 // the counters; timers fire by themselves.
 #include <gtest/gtest.h>
 
-#include "../lcmtypes/sample_messages.hpp"
+#include "../wire_contract/sample_messages.hpp"
 #include "test_support.hpp"
 #include "tofguard/clock.hpp"
 #include "tofguard/config.hpp"

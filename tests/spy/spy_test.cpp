@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <thread>
 
-#include "../lcmtypes/sample_messages.hpp"
+#include "../wire_contract/sample_messages.hpp"
 #include "message_format.hpp"
 #include "status_board.hpp"
 #include "test_support.hpp"
