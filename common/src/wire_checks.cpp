@@ -45,6 +45,14 @@ std::string check_depth_image(const depth_image_t& image) {
   return "";
 }
 
+std::string check_depth_image_from(const depth_image_t& image, const std::string& camera_id) {
+  std::string problem = check_depth_image(image);
+  if (problem.empty() && image.camera_id != camera_id) {
+    problem = "camera_id: expected '" + camera_id + "', got '" + image.camera_id + "'";
+  }
+  return problem;
+}
+
 std::string check_joint_state(const joint_state_t& state) {
   if (state.num_joints < 0) return expected("num_joints", "a count >= 0", state.num_joints);
   std::set<std::string> seen;

@@ -69,13 +69,7 @@ int run_discrepancy(const Config& config) {
   };
 
   const std::string camera_id = config.camera.id;
-  auto check_camera = [camera_id](const depth_image_t& image) {
-    std::string problem = check_depth_image(image);
-    if (problem.empty() && image.camera_id != camera_id) {
-      problem = "camera_id: expected '" + camera_id + "', got '" + image.camera_id + "'";
-    }
-    return problem;
-  };
+  auto check_camera = [camera_id](const depth_image_t& image) { return check_depth_image_from(image, camera_id); };
 
   node.subscribe<depth_image_t>(
       node.images(), config.channels.depth,

@@ -70,13 +70,7 @@ int run_risk(const Config& config) {
   const std::string camera_id = config.camera.id;
   node.subscribe<depth_image_t>(
       node.images(), config.channels.depth, [&](const depth_image_t&) { monitor.on_depth(monotonic_us()); },
-      [camera_id](const depth_image_t& image) {
-        std::string problem = check_depth_image(image);
-        if (problem.empty() && image.camera_id != camera_id) {
-          problem = "camera_id: expected '" + camera_id + "', got '" + image.camera_id + "'";
-        }
-        return problem;
-      });
+      [camera_id](const depth_image_t& image) { return check_depth_image_from(image, camera_id); });
   node.subscribe<joint_state_t>(
       node.safety(), config.channels.joint_state,
       [&](const joint_state_t& s) { monitor.on_joint_state(s, monotonic_us()); },

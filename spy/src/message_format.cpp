@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "tofguard/camera_pose_t.hpp"
+#include "tofguard/decode.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/heartbeat_t.hpp"
@@ -126,13 +127,9 @@ using Formatter = std::function<std::optional<std::string>(const void*, int)>;
 template <class T>
 std::pair<int64_t, std::pair<std::string, Formatter>> entry() {
   Formatter f = [](const void* data, int size) -> std::optional<std::string> {
-    T m;
-    try {
-      if (m.decode(data, 0, size) < 0) return std::nullopt;
-    } catch (const std::exception&) {
-      return std::nullopt;
-    }
-    return format(m);
+    const std::optional<T> m = decode_message<T>(data, size);
+    if (!m) return std::nullopt;
+    return format(*m);
   };
   return {T::getHash(), {T::getTypeName(), f}};
 }

@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "message_format.hpp"
+#include "tofguard/decode.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/link_labels_t.hpp"
 #include "tofguard/risk_names.hpp"
@@ -12,17 +13,6 @@ namespace tofguard::spy {
 namespace {
 
 constexpr int64_t kRateWindowUs = 2'000'000;
-
-template <class T>
-std::optional<T> decode(const void* data, int size) {
-  T m;
-  try {
-    if (m.decode(data, 0, size) < 0) return std::nullopt;
-  } catch (const std::exception&) {
-    return std::nullopt;
-  }
-  return m;
-}
 
 std::string age(int64_t us) {
   std::ostringstream s;
@@ -42,22 +32,22 @@ void StatusBoard::on_message(const std::string& channel, const void* data, int s
   const std::string type = type_of(data, size);
   int64_t camera_utime = 0;
   if (type == "safety_status_t") {
-    if (auto m = decode<safety_status_t>(data, size)) {
+    if (auto m = decode_message<safety_status_t>(data, size)) {
       status_ = m;
       status_arrival_us_ = now_us;
     }
   } else if (type == "risk_t") {
-    if (auto m = decode<risk_t>(data, size)) {
+    if (auto m = decode_message<risk_t>(data, size)) {
       risk_ = m;
       risk_arrival_us_ = now_us;
       if (m->seq >= 0) camera_utime = m->utime;
     }
   } else if (type == "heartbeat_t") {
-    if (auto m = decode<heartbeat_t>(data, size)) heartbeats_[m->process] = {*m, now_us};
+    if (auto m = decode_message<heartbeat_t>(data, size)) heartbeats_[m->process] = {*m, now_us};
   } else if (type == "depth_image_t") {
-    if (auto m = decode<depth_image_t>(data, size)) camera_utime = m->utime;
+    if (auto m = decode_message<depth_image_t>(data, size)) camera_utime = m->utime;
   } else if (type == "link_labels_t") {
-    if (auto m = decode<link_labels_t>(data, size)) camera_utime = m->utime;
+    if (auto m = decode_message<link_labels_t>(data, size)) camera_utime = m->utime;
   }
   if (camera_utime > 0) stats.latency_us = now_utime - camera_utime;
 }

@@ -16,13 +16,6 @@
 namespace tofguard::test {
 namespace {
 
-template <class T>
-std::vector<uint8_t> encoded(const T& message) {
-  std::vector<uint8_t> bytes(message.getEncodedSize());
-  message.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-  return bytes;
-}
-
 const std::vector<std::pair<std::string, std::vector<uint8_t>>>& log_events() {
   static const std::vector<std::pair<std::string, std::vector<uint8_t>>> events = {
       {"TOF_DEPTH", encoded(sample_depth_image())},

@@ -21,13 +21,6 @@ namespace {
 constexpr const char* kUrl = "udpm://239.255.76.67:7667?ttl=0";
 constexpr const char* kProbeChannel = "ROUNDTRIP_PROBE";
 
-template <class T>
-std::vector<uint8_t> encoded(const T& message) {
-  std::vector<uint8_t> bytes(message.getEncodedSize());
-  message.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-  return bytes;
-}
-
 // Every message of the wire contract, encoded, by channel.
 std::map<std::string, std::vector<uint8_t>> sample_payloads() {
   return {

@@ -1,6 +1,9 @@
 #pragma once
 // One message of each wire type with every field set to a distinctive value,
 // shared by the round-trip test (C++) and mirrored in DecodeLog.java.
+#include <cstdint>
+#include <vector>
+
 #include "tofguard/camera_pose_t.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/heartbeat_t.hpp"
@@ -12,6 +15,14 @@
 #include "tofguard/safety_status_t.hpp"
 
 namespace tofguard::test {
+
+// A message's wire bytes (fingerprint first).
+template <class T>
+std::vector<uint8_t> encoded(const T& message) {
+  std::vector<uint8_t> bytes(message.getEncodedSize());
+  message.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  return bytes;
+}
 
 inline depth_image_t sample_depth_image() {
   depth_image_t m;

@@ -2,8 +2,11 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include <type_traits>
+
 #include <opencv2/imgproc.hpp>
 
+#include "tofguard/decode.hpp"
 #include "tofguard/risk_names.hpp"
 #include "tofguard/wire_checks.hpp"
 
@@ -95,10 +98,13 @@ LogFrames read_log_frames(const std::string& path, const ChannelNames& channels,
   std::map<int64_t, depth_image_t> rendered;
   std::map<int64_t, link_labels_t> labels;
   std::map<int64_t, risk_t> risks;
+  // Decodes the event as the type of *message; counts it as skipped if it
+  // is not one.
   auto decode = [&](const lcm::LogEvent* event, auto* message) {
-    try {
-      if (message->decode(event->data, 0, event->datalen) >= 0) return true;
-    } catch (const std::exception&) {
+    using T = std::remove_pointer_t<decltype(message)>;
+    if (auto m = decode_message<T>(event->data, event->datalen)) {
+      *message = *m;
+      return true;
     }
     result.skipped++;
     return false;

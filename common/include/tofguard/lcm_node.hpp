@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "tofguard/config.hpp"
+#include "tofguard/decode.hpp"
 #include "tofguard/error_log.hpp"
 #include "tofguard/heartbeat.hpp"
 
@@ -90,19 +91,14 @@ struct LcmNode::CheckedSubscription : LcmNode::SubscriptionBase {
   std::function<std::string(const T&)> check;
 
   void handle(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
-    T message;
-    int decoded = -1;
-    try {
-      decoded = message.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size));
-    } catch (const std::exception&) {
-      decoded = -1;  // absurd array sizes make the generated decoder throw
-    }
-    if (decoded < 0) {
+    const std::optional<T> decoded = decode_message<T>(rbuf->data, static_cast<int>(rbuf->data_size));
+    if (!decoded) {
       node->counters().decode_errors++;
       node->errors().report(channel, channel + ": cannot decode as " + T::getTypeName() +
                                          " (wrong fingerprint, or truncated / malformed)");
       return;
     }
+    const T& message = *decoded;
     if (check) {
       const std::string problem = check(message);
       if (!problem.empty()) {

@@ -18,6 +18,8 @@ namespace tofguard {
 constexpr int kMaxImageSide = 8192;
 
 std::string check_depth_image(const depth_image_t& image);
+// check_depth_image, and the frame must come from camera `camera_id`.
+std::string check_depth_image_from(const depth_image_t& image, const std::string& camera_id);
 std::string check_joint_state(const joint_state_t& state);
 // The rotation must be a unit quaternion within 1e-3.
 std::string check_camera_pose(const camera_pose_t& pose);
