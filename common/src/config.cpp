@@ -151,6 +151,8 @@ void read_channels(YamlMap map, ChannelNames* c) {
   name("reset_reply", &c->reset_reply);
   name("heartbeat", &c->heartbeat);
   name("power", &c->power);
+  name("motion_estimate", &c->motion_estimate);
+  name("planned_trajectory", &c->planned_trajectory);
   name("sim_true_joint_state", &c->sim_true_joint_state);
   name("sim_joint_fault", &c->sim_joint_fault);
   name("sim_camera_fault", &c->sim_camera_fault);

@@ -43,6 +43,10 @@ struct ChannelNames {
   std::string heartbeat = "SAFETY_HEARTBEAT";
   // The power-cut actuator `lcm` (power_relay_t, positive logic).
   std::string power = "SAFETY_POWER";
+  // tofguard-estimator's joint offsets and camera correction
+  // (motion_estimate_t) and the arm controller's plan (planned_trajectory_t).
+  std::string motion_estimate = "MOTION_ESTIMATE";
+  std::string planned_trajectory = "PLANNED_TRAJECTORY";
   // Simulation only: the simulated arm's true joint state (for the simulated
   // camera) and run-time encoder fault injection.
   std::string sim_true_joint_state = "SIM_TRUE_JOINT_STATE";
