@@ -1,0 +1,706 @@
+#include "motion_estimator.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include <Eigen/Cholesky>
+#include <opencv2/imgproc.hpp>
+
+namespace tofguard::estimator {
+
+using renderer::JointType;
+
+// The current estimate: joint offsets (added to each frame's reported
+// positions, actuated order) and the camera correction.
+struct MotionEstimator::State {
+  std::vector<double> joint_offsets;
+  // Added to the measured depth of the robot's surfaces, metres along Z.
+  double robot_depth_offset_m = 0;
+  Eigen::Isometry3d correction = Eigen::Isometry3d::Identity();
+};
+
+// Parameters after the joints: camera translation (3), camera rotation (3)
+// (a twist in the seen optical frame), and the robot's depth offset (1).
+constexpr int kExtraParams = 7;
+
+// Normal equations of one iteration, parameters ordered [joints...,
+// kExtraParams].
+struct MotionEstimator::Linearization {
+  Eigen::MatrixXd hessian;
+  Eigen::VectorXd gradient;
+  double weighted_sq = 0;
+  int num_points = 0;
+  int num_inliers = 0;
+  // Inliers on links each joint moves.
+  std::vector<int> joint_points;
+  double clipped_sq = 0;
+  // Contour residuals, and those inside the robust scale.
+  int num_contour_points = 0;
+  int num_contour_inliers = 0;
+
+  void reset(int num_joints) {
+    hessian = Eigen::MatrixXd::Zero(num_joints + kExtraParams, num_joints + kExtraParams);
+    gradient = Eigen::VectorXd::Zero(num_joints + kExtraParams);
+    weighted_sq = 0;
+    num_points = 0;
+    num_inliers = 0;
+    joint_points.assign(num_joints, 0);
+    clipped_sq = 0;
+    num_contour_points = 0;
+    num_contour_inliers = 0;
+  }
+  double clipped_rms_m() const { return num_points > 0 ? std::sqrt(clipped_sq / num_points) : 0.0; }
+};
+
+// A rendered robot point, for the joint search.
+struct MotionEstimator::Sample {
+  int link;
+  Eigen::Vector3d world;
+};
+
+namespace {
+
+int64_t now_us() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+bool finite(const Eigen::Isometry3d& pose) { return pose.matrix().allFinite(); }
+
+// exp of a small twist (translation v, rotation w about the axes of the
+// frame it is applied in, on the right).
+Eigen::Isometry3d twist_exp(const Eigen::Vector3d& v, const Eigen::Vector3d& w) {
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  const double angle = w.norm();
+  if (angle > 0) t.linear() = Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
+  t.translation() = v;
+  return t;
+}
+
+}  // namespace
+
+bool significant_offset(const JointEstimate& joint, double min_offset, double sigmas) {
+  const double offset = std::abs(joint.offset());
+  return joint.observable && offset >= min_offset && offset >= sigmas * joint.sigma;
+}
+
+int suspect_joint(const EstimateResult& result, double min_offset, double sigmas) {
+  int best = -1;
+  for (size_t k = 0; k < result.joints.size(); ++k) {
+    if (!significant_offset(result.joints[k], min_offset, sigmas)) continue;
+    if (best < 0 || std::abs(result.joints[k].offset()) > std::abs(result.joints[best].offset())) {
+      best = static_cast<int>(k);
+    }
+  }
+  return best;
+}
+
+double correction_angle_rad(const EstimateResult& result) {
+  return Eigen::AngleAxisd(result.correction.linear()).angle();
+}
+
+MotionEstimator::MotionEstimator(const renderer::SceneModel& scene, renderer::DepthRenderer* renderer,
+                                 const EstimatorOptions& options)
+    : scene_(scene), renderer_(renderer), options_(options) {
+  if (renderer_ == nullptr) throw std::invalid_argument("MotionEstimator: renderer is null");
+  const EstimatorOptions& o = options_;
+  if (o.pixel_stride < 1 || !(o.final_robust_scale_m > 0) || !(o.initial_robust_scale_m >= o.final_robust_scale_m) ||
+      !(o.robust_scale_factor > 0 && o.robust_scale_factor < 1) || !(o.gate_scales >= 1) ||
+      o.max_iterations < 1 || !(o.final_damping >= 0) || o.max_camera_iterations < 1 || !(o.step_tolerance > 0) ||
+      !(o.joint_search_step_rad > 0) || !(o.joint_search_range_rad >= 0) || o.joint_search_rounds < 0 ||
+      o.min_joint_points < 1 || !(o.max_joint_sigma > 0) || !(o.sigma_scale > 0) || !(o.residual_clip_m > 0) ||
+      !(o.noise_sigma_at_0m_m > 0) || !(o.model_sigma_m >= 0) || !(o.noise_sigma_per_m2_m >= 0) || !(o.normal_jump_m > 0) || !(o.contour_jump_fraction > 0) ||
+      !(o.final_contour_scale_px > 0) || !(o.contour_sigma_px > 0)) {
+    throw std::invalid_argument("MotionEstimator: options out of range");
+  }
+  num_params_ = static_cast<int>(scene_.actuated_joint_names.size());
+  std::map<std::string, int> param_of;
+  for (int k = 0; k < num_params_; ++k) param_of[scene_.actuated_joint_names[k]] = k;
+  chains_.resize(scene_.links.size());
+  for (size_t l = 0; l < scene_.links.size(); ++l) {
+    int joint_index = scene_.links[l].parent_joint;
+    while (joint_index >= 0) {
+      const renderer::Joint& joint = scene_.joints[joint_index];
+      if (joint.type != JointType::kFixed) {
+        // A mimic joint moves with its leader: d(value)/d(leader) is the
+        // product of the multipliers down the mimic chain.
+        double multiplier = 1;
+        int leader = joint_index;
+        while (scene_.joints[leader].mimic_joint >= 0) {
+          multiplier *= scene_.joints[leader].mimic_multiplier;
+          leader = scene_.joints[leader].mimic_joint;
+        }
+        const auto found = param_of.find(scene_.joints[leader].name);
+        if (found != param_of.end()) chains_[l].push_back({joint_index, found->second, multiplier});
+      }
+      joint_index = scene_.links[joint.parent_link].parent_joint;
+    }
+  }
+}
+
+std::string MotionEstimator::check_frame(const EstimatorFrame& frame) const {
+  const std::string intrinsics = renderer::check_intrinsics(frame.intrinsics);
+  if (!intrinsics.empty()) return "intrinsics: " + intrinsics;
+  const size_t pixels = static_cast<size_t>(frame.intrinsics.width) * frame.intrinsics.height;
+  if (frame.depth_m.size() != pixels) {
+    return "depth image: expected " + std::to_string(pixels) + " pixels, got " + std::to_string(frame.depth_m.size());
+  }
+  for (const std::string& name : scene_.actuated_joint_names) {
+    const auto found = frame.reported_joints.find(name);
+    if (found == frame.reported_joints.end()) return "joint '" + name + "' missing from the joint state";
+    if (!std::isfinite(found->second)) return "joint '" + name + "' is not a finite number";
+  }
+  if (!finite(frame.world_from_optical)) return "camera pose is not finite";
+  return "";
+}
+
+namespace {
+
+renderer::JointPositions joints_at(const renderer::SceneModel& scene, const EstimatorFrame& frame,
+                                   const std::vector<double>& offsets) {
+  renderer::JointPositions joints = frame.reported_joints;
+  for (size_t k = 0; k < offsets.size(); ++k) joints[scene.actuated_joint_names[k]] += offsets[k];
+  return joints;
+}
+
+struct JointAxis {
+  Eigen::Vector3d axis_world;
+  Eigen::Vector3d origin_world;
+};
+
+std::vector<JointAxis> joint_axes(const renderer::SceneModel& scene, const renderer::LinkPoses& poses) {
+  std::vector<JointAxis> axes(scene.joints.size());
+  for (size_t j = 0; j < scene.joints.size(); ++j) {
+    const renderer::Joint& joint = scene.joints[j];
+    const Eigen::Isometry3d world_from_joint = poses.world_from_link[joint.parent_link] * joint.parent_from_joint;
+    axes[j].axis_world = world_from_joint.linear() * joint.axis;
+    axes[j].origin_world = world_from_joint.translation();
+  }
+  return axes;
+}
+
+int link_of_label(int16_t label, int num_robot_links) {
+  if (label >= renderer::kLabelRobotFirst && label < renderer::kLabelEnvironmentFirst) {
+    return label - renderer::kLabelRobotFirst;
+  }
+  if (label >= renderer::kLabelEnvironmentFirst && label < renderer::kLabelExtraObjectFirst) {
+    return num_robot_links + label - renderer::kLabelEnvironmentFirst;
+  }
+  return -1;
+}
+
+}  // namespace
+
+const MotionEstimator::MeasuredEdges& MotionEstimator::edges_of(const EstimatorFrame& frame) {
+  const auto found = edges_.find(frame.depth_m.data());
+  if (found != edges_.end()) return found->second;
+  const int width = frame.intrinsics.width;
+  const int height = frame.intrinsics.height;
+  // Occluding contours: the near side of a depth step between two valid
+  // pixels.
+  cv::Mat not_edge(height, width, CV_8U, cv::Scalar(255));
+  std::vector<int> edge_pixels;
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      const size_t i = static_cast<size_t>(v) * width + u;
+      const float z = frame.depth_m[i];
+      if (!(z > 0) || !std::isfinite(z)) continue;
+      const float jump = static_cast<float>(options_.contour_jump_fraction) * z;
+      bool edge = false;
+      auto farther = [&](size_t j) {
+        const float zj = frame.depth_m[j];
+        return zj > 0 && std::isfinite(zj) && zj - z > jump;
+      };
+      if (u > 0) edge = edge || farther(i - 1);
+      if (u + 1 < width) edge = edge || farther(i + 1);
+      if (v > 0) edge = edge || farther(i - width);
+      if (v + 1 < height) edge = edge || farther(i + width);
+      if (edge) not_edge.at<uint8_t>(v, u) = 0;
+    }
+  }
+  MeasuredEdges& edges = edges_[frame.depth_m.data()];
+  edges.nearest.assign(frame.depth_m.size(), -1);
+  if (cv::countNonZero(not_edge) == static_cast<int>(frame.depth_m.size())) return edges;
+  cv::Mat distance, labels;
+  cv::distanceTransform(not_edge, distance, labels, cv::DIST_L2, cv::DIST_MASK_5, cv::DIST_LABEL_PIXEL);
+  // Each edge pixel carries its own label.
+  std::map<int, int> pixel_of_label;
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      if (not_edge.at<uint8_t>(v, u) == 0) pixel_of_label[labels.at<int>(v, u)] = v * width + u;
+    }
+  }
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      const auto p = pixel_of_label.find(labels.at<int>(v, u));
+      if (p != pixel_of_label.end()) edges.nearest[static_cast<size_t>(v) * width + u] = p->second;
+    }
+  }
+  return edges;
+}
+
+std::string MotionEstimator::linearize(const EstimatorFrame& frame, const State& state, double scale,
+                                       PointSet points, bool joints_free, Linearization* lin,
+                                       std::vector<Sample>* samples) {
+  const renderer::LinkPoses poses = renderer::forward_kinematics(scene_, joints_at(scene_, frame, state.joint_offsets));
+  if (!poses.usable) return poses.unusable_reason;
+  const Eigen::Isometry3d world_from_optical = frame.world_from_optical * state.correction;
+  const renderer::RenderResult rendered = renderer_->render_at(poses, world_from_optical, frame.intrinsics);
+  if (!rendered.usable) return "render: " + rendered.unusable_reason;
+  const std::vector<JointAxis> axes = joint_axes(scene_, poses);
+  const Eigen::Matrix3d optical_from_world_rotation = world_from_optical.linear().transpose();
+  const MeasuredEdges& edges = edges_of(frame);
+
+  const Intrinsics& in = frame.intrinsics;
+  const int width = in.width;
+  const int height = in.height;
+  const int stride = options_.pixel_stride;
+  const int n = num_params_;
+  const double gate = options_.gate_scales * scale;
+  const double clip = options_.residual_clip_m;
+  const double sigma_1m = options_.noise_sigma_at_0m_m + options_.noise_sigma_per_m2_m;
+  // The contour scale shrinks with the depth scale.
+  const double contour_scale_px = options_.final_contour_scale_px * scale / options_.final_robust_scale_m;
+  const double contour_weight = sigma_1m * sigma_1m / (options_.contour_sigma_px * options_.contour_sigma_px);
+  const std::vector<float>& model = rendered.depth_m;
+  const std::vector<int16_t>& labels = rendered.labels;
+  auto back_project = [&](int u, int v, double z) {
+    return Eigen::Vector3d((u - in.cx) * z / in.fx, (v - in.cy) * z / in.fy, z);
+  };
+  Eigen::VectorXd row(n + kExtraParams);
+  // Adds one residual whose derivative with respect to the model point
+  // (seen optical frame) is `g`.
+  auto add = [&](const std::vector<ChainJoint>& chain, const Eigen::Vector3d& m, const Eigen::Vector3d& world,
+                 const Eigen::Vector3d& g, double residual, double weight, bool count_joint_points,
+                 double d_depth_offset) {
+    row.setZero();
+    row[n + 6] = d_depth_offset;
+    if (joints_free) {
+      for (const ChainJoint& c : chain) {
+        const JointAxis& axis = axes[c.scene_joint];
+        const Eigen::Vector3d d_world = scene_.joints[c.scene_joint].type == JointType::kPrismatic
+                                            ? axis.axis_world
+                                            : Eigen::Vector3d(axis.axis_world.cross(world - axis.origin_world));
+        row[c.param] += c.multiplier * g.dot(optical_from_world_rotation * d_world);
+        if (count_joint_points) ++lin->joint_points[c.param];
+      }
+    }
+    // The seen frame moved by the twist (v, w): m' = m - v - w x m.
+    row.segment<3>(n) = -g;
+    row.segment<3>(n + 3) = g.cross(m);
+    lin->hessian.selfadjointView<Eigen::Upper>().rankUpdate(row, weight);
+    lin->gradient += weight * residual * row;
+    lin->weighted_sq += weight * residual * residual;
+  };
+
+  for (int v = 1; v + 1 < height; ++v) {
+    for (int u = 1; u + 1 < width; ++u) {
+      const size_t i = static_cast<size_t>(v) * width + u;
+      const int link = link_of_label(labels[i], scene_.num_robot_links);
+      if (link < 0) continue;
+      const std::vector<ChainJoint>& chain = chains_[link];
+      if (points == PointSet::kStatic && !chain.empty()) continue;
+      const double z_model = model[i];
+      if (!(z_model > 0)) continue;
+      const size_t left = i - 1, right = i + 1, up = i - width, down = i + width;
+
+      // Contour term: a rendered occluding contour pixel against the
+      // nearest measured one, distance along the contour's normal, pixels.
+      Eigen::Vector2d outward = Eigen::Vector2d::Zero();
+      const double contour_jump = options_.contour_jump_fraction * z_model;
+      auto farther = [&](size_t j) { return model[j] > 0 && model[j] - z_model > contour_jump; };
+      if (farther(left)) outward.x() -= 1;
+      if (farther(right)) outward.x() += 1;
+      if (farther(up)) outward.y() -= 1;
+      if (farther(down)) outward.y() += 1;
+      if (outward.squaredNorm() > 0 && edges.nearest[i] >= 0) {
+        outward.normalize();
+        const int edge_u = edges.nearest[i] % width;
+        const int edge_v = edges.nearest[i] / width;
+        const double e = outward.dot(Eigen::Vector2d(u - edge_u, v - edge_v));
+        ++lin->num_contour_points;
+        if (std::abs(e) < contour_scale_px) {
+          const double t = e / contour_scale_px;
+          const double tukey = (1 - t * t) * (1 - t * t);
+          const Eigen::Vector3d m = back_project(u, v, z_model);
+          const double inv_z = 1.0 / m.z();
+          // d(e)/d(m) = outward^T * d(pixel)/d(m).
+          const Eigen::Vector3d g(outward.x() * in.fx * inv_z, outward.y() * in.fy * inv_z,
+                                  -(outward.x() * in.fx * m.x() + outward.y() * in.fy * m.y()) * inv_z * inv_z);
+          add(chain, m, world_from_optical * m, g, e, tukey * contour_weight, false, 0.0);
+          ++lin->num_contour_inliers;
+        }
+      }
+
+      // Depth term (every stride-th pixel): point-to-plane against the
+      // measured point on the same pixel, with the rendered surface's
+      // normal from the neighbouring pixels of the same link; none on a
+      // silhouette.
+      if (u % stride != 0 || v % stride != 0) continue;
+      const double z_measured = frame.depth_m[i];
+      if (!(z_measured > 0) || !std::isfinite(z_measured)) continue;
+      bool smooth = true;
+      for (size_t nb : {left, right, up, down}) {
+        smooth = smooth && labels[nb] == labels[i] && std::abs(model[nb] - z_model) < options_.normal_jump_m;
+      }
+      if (!smooth) continue;
+      const Eigen::Vector3d m = back_project(u, v, z_model);
+      Eigen::Vector3d normal = (back_project(u + 1, v, model[right]) - back_project(u - 1, v, model[left]))
+                                   .cross(back_project(u, v + 1, model[down]) - back_project(u, v - 1, model[up]));
+      const double normal_norm = normal.norm();
+      if (!(normal_norm > 0)) continue;
+      normal /= normal_norm;
+      if (normal.dot(m) > 0) normal = -normal;
+      const Eigen::Vector3d world = world_from_optical * m;
+      if (samples != nullptr && !chain.empty()) samples->push_back({link, world});
+
+      // The robot's measured surfaces corrected by the depth offset: the
+      // ToF camera's systematic error (calibration residual, multipath)
+      // shifts a small object's surface along the rays by about the same
+      // amount, which would otherwise turn the distal joints.
+      const bool robot = labels[i] < renderer::kLabelEnvironmentFirst;
+      const Eigen::Vector3d ray((u - in.cx) / in.fx, (v - in.cy) / in.fy, 1.0);
+      const Eigen::Vector3d d = back_project(u, v, z_measured) + (robot ? state.robot_depth_offset_m : 0.0) * ray;
+      const double residual = normal.dot(m - d);
+      const double depth_difference = z_model - z_measured;
+      ++lin->num_points;
+      const bool gated = std::abs(depth_difference) > gate;
+      const double clipped = gated ? clip : std::min(std::abs(residual), clip);
+      lin->clipped_sq += clipped * clipped;
+      if (gated || std::abs(residual) >= scale) continue;
+      const double t = residual / scale;
+      const double tukey = (1 - t * t) * (1 - t * t);
+      const double sigma = options_.noise_sigma_at_0m_m + options_.noise_sigma_per_m2_m * z_measured * z_measured;
+      ++lin->num_inliers;
+      add(chain, m, world, normal, residual,
+          tukey * sigma_1m * sigma_1m / (sigma * sigma + options_.model_sigma_m * options_.model_sigma_m), true,
+          robot ? -normal.dot(ray) : 0.0);
+    }
+  }
+  lin->hessian.triangularView<Eigen::StrictlyLower>() = lin->hessian.transpose().triangularView<Eigen::StrictlyLower>();
+  return "";
+}
+
+namespace {
+
+// Which parameters a solve moves: joints seen by enough inliers (and with
+// information), the camera's six when free.
+std::vector<int> active_parameters(const Eigen::MatrixXd& hessian, const std::vector<int>& joint_points,
+                                   int num_joints, bool joints_free, bool camera_free, bool depth_offset_free,
+                                   int min_joint_points) {
+  std::vector<int> active;
+  if (joints_free) {
+    for (int k = 0; k < num_joints; ++k) {
+      if (joint_points[k] >= min_joint_points && hessian(k, k) > 1e-12) active.push_back(k);
+    }
+  }
+  if (camera_free) {
+    for (int k = 0; k < 6; ++k) active.push_back(num_joints + k);
+  }
+  if (depth_offset_free && hessian(num_joints + 6, num_joints + 6) > 1e-12) active.push_back(num_joints + 6);
+  return active;
+}
+
+}  // namespace
+
+std::string MotionEstimator::solve(const std::vector<const EstimatorFrame*>& frames, bool joints_free,
+                                   bool camera_free, PointSet points, int max_iterations, State* state,
+                                   Linearization* final_lin, bool* converged, int* iterations) {
+  const int n = num_params_;
+  *converged = false;
+  Linearization lin;
+  for (int it = 0; it < max_iterations; ++it) {
+    const double scale = std::max(options_.final_robust_scale_m,
+                                  options_.initial_robust_scale_m * std::pow(options_.robust_scale_factor, it));
+    const bool final_scale = scale <= options_.final_robust_scale_m * (1 + 1e-9);
+    lin.reset(n);
+    for (const EstimatorFrame* frame : frames) {
+      const std::string error = linearize(*frame, *state, scale, points, joints_free, &lin, nullptr);
+      if (!error.empty()) return error;
+    }
+    ++*iterations;
+    *final_lin = lin;
+    const std::vector<int> active =
+        active_parameters(lin.hessian, lin.joint_points, n, joints_free, camera_free,
+                        joints_free && options_.estimate_robot_depth_offset, options_.min_joint_points);
+    if (active.empty()) {
+      *converged = true;
+      return "";
+    }
+    if (lin.num_inliers < static_cast<int>(active.size()) + 20) {
+      return "too few model points match the image (" + std::to_string(lin.num_inliers) + " inliers)";
+    }
+    const int p = static_cast<int>(active.size());
+    Eigen::MatrixXd a(p, p);
+    Eigen::VectorXd b(p);
+    for (int r = 0; r < p; ++r) {
+      b[r] = lin.gradient[active[r]];
+      for (int c = 0; c < p; ++c) a(r, c) = lin.hessian(active[r], active[c]);
+    }
+    // A little Levenberg-Marquardt damping keeps weakly seen directions
+    // from jumping.
+    for (int r = 0; r < p; ++r) a(r, r) *= 1.0 + (final_scale ? options_.final_damping : 1e-3);
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(a);
+    if (ldlt.info() != Eigen::Success) return "normal equations are singular";
+    const Eigen::VectorXd step = -ldlt.solve(b);
+    if (!step.allFinite()) return "solver diverged (non-finite step)";
+
+    Eigen::VectorXd full = Eigen::VectorXd::Zero(n + kExtraParams);
+    for (int r = 0; r < p; ++r) full[active[r]] = step[r];
+    double largest = 0;
+    for (int k = 0; k < n; ++k) {
+      const double s = std::clamp(full[k], -options_.max_joint_step, options_.max_joint_step);
+      state->joint_offsets[k] += s;
+      largest = std::max(largest, std::abs(s));
+    }
+    Eigen::Vector3d v = full.segment<3>(n);
+    Eigen::Vector3d w = full.segment<3>(n + 3);
+    if (v.norm() > options_.max_camera_translation_step_m) v *= options_.max_camera_translation_step_m / v.norm();
+    if (w.norm() > options_.max_camera_rotation_step_rad) w *= options_.max_camera_rotation_step_rad / w.norm();
+    largest = std::max({largest, v.cwiseAbs().maxCoeff(), w.cwiseAbs().maxCoeff()});
+    state->robot_depth_offset_m += std::clamp(full[n + 6], -0.02, 0.02);
+    state->correction = state->correction * twist_exp(v, w);
+    if (final_scale && largest < options_.step_tolerance) {
+      *converged = true;
+      return "";
+    }
+  }
+  return "";
+}
+
+int MotionEstimator::search_joints(const EstimatorFrame& frame, State* state, std::string* error) {
+  const Intrinsics& in = frame.intrinsics;
+  const int width = in.width;
+  const int height = in.height;
+  const double tolerance_floor = options_.final_robust_scale_m;
+  int moves = 0;
+  std::vector<double> grid;
+  const int steps = static_cast<int>(std::floor(options_.joint_search_range_rad / options_.joint_search_step_rad));
+  for (int s = -steps; s <= steps; ++s) {
+    if (s != 0) grid.push_back(s * options_.joint_search_step_rad);
+  }
+  for (int round = 0; round < options_.joint_search_rounds; ++round) {
+    std::vector<Sample> samples;
+    Linearization scratch;
+    scratch.reset(num_params_);
+    *error = linearize(frame, *state, options_.final_robust_scale_m, PointSet::kAll, false, &scratch, &samples);
+    if (!error->empty()) return moves;
+    const renderer::LinkPoses base = renderer::forward_kinematics(scene_, joints_at(scene_, frame, state->joint_offsets));
+    const Eigen::Isometry3d optical_from_world = (frame.world_from_optical * state->correction).inverse();
+
+    // +1 for a point the camera sees where the model puts it, -1 for one
+    // the camera sees through (it measures farther), 0 when something
+    // nearer hides it, it has no return, or it leaves the image.
+    auto score = [&](const std::vector<const Sample*>& distal, const std::vector<Eigen::Isometry3d>& moved) {
+      int total = 0;
+      for (const Sample* s : distal) {
+        const Eigen::Vector3d m = optical_from_world * (moved[s->link] * s->world);
+        if (!(m.z() > 0)) continue;
+        const int u = static_cast<int>(std::lround(in.fx * m.x() / m.z() + in.cx));
+        const int v = static_cast<int>(std::lround(in.fy * m.y() / m.z() + in.cy));
+        if (u < 0 || v < 0 || u >= width || v >= height) continue;
+        const double z = frame.depth_m[static_cast<size_t>(v) * width + u];
+        if (!(z > 0) || !std::isfinite(z)) continue;
+        const double sigma = options_.noise_sigma_at_0m_m + options_.noise_sigma_per_m2_m * z * z;
+        const double tolerance = std::max(tolerance_floor, 3 * sigma);
+        const double dz = m.z() - z;
+        if (std::abs(dz) <= tolerance) {
+          ++total;
+        } else if (dz < 0) {
+          --total;
+        }
+      }
+      return total;
+    };
+
+    int best_param = -1;
+    double best_offset = 0;
+    double best_gain_fraction = 0;
+    std::vector<Eigen::Isometry3d> moved(scene_.links.size(), Eigen::Isometry3d::Identity());
+    for (int k = 0; k < num_params_; ++k) {
+      std::vector<const Sample*> distal;
+      for (const Sample& s : samples) {
+        for (const ChainJoint& c : chains_[s.link]) {
+          if (c.param == k) {
+            distal.push_back(&s);
+            break;
+          }
+        }
+      }
+      if (static_cast<int>(distal.size()) < options_.min_joint_points) continue;
+      std::fill(moved.begin(), moved.end(), Eigen::Isometry3d::Identity());
+      const int base_score = score(distal, moved);
+      for (double offset : grid) {
+        std::vector<double> offsets = state->joint_offsets;
+        offsets[k] += offset;
+        const renderer::LinkPoses poses = renderer::forward_kinematics(scene_, joints_at(scene_, frame, offsets));
+        if (!poses.usable) continue;
+        for (size_t l = 0; l < moved.size(); ++l) {
+          moved[l] = poses.world_from_link[l] * base.world_from_link[l].inverse();
+        }
+        const int gain = score(distal, moved) - base_score;
+        const double fraction = static_cast<double>(gain) / distal.size();
+        if (gain >= options_.min_joint_points && fraction >= options_.min_search_gain_fraction &&
+            fraction > best_gain_fraction) {
+          best_gain_fraction = fraction;
+          best_param = k;
+          best_offset = offset;
+        }
+      }
+    }
+    if (best_param < 0) break;
+    state->joint_offsets[best_param] += best_offset;
+    ++moves;
+  }
+  return moves;
+}
+
+EstimateResult MotionEstimator::finish(const EstimatorFrame& frame, const State& state, const Linearization& lin,
+                                       bool camera_free, bool joints_free) const {
+  EstimateResult result;
+  result.usable = true;
+  const int n = num_params_;
+  const std::vector<int> active =
+      active_parameters(lin.hessian, lin.joint_points, n, joints_free, camera_free,
+                        joints_free && options_.estimate_robot_depth_offset, options_.min_joint_points);
+  const int p = static_cast<int>(active.size());
+  std::vector<double> variance(n + kExtraParams, -1.0);
+  if (p > 0) {
+    Eigen::MatrixXd a(p, p);
+    for (int r = 0; r < p; ++r)
+      for (int c = 0; c < p; ++c) a(r, c) = lin.hessian(active[r], active[c]);
+    const double dof = std::max(1, lin.num_inliers - p);
+    const double residual_variance = lin.weighted_sq / dof;
+    const Eigen::MatrixXd covariance = residual_variance * a.ldlt().solve(Eigen::MatrixXd::Identity(p, p));
+    for (int r = 0; r < p; ++r) variance[active[r]] = covariance(r, r);
+  }
+  auto sigma_of = [&](int k) {
+    return variance[k] >= 0 ? options_.sigma_scale * std::sqrt(variance[k]) : kUnobservableSigma;
+  };
+  for (int k = 0; k < n; ++k) {
+    JointEstimate joint;
+    joint.name = scene_.actuated_joint_names[k];
+    joint.reported = frame.reported_joints.at(joint.name);
+    joint.sigma = sigma_of(k);
+    joint.observable = joints_free && variance[k] >= 0 && joint.sigma <= options_.max_joint_sigma;
+    if (!joint.observable) joint.sigma = kUnobservableSigma;
+    joint.estimated = joint.observable ? joint.reported + state.joint_offsets[k] : joint.reported;
+    result.joints.push_back(joint);
+  }
+  result.camera_estimated = camera_free;
+  if (camera_free) {
+    result.correction = state.correction;
+    double translation = 0, rotation = 0;
+    for (int k = 0; k < 3; ++k) {
+      translation = std::max(translation, sigma_of(n + k));
+      rotation = std::max(rotation, sigma_of(n + 3 + k));
+    }
+    result.correction_translation_sigma_m = translation;
+    result.correction_rotation_sigma_rad = rotation;
+  }
+  result.robot_depth_offset_m = state.robot_depth_offset_m;
+  result.num_points = lin.num_points;
+  result.num_inliers = lin.num_inliers;
+  result.residual_after_m = lin.clipped_rms_m();
+  return result;
+}
+
+EstimateResult MotionEstimator::estimate(const EstimatorFrame& frame) {
+  const int64_t start = now_us();
+  EstimateResult unusable;
+  auto fail = [&](const std::string& why) {
+    unusable.usable = false;
+    unusable.unusable_reason = why;
+    unusable.compute_us = now_us() - start;
+    return unusable;
+  };
+  const std::string problem = check_frame(frame);
+  if (!problem.empty()) return fail(problem);
+  edges_.clear();
+
+  State state;
+  state.joint_offsets.assign(num_params_, 0.0);
+  Linearization before;
+  before.reset(num_params_);
+  std::string error = linearize(frame, state, options_.final_robust_scale_m, PointSet::kAll, false, &before, nullptr);
+  if (!error.empty()) return fail(error);
+
+  const bool joints_free = options_.estimate_joints;
+  const bool camera_free = options_.estimate_camera;
+  const std::vector<const EstimatorFrame*> frames{&frame};
+  int iterations = 0;
+  bool converged = true;
+  Linearization lin = before;
+  if (joints_free && camera_free) {
+    // The camera first from what no joint moves.
+    error = solve(frames, false, true, PointSet::kStatic, options_.max_camera_iterations, &state, &lin, &converged,
+                  &iterations);
+    if (!error.empty()) return fail("camera: " + error);
+  }
+  int moves = 0;
+  if (joints_free) {
+    moves = search_joints(frame, &state, &error);
+    if (!error.empty()) return fail("joint search: " + error);
+  }
+  if (joints_free || camera_free) {
+    error = solve(frames, joints_free, camera_free, PointSet::kAll, options_.max_iterations, &state, &lin,
+                  &converged, &iterations);
+    if (!error.empty()) return fail(error);
+  }
+  EstimateResult result = finish(frame, state, lin, camera_free, joints_free);
+  result.converged = converged;
+  result.iterations = iterations;
+  result.search_moves = moves;
+  result.residual_before_m = before.clipped_rms_m();
+  result.compute_us = now_us() - start;
+  return result;
+}
+
+EstimateResult MotionEstimator::estimate_camera(const std::vector<EstimatorFrame>& frames) {
+  const int64_t start = now_us();
+  EstimateResult unusable;
+  auto fail = [&](const std::string& why) {
+    unusable.usable = false;
+    unusable.unusable_reason = why;
+    unusable.compute_us = now_us() - start;
+    return unusable;
+  };
+  if (frames.empty()) return fail("no frames");
+  edges_.clear();
+  std::vector<const EstimatorFrame*> pointers;
+  for (size_t f = 0; f < frames.size(); ++f) {
+    const std::string problem = check_frame(frames[f]);
+    if (!problem.empty()) return fail("frame " + std::to_string(f) + ": " + problem);
+    if (!frames[f].world_from_optical.isApprox(frames[0].world_from_optical, 1e-9)) {
+      return fail("frame " + std::to_string(f) + ": initial camera pose differs from frame 0's");
+    }
+    pointers.push_back(&frames[f]);
+  }
+  State state;
+  state.joint_offsets.assign(num_params_, 0.0);
+  Linearization before;
+  before.reset(num_params_);
+  for (const EstimatorFrame* frame : pointers) {
+    const std::string error =
+        linearize(*frame, state, options_.final_robust_scale_m, PointSet::kAll, false, &before, nullptr);
+    if (!error.empty()) return fail(error);
+  }
+  Linearization lin = before;
+  int iterations = 0;
+  bool converged = false;
+  const std::string error =
+      solve(pointers, false, true, PointSet::kAll, options_.max_iterations, &state, &lin, &converged, &iterations);
+  if (!error.empty()) return fail(error);
+  EstimateResult result = finish(frames[0], state, lin, true, false);
+  result.converged = converged;
+  result.iterations = iterations;
+  result.residual_before_m = before.clipped_rms_m();
+  result.compute_us = now_us() - start;
+  return result;
+}
+
+}  // namespace tofguard::estimator

@@ -1,0 +1,45 @@
+#pragma once
+// Depth frames as the simulated ToF camera publishes them, made in-process
+// for the estimator's tests and benchmark: the URDF scene rendered with the
+// renderer library at the true joints and the true camera pose, the camera's
+// ToF error model (noise, mixed and invalid pixels, systematic error) applied,
+// then the config's distance calibration, like tofguard-camera does.
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "depth_calibration.hpp"
+#include "depth_renderer.hpp"
+#include "scene_model.hpp"
+#include "tof_error_model.hpp"
+#include "tofguard/config.hpp"
+
+namespace tofguard::estimator::testing {
+
+class SimulatedFrames {
+ public:
+  // The config's robot and environment (visual geometry, no padding: what
+  // the camera sees), its camera's error model and calibration.
+  explicit SimulatedFrames(const Config& config);
+
+  // Calibrated Z in metres (0 = no return), row-major, for `intrinsics`.
+  // `frame_index` selects the noise. Throws std::runtime_error when the
+  // scene cannot be rendered.
+  std::vector<float> capture(const renderer::JointPositions& true_joints,
+                             const Eigen::Isometry3d& true_world_from_optical, const Intrinsics& intrinsics,
+                             uint64_t frame_index, const std::vector<renderer::ExtraObject>& objects = {});
+
+  const renderer::SceneModel& scene() const { return scene_; }
+  // The renderer, to share with an estimator on the same thread.
+  renderer::DepthRenderer& renderer() { return *renderer_; }
+
+ private:
+  Config config_;
+  renderer::SceneModel scene_;
+  std::unique_ptr<renderer::DepthRenderer> renderer_;
+  camera::DepthCalibration calibration_;
+};
+
+}  // namespace tofguard::estimator::testing
