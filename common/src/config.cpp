@@ -188,6 +188,24 @@ DiscrepancyConfig read_discrepancy(YamlMap map) {
   return d;
 }
 
+EstimatorConfig read_estimator(YamlMap map) {
+  EstimatorConfig e;
+  e.estimate_joints = map.boolean("estimate_joints");
+  e.estimate_camera = map.boolean("estimate_camera");
+  {
+    YamlMap warning = map.map("warning");
+    e.warning_mismatch_fraction = warning.number("mismatch_fraction", 0, 1);
+    e.warning_p95_abs_dis_mm = warning.number("p95_abs_dis_mm", 0, 32767);
+    warning.finish();
+  }
+  e.periodic_period_ms = map.number("periodic_period_ms", 10, 3600000);
+  e.max_pending_frames = static_cast<int>(map.integer("max_pending_frames", 1, 100));
+  e.max_iterations = static_cast<int>(map.integer("max_iterations", 1, 100));
+  e.pixel_stride = static_cast<int>(map.integer("pixel_stride", 1, 8));
+  map.finish();
+  return e;
+}
+
 RiskConfig read_risk(YamlMap map) {
   RiskConfig r;
   r.check_period_ms = map.number("check_period_ms", 1, 1000);
@@ -415,6 +433,7 @@ Config load_config(const std::string& path, const char* lcm_default_url_env) {
   // Safety chain sections (required: no silent defaults for thresholds).
   config.discrepancy = read_discrepancy(root.map("discrepancy"));
   config.risk = read_risk(root.map("risk"));
+  config.estimator = read_estimator(root.map("estimator"));
   config.joints_sim = read_joints_sim(root.map("joints_sim"));
   config.intervention = read_intervention(root.map("intervention"));
   if (auto launch = root.optional_map("launch")) config.launch = read_launch(*launch);

@@ -267,6 +267,28 @@ struct RiskConfig {
   double unclassified_blob_area_m2 = 0;
 };
 
+// tofguard-estimator (docs/estimator.md): when to estimate the joint
+// offsets and the camera correction that best explain a camera frame.
+struct EstimatorConfig {
+  // Which parameters are estimated.
+  bool estimate_joints = true;
+  bool estimate_camera = true;
+  // A frame is estimated at once (TRIGGER_WARNING) when its discrepancy_t is
+  // usable and its mismatch_fraction reaches warning_mismatch_fraction or
+  // its p95_abs_dis_mm reaches warning_p95_abs_dis_mm.
+  double warning_mismatch_fraction = 0;
+  double warning_p95_abs_dis_mm = 0;
+  // And the newest frame every periodic_period_ms (TRIGGER_PERIODIC),
+  // milliseconds.
+  double periodic_period_ms = 0;
+  // Camera frames kept (by seq) until their discrepancy arrives.
+  int max_pending_frames = 0;
+  // Gauss-Newton iterations (one render each) of the joints-and-camera
+  // stage, and every pixel_stride-th pixel's depth residual.
+  int max_iterations = 0;
+  int pixel_stride = 0;
+};
+
 // One joint's periodic motion in the simulated arm:
 // position = center + amplitude * sin(2*pi*t/period_s + phase), radians (or
 // metres for a prismatic joint); t is the arm's motion time, which stands
@@ -363,6 +385,7 @@ struct Config {
   RendererConfig renderer;
   DiscrepancyConfig discrepancy;
   RiskConfig risk;
+  EstimatorConfig estimator;
   JointsSimConfig joints_sim;
   InterventionConfig intervention;
   // Optional: only tofguard-launch needs it.

@@ -1,0 +1,268 @@
+#include "estimator_process.hpp"
+
+#include <chrono>
+#include <cmath>
+
+#include "depth_renderer.hpp"
+#include "kinematics.hpp"
+
+namespace tofguard::estimator {
+
+ProcessInfo process_info() {
+  return {"tofguard-estimator",
+          "Estimates which joint offsets and which camera-pose correction best explain the camera's depth image "
+          "(docs/estimator.md): TOF_DEPTH, JOINT_STATE, CAMERA_POSE, SAFETY_DISCREPANCY -> MOTION_ESTIMATE, for "
+          "every frame whose discrepancy passes the warning level and periodically."};
+}
+
+EstimatorOptions options_from_config(const Config& config) {
+  EstimatorOptions o;
+  o.estimate_joints = config.estimator.estimate_joints;
+  o.estimate_camera = config.estimator.estimate_camera;
+  o.noise_sigma_at_0m_m = std::max(1e-4, config.discrepancy.noise_sigma_at_0m_mm / 1000.0);
+  o.noise_sigma_per_m2_m = config.discrepancy.noise_sigma_per_m2_mm / 1000.0;
+  o.max_iterations = config.estimator.max_iterations;
+  o.pixel_stride = config.estimator.pixel_stride;
+  return o;
+}
+
+renderer::SceneModel load_estimator_scene(const Config& config) {
+  renderer::SceneOptions options;
+  options.geometry = renderer::GeometrySource::kVisual;
+  options.padding_m = 0;
+  options.package_paths = config.robot.package_paths;
+  return renderer::load_scene(config.robot.urdf_path, config.environment.urdf_paths, options);
+}
+
+std::string check_discrepancy(const discrepancy_t& d) {
+  if (!std::isfinite(d.mismatch_fraction) || d.mismatch_fraction < 0 || d.mismatch_fraction > 1) {
+    return "mismatch_fraction: expected 0..1, got " + std::to_string(d.mismatch_fraction);
+  }
+  if (!std::isfinite(d.p95_abs_dis_mm) || d.p95_abs_dis_mm < 0) {
+    return "p95_abs_dis_mm: expected a finite value >= 0, got " + std::to_string(d.p95_abs_dis_mm);
+  }
+  return "";
+}
+
+EstimatorScheduler::EstimatorScheduler(const Config& config, const renderer::SceneModel& scene)
+    : config_(config),
+      scene_(scene),
+      history_(static_cast<int64_t>(std::llround(config.renderer.max_extrapolation_ms * 1000.0))) {
+  camera_poses_[config.camera.id] = config.camera.pose;
+}
+
+bool EstimatorScheduler::on_joint_state(const joint_state_t& state) {
+  if (state.robot_id != config_.robot.id) return false;
+  renderer::JointPositions positions;
+  for (int i = 0; i < state.num_joints; ++i) positions[state.name[i]] = state.position[i];
+  const bool added = history_.add(state.utime, positions);
+  // A frame waiting for its joints may now be ready.
+  return added;
+}
+
+void EstimatorScheduler::on_camera_pose(const camera_pose_t& message) {
+  CameraPose pose;
+  pose.frame_id = message.frame_id;
+  pose.translation_m = Eigen::Vector3d(message.translation[0], message.translation[1], message.translation[2]);
+  pose.rotation = Eigen::Quaterniond(message.rotation[0], message.rotation[1], message.rotation[2], message.rotation[3]);
+  camera_poses_[message.camera_id] = pose;
+}
+
+bool EstimatorScheduler::on_depth(const depth_image_t& frame) {
+  if (frame.camera_id != config_.camera.id) return false;
+  frames_[frame.seq] = frame;
+  while (static_cast<int>(frames_.size()) > config_.estimator.max_pending_frames) {
+    const int64_t oldest = frames_.begin()->first;
+    if (wanted_.count(oldest) > 0) {
+      wanted_.erase(oldest);
+      ++missed_;
+    }
+    frames_.erase(frames_.begin());
+  }
+  // Wanted seqs older than every kept frame will never come.
+  while (!wanted_.empty() && wanted_.begin()->first < frames_.begin()->first) {
+    wanted_.erase(wanted_.begin());
+    ++missed_;
+  }
+  while (estimated_.size() > 1000) estimated_.erase(estimated_.begin());
+  const auto w = wanted_.find(frame.seq);
+  if (w != wanted_.end()) {
+    ready_.push_back(build(frame, w->second));
+    estimated_.insert(frame.seq);
+    wanted_.erase(w);
+  }
+  return true;
+}
+
+void EstimatorScheduler::on_discrepancy(const discrepancy_t& d) {
+  if (d.camera_id != config_.camera.id || !d.usable) return;
+  const bool warning = d.mismatch_fraction >= config_.estimator.warning_mismatch_fraction ||
+                       d.p95_abs_dis_mm >= config_.estimator.warning_p95_abs_dis_mm;
+  if (!warning || estimated_.count(d.seq) > 0) return;
+  const auto f = frames_.find(d.seq);
+  if (f != frames_.end()) {
+    ready_.push_back(build(f->second, motion_estimate_t::TRIGGER_WARNING));
+    estimated_.insert(d.seq);
+  } else if (frames_.empty() || d.seq > frames_.begin()->first) {
+    wanted_[d.seq] = motion_estimate_t::TRIGGER_WARNING;
+  } else {
+    ++missed_;
+  }
+}
+
+void EstimatorScheduler::request_newest() {
+  if (frames_.empty()) return;
+  const auto newest = std::prev(frames_.end());
+  if (estimated_.count(newest->first) > 0) return;
+  ready_.push_back(build(newest->second, motion_estimate_t::TRIGGER_PERIODIC));
+  estimated_.insert(newest->first);
+}
+
+std::vector<ScheduledWork> EstimatorScheduler::take_ready() {
+  std::vector<ScheduledWork> out;
+  out.swap(ready_);
+  return out;
+}
+
+ScheduledWork EstimatorScheduler::build(const depth_image_t& frame, int8_t trigger) const {
+  ScheduledWork work;
+  EstimateContext context;
+  context.utime = frame.utime;
+  context.seq = frame.seq;
+  context.camera_id = frame.camera_id;
+  context.trigger = trigger;
+  context.joint_names = scene_.actuated_joint_names;
+  const auto pose = camera_poses_.find(frame.camera_id);
+  if (pose != camera_poses_.end()) {
+    context.frame_id = pose->second.frame_id;
+    context.frame_from_optical.linear() = pose->second.rotation.normalized().toRotationMatrix();
+    context.frame_from_optical.translation() = pose->second.translation_m;
+  }
+  const renderer::JointsAtTime joints = history_.at(frame.utime);
+  for (const std::string& name : context.joint_names) {
+    const auto found = joints.joints.find(name);
+    context.reported_positions.push_back(found != joints.joints.end() ? found->second : 0.0);
+  }
+  if (!joints.usable) {
+    work.unusable = unusable_message(context, "joint state: " + joints.unusable_reason);
+    return work;
+  }
+  if (pose == camera_poses_.end()) {
+    work.unusable = unusable_message(context, "no camera pose for camera '" + frame.camera_id + "'");
+    return work;
+  }
+  const int frame_link = scene_.find_link(context.frame_id);
+  if (frame_link < 0) {
+    work.unusable = unusable_message(context, "camera pose frame '" + context.frame_id + "' is not a model link");
+    return work;
+  }
+  // A camera on a moving link would move with the joints being estimated:
+  // not modelled.
+  for (int j = scene_.links[frame_link].parent_joint; j >= 0;
+       j = scene_.links[scene_.joints[j].parent_link].parent_joint) {
+    if (scene_.joints[j].type != renderer::JointType::kFixed) {
+      work.unusable = unusable_message(
+          context, "camera pose frame '" + context.frame_id + "' moves with joint '" + scene_.joints[j].name +
+                       "': a camera on the arm is not supported by the estimator");
+      return work;
+    }
+  }
+  const renderer::LinkPoses poses = renderer::forward_kinematics(scene_, joints.joints);
+  if (!poses.usable) {
+    work.unusable = unusable_message(context, poses.unusable_reason);
+    return work;
+  }
+  EstimateJob job;
+  job.context = context;
+  job.frame.intrinsics = Intrinsics{frame.width, frame.height, frame.fx, frame.fy, frame.cx, frame.cy};
+  job.frame.reported_joints = joints.joints;
+  job.frame.world_from_optical = poses.world_from_link[frame_link] * context.frame_from_optical;
+  job.frame.depth_m.resize(frame.depth_mm.size());
+  for (size_t i = 0; i < frame.depth_mm.size(); ++i) {
+    job.frame.depth_m[i] = frame.depth_mm[i] > 0 ? frame.depth_mm[i] / 1000.0f : 0.0f;
+  }
+  work.job = std::move(job);
+  return work;
+}
+
+EstimatorWorker::EstimatorWorker(const renderer::SceneModel& scene, const Config& config)
+    : scene_(scene), config_(config), thread_([this] { run(); }) {}
+
+EstimatorWorker::~EstimatorWorker() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_all();
+  thread_.join();
+}
+
+std::string EstimatorWorker::wait_ready() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  if (!wake_.wait_for(lock, std::chrono::seconds(30), [&] { return started_; })) {
+    return "the estimator's renderer did not start within 30 s";
+  }
+  return start_error_;
+}
+
+bool EstimatorWorker::post(EstimateJob job) {
+  bool dropped;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    dropped = pending_.has_value();
+    pending_ = std::move(job);
+  }
+  wake_.notify_all();
+  return dropped;
+}
+
+std::vector<motion_estimate_t> EstimatorWorker::take_results() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<motion_estimate_t> out;
+  out.swap(results_);
+  return out;
+}
+
+bool EstimatorWorker::busy() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return working_ || pending_.has_value();
+}
+
+void EstimatorWorker::run() {
+  std::unique_ptr<renderer::DepthRenderer> renderer;
+  std::unique_ptr<MotionEstimator> estimator;
+  try {
+    // The renderer's GL context belongs to this thread.
+    renderer = std::make_unique<renderer::DepthRenderer>(scene_, config_.renderer.near_m, config_.renderer.far_m);
+    estimator = std::make_unique<MotionEstimator>(scene_, renderer.get(), options_from_config(config_));
+  } catch (const std::exception& e) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    start_error_ = e.what();
+    started_ = true;
+    wake_.notify_all();
+    return;
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    started_ = true;
+  }
+  wake_.notify_all();
+  while (true) {
+    EstimateJob job;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      wake_.wait(lock, [&] { return stop_ || pending_.has_value(); });
+      if (stop_) return;
+      job = std::move(*pending_);
+      pending_.reset();
+      working_ = true;
+    }
+    const EstimateResult result = estimator->estimate(job.frame);
+    motion_estimate_t message = to_message(result, job.context);
+    std::lock_guard<std::mutex> lock(mutex_);
+    results_.push_back(std::move(message));
+    working_ = false;
+  }
+}
+
+}  // namespace tofguard::estimator
