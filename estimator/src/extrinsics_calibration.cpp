@@ -1,0 +1,186 @@
+#include "extrinsics_calibration.hpp"
+
+#include <lcm/lcm-cpp.hpp>
+
+#include <cmath>
+#include <iomanip>
+#include <limits>
+#include <memory>
+#include <sstream>
+
+#include "depth_renderer.hpp"
+#include "estimator_process.hpp"
+#include "joint_history.hpp"
+#include "tofguard/decode.hpp"
+#include "tofguard/depth_image_t.hpp"
+#include "tofguard/joint_state_t.hpp"
+#include "tofguard/wire_checks.hpp"
+
+namespace tofguard::estimator {
+
+namespace {
+
+double pose_distance(const renderer::JointPositions& a, const renderer::JointPositions& b) {
+  double d = 0;
+  for (const auto& [name, value] : a) {
+    const auto other = b.find(name);
+    if (other != b.end()) d = std::max(d, std::abs(value - other->second));
+  }
+  return d;
+}
+
+}  // namespace
+
+std::string pose_yaml(const CameraPose& pose) {
+  const Eigen::Quaterniond q = pose.rotation.normalized();
+  std::ostringstream out;
+  out << std::setprecision(9);
+  out << "pose:\n"
+      << "  frame: " << pose.frame_id << "\n"
+      << "  translation_m: [" << pose.translation_m.x() << ", " << pose.translation_m.y() << ", "
+      << pose.translation_m.z() << "]\n"
+      << "  rotation_wxyz: [" << q.w() << ", " << q.x() << ", " << q.y() << ", " << q.z() << "]\n";
+  return out.str();
+}
+
+CalibrationResult calibrate_extrinsics(const Config& config, const std::string& log_path,
+                                       const CalibrationOptions& options) {
+  CalibrationResult result;
+  lcm::LogFile log(log_path, "r");
+  if (!log.good()) {
+    result.error = log_path + ": cannot open as an LCM log";
+    return result;
+  }
+  // Every joint state first (the frames need the states around them).
+  renderer::JointHistory history(static_cast<int64_t>(std::llround(config.renderer.max_extrapolation_ms * 1000.0)),
+                                 std::numeric_limits<int64_t>::max() / 4, std::numeric_limits<size_t>::max());
+  std::vector<depth_image_t> frames;
+  int joint_states = 0;
+  for (const lcm::LogEvent* event = log.readNextEvent(); event != nullptr; event = log.readNextEvent()) {
+    if (event->channel == config.channels.joint_state) {
+      const auto state = decode_message<joint_state_t>(event->data, event->datalen);
+      if (!state || !check_joint_state(*state).empty() || state->robot_id != config.robot.id) continue;
+      renderer::JointPositions positions;
+      for (int i = 0; i < state->num_joints; ++i) positions[state->name[i]] = state->position[i];
+      if (history.add(state->utime, positions)) ++joint_states;
+    } else if (event->channel == config.channels.depth) {
+      const auto frame = decode_message<depth_image_t>(event->data, event->datalen);
+      if (!frame || !check_depth_image_from(*frame, config.camera.id).empty()) continue;
+      frames.push_back(*frame);
+    }
+  }
+  result.frames_in_log = static_cast<int>(frames.size());
+  if (frames.empty()) {
+    result.error = log_path + ": no " + config.channels.depth + " frames of camera '" + config.camera.id + "'";
+    return result;
+  }
+  if (joint_states == 0) {
+    result.error = log_path + ": no " + config.channels.joint_state + " messages of robot '" + config.robot.id + "'";
+    return result;
+  }
+
+  const renderer::SceneModel scene = load_estimator_scene(config);
+  const int frame_link = scene.find_link(config.camera.pose.frame_id);
+  if (frame_link < 0) {
+    result.error = "camera.pose.frame '" + config.camera.pose.frame_id + "' is not a model link";
+    return result;
+  }
+  if (scene.links[frame_link].parent_joint >= 0) {
+    for (int j = scene.links[frame_link].parent_joint; j >= 0;
+         j = scene.links[scene.joints[j].parent_link].parent_joint) {
+      if (scene.joints[j].type != renderer::JointType::kFixed) {
+        result.error = "camera.pose.frame '" + config.camera.pose.frame_id + "' moves with joint '" +
+                       scene.joints[j].name + "': only a static camera can be calibrated";
+        return result;
+      }
+    }
+  }
+
+  // Frames with joint states around them, then the most diverse poses.
+  struct Candidate {
+    const depth_image_t* frame;
+    renderer::JointPositions joints;
+  };
+  std::vector<Candidate> candidates;
+  for (const depth_image_t& frame : frames) {
+    const renderer::JointsAtTime joints = history.at(frame.utime);
+    if (joints.usable) candidates.push_back({&frame, joints.joints});
+  }
+  std::vector<const Candidate*> chosen;
+  if (!candidates.empty()) chosen.push_back(&candidates.front());
+  while (static_cast<int>(chosen.size()) < options.max_frames) {
+    const Candidate* best = nullptr;
+    double best_distance = options.min_pose_distance_rad;
+    for (const Candidate& c : candidates) {
+      double nearest = std::numeric_limits<double>::infinity();
+      for (const Candidate* o : chosen) nearest = std::min(nearest, pose_distance(c.joints, o->joints));
+      if (nearest >= best_distance) {
+        best_distance = nearest;
+        best = &c;
+      }
+    }
+    if (best == nullptr) break;
+    chosen.push_back(best);
+  }
+  result.frames_used = static_cast<int>(chosen.size());
+  if (result.frames_used < options.min_frames) {
+    result.error = log_path + ": too few frames with distinct arm poses (" + std::to_string(result.frames_used) +
+                   " at least " + std::to_string(options.min_pose_distance_rad) + " rad apart, of " +
+                   std::to_string(frames.size()) + " frames; need " + std::to_string(options.min_frames) + ")";
+    return result;
+  }
+
+  const renderer::LinkPoses static_poses = renderer::forward_kinematics(scene, chosen.front()->joints);
+  if (!static_poses.usable) {
+    result.error = static_poses.unusable_reason;
+    return result;
+  }
+  Eigen::Isometry3d frame_from_optical = Eigen::Isometry3d::Identity();
+  frame_from_optical.linear() = config.camera.pose.rotation.normalized().toRotationMatrix();
+  frame_from_optical.translation() = config.camera.pose.translation_m;
+  const Eigen::Isometry3d world_from_optical = static_poses.world_from_link[frame_link] * frame_from_optical;
+
+  std::vector<EstimatorFrame> estimator_frames;
+  for (const Candidate* c : chosen) {
+    EstimatorFrame f;
+    const depth_image_t& d = *c->frame;
+    f.intrinsics = Intrinsics{d.width, d.height, d.fx, d.fy, d.cx, d.cy};
+    f.reported_joints = c->joints;
+    f.world_from_optical = world_from_optical;
+    f.depth_m.resize(d.depth_mm.size());
+    for (size_t i = 0; i < d.depth_mm.size(); ++i) f.depth_m[i] = d.depth_mm[i] > 0 ? d.depth_mm[i] / 1000.0f : 0.0f;
+    estimator_frames.push_back(std::move(f));
+  }
+  EstimatorOptions estimator_options = options_from_config(config);
+  estimator_options.estimate_joints = false;
+  estimator_options.estimate_camera = true;
+  estimator_options.max_iterations = options.max_iterations;
+  // A 5 cm / 5 degree start is 15-20 pixels off: start coarser and shrink
+  // more slowly than for a frame-to-frame estimate.
+  estimator_options.initial_robust_scale_m = options.initial_robust_scale_m;
+  estimator_options.robust_scale_factor = options.robust_scale_factor;
+  renderer::DepthRenderer renderer(scene, config.renderer.near_m, config.renderer.far_m);
+  MotionEstimator estimator(scene, &renderer, estimator_options);
+  const EstimateResult estimate = estimator.estimate_camera(estimator_frames);
+  if (!estimate.usable) {
+    result.error = "cannot estimate the camera pose: " + estimate.unusable_reason;
+    return result;
+  }
+  result.iterations = estimate.iterations;
+  result.residual_before_mm = estimate.residual_before_m * 1000;
+  result.residual_after_mm = estimate.residual_after_m * 1000;
+  result.translation_sigma_m = estimate.correction_translation_sigma_m;
+  result.rotation_sigma_rad = estimate.correction_rotation_sigma_rad;
+  const Eigen::Isometry3d estimated = frame_from_optical * estimate.correction;
+  result.pose.frame_id = config.camera.pose.frame_id;
+  result.pose.translation_m = estimated.translation();
+  result.pose.rotation = Eigen::Quaterniond(estimated.linear());
+  if (!estimate.converged) {
+    result.error = "did not converge in " + std::to_string(estimate.iterations) +
+                   " iterations (residual " + std::to_string(result.residual_before_mm) + " -> " +
+                   std::to_string(result.residual_after_mm) + " mm): is the initial pose within ~5 cm / 5 deg?";
+  }
+  return result;
+}
+
+}  // namespace tofguard::estimator
