@@ -34,6 +34,21 @@ renderer::SceneModel load_estimator_scene(const Config& config) {
   return renderer::load_scene(config.robot.urdf_path, config.environment.urdf_paths, options);
 }
 
+std::string moving_joint_of(const renderer::SceneModel& scene, int link) {
+  for (int j = scene.links[link].parent_joint; j >= 0; j = scene.links[scene.joints[j].parent_link].parent_joint) {
+    if (scene.joints[j].type != renderer::JointType::kFixed) return scene.joints[j].name;
+  }
+  return "";
+}
+
+std::vector<float> depth_in_metres(const depth_image_t& frame) {
+  std::vector<float> depth_m(frame.depth_mm.size());
+  for (size_t i = 0; i < frame.depth_mm.size(); ++i) {
+    depth_m[i] = frame.depth_mm[i] > 0 ? frame.depth_mm[i] / 1000.0f : 0.0f;
+  }
+  return depth_m;
+}
+
 std::string check_discrepancy(const discrepancy_t& d) {
   if (!std::isfinite(d.mismatch_fraction) || d.mismatch_fraction < 0 || d.mismatch_fraction > 1) {
     return "mismatch_fraction: expected 0..1, got " + std::to_string(d.mismatch_fraction);
@@ -158,14 +173,11 @@ ScheduledWork EstimatorScheduler::build(const depth_image_t& frame, int8_t trigg
   }
   // A camera on a moving link would move with the joints being estimated:
   // not modelled.
-  for (int j = scene_.links[frame_link].parent_joint; j >= 0;
-       j = scene_.links[scene_.joints[j].parent_link].parent_joint) {
-    if (scene_.joints[j].type != renderer::JointType::kFixed) {
-      work.unusable = unusable_message(
-          context, "camera pose frame '" + context.frame_id + "' moves with joint '" + scene_.joints[j].name +
-                       "': a camera on the arm is not supported by the estimator");
-      return work;
-    }
+  const std::string moving = moving_joint_of(scene_, frame_link);
+  if (!moving.empty()) {
+    work.unusable = unusable_message(context, "camera pose frame '" + context.frame_id + "' moves with joint '" +
+                                                  moving + "': a camera on the arm is not supported by the estimator");
+    return work;
   }
   const renderer::LinkPoses poses = renderer::forward_kinematics(scene_, joints.joints);
   if (!poses.usable) {
@@ -177,10 +189,7 @@ ScheduledWork EstimatorScheduler::build(const depth_image_t& frame, int8_t trigg
   job.frame.intrinsics = Intrinsics{frame.width, frame.height, frame.fx, frame.fy, frame.cx, frame.cy};
   job.frame.reported_joints = joints.joints;
   job.frame.world_from_optical = poses.world_from_link[frame_link] * context.frame_from_optical;
-  job.frame.depth_m.resize(frame.depth_mm.size());
-  for (size_t i = 0; i < frame.depth_mm.size(); ++i) {
-    job.frame.depth_m[i] = frame.depth_mm[i] > 0 ? frame.depth_mm[i] / 1000.0f : 0.0f;
-  }
+  job.frame.depth_m = depth_in_metres(frame);
   work.job = std::move(job);
   return work;
 }

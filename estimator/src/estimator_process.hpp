@@ -46,6 +46,13 @@ EstimatorOptions options_from_config(const Config& config);
 // environment as the camera sees them (visual geometry, no padding).
 renderer::SceneModel load_estimator_scene(const Config& config);
 
+// The name of a joint that moves `link` (the nearest one up the chain), ""
+// for a static link.
+std::string moving_joint_of(const renderer::SceneModel& scene, int link);
+
+// A depth_image_t's depth in metres (0 = no return), row-major.
+std::vector<float> depth_in_metres(const depth_image_t& frame);
+
 // "" for a discrepancy_t the trigger may use, else one line naming the
 // field.
 std::string check_discrepancy(const discrepancy_t& d);

@@ -85,15 +85,11 @@ CalibrationResult calibrate_extrinsics(const Config& config, const std::string& 
     result.error = "camera.pose.frame '" + config.camera.pose.frame_id + "' is not a model link";
     return result;
   }
-  if (scene.links[frame_link].parent_joint >= 0) {
-    for (int j = scene.links[frame_link].parent_joint; j >= 0;
-         j = scene.links[scene.joints[j].parent_link].parent_joint) {
-      if (scene.joints[j].type != renderer::JointType::kFixed) {
-        result.error = "camera.pose.frame '" + config.camera.pose.frame_id + "' moves with joint '" +
-                       scene.joints[j].name + "': only a static camera can be calibrated";
-        return result;
-      }
-    }
+  const std::string moving = moving_joint_of(scene, frame_link);
+  if (!moving.empty()) {
+    result.error = "camera.pose.frame '" + config.camera.pose.frame_id + "' moves with joint '" + moving +
+                   "': only a static camera can be calibrated";
+    return result;
   }
 
   // Frames with joint states around them, then the most diverse poses.
@@ -147,8 +143,7 @@ CalibrationResult calibrate_extrinsics(const Config& config, const std::string& 
     f.intrinsics = Intrinsics{d.width, d.height, d.fx, d.fy, d.cx, d.cy};
     f.reported_joints = c->joints;
     f.world_from_optical = world_from_optical;
-    f.depth_m.resize(d.depth_mm.size());
-    for (size_t i = 0; i < d.depth_mm.size(); ++i) f.depth_m[i] = d.depth_mm[i] > 0 ? d.depth_mm[i] / 1000.0f : 0.0f;
+    f.depth_m = depth_in_metres(d);
     estimator_frames.push_back(std::move(f));
   }
   EstimatorOptions estimator_options = options_from_config(config);

@@ -69,6 +69,14 @@ int64_t now_us() {
       .count();
 }
 
+EstimateResult unusable_result(const std::string& why, int64_t start_us) {
+  EstimateResult result;
+  result.usable = false;
+  result.unusable_reason = why;
+  result.compute_us = now_us() - start_us;
+  return result;
+}
+
 bool finite(const Eigen::Isometry3d& pose) { return pose.matrix().allFinite(); }
 
 // exp of a small twist (translation v, rotation w about the axes of the
@@ -611,13 +619,7 @@ EstimateResult MotionEstimator::finish(const EstimatorFrame& frame, const State&
 
 EstimateResult MotionEstimator::estimate(const EstimatorFrame& frame) {
   const int64_t start = now_us();
-  EstimateResult unusable;
-  auto fail = [&](const std::string& why) {
-    unusable.usable = false;
-    unusable.unusable_reason = why;
-    unusable.compute_us = now_us() - start;
-    return unusable;
-  };
+  auto fail = [&](const std::string& why) { return unusable_result(why, start); };
   const std::string problem = check_frame(frame);
   if (!problem.empty()) return fail(problem);
   edges_.clear();
@@ -662,13 +664,7 @@ EstimateResult MotionEstimator::estimate(const EstimatorFrame& frame) {
 
 EstimateResult MotionEstimator::estimate_camera(const std::vector<EstimatorFrame>& frames) {
   const int64_t start = now_us();
-  EstimateResult unusable;
-  auto fail = [&](const std::string& why) {
-    unusable.usable = false;
-    unusable.unusable_reason = why;
-    unusable.compute_us = now_us() - start;
-    return unusable;
-  };
+  auto fail = [&](const std::string& why) { return unusable_result(why, start); };
   if (frames.empty()) return fail("no frames");
   edges_.clear();
   std::vector<const EstimatorFrame*> pointers;

@@ -2,25 +2,14 @@
 
 #include <stdexcept>
 
+#include "estimator_process.hpp"
 #include "kinematics.hpp"
 
 namespace tofguard::estimator::testing {
 
-namespace {
-
-renderer::SceneModel load_camera_scene(const Config& config) {
-  renderer::SceneOptions options;
-  options.geometry = renderer::GeometrySource::kVisual;
-  options.padding_m = 0;
-  options.package_paths = config.robot.package_paths;
-  return renderer::load_scene(config.robot.urdf_path, config.environment.urdf_paths, options);
-}
-
-}  // namespace
-
 SimulatedFrames::SimulatedFrames(const Config& config)
     : config_(config),
-      scene_(load_camera_scene(config)),
+      scene_(load_estimator_scene(config)),
       renderer_(std::make_unique<renderer::DepthRenderer>(scene_, config.renderer.near_m, config.renderer.far_m)),
       calibration_(config.camera.depth_calibration.enabled ? config.camera.depth_calibration.coefficients_m
                                                            : std::vector<double>{}) {}

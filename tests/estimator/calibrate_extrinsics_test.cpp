@@ -12,6 +12,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "depth_message.hpp"
 #include "estimator_test_support.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/joint_state_t.hpp"
@@ -61,20 +62,8 @@ std::string write_log(const std::string& name, const Config& config, const std::
     write_event(&log, state.utime, config.channels.joint_state, state);
     if (with_depth) {
       const std::vector<float> depth_m = frames.capture(poses[k], camera, in, k + 1);
-      depth_image_t frame;
-      frame.utime = utime;
-      frame.seq = static_cast<int64_t>(k);
-      frame.camera_id = config.camera.id;
-      frame.width = in.width;
-      frame.height = in.height;
-      frame.fx = in.fx;
-      frame.fy = in.fy;
-      frame.cx = in.cx;
-      frame.cy = in.cy;
-      frame.calibrated = true;
-      frame.num_pixels = static_cast<int32_t>(depth_m.size());
-      for (float d : depth_m) frame.depth_mm.push_back(static_cast<int16_t>(std::lround(d * 1000)));
-      frame.num_amplitude = 0;
+      const depth_image_t frame =
+          camera::make_depth_image(config.camera, utime, static_cast<int64_t>(k), true, depth_m, {});
       write_event(&log, utime, config.channels.depth, frame);
     }
     state.utime = utime + 5000;
