@@ -42,7 +42,15 @@ int run(const Config& config, const std::vector<std::string>& rest) {
       },
       check_joint_state);
   node.subscribe<camera_pose_t>(
-      node.safety(), config.channels.camera_pose, [&](const camera_pose_t& pose) { service->on_camera_pose(pose); },
+      node.safety(), config.channels.camera_pose,
+      [&](const camera_pose_t& pose) {
+        if (!service->on_camera_pose(pose)) {
+          node.counters().validation_errors++;
+          node.errors().report(config.channels.camera_pose, config.channels.camera_pose + ": utime: expected a pose newer than camera '" +
+                                                                pose.camera_id + "''s newest, got " +
+                                                                std::to_string(pose.utime) + "; ignored");
+        }
+      },
       check_camera_pose);
   node.subscribe<depth_image_t>(
       node.images(), config.channels.depth,

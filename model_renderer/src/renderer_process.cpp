@@ -36,8 +36,10 @@ RendererService::RendererService(const Config& config)
     : config_(config),
       scene_(load_scene(config.robot.urdf_path, config.environment.urdf_paths, scene_options(config))),
       renderer_(make_renderer(scene_, config.renderer)),
-      history_(static_cast<int64_t>(std::llround(config.renderer.max_extrapolation_ms * 1000.0))) {
-  camera_poses_[config.camera.id] = config.camera.pose;
+      history_(static_cast<int64_t>(std::llround(config.renderer.max_extrapolation_ms * 1000.0))),
+      camera_poses_(static_cast<int64_t>(std::llround(config.renderer.camera_pose_history_ms * 1000.0)),
+                    static_cast<int64_t>(std::llround(config.renderer.camera_pose_max_extrapolation_ms * 1000.0))) {
+  camera_poses_.set_static(config.camera.id, config.camera.pose);
 }
 
 bool RendererService::on_joint_state(const joint_state_t& state) {
@@ -47,12 +49,14 @@ bool RendererService::on_joint_state(const joint_state_t& state) {
   return history_.add(state.utime, positions);
 }
 
-void RendererService::on_camera_pose(const camera_pose_t& message) {
+bool RendererService::on_camera_pose(const camera_pose_t& message) {
   CameraPose pose;
   pose.frame_id = message.frame_id;
   pose.translation_m = Eigen::Vector3d(message.translation[0], message.translation[1], message.translation[2]);
-  pose.rotation = Eigen::Quaterniond(message.rotation[0], message.rotation[1], message.rotation[2], message.rotation[3]);
-  camera_poses_[message.camera_id] = pose;
+  // check_camera_pose allows a norm within 1e-3 of 1: normalise.
+  pose.rotation =
+      Eigen::Quaterniond(message.rotation[0], message.rotation[1], message.rotation[2], message.rotation[3]).normalized();
+  return camera_poses_.add(message.camera_id, message.utime, pose);
 }
 
 bool RendererService::on_depth(const depth_image_t& frame) {
@@ -83,15 +87,15 @@ RenderedFrame RendererService::render(const depth_image_t& frame) {
   labels.usable = false;
 
   const JointsAtTime joints = history_.at(frame.utime);
-  const auto pose = camera_poses_.find(frame.camera_id);
+  const PoseAtTime pose = camera_poses_.at(frame.camera_id, frame.utime);
   RenderResult result;
   if (!joints.usable) {
     result.unusable_reason = joints.unusable_reason;
-  } else if (pose == camera_poses_.end()) {
-    result.unusable_reason = "no camera pose for camera '" + frame.camera_id + "'";
+  } else if (!pose.usable) {
+    result.unusable_reason = pose.unusable_reason;
   } else {
     const Intrinsics intrinsics{frame.width, frame.height, frame.fx, frame.fy, frame.cx, frame.cy};
-    result = renderer_->render(joints.joints, pose->second, intrinsics);
+    result = renderer_->render(joints.joints, pose.pose, intrinsics);
   }
   if (!result.usable) {
     labels.unusable_reason = result.unusable_reason;

@@ -1,8 +1,9 @@
 #pragma once
 // tofguard-renderer's logic without LCM: for each TOF_DEPTH frame, the
 // model rendered at the joints interpolated at the frame's utime, from the
-// newest CAMERA_POSE for that camera (or the config's static pose), at the
-// frame's own size and intrinsics.
+// camera pose at the frame's utime (CameraPoseHistory: CAMERA_POSE per
+// camera_id, or the config's static pose), at the frame's own size and
+// intrinsics.
 //
 // Outputs per frame (both carry the camera frame's utime, seq, camera_id):
 //   TOF_LABELS   link_labels_t, always; usable=false with the reason when
@@ -21,6 +22,7 @@
 #include <optional>
 #include <string>
 
+#include "camera_pose_history.hpp"
 #include "depth_renderer.hpp"
 #include "joint_history.hpp"
 #include "tofguard/camera_pose_t.hpp"
@@ -56,7 +58,9 @@ class RendererService {
   // Returns false (and ignores it) for a message from another robot or not
   // newer than the last; the caller counts that.
   bool on_joint_state(const joint_state_t& state);
-  void on_camera_pose(const camera_pose_t& pose);
+  // Returns false (and ignores it) for a pose not newer than the camera's
+  // newest; the caller counts that.
+  bool on_camera_pose(const camera_pose_t& pose);
   // Keeps the frame as the pending one; returns true when it replaced a
   // pending frame that was never rendered (one dropped frame).
   bool on_depth(const depth_image_t& frame);
@@ -75,7 +79,7 @@ class RendererService {
   SceneModel scene_;
   std::unique_ptr<DepthRenderer> renderer_;
   JointHistory history_;
-  std::map<std::string, CameraPose> camera_poses_;  // by camera_id
+  CameraPoseHistory camera_poses_;
   std::optional<depth_image_t> pending_;
 };
 

@@ -70,6 +70,18 @@ struct Bench {
       publish_joints(next_joint_utime, arm_at(next_joint_utime, t0));
     }
   }
+  void publish_pose(int64_t utime, const CameraPose& pose) {
+    camera_pose_t m;
+    m.utime = utime;
+    m.camera_id = config.camera.id;
+    m.frame_id = pose.frame_id;
+    for (int i = 0; i < 3; ++i) m.translation[i] = pose.translation_m[i];
+    m.rotation[0] = pose.rotation.w();
+    m.rotation[1] = pose.rotation.x();
+    m.rotation[2] = pose.rotation.y();
+    m.rotation[3] = pose.rotation.z();
+    safety.publish(config.channels.camera_pose, &m);
+  }
   int64_t publish_frame(int64_t utime) {
     const Intrinsics& k = config.camera.intrinsics;
     depth_image_t f;
@@ -200,6 +212,99 @@ TEST(RendererProcess, RendersFramesAtInterpolatedJointsAndMarksUnusableOnes) {
   EXPECT_LE(bench.heartbeat.frames_out + bench.heartbeat.frames_dropped, frames_sent);
   EXPECT_EQ(bench.heartbeat.validation_errors, 0);
   EXPECT_EQ(bench.heartbeat.decode_errors, 0);
+
+  process.signal(SIGTERM);
+  EXPECT_EQ(process.wait(std::chrono::seconds(5)), 0) << process.stderr_text();
+}
+
+// Robot pixels whose label or depth (beyond 1 mm) differ from `expected`.
+int differing_pixels(const depth_image_t& out, const link_labels_t& labels, const RenderResult& expected) {
+  int differing = 0;
+  for (size_t i = 0; i < expected.depth_m.size(); ++i) {
+    differing += std::abs(out.depth_mm[i] - std::lround(expected.depth_m[i] * 1000)) > 1 ||
+                 labels.label[i] != expected.labels[i];
+  }
+  return differing;
+}
+
+TEST(RendererProcess, FollowsAMovingCameraAtEachFramesUtime) {
+  tofguard::test::Subprocess process(
+      "renderer-process-moving-camera",
+      {tofguard::test::bin_dir() + "/tofguard-renderer", "--config", tofguard::test::source_dir() + "/config/sim.yaml"});
+  Bench bench;
+  const Config& config = bench.config;
+  // The configured pose panned by `deg` about the world's vertical axis.
+  auto panned = [&](double deg) {
+    CameraPose p = config.camera.pose;
+    p.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(deg * M_PI / 180, Eigen::Vector3d::UnitZ())) * p.rotation;
+    return p;
+  };
+  // The head pans 6 deg between two readings 66 ms apart (90 deg/s).
+  const int64_t t0 = bench.t0;
+  const int64_t t1 = t0 + 66'000;
+  // Once the process listens (its heartbeat comes after it subscribed).
+  ASSERT_TRUE(wait_until([&] { return bench.heartbeat.utime > 0; }, std::chrono::seconds(20), [&] { bench.pump(); }))
+      << process.stderr_text();
+  bench.publish_joints_until(t1 + 40'000);
+  bench.publish_pose(t0, panned(0));
+  bench.publish_pose(t1, panned(6));
+
+  // A frame between the readings, and one past the newest beyond the 40 ms
+  // limit. Until the process is up, and while a frame may overtake its pose
+  // (poses travel on the safety URL, frames on the image URL), send them
+  // again with new seqs.
+  const int64_t mid_utime = t0 + 22'000;    // a third of the way: pan 2 deg
+  const int64_t late_utime = t1 + 41'000;
+  int64_t mid_seq = -1;
+  int64_t late_seq = -1;
+  int64_t mid_sent_us = 0;
+  ASSERT_TRUE(wait_until(
+      [&] {
+        return mid_seq > 0 && bench.labels.count(mid_seq) && bench.labels.at(mid_seq).usable &&
+               bench.rendered.count(mid_seq) && late_seq > 0 && bench.labels.count(late_seq);
+      },
+      std::chrono::seconds(20),
+      [&] {
+        // (A frame sent while the process was still subscribing is lost.)
+        const bool unanswered = mid_seq > 0 && !bench.labels.count(mid_seq) && monotonic_us() - mid_sent_us > 300'000;
+        if (mid_seq > 0 && bench.labels.count(mid_seq) &&
+            bench.labels.at(mid_seq).unusable_reason == "no joint state received yet") {
+          // The first messages after the process subscribed can be lost:
+          // send the joint states and poses again.
+          bench.next_joint_utime = t0;
+          bench.publish_joints_until(t1 + 40'000);
+          bench.publish_pose(t0, panned(0));
+          bench.publish_pose(t1, panned(6));
+        }
+        if (mid_seq < 0 || unanswered || (bench.labels.count(mid_seq) && !bench.labels.at(mid_seq).usable)) {
+          mid_seq = bench.publish_frame(mid_utime);
+          mid_sent_us = monotonic_us();
+        }
+        if (mid_seq > 0 && bench.labels.count(mid_seq) && bench.labels.at(mid_seq).usable && late_seq < 0) {
+          late_seq = bench.publish_frame(late_utime);
+        }
+        bench.pump();
+      }))
+      << process.stderr_text() << "heartbeat in " << bench.heartbeat.frames_in << " validation " << bench.heartbeat.validation_errors
+      << " decode " << bench.heartbeat.decode_errors << " status " << bench.heartbeat.status << "; mid seq " << mid_seq << " late seq " << late_seq << ", labels: " << [&] {
+           std::string why;
+           for (const auto& [seq, l] : bench.labels) why += std::to_string(seq) + ": " + (l.usable ? "usable" : l.unusable_reason) + "; ";
+           return why;
+         }();
+
+  const SceneModel scene = load_scene(config.robot.urdf_path, config.environment.urdf_paths, scene_options(config));
+  DepthRenderer renderer(scene, config.renderer.near_m, config.renderer.far_m);
+  const RenderResult at_mid = renderer.render(arm_at(mid_utime, t0), panned(2), config.camera.intrinsics);
+  const RenderResult unpanned = renderer.render(arm_at(mid_utime, t0), panned(0), config.camera.intrinsics);
+  ASSERT_TRUE(at_mid.usable);
+  EXPECT_EQ(differing_pixels(bench.rendered.at(mid_seq), bench.labels.at(mid_seq), at_mid), 0);
+  // (The newest or the oldest pose alone would not do.)
+  EXPECT_GT(differing_pixels(bench.rendered.at(mid_seq), bench.labels.at(mid_seq), unpanned), 500);
+
+  EXPECT_FALSE(bench.labels.at(late_seq).usable);
+  EXPECT_EQ(bench.labels.at(late_seq).unusable_reason,
+            "newest camera pose of moving camera 'tof-mast' is 41.0 ms older than the frame (limit 40.0 ms)");
+  EXPECT_EQ(bench.rendered.count(late_seq), 0u);
 
   process.signal(SIGTERM);
   EXPECT_EQ(process.wait(std::chrono::seconds(5)), 0) << process.stderr_text();
