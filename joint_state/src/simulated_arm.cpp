@@ -105,4 +105,14 @@ ArmState SimulatedArm::reported_state() const {
   return reported;
 }
 
+std::vector<double> SimulatedArm::planned_reported_positions(double ahead_s) const {
+  std::vector<double> positions(motion_.size());
+  const double t = motion_time_s_ + (moving_ ? ahead_s : 0.0);
+  for (size_t i = 0; i < motion_.size(); ++i) {
+    const JointMotion& m = motion_[i];
+    positions[i] = m.center + m.amplitude * std::sin(2 * M_PI / m.period_s * t + m.phase_rad) + offsets_.at(m.joint);
+  }
+  return positions;
+}
+
 }  // namespace tofguard::joints_sim

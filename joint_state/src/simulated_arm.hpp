@@ -40,6 +40,12 @@ class SimulatedArm {
   bool set_encoder_offset(const std::string& joint, double offset);
 
   const ArmState& true_state() const { return true_state_; }
+  // The arm's plan: the reported (encoder) positions `ahead_s` seconds of
+  // process time from now, assuming it keeps its current permission: the
+  // periodic motion while moving, where it is while halted. What a
+  // controller following its encoders plans (an encoder offset is in the
+  // plan, so a faulty encoder does not make the arm "leave its plan").
+  std::vector<double> planned_reported_positions(double ahead_s) const;
   // What the encoders report: true position + offset; velocity as true.
   ArmState reported_state() const;
   double elapsed_s() const { return elapsed_s_; }
