@@ -7,6 +7,8 @@
 
 #include <iostream>
 #include <map>
+#include <optional>
+#include <regex>
 
 #include "depth_renderer.hpp"
 #include "renderer_process.hpp"
@@ -64,12 +66,14 @@ struct Bench {
     m.num_joints = static_cast<int32_t>(m.name.size());
     safety.publish(config.channels.joint_state, &m);
   }
-  // Joint states every 10 ms of utime up to `until`.
+  // Joint states every 10 ms of utime up to `until`: arm_at, or
+  // `fixed_joints` when set.
   void publish_joints_until(int64_t until) {
     for (; next_joint_utime <= until; next_joint_utime += 10'000) {
-      publish_joints(next_joint_utime, arm_at(next_joint_utime, t0));
+      publish_joints(next_joint_utime, fixed_joints ? *fixed_joints : arm_at(next_joint_utime, t0));
     }
   }
+  std::optional<JointPositions> fixed_joints;
   void publish_pose(int64_t utime, const CameraPose& pose) {
     camera_pose_t m;
     m.utime = utime;
@@ -305,6 +309,105 @@ TEST(RendererProcess, FollowsAMovingCameraAtEachFramesUtime) {
   EXPECT_EQ(bench.labels.at(late_seq).unusable_reason,
             "newest camera pose of moving camera 'tof-mast' is 41.0 ms older than the frame (limit 40.0 ms)");
   EXPECT_EQ(bench.rendered.count(late_seq), 0u);
+
+  process.signal(SIGTERM);
+  EXPECT_EQ(process.wait(std::chrono::seconds(5)), 0) << process.stderr_text();
+}
+
+// "N hits, M misses" from the renderer's heartbeat status.
+std::pair<int, int> prediction_counts(const heartbeat_t& hb) {
+  static const std::regex counts("prediction: (\\d+) hits, (\\d+) misses");
+  std::smatch m;
+  if (!std::regex_search(hb.status, m, counts)) return {-1, -1};
+  return {std::stoi(m[1].str()), std::stoi(m[2].str())};
+}
+
+TEST(RendererProcess, APlannedFrameIsRenderedAheadAndIdenticalToTheNormalRendering) {
+  tofguard::test::Subprocess process(
+      "renderer-process-prediction",
+      {tofguard::test::bin_dir() + "/tofguard-renderer", "--config", tofguard::test::source_dir() + "/config/sim.yaml"});
+  Bench bench;
+  const Config& config = bench.config;
+  ASSERT_TRUE(wait_until([&] { return bench.heartbeat.utime > 0; }, std::chrono::seconds(20), [&] { bench.pump(); }))
+      << process.stderr_text();
+  // The arm holds still where its plan says, for 10 s.
+  const JointPositions planned = arm_at(bench.t0 + 300'000, bench.t0);
+  bench.fixed_joints = planned;
+  planned_trajectory_t plan;
+  plan.utime = bench.t0;
+  for (const auto& [name, value] : planned) plan.joint_name.push_back(name);
+  plan.num_joints = static_cast<int32_t>(plan.joint_name.size());
+  plan.point_utime = {bench.t0, bench.t0 + 10'000'000};
+  plan.num_points = 2;
+  for (int p = 0; p < 2; ++p) {
+    plan.position.emplace_back();
+    for (const auto& [name, value] : planned) plan.position.back().push_back(value);
+  }
+
+  // Frames every 33 ms of utime, one at a time, each after its joint states;
+  // the plan sent again until the process has it.
+  std::vector<int64_t> seqs;
+  // (The first messages after the process subscribed can be lost: a frame
+  // without an answer is sent again with a new seq.)
+  auto send_frame = [&](int64_t utime) {
+    bench.publish_joints_until(utime + 20'000);
+    for (int attempt = 0; attempt < 5; ++attempt) {
+      const int64_t seq = bench.publish_frame(utime);
+      if (wait_until([&] { return bench.labels.count(seq) > 0; }, std::chrono::seconds(1), [&] { bench.pump(); })) {
+        seqs.push_back(seq);
+        return seq;
+      }
+    }
+    ADD_FAILURE() << "no labels for the frame at " << utime << "\n" << process.stderr_text();
+    return int64_t{-1};
+  };
+  int64_t utime = bench.t0 + 33'000;
+  ASSERT_TRUE(wait_until(
+      [&] { return prediction_counts(bench.heartbeat).first >= 3; }, std::chrono::seconds(20),
+      [&] {
+        bench.safety.publish(config.channels.planned_trajectory, &plan);
+        send_frame(utime);
+        utime += 33'000;
+        // Give the process its idle time to render ahead, as a camera does.
+        const int64_t until = monotonic_us() + 30'000;
+        while (monotonic_us() < until) bench.pump();
+      }))
+      << process.stderr_text() << bench.heartbeat.status;
+  const auto [hits, misses] = prediction_counts(bench.heartbeat);
+  EXPECT_EQ(misses, 0) << bench.heartbeat.status;
+
+  // Every rendered frame is the library's rendering at the planned joints:
+  // those published from a prediction are identical to the others.
+  const SceneModel scene = load_scene(config.robot.urdf_path, config.environment.urdf_paths, scene_options(config));
+  DepthRenderer renderer(scene, config.renderer.near_m, config.renderer.far_m);
+  const RenderResult expected = renderer.render(planned, config.camera.pose, config.camera.intrinsics);
+  ASSERT_TRUE(expected.usable);
+  int compared = 0;
+  for (const int64_t seq : seqs) {
+    if (!bench.rendered.count(seq)) continue;
+    ++compared;
+    const depth_image_t& out = bench.rendered.at(seq);
+    for (size_t i = 0; i < expected.depth_m.size(); ++i) {
+      ASSERT_EQ(out.depth_mm[i], static_cast<int16_t>(std::round(expected.depth_m[i] * 1000.0))) << seq << " " << i;
+      ASSERT_EQ(bench.labels.at(seq).label[i], expected.labels[i]) << seq << " " << i;
+    }
+  }
+  EXPECT_GE(compared, hits);
+
+  // The arm leaves the plan by 0.2 deg at a2: a miss, rendered at the
+  // reported joints.
+  JointPositions off = planned;
+  off["a2"] += 0.2 * M_PI / 180;
+  bench.fixed_joints = off;
+  const int64_t off_seq = send_frame(utime);
+  ASSERT_TRUE(wait_until([&] { return prediction_counts(bench.heartbeat).second >= 1; }, std::chrono::seconds(5),
+                         [&] { bench.pump(); }))
+      << bench.heartbeat.status;
+  EXPECT_EQ(prediction_counts(bench.heartbeat).first, hits);
+  ASSERT_TRUE(bench.rendered.count(off_seq));
+  const RenderResult at_off = renderer.render(off, config.camera.pose, config.camera.intrinsics);
+  EXPECT_EQ(differing_pixels(bench.rendered.at(off_seq), bench.labels.at(off_seq), at_off), 0);
+  std::cout << "prediction: " << bench.heartbeat.status << "\n";
 
   process.signal(SIGTERM);
   EXPECT_EQ(process.wait(std::chrono::seconds(5)), 0) << process.stderr_text();
