@@ -72,6 +72,7 @@ int run(const Config& config, const std::vector<std::string>& rest) {
   const int64_t plan_period_us = static_cast<int64_t>(1e6 / sim.plan_rate_hz);
   int64_t next_plan_us = 0;
   bool planned_allowed = false;
+  int planned_offsets_version = 0;
   auto publish_plan = [&](int64_t utime) {
     planned_trajectory_t plan;
     plan.utime = utime;
@@ -94,13 +95,17 @@ int run(const Config& config, const std::vector<std::string>& rest) {
     const int64_t utime = wall_utime();
     const joint_state_t reported = to_message(arm->reported_state(), config.robot.id, utime);
     const joint_state_t truth = to_message(arm->true_state(), config.robot.id, utime);
-    node.safety().publish(config.channels.joint_state, &reported);
-    node.safety().publish(config.channels.sim_true_joint_state, &truth);
-    if (sim.publish_plan && (now_us >= next_plan_us || allowed != planned_allowed)) {
+    // The plan goes first: a replanned arm (halted, resumed, encoder jump)
+    // is never seen off its old plan.
+    if (sim.publish_plan && (now_us >= next_plan_us || allowed != planned_allowed ||
+                             arm->offsets_version() != planned_offsets_version)) {
       publish_plan(utime);
       next_plan_us = now_us + plan_period_us;
       planned_allowed = allowed;
+      planned_offsets_version = arm->offsets_version();
     }
+    node.safety().publish(config.channels.joint_state, &reported);
+    node.safety().publish(config.channels.sim_true_joint_state, &truth);
     node.counters().frames_out++;
     node.heartbeat().set_status(allowed ? "moving" : "halted: no permission to move");
   });

@@ -82,6 +82,7 @@ void SimulatedArm::step(double dt_s, bool motion_allowed) {
   for (auto it = scheduled_faults_.begin(); it != scheduled_faults_.end();) {
     if (elapsed_s_ >= it->at_s) {
       offsets_[it->joint] = it->offset;
+      ++offsets_version_;
       it = scheduled_faults_.erase(it);
     } else {
       ++it;
@@ -94,6 +95,7 @@ bool SimulatedArm::set_encoder_offset(const std::string& joint, double offset) {
   auto it = offsets_.find(joint);
   if (it == offsets_.end()) return false;
   it->second = offset;
+  ++offsets_version_;
   return true;
 }
 

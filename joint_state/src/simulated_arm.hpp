@@ -49,6 +49,9 @@ class SimulatedArm {
   // What the encoders report: true position + offset; velocity as true.
   ArmState reported_state() const;
   double elapsed_s() const { return elapsed_s_; }
+  // Counts changes of the encoder offsets (a controller replans when its
+  // encoders jump).
+  int offsets_version() const { return offsets_version_; }
   bool moving() const { return moving_; }
 
  private:
@@ -58,6 +61,7 @@ class SimulatedArm {
   std::vector<EncoderFault> scheduled_faults_;
   std::map<std::string, double> offsets_;
   double elapsed_s_ = 0;
+  int offsets_version_ = 0;
   double motion_time_s_ = 0;
   bool moving_ = false;
   ArmState true_state_;
