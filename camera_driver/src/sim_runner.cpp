@@ -9,7 +9,7 @@
 #include "scene_model.hpp"
 #include "sim_camera.hpp"
 #include "tofguard/clock.hpp"
-#include "tofguard/camera_pose_t.hpp"
+#include "tofguard/camera_pose_message.hpp"
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/lcm_node.hpp"
 #include "tofguard/sim_camera_fault_t.hpp"
@@ -76,19 +76,6 @@ std::string check_fault(const sim_camera_fault_t& f) {
     return "object_size_m: expected 3 sizes > 0";
   }
   return "";
-}
-
-camera_pose_t to_pose_message(const std::string& camera_id, int64_t utime, const CameraPose& pose) {
-  camera_pose_t m;
-  m.utime = utime;
-  m.camera_id = camera_id;
-  m.frame_id = pose.frame_id;
-  for (int i = 0; i < 3; ++i) m.translation[i] = pose.translation_m[i];
-  m.rotation[0] = pose.rotation.w();
-  m.rotation[1] = pose.rotation.x();
-  m.rotation[2] = pose.rotation.y();
-  m.rotation[3] = pose.rotation.z();
-  return m;
 }
 
 ActiveSimFault to_fault(const sim_camera_fault_t& m, int64_t now_utime) {
@@ -172,7 +159,7 @@ int run_sim_camera(const Config& config) {
     // The pan-tilt head's reading for this frame, before the frame, so that
     // the renderer has it when the frame comes (it follows the head).
     if (const std::optional<CameraPose> reported = sim.reported_pose(capture_utime)) {
-      const camera_pose_t pose = to_pose_message(camera_config.id, capture_utime, *reported);
+      const camera_pose_t pose = to_camera_pose_message(camera_config.id, capture_utime, *reported);
       node.safety().publish(config.channels.camera_pose, &pose);
     }
     const SimulatedCamera::Frame frame = sim.capture(capture_utime, static_cast<uint64_t>(slot));

@@ -457,6 +457,7 @@ Config load_config(const std::string& path, const char* lcm_default_url_env) {
       YamlMap poses = renderer.map("camera_pose");
       config.renderer.camera_pose_history_ms = poses.number("history_ms", 10, 60000);
       config.renderer.camera_pose_max_extrapolation_ms = poses.number("max_extrapolation_ms", 0, 1000);
+      config.renderer.camera_pose_max_gap_ms = poses.number("max_gap_ms", 1, 10000);
       poses.finish();
     }
     {

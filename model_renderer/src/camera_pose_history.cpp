@@ -26,8 +26,10 @@ std::string ms(int64_t us) {
 
 }  // namespace
 
-CameraPoseHistory::CameraPoseHistory(int64_t history_us, int64_t max_extrapolation_us)
-    : history_us_(history_us), max_extrapolation_us_(std::max<int64_t>(0, max_extrapolation_us)) {}
+CameraPoseHistory::CameraPoseHistory(int64_t history_us, int64_t max_extrapolation_us, int64_t max_gap_us)
+    : history_us_(history_us),
+      max_extrapolation_us_(std::max<int64_t>(0, max_extrapolation_us)),
+      max_gap_us_(max_gap_us) {}
 
 void CameraPoseHistory::set_static(const std::string& camera_id, const CameraPose& pose) {
   static_poses_[camera_id] = pose;
@@ -37,15 +39,20 @@ bool CameraPoseHistory::add(const std::string& camera_id, int64_t utime, const C
   Camera& camera = cameras_[camera_id];
   if (!camera.poses.empty() && camera.poses.back().pose.frame_id != pose.frame_id) camera = Camera{};
   if (!camera.poses.empty() && utime <= camera.poses.back().utime) return false;
-  if (!camera.poses.empty() && !same_pose(camera.poses.back().pose, pose)) camera.moving = true;
   camera.poses.push_back({utime, pose});
   while (camera.poses.size() > 2 && camera.poses.front().utime < utime - history_us_) camera.poses.pop_front();
   return true;
 }
 
+bool CameraPoseHistory::motion(const Sample& a, const Sample& b) const {
+  return b.utime - a.utime <= max_gap_us_ && !same_pose(a.pose, b.pose);
+}
+
 bool CameraPoseHistory::moving(const std::string& camera_id) const {
   const auto it = cameras_.find(camera_id);
-  return it != cameras_.end() && it->second.moving;
+  if (it == cameras_.end() || it->second.poses.size() < 2) return false;
+  const std::deque<Sample>& poses = it->second.poses;
+  return motion(poses[poses.size() - 2], poses.back());
 }
 
 CameraPose CameraPoseHistory::blend(const Sample& a, const Sample& b, int64_t utime) {
@@ -76,34 +83,39 @@ PoseAtTime CameraPoseHistory::at(const std::string& camera_id, int64_t utime) co
   }
   const std::deque<Sample>& poses = camera->second.poses;
   result.usable = true;
-  if (!camera->second.moving) {
-    result.pose = poses.back().pose;
-    return result;
-  }
   const Sample& newest = poses.back();
   const Sample& oldest = poses.front();
-  if (utime > newest.utime) {
+  if (utime >= newest.utime) {
     const int64_t ahead_us = utime - newest.utime;
-    if (ahead_us > max_extrapolation_us_) {
+    if (poses.size() < 2 || !motion(poses[poses.size() - 2], newest)) {
+      result.pose = newest.pose;  // at rest, or a calibration: holds
+    } else if (ahead_us > max_extrapolation_us_) {
       result.usable = false;
       result.unusable_reason = "newest camera pose of moving camera '" + camera_id + "' is " + ms(ahead_us) +
                                " older than the frame (limit " + ms(max_extrapolation_us_) + ")";
-      return result;
+    } else {
+      result.pose = blend(poses[poses.size() - 2], newest, utime);
     }
-    result.pose = blend(poses[poses.size() - 2], newest, utime);
   } else if (utime < oldest.utime) {
     const int64_t behind_us = oldest.utime - utime;
-    if (behind_us > max_extrapolation_us_) {
+    if (poses.size() >= 2 && motion(oldest, poses[1]) && behind_us > max_extrapolation_us_) {
       result.usable = false;
       result.unusable_reason = "frame is " + ms(behind_us) + " older than the oldest camera pose kept of moving camera '" +
                                camera_id + "' (limit " + ms(max_extrapolation_us_) + ")";
-      return result;
+    } else {
+      result.pose = oldest.pose;
     }
-    result.pose = oldest.pose;
   } else {
     const auto after = std::lower_bound(poses.begin(), poses.end(), utime,
                                         [](const Sample& s, int64_t t) { return s.utime < t; });
-    result.pose = after->utime == utime ? after->pose : blend(*(after - 1), *after, utime);
+    const Sample& before = *(after - 1);
+    if (after->utime == utime) {
+      result.pose = after->pose;
+    } else if (motion(before, *after)) {
+      result.pose = blend(before, *after, utime);
+    } else {
+      result.pose = before.pose;  // a step: the earlier pose holds until the next
+    }
   }
   return result;
 }

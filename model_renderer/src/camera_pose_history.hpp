@@ -8,14 +8,15 @@
 // Lookup rules (docs/renderer.md, "Camera pose history"):
 //  - no CAMERA_POSE for the camera yet: its static pose (the config's
 //    camera.pose for camera.id), else unusable;
-//  - every pose received for the camera so far is the same (a calibration
-//    published once or repeated): that pose, at any time, like the config's;
-//  - once the camera's pose has changed, it is "moving": between two poses
-//    the pose is interpolated (translation linearly, rotation by slerp);
-//    beyond the newest pose it is extrapolated linearly from the last two,
-//    at most max_extrapolation_us; before the oldest pose kept, that pose is
-//    held for at most max_extrapolation_us; further is unusable (one line
-//    naming the camera, the gap and the limit).
+//  - two poses at most max_gap_us apart that differ are a motion (a pan-tilt
+//    head's readings): between them the pose is interpolated (translation
+//    linearly, rotation by slerp); beyond the newest of such a pair it is
+//    extrapolated with the same motion at most max_extrapolation_us, and
+//    before the oldest pose kept held for at most that long; further is
+//    unusable (one line naming the camera, the gap and the limit);
+//  - otherwise (one pose, equal poses, or poses further apart: a
+//    calibration published now and then) a pose holds from its utime until
+//    the next one, and the newest holds from then on, like the config's.
 // A pose in another frame_id than the camera's previous ones starts the
 // camera's history anew (interpolating across frames means nothing).
 //
@@ -41,7 +42,7 @@ class CameraPoseHistory {
  public:
   // Keeps poses no older than `history_us` behind each camera's newest (at
   // least two).
-  CameraPoseHistory(int64_t history_us, int64_t max_extrapolation_us);
+  CameraPoseHistory(int64_t history_us, int64_t max_extrapolation_us, int64_t max_gap_us);
 
   // The pose used for `camera_id` while no CAMERA_POSE has come for it.
   void set_static(const std::string& camera_id, const CameraPose& pose);
@@ -53,7 +54,8 @@ class CameraPoseHistory {
 
   PoseAtTime at(const std::string& camera_id, int64_t utime) const;
 
-  // True once the camera's reported pose has changed.
+  // True when the camera's two newest poses are a motion (they differ and
+  // are at most max_gap_us apart).
   bool moving(const std::string& camera_id) const;
 
  private:
@@ -63,12 +65,14 @@ class CameraPoseHistory {
   };
   struct Camera {
     std::deque<Sample> poses;
-    bool moving = false;
   };
   static CameraPose blend(const Sample& a, const Sample& b, int64_t utime);
+  // True when a and b (a before b) are a motion.
+  bool motion(const Sample& a, const Sample& b) const;
 
   int64_t history_us_;
   int64_t max_extrapolation_us_;
+  int64_t max_gap_us_;
   std::map<std::string, CameraPose> static_poses_;
   std::map<std::string, Camera> cameras_;
 };

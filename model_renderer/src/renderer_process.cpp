@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "tofguard/camera_pose_message.hpp"
+
 namespace tofguard::renderer {
 
 ProcessInfo process_info() {
@@ -40,7 +42,8 @@ RendererService::RendererService(const Config& config)
       renderer_(make_renderer(scene_, config.renderer)),
       history_(static_cast<int64_t>(std::llround(config.renderer.max_extrapolation_ms * 1000.0))),
       camera_poses_(static_cast<int64_t>(std::llround(config.renderer.camera_pose_history_ms * 1000.0)),
-                    static_cast<int64_t>(std::llround(config.renderer.camera_pose_max_extrapolation_ms * 1000.0))) {
+                    static_cast<int64_t>(std::llround(config.renderer.camera_pose_max_extrapolation_ms * 1000.0)),
+                    static_cast<int64_t>(std::llround(config.renderer.camera_pose_max_gap_ms * 1000.0))) {
   camera_poses_.set_static(config.camera.id, config.camera.pose);
   for (const Joint& joint : scene_.joints) {
     if (joint.type == JointType::kPrismatic) prismatic_joints_.insert(joint.name);
@@ -55,13 +58,7 @@ bool RendererService::on_joint_state(const joint_state_t& state) {
 }
 
 bool RendererService::on_camera_pose(const camera_pose_t& message) {
-  CameraPose pose;
-  pose.frame_id = message.frame_id;
-  pose.translation_m = Eigen::Vector3d(message.translation[0], message.translation[1], message.translation[2]);
-  // check_camera_pose allows a norm within 1e-3 of 1: normalise.
-  pose.rotation =
-      Eigen::Quaterniond(message.rotation[0], message.rotation[1], message.rotation[2], message.rotation[3]).normalized();
-  return camera_poses_.add(message.camera_id, message.utime, pose);
+  return camera_poses_.add(message.camera_id, message.utime, from_camera_pose_message(message));
 }
 
 bool RendererService::on_depth(const depth_image_t& frame) {

@@ -11,7 +11,7 @@
 #include "depth_renderer.hpp"
 #include "renderer_process.hpp"
 #include "test_support.hpp"
-#include "tofguard/camera_pose_t.hpp"
+#include "tofguard/camera_pose_message.hpp"
 #include "tofguard/clock.hpp"
 #include "tofguard/config.hpp"
 #include "tofguard/depth_image_t.hpp"
@@ -198,10 +198,7 @@ TEST(SimCameraProcess, PanTiltHeadPublishesThePoseOfEachFrameAndAnOffsetReadingD
     const camera_pose_t& m = rig.poses.at(frame.utime);
     EXPECT_EQ(m.camera_id, "tof-mast");
     EXPECT_EQ(m.frame_id, config.camera.pose.frame_id);
-    CameraPose pose;
-    pose.frame_id = m.frame_id;
-    pose.translation_m = Eigen::Vector3d(m.translation[0], m.translation[1], m.translation[2]);
-    pose.rotation = Eigen::Quaterniond(m.rotation[0], m.rotation[1], m.rotation[2], m.rotation[3]);
+    const CameraPose pose = from_camera_pose_message(m);
     EXPECT_LT((pose.translation_m - config.camera.pose.translation_m).norm(), 1e-9);
     const Eigen::Vector3d forward = pose.rotation * Eigen::Vector3d::UnitZ();
     const Eigen::Vector3d configured = config.camera.pose.rotation * Eigen::Vector3d::UnitZ();

@@ -1,5 +1,6 @@
 // CameraPoseHistory: the camera pose at a frame's utime (interpolated,
-// bounded extrapolation, unusable beyond), static poses held, frame changes.
+// bounded extrapolation, unusable beyond), static poses and calibration
+// steps held, frame changes.
 #include "camera_pose_history.hpp"
 
 #include <gtest/gtest.h>
@@ -30,7 +31,7 @@ double pan_deg_of(const CameraPose& p) {
 }
 
 TEST(CameraPoseHistory, StaticPoseUntilAPoseArrivesAndUnchangingPosesAreHeldForever) {
-  CameraPoseHistory h(2'000'000, 40'000);
+  CameraPoseHistory h(2'000'000, 40'000, 80'000);
   EXPECT_FALSE(h.at("cam", kT0).usable);
   EXPECT_EQ(h.at("cam", kT0).unusable_reason, "no camera pose for camera 'cam'");
   h.set_static("cam", panned(0));
@@ -48,7 +49,7 @@ TEST(CameraPoseHistory, StaticPoseUntilAPoseArrivesAndUnchangingPosesAreHeldFore
 }
 
 TEST(CameraPoseHistory, AMovingCameraIsInterpolatedAndExtrapolatedOnlyAsFarAsTheLimit) {
-  CameraPoseHistory h(2'000'000, 40'000);
+  CameraPoseHistory h(2'000'000, 40'000, 80'000);
   // Panning at 100 deg/s and moving 1 m/s along x.
   for (int i = 0; i <= 3; ++i) ASSERT_TRUE(h.add("cam", kT0 + i * 33'000, panned(3.3 * i, 0.033 * i)));
   EXPECT_TRUE(h.moving("cam"));
@@ -78,8 +79,28 @@ TEST(CameraPoseHistory, AMovingCameraIsInterpolatedAndExtrapolatedOnlyAsFarAsThe
   EXPECT_FALSE(h.at("other", kT0).usable);
 }
 
+TEST(CameraPoseHistory, ACalibrationPublishedNowAndThenIsAStepNotAMotion) {
+  CameraPoseHistory h(2'000'000, 40'000, 80'000);
+  h.set_static("cam", panned(0));
+  // 10 Hz: A, A, then the recalibrated B, B.
+  ASSERT_TRUE(h.add("cam", kT0, panned(0, 0.1)));
+  ASSERT_TRUE(h.add("cam", kT0 + 100'000, panned(0, 0.1)));
+  ASSERT_TRUE(h.add("cam", kT0 + 200'000, panned(2, 0.3)));
+  EXPECT_FALSE(h.moving("cam"));
+  // B from its utime on, as long as it is the newest, however late the frame.
+  for (int64_t t : {kT0 + 200'000, kT0 + 290'000, kT0 + 10'000'000}) {
+    const PoseAtTime p = h.at("cam", t);
+    ASSERT_TRUE(p.usable) << p.unusable_reason;
+    EXPECT_DOUBLE_EQ(p.pose.translation_m.x(), 0.3);
+  }
+  // Before it, A (no blend across the step).
+  EXPECT_DOUBLE_EQ(h.at("cam", kT0 + 150'000).pose.translation_m.x(), 0.1);
+  ASSERT_TRUE(h.add("cam", kT0 + 300'000, panned(2, 0.3)));
+  EXPECT_DOUBLE_EQ(h.at("cam", kT0 + 250'000).pose.translation_m.x(), 0.3);
+}
+
 TEST(CameraPoseHistory, KeepsOnlyTheHistorySpanAndStartsAnewInAnotherFrame) {
-  CameraPoseHistory h(100'000, 10'000);
+  CameraPoseHistory h(100'000, 10'000, 80'000);
   for (int i = 0; i <= 10; ++i) ASSERT_TRUE(h.add("cam", kT0 + i * 33'000, panned(i)));
   // Oldest kept: 330 - 100 = 230 ms -> the pose at 231 ms.
   EXPECT_TRUE(h.at("cam", kT0 + 231'000).usable);

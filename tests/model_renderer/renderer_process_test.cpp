@@ -13,6 +13,7 @@
 #include "depth_renderer.hpp"
 #include "renderer_process.hpp"
 #include "test_support.hpp"
+#include "tofguard/camera_pose_message.hpp"
 #include "tofguard/clock.hpp"
 #include "tofguard/heartbeat_t.hpp"
 
@@ -75,15 +76,7 @@ struct Bench {
   }
   std::optional<JointPositions> fixed_joints;
   void publish_pose(int64_t utime, const CameraPose& pose) {
-    camera_pose_t m;
-    m.utime = utime;
-    m.camera_id = config.camera.id;
-    m.frame_id = pose.frame_id;
-    for (int i = 0; i < 3; ++i) m.translation[i] = pose.translation_m[i];
-    m.rotation[0] = pose.rotation.w();
-    m.rotation[1] = pose.rotation.x();
-    m.rotation[2] = pose.rotation.y();
-    m.rotation[3] = pose.rotation.z();
+    const camera_pose_t m = to_camera_pose_message(config.camera.id, utime, pose);
     safety.publish(config.channels.camera_pose, &m);
   }
   int64_t publish_frame(int64_t utime) {

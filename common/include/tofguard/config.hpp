@@ -210,12 +210,14 @@ struct RendererConfig {
   double max_extrapolation_ms = 0;
   // Camera poses (CAMERA_POSE) are kept per camera_id for
   // camera_pose_history_ms and looked up at each frame's utime
-  // (interpolated; docs/renderer.md). A camera whose reported pose has
-  // changed is "moving": a frame further than camera_pose_max_extrapolation_ms
-  // beyond its newest pose (or before its oldest kept pose) is unusable. A
-  // camera whose poses never changed keeps its pose, like the config's.
+  // (CameraPoseHistory, docs/renderer.md). Two differing poses at most
+  // camera_pose_max_gap_ms apart are a motion (interpolated); a frame
+  // further than camera_pose_max_extrapolation_ms beyond a moving camera's
+  // newest pose is unusable. Poses further apart are steps (a calibration
+  // published now and then): each holds until the next.
   double camera_pose_history_ms = 0;
   double camera_pose_max_extrapolation_ms = 0;
+  double camera_pose_max_gap_ms = 0;
   // Prediction from PLANNED_TRAJECTORY (docs/renderer.md): the next frame
   // is rendered ahead at the plan's joints for its expected utime; when the
   // frame comes and every joint interpolated at its utime is within
