@@ -79,6 +79,10 @@ namespace {
 constexpr double kDegToRad = M_PI / 180.0;
 // Frame intervals kept to learn the camera period (their median).
 constexpr size_t kKeptIntervals = 9;
+// After this many misses in a row, predict only every kProbeEveryFrames-th
+// frame until a hit.
+constexpr int kMissesBeforeProbing = 5;
+constexpr int kProbeEveryFrames = 8;
 
 }  // namespace
 
@@ -103,6 +107,8 @@ void RendererService::plan_prediction(const depth_image_t& frame) {
   prediction_.reset();
   const int64_t period_us = frame_period_us();
   if (!config_.renderer.prediction_enabled || period_us <= 0) return;
+  if (consecutive_misses_ >= kMissesBeforeProbing && ++frames_since_probe_ < kProbeEveryFrames) return;
+  frames_since_probe_ = 0;
   const int64_t utime = frame.utime + period_us;
   const auto planned = plan_.at(utime);
   if (!planned) return;
@@ -164,9 +170,12 @@ RenderedFrame RendererService::render(const depth_image_t& frame) {
     result.unusable_reason = pose.unusable_reason;
   } else if (prediction_ && prediction_matches(frame, joints.joints, pose.pose)) {
     prediction_stats_.hits++;
+    consecutive_misses_ = 0;
     result = std::move(prediction_->result);
   } else {
-    (prediction_ && prediction_->rendered ? prediction_stats_.misses : prediction_stats_.without)++;
+    const bool missed = prediction_ && prediction_->rendered;
+    (missed ? prediction_stats_.misses : prediction_stats_.without)++;
+    if (missed) ++consecutive_misses_;
     const Intrinsics intrinsics{frame.width, frame.height, frame.fx, frame.fy, frame.cx, frame.cy};
     result = renderer_->render(joints.joints, pose.pose, intrinsics);
   }

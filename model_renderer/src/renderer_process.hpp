@@ -28,7 +28,10 @@
 // prediction's: within the tolerances, the image rendered ahead is
 // published at once (a hit); otherwise the frame is rendered as usual (a
 // miss). The image is always the model at the frame's own joints within
-// the tolerance, never the plan's guess beyond it.
+// the tolerance, never the plan's guess beyond it. After 5 misses in a row
+// (an arm that does not follow its plan that closely, or a jittery camera)
+// only every 8th frame is predicted until one hits, so that useless
+// predictions do not double the rendering work.
 #include <deque>
 #include <memory>
 #include <optional>
@@ -134,6 +137,10 @@ class RendererService {
   std::deque<int64_t> frame_intervals_us_;
   std::optional<Prediction> prediction_;
   PredictionStats prediction_stats_;
+  // Misses in a row, and frames since the last prediction while they are
+  // many (then only every kProbeEveryFrames-th frame is predicted).
+  int consecutive_misses_ = 0;
+  int frames_since_probe_ = 0;
 };
 
 }  // namespace tofguard::renderer

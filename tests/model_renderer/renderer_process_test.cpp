@@ -242,9 +242,20 @@ TEST(RendererProcess, FollowsAMovingCameraAtEachFramesUtime) {
   // Once the process listens (its heartbeat comes after it subscribed).
   ASSERT_TRUE(wait_until([&] { return bench.heartbeat.utime > 0; }, std::chrono::seconds(20), [&] { bench.pump(); }))
       << process.stderr_text();
-  bench.publish_joints_until(t1 + 40'000);
-  bench.publish_pose(t0, panned(0));
-  bench.publish_pose(t1, panned(6));
+  // Joint states and both readings, until the process has taken them all
+  // in (11 joint states + 2 poses; the first messages after it subscribed
+  // can be lost, and repeats are ignored).
+  int64_t sent_us = 0;
+  ASSERT_TRUE(wait_until([&] { return bench.heartbeat.frames_in >= 13; }, std::chrono::seconds(10), [&] {
+    if (monotonic_us() - sent_us > 300'000) {
+      sent_us = monotonic_us();
+      bench.next_joint_utime = t0;
+      bench.publish_joints_until(t1 + 40'000);
+      bench.publish_pose(t0, panned(0));
+      bench.publish_pose(t1, panned(6));
+    }
+    bench.pump();
+  })) << bench.heartbeat.frames_in;
 
   // A frame between the readings, and one past the newest beyond the 40 ms
   // limit. Until the process is up, and while a frame may overtake its pose
@@ -264,15 +275,6 @@ TEST(RendererProcess, FollowsAMovingCameraAtEachFramesUtime) {
       [&] {
         // (A frame sent while the process was still subscribing is lost.)
         const bool unanswered = mid_seq > 0 && !bench.labels.count(mid_seq) && monotonic_us() - mid_sent_us > 300'000;
-        if (mid_seq > 0 && bench.labels.count(mid_seq) &&
-            bench.labels.at(mid_seq).unusable_reason == "no joint state received yet") {
-          // The first messages after the process subscribed can be lost:
-          // send the joint states and poses again.
-          bench.next_joint_utime = t0;
-          bench.publish_joints_until(t1 + 40'000);
-          bench.publish_pose(t0, panned(0));
-          bench.publish_pose(t1, panned(6));
-        }
         if (mid_seq < 0 || unanswered || (bench.labels.count(mid_seq) && !bench.labels.at(mid_seq).usable)) {
           mid_seq = bench.publish_frame(mid_utime);
           mid_sent_us = monotonic_us();
@@ -346,7 +348,10 @@ TEST(RendererProcess, APlannedFrameIsRenderedAheadAndIdenticalToTheNormalRenderi
     bench.publish_joints_until(utime + 20'000);
     for (int attempt = 0; attempt < 5; ++attempt) {
       const int64_t seq = bench.publish_frame(utime);
-      if (wait_until([&] { return bench.labels.count(seq) > 0; }, std::chrono::seconds(1), [&] { bench.pump(); })) {
+      const auto answered = [&] {
+        return bench.labels.count(seq) > 0 && (!bench.labels.at(seq).usable || bench.rendered.count(seq) > 0);
+      };
+      if (wait_until(answered, std::chrono::seconds(1), [&] { bench.pump(); })) {
         seqs.push_back(seq);
         return seq;
       }
@@ -366,6 +371,10 @@ TEST(RendererProcess, APlannedFrameIsRenderedAheadAndIdenticalToTheNormalRenderi
         while (monotonic_us() < until) bench.pump();
       }))
       << process.stderr_text() << bench.heartbeat.status;
+  // The counts once the heartbeat has caught up with the last frame.
+  const int64_t last_utime = utime - 33'000;
+  ASSERT_TRUE(wait_until([&] { return bench.heartbeat.last_frame_utime == last_utime; }, std::chrono::seconds(5),
+                         [&] { bench.pump(); }));
   const auto [hits, misses] = prediction_counts(bench.heartbeat);
   EXPECT_EQ(misses, 0) << bench.heartbeat.status;
 
@@ -392,11 +401,20 @@ TEST(RendererProcess, APlannedFrameIsRenderedAheadAndIdenticalToTheNormalRenderi
   JointPositions off = planned;
   off["a2"] += 0.2 * M_PI / 180;
   bench.fixed_joints = off;
+  // Its joint states first, taken in before the frame comes (else the frame
+  // may overtake them and be extrapolated from the planned ones).
+  const int64_t in_before = bench.heartbeat.frames_in;
+  const int64_t joint_states = (utime + 20'000 - bench.next_joint_utime) / 10'000 + 1;
+  bench.publish_joints_until(utime + 20'000);
+  ASSERT_TRUE(wait_until([&] { return bench.heartbeat.frames_in >= in_before + joint_states; },
+                         std::chrono::seconds(5), [&] { bench.pump(); }));
   const int64_t off_seq = send_frame(utime);
-  ASSERT_TRUE(wait_until([&] { return prediction_counts(bench.heartbeat).second >= 1; }, std::chrono::seconds(5),
+  ASSERT_GE(off_seq, 0);
+  ASSERT_TRUE(wait_until([&] { return bench.heartbeat.last_frame_utime == utime; }, std::chrono::seconds(5),
                          [&] { bench.pump(); }))
       << bench.heartbeat.status;
   EXPECT_EQ(prediction_counts(bench.heartbeat).first, hits);
+  EXPECT_EQ(prediction_counts(bench.heartbeat).second, 1) << bench.heartbeat.status;
   ASSERT_TRUE(bench.rendered.count(off_seq));
   const RenderResult at_off = renderer.render(off, config.camera.pose, config.camera.intrinsics);
   EXPECT_EQ(differing_pixels(bench.rendered.at(off_seq), bench.labels.at(off_seq), at_off), 0);
