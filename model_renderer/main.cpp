@@ -1,4 +1,4 @@
-// tofguard-renderer: TOF_DEPTH, JOINT_STATE, CAMERA_POSE -> TOF_LABELS,
+// tofguard-renderer: TOF_DEPTH, JOINT_STATE, CAMERA_POSE, PLANNED_TRAJECTORY -> TOF_LABELS,
 // TOF_RENDERED (see src/renderer_process.hpp); also the one-shot
 // `tofguard-renderer render ...` command (src/render_cli.hpp).
 #include <iostream>
@@ -42,8 +42,19 @@ int run(const Config& config, const std::vector<std::string>& rest) {
       },
       check_joint_state);
   node.subscribe<camera_pose_t>(
-      node.safety(), config.channels.camera_pose, [&](const camera_pose_t& pose) { service->on_camera_pose(pose); },
+      node.safety(), config.channels.camera_pose,
+      [&](const camera_pose_t& pose) {
+        if (!service->on_camera_pose(pose)) {
+          node.counters().validation_errors++;
+          node.errors().report(config.channels.camera_pose, config.channels.camera_pose + ": utime: expected a pose newer than camera '" +
+                                                                pose.camera_id + "''s newest, got " +
+                                                                std::to_string(pose.utime) + "; ignored");
+        }
+      },
       check_camera_pose);
+  node.subscribe<planned_trajectory_t>(
+      node.safety(), config.channels.planned_trajectory, [&](const planned_trajectory_t& plan) { service->on_plan(plan); },
+      check_planned_trajectory);
   node.subscribe<depth_image_t>(
       node.images(), config.channels.depth,
       [&](const depth_image_t& frame) {
@@ -61,8 +72,20 @@ int run(const Config& config, const std::vector<std::string>& rest) {
       if (!safety && !images) return;
     }
   };
-  while (node.spin_once(service->has_pending() ? 0 : 20)) {
-    if (!service->has_pending()) continue;
+  auto status = [&](const std::string& what) {
+    const RendererService::PredictionStats& p = service->prediction_stats();
+    node.heartbeat().set_status(what + "; prediction: " + std::to_string(p.hits) + " hits, " +
+                                std::to_string(p.misses) + " misses, " + std::to_string(p.without) +
+                                " frames without one, " + std::to_string(p.rendered) + " rendered ahead");
+  };
+  while (node.spin_once(service->has_pending() || service->has_prediction_to_render() ? 0 : 20)) {
+    if (!service->has_pending()) {
+      // Idle: render the next frame ahead from the plan, unless a frame
+      // has come meanwhile.
+      drain();
+      if (!service->has_pending()) service->render_prediction();
+      continue;
+    }
     drain();
     const std::optional<RenderedFrame> rendered = service->render_pending();
     if (!rendered) continue;
@@ -70,8 +93,7 @@ int run(const Config& config, const std::vector<std::string>& rest) {
     if (rendered->depth) node.images().publish(config.channels.rendered, &*rendered->depth);
     node.counters().frames_out++;
     node.heartbeat().set_last_frame_utime(rendered->labels.utime);
-    node.heartbeat().set_status(rendered->labels.usable ? "rendering"
-                                                        : "frame unusable: " + rendered->labels.unusable_reason);
+    status(rendered->labels.usable ? "rendering" : "frame unusable: " + rendered->labels.unusable_reason);
     if (!rendered->labels.usable) node.errors().report("unusable", "frame unusable: " + rendered->labels.unusable_reason);
   }
   return 0;

@@ -22,6 +22,7 @@ SimulatedCamera::SimulatedCamera(const CameraConfig& config, SceneRenderer* rend
                                  int64_t start_utime)
     : config_(config),
       renderer_(renderer),
+      start_utime_(start_utime),
       model_(config.sim, config.intrinsics),
       joints_(kMaxExtrapolationUs) {
   for (const SimCameraFaultConfig& f : config.sim.faults) {
@@ -34,8 +35,40 @@ void SimulatedCamera::clear_faults(int64_t utime) {
   for (ActiveSimFault& f : faults_) f.end_utime = std::min(f.end_utime, utime);
 }
 
-CameraPose SimulatedCamera::true_pose(int64_t utime) const {
+CameraPose SimulatedCamera::turned_pose(double pan_rad, double tilt_rad) const {
   CameraPose pose = config_.pose;
+  pose.rotation = (Eigen::Quaterniond(Eigen::AngleAxisd(pan_rad, Eigen::Vector3d::UnitZ())) * pose.rotation *
+                   Eigen::Quaterniond(Eigen::AngleAxisd(tilt_rad, Eigen::Vector3d::UnitX())))
+                      .normalized();
+  return pose;
+}
+
+double SimulatedCamera::true_pan_rad(int64_t utime) const {
+  if (!config_.sim.pan_tilt_enabled) return 0;
+  const double t = (utime - start_utime_) * 1e-6;
+  return config_.sim.pan_amplitude_rad * std::sin(2 * M_PI * t / config_.sim.pan_period_s);
+}
+
+double SimulatedCamera::true_tilt_rad(int64_t utime) const {
+  if (!config_.sim.pan_tilt_enabled) return 0;
+  const double t = (utime - start_utime_) * 1e-6;
+  return config_.sim.tilt_amplitude_rad * std::sin(2 * M_PI * t / config_.sim.tilt_period_s);
+}
+
+std::optional<CameraPose> SimulatedCamera::reported_pose(int64_t utime) const {
+  if (!config_.sim.pan_tilt_enabled) return std::nullopt;
+  double pan = true_pan_rad(utime);
+  double tilt = true_tilt_rad(utime);
+  for (const ActiveSimFault& f : faults_) {
+    if (f.fault.kind != "pan_tilt_offset" || !active(f, utime)) continue;
+    pan += f.fault.pan_offset_rad;
+    tilt += f.fault.tilt_offset_rad;
+  }
+  return turned_pose(pan, tilt);
+}
+
+CameraPose SimulatedCamera::true_pose(int64_t utime) const {
+  CameraPose pose = turned_pose(true_pan_rad(utime), true_tilt_rad(utime));
   for (const ActiveSimFault& f : faults_) {
     if (f.fault.kind != "pose_drift" || utime < f.start_utime) continue;
     // The drift accumulates while the fault lasts and stays afterwards (a

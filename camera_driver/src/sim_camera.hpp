@@ -83,9 +83,15 @@ class SimulatedCamera {
   // selects the noise (the same index gives the same noise).
   Frame capture(int64_t capture_utime, uint64_t frame_index);
 
-  // The camera pose the scene is rendered from at `utime` (the config's
-  // pose plus any pose drift).
+  // The camera pose the scene is rendered from at `utime`: the config's
+  // pose turned by the pan-tilt head's true pan and tilt (camera.sim.pan_tilt),
+  // plus any pose drift.
   CameraPose true_pose(int64_t utime) const;
+  // What the pan-tilt head reports at `utime` (published on CAMERA_POSE
+  // with each frame): the config's pose turned by the head's reading, i.e.
+  // the true pan and tilt plus any pan_tilt_offset fault (a drift is not
+  // seen by the head). nullopt for a camera without a pan-tilt head.
+  std::optional<CameraPose> reported_pose(int64_t utime) const;
   // Intruding boxes at `utime`.
   std::vector<SimBox> boxes(int64_t utime) const;
 
@@ -94,8 +100,16 @@ class SimulatedCamera {
     return utime >= f.start_utime && utime < f.end_utime;
   }
 
+  // The config's pose turned by `pan_rad` about the pose frame's z axis and
+  // `tilt_rad` about the optical x axis (SimCameraConfig).
+  CameraPose turned_pose(double pan_rad, double tilt_rad) const;
+  // The head's true pan and tilt at `utime`, radians.
+  double true_pan_rad(int64_t utime) const;
+  double true_tilt_rad(int64_t utime) const;
+
   CameraConfig config_;
   SceneRenderer* renderer_;
+  int64_t start_utime_;
   TofErrorModel model_;
   renderer::JointHistory joints_;
   std::vector<ActiveSimFault> faults_;

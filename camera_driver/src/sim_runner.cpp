@@ -9,6 +9,7 @@
 #include "scene_model.hpp"
 #include "sim_camera.hpp"
 #include "tofguard/clock.hpp"
+#include "tofguard/camera_pose_message.hpp"
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/lcm_node.hpp"
 #include "tofguard/sim_camera_fault_t.hpp"
@@ -155,6 +156,12 @@ int run_sim_camera(const Config& config) {
     }
     last_slot = slot;
     const int64_t capture_utime = wall_utime() - period_us;
+    // The pan-tilt head's reading for this frame, before the frame, so that
+    // the renderer has it when the frame comes (it follows the head).
+    if (const std::optional<CameraPose> reported = sim.reported_pose(capture_utime)) {
+      const camera_pose_t pose = to_camera_pose_message(camera_config.id, capture_utime, *reported);
+      node.safety().publish(config.channels.camera_pose, &pose);
+    }
     const SimulatedCamera::Frame frame = sim.capture(capture_utime, static_cast<uint64_t>(slot));
     if (frame.outcome != SimulatedCamera::Frame::Outcome::kImage) {
       node.counters().frames_dropped++;

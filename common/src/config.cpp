@@ -83,7 +83,7 @@ Eigen::Vector3d vector3(YamlMap& map, const std::string& key, double limit) {
 
 SimCameraFaultConfig read_sim_fault(YamlMap map) {
   SimCameraFaultConfig f;
-  f.kind = map.choice("kind", {"frozen_image", "stall", "pose_drift", "intruding_object"});
+  f.kind = map.choice("kind", {"frozen_image", "stall", "pose_drift", "intruding_object", "pan_tilt_offset"});
   f.start_s = map.number("start_s", 0, 1e6);
   f.duration_s = map.number("duration_s", 0, 1e6);
   if (f.kind == "pose_drift") {
@@ -96,6 +96,9 @@ SimCameraFaultConfig read_sim_fault(YamlMap map) {
     if (map.optional("velocity_m_per_s")) {
       f.object_velocity_m_per_s = vector3(map, "velocity_m_per_s", 10);
     }
+  } else if (f.kind == "pan_tilt_offset") {
+    f.pan_offset_rad = map.number("pan_offset_deg", -180, 180) * M_PI / 180.0;
+    f.tilt_offset_rad = map.number("tilt_offset_deg", -90, 90) * M_PI / 180.0;
   }
   map.finish();
   return f;
@@ -130,6 +133,19 @@ SimCameraConfig read_sim(YamlMap map) {
   }
   if (map.optional("faults")) {
     for (YamlMap& fault : map.maps("faults")) c.faults.push_back(read_sim_fault(fault));
+  }
+  if (auto pan_tilt = map.optional_map("pan_tilt")) {
+    c.pan_tilt_enabled = true;
+    c.pan_amplitude_rad = pan_tilt->number("pan_amplitude_deg", 0, 180) * M_PI / 180.0;
+    c.pan_period_s = pan_tilt->number("pan_period_s", 0.1, 1e6);
+    c.tilt_amplitude_rad = pan_tilt->number("tilt_amplitude_deg", 0, 90) * M_PI / 180.0;
+    c.tilt_period_s = pan_tilt->number("tilt_period_s", 0.1, 1e6);
+    pan_tilt->finish();
+  }
+  for (const SimCameraFaultConfig& f : c.faults) {
+    if (f.kind == "pan_tilt_offset" && !c.pan_tilt_enabled) {
+      map.fail("faults", "a pan_tilt_offset fault only with camera.sim.pan_tilt (a camera with a pan-tilt head)");
+    }
   }
   map.finish();
   return c;
@@ -252,6 +268,25 @@ RiskConfig read_risk(YamlMap map) {
   }
   r.unknown_object_min_area_m2 = map.number("unknown_object_min_area_m2", 1e-6, 100);
   r.unclassified_blob_area_m2 = map.number("unclassified_blob_area_m2", 1e-6, 100);
+  {
+    YamlMap estimate = map.map("estimate");
+    r.estimate_enabled = estimate.boolean("enabled");
+    r.estimate_wait_ms = estimate.number("wait_ms", 0, 1000);
+    r.estimate_sigmas = estimate.number("sigmas", 0, 100);
+    r.estimate_min_joint_offset_deg = estimate.number("min_joint_offset_deg", 0, 180);
+    r.estimate_min_joint_offset_m = estimate.number("min_joint_offset_m", 0, 10);
+    r.estimate_min_translation_m = estimate.number("min_translation_m", 0, 10);
+    r.estimate_min_rotation_deg = estimate.number("min_rotation_deg", 0, 180);
+    r.estimate_unexplained_residual_mm = estimate.number("unexplained_residual_mm", 0, 10000);
+    estimate.finish();
+  }
+  {
+    YamlMap plan = map.map("plan");
+    r.plan_enabled = plan.boolean("enabled");
+    r.plan_max_deviation_deg = plan.number("max_deviation_deg", 0.01, 180);
+    r.plan_max_deviation_m = plan.number("max_deviation_m", 1e-4, 10);
+    plan.finish();
+  }
   map.finish();
   return r;
 }
@@ -282,6 +317,15 @@ JointsSimConfig read_joints_sim(YamlMap map) {
       f.finish();
       sim.faults.push_back(fault);
     }
+  }
+  {
+    YamlMap plan = map.map("plan");
+    sim.publish_plan = plan.boolean("publish");
+    sim.plan_rate_hz = plan.number("rate_hz", 0.1, 1000);
+    sim.plan_horizon_ms = plan.number("horizon_ms", 1, 60000);
+    sim.plan_step_ms = plan.number("step_ms", 1, 10000);
+    if (sim.plan_step_ms > sim.plan_horizon_ms) plan.fail("step_ms", "a step no longer than horizon_ms");
+    plan.finish();
   }
   map.finish();
   return sim;
@@ -427,6 +471,22 @@ Config load_config(const std::string& path, const char* lcm_default_url_env) {
                     std::to_string(config.renderer.far_m));
     }
     config.renderer.max_extrapolation_ms = renderer.number("max_extrapolation_ms", 0, 1000);
+    {
+      YamlMap poses = renderer.map("camera_pose");
+      config.renderer.camera_pose_history_ms = poses.number("history_ms", 10, 60000);
+      config.renderer.camera_pose_max_extrapolation_ms = poses.number("max_extrapolation_ms", 0, 1000);
+      config.renderer.camera_pose_max_gap_ms = poses.number("max_gap_ms", 1, 10000);
+      poses.finish();
+    }
+    {
+      YamlMap prediction = renderer.map("prediction");
+      config.renderer.prediction_enabled = prediction.boolean("enabled");
+      config.renderer.prediction_joint_tolerance_deg = prediction.number("joint_tolerance_deg", 0, 10);
+      config.renderer.prediction_joint_tolerance_m = prediction.number("joint_tolerance_m", 0, 1);
+      config.renderer.prediction_pose_tolerance_mm = prediction.number("pose_tolerance_mm", 0, 100);
+      config.renderer.prediction_pose_tolerance_deg = prediction.number("pose_tolerance_deg", 0, 10);
+      prediction.finish();
+    }
     renderer.finish();
   }
 

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <set>
 #include <sstream>
+#include <vector>
 
 namespace tofguard {
 namespace {
@@ -19,6 +20,29 @@ std::string check_size(int32_t width, int32_t height) {
   }
   if (height <= 0 || height > kMaxImageSide) {
     return expected("height", "1.." + std::to_string(kMaxImageSide), height);
+  }
+  return "";
+}
+
+// "" when names are non-empty and unique.
+std::string check_names(const std::vector<std::string>& names, const std::string& field) {
+  std::set<std::string> seen;
+  for (size_t i = 0; i < names.size(); ++i) {
+    const std::string at = field + "[" + std::to_string(i) + "]";
+    if (names[i].empty()) return at + ": expected a joint name, got an empty string";
+    if (!seen.insert(names[i]).second) return at + ": expected unique joint names, got '" + names[i] + "' twice";
+  }
+  return "";
+}
+
+std::string check_unit_quaternion(const double q[4], const std::string& field) {
+  double norm2 = 0;
+  for (int i = 0; i < 4; ++i) {
+    if (!std::isfinite(q[i])) return expected(field + "[" + std::to_string(i) + "]", "a finite number", q[i]);
+    norm2 += q[i] * q[i];
+  }
+  if (std::abs(std::sqrt(norm2) - 1.0) > 1e-3) {
+    return expected(field, "a unit quaternion w,x,y,z (norm 1 within 1e-3), norm", std::sqrt(norm2));
   }
   return "";
 }
@@ -55,13 +79,9 @@ std::string check_depth_image_from(const depth_image_t& image, const std::string
 
 std::string check_joint_state(const joint_state_t& state) {
   if (state.num_joints < 0) return expected("num_joints", "a count >= 0", state.num_joints);
-  std::set<std::string> seen;
+  if (auto problem = check_names(state.name, "name"); !problem.empty()) return problem;
   for (int i = 0; i < state.num_joints; ++i) {
     const std::string at = "[" + std::to_string(i) + "]";
-    if (state.name[i].empty()) return "name" + at + ": expected a joint name, got an empty string";
-    if (!seen.insert(state.name[i]).second) {
-      return "name" + at + ": expected unique joint names, got '" + state.name[i] + "' twice";
-    }
     if (!std::isfinite(state.position[i])) {
       return expected("position" + at + " (" + state.name[i] + ")", "a finite number", state.position[i]);
     }
@@ -80,17 +100,7 @@ std::string check_camera_pose(const camera_pose_t& pose) {
                       pose.translation[i]);
     }
   }
-  double norm2 = 0;
-  for (int i = 0; i < 4; ++i) {
-    if (!std::isfinite(pose.rotation[i])) {
-      return expected("rotation[" + std::to_string(i) + "]", "a finite number", pose.rotation[i]);
-    }
-    norm2 += pose.rotation[i] * pose.rotation[i];
-  }
-  if (std::abs(std::sqrt(norm2) - 1.0) > 1e-3) {
-    return expected("rotation", "a unit quaternion w,x,y,z (norm 1 within 1e-3), norm", std::sqrt(norm2));
-  }
-  return "";
+  return check_unit_quaternion(pose.rotation, "rotation");
 }
 
 std::string check_link_labels(const link_labels_t& labels) {
@@ -133,6 +143,90 @@ std::string check_safety_status(const safety_status_t& status) {
   }
   if (status.motion_allowed && status.stop != safety_status_t::STOP_NONE) {
     return expected("stop", "STOP_NONE while motion_allowed is true", status.stop);
+  }
+  return "";
+}
+
+std::string check_motion_estimate(const motion_estimate_t& e) {
+  if (e.utime <= 0) return expected("utime", "a capture time > 0", static_cast<double>(e.utime));
+  if (e.seq < 0) return expected("seq", "a frame number >= 0", static_cast<double>(e.seq));
+  if (e.camera_id.empty()) return "camera_id: expected a camera name, got an empty string";
+  if (e.trigger < motion_estimate_t::TRIGGER_PERIODIC || e.trigger > motion_estimate_t::TRIGGER_REQUEST) {
+    return expected("trigger", "one of the TRIGGER_ constants (0..2)", e.trigger);
+  }
+  if (!e.usable) {
+    if (e.unusable_reason.empty()) return "unusable_reason: expected a reason for an unusable estimate, got an empty string";
+    return "";
+  }
+  if (e.num_joints < 0) return expected("num_joints", "a count >= 0", e.num_joints);
+  if (auto problem = check_names(e.joint_name, "joint_name"); !problem.empty()) return problem;
+  for (int i = 0; i < e.num_joints; ++i) {
+    const std::string at = "[" + std::to_string(i) + "] (" + e.joint_name[i] + ")";
+    if (!std::isfinite(e.reported_position[i])) {
+      return expected("reported_position" + at, "a finite number", e.reported_position[i]);
+    }
+    if (!std::isfinite(e.estimated_position[i])) {
+      return expected("estimated_position" + at, "a finite number", e.estimated_position[i]);
+    }
+    if (!std::isfinite(e.position_sigma[i]) || e.position_sigma[i] < 0) {
+      return expected("position_sigma" + at, "a finite sigma >= 0", e.position_sigma[i]);
+    }
+  }
+  for (int i = 0; i < 3; ++i) {
+    if (!std::isfinite(e.correction_translation[i])) {
+      return expected("correction_translation[" + std::to_string(i) + "]", "a finite number of metres",
+                      e.correction_translation[i]);
+    }
+    if (!std::isfinite(e.estimated_translation[i])) {
+      return expected("estimated_translation[" + std::to_string(i) + "]", "a finite number of metres",
+                      e.estimated_translation[i]);
+    }
+  }
+  if (auto problem = check_unit_quaternion(e.correction_rotation, "correction_rotation"); !problem.empty()) {
+    return problem;
+  }
+  if (auto problem = check_unit_quaternion(e.estimated_rotation, "estimated_rotation"); !problem.empty()) {
+    return problem;
+  }
+  if (!std::isfinite(e.correction_translation_sigma_m) || e.correction_translation_sigma_m < 0) {
+    return expected("correction_translation_sigma_m", "a finite sigma >= 0", e.correction_translation_sigma_m);
+  }
+  if (!std::isfinite(e.correction_rotation_sigma_rad) || e.correction_rotation_sigma_rad < 0) {
+    return expected("correction_rotation_sigma_rad", "a finite sigma >= 0", e.correction_rotation_sigma_rad);
+  }
+  if (e.frame_id.empty()) return "frame_id: expected a URDF link name, got an empty string";
+  if (e.num_points < 0 || e.num_inliers < 0 || e.num_inliers > e.num_points) {
+    return expected("num_inliers", "0..num_points = " + std::to_string(e.num_points), e.num_inliers);
+  }
+  if (!std::isfinite(e.residual_before_mm) || e.residual_before_mm < 0) {
+    return expected("residual_before_mm", "a finite residual >= 0", e.residual_before_mm);
+  }
+  if (!std::isfinite(e.residual_after_mm) || e.residual_after_mm < 0) {
+    return expected("residual_after_mm", "a finite residual >= 0", e.residual_after_mm);
+  }
+  return "";
+}
+
+std::string check_planned_trajectory(const planned_trajectory_t& plan) {
+  if (plan.num_joints <= 0) return expected("num_joints", "a count >= 1", plan.num_joints);
+  if (plan.num_points <= 0) return expected("num_points", "a count >= 1", plan.num_points);
+  if (auto problem = check_names(plan.joint_name, "joint_name"); !problem.empty()) return problem;
+  for (int i = 0; i < plan.num_points; ++i) {
+    const std::string at = "[" + std::to_string(i) + "]";
+    if (plan.point_utime[i] <= 0) {
+      return expected("point_utime" + at, "a time > 0", static_cast<double>(plan.point_utime[i]));
+    }
+    if (i > 0 && plan.point_utime[i] <= plan.point_utime[i - 1]) {
+      return expected("point_utime" + at, "strictly increasing times, previous " +
+                                             std::to_string(plan.point_utime[i - 1]) + ", got",
+                      static_cast<double>(plan.point_utime[i]));
+    }
+    for (int j = 0; j < plan.num_joints; ++j) {
+      if (!std::isfinite(plan.position[i][j])) {
+        return expected("position" + at + "[" + std::to_string(j) + "] (" + plan.joint_name[j] + ")",
+                        "a finite number", plan.position[i][j]);
+      }
+    }
   }
   return "";
 }

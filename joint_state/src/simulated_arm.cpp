@@ -82,6 +82,7 @@ void SimulatedArm::step(double dt_s, bool motion_allowed) {
   for (auto it = scheduled_faults_.begin(); it != scheduled_faults_.end();) {
     if (elapsed_s_ >= it->at_s) {
       offsets_[it->joint] = it->offset;
+      ++offsets_version_;
       it = scheduled_faults_.erase(it);
     } else {
       ++it;
@@ -94,6 +95,7 @@ bool SimulatedArm::set_encoder_offset(const std::string& joint, double offset) {
   auto it = offsets_.find(joint);
   if (it == offsets_.end()) return false;
   it->second = offset;
+  ++offsets_version_;
   return true;
 }
 
@@ -103,6 +105,16 @@ ArmState SimulatedArm::reported_state() const {
     reported.position[i] += offsets_.at(reported.name[i]);
   }
   return reported;
+}
+
+std::vector<double> SimulatedArm::planned_reported_positions(double ahead_s) const {
+  std::vector<double> positions(motion_.size());
+  const double t = motion_time_s_ + (moving_ ? ahead_s : 0.0);
+  for (size_t i = 0; i < motion_.size(); ++i) {
+    const JointMotion& m = motion_[i];
+    positions[i] = m.center + m.amplitude * std::sin(2 * M_PI / m.period_s * t + m.phase_rad) + offsets_.at(m.joint);
+  }
+  return positions;
 }
 
 }  // namespace tofguard::joints_sim

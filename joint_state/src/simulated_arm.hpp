@@ -40,9 +40,18 @@ class SimulatedArm {
   bool set_encoder_offset(const std::string& joint, double offset);
 
   const ArmState& true_state() const { return true_state_; }
+  // The arm's plan: the reported (encoder) positions `ahead_s` seconds of
+  // process time from now, assuming it keeps its current permission: the
+  // periodic motion while moving, where it is while halted. What a
+  // controller following its encoders plans (an encoder offset is in the
+  // plan, so a faulty encoder does not make the arm "leave its plan").
+  std::vector<double> planned_reported_positions(double ahead_s) const;
   // What the encoders report: true position + offset; velocity as true.
   ArmState reported_state() const;
   double elapsed_s() const { return elapsed_s_; }
+  // Counts changes of the encoder offsets (a controller replans when its
+  // encoders jump).
+  int offsets_version() const { return offsets_version_; }
   bool moving() const { return moving_; }
 
  private:
@@ -52,6 +61,7 @@ class SimulatedArm {
   std::vector<EncoderFault> scheduled_faults_;
   std::map<std::string, double> offsets_;
   double elapsed_s_ = 0;
+  int offsets_version_ = 0;
   double motion_time_s_ = 0;
   bool moving_ = false;
   ArmState true_state_;

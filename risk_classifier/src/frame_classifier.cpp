@@ -9,13 +9,13 @@
 #include "tofguard/risk_t.hpp"
 
 namespace tofguard::risk {
-namespace {
-
 std::string fixed(double value, int decimals) {
   std::ostringstream s;
   s << std::fixed << std::setprecision(decimals) << value;
   return s.str();
 }
+
+namespace {
 
 FrameFinding finding(int8_t cause, std::string suspect, double score, double threshold, std::string detail) {
   return FrameFinding{cause, std::move(suspect), score, threshold, std::move(detail)};

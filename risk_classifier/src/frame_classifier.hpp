@@ -36,6 +36,9 @@ struct ClassifierContext {
 FrameFinding classify_frame(const discrepancy_t& frame, const RobotTree& robot, const RiskConfig& config,
                             const ClassifierContext& context);
 
+// `value` with `decimals` digits after the point, for detail lines.
+std::string fixed(double value, int decimals);
+
 // True for the causes that count as sensor/component faults (debounced
 // with risk.sensor_debounce_frames).
 bool is_fault_cause(int8_t cause);

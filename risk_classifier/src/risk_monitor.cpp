@@ -3,10 +3,23 @@
 #include <algorithm>
 #include <cmath>
 
+#include "estimate_finding.hpp"
+
 namespace tofguard::risk {
 namespace {
 
 int64_t ms_to_us(double ms) { return static_cast<int64_t>(std::llround(ms * 1000.0)); }
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+// Estimates kept for frames still to come or waiting, and judged frames
+// remembered for counting late estimates.
+constexpr size_t kKeptEstimates = 16;
+constexpr size_t kKeptJudgedSeqs = 64;
+
+bool is_model_mismatch(int8_t cause) {
+  return cause == risk_t::CAUSE_JOINT_ERROR || cause == risk_t::CAUSE_CALIBRATION_ERROR ||
+         cause == risk_t::CAUSE_UNKNOWN_OBJECT || cause == risk_t::CAUSE_UNCLASSIFIED;
+}
 
 }  // namespace
 
@@ -38,6 +51,41 @@ void RiskMonitor::on_joint_state(const joint_state_t& state, int64_t now_us) {
   double fastest = 0;
   for (double v : state.velocity) fastest = std::max(fastest, std::abs(v));
   arm_moving_ = fastest >= config_.risk.moving_joint_speed_rad_s;
+  last_joint_state_ = state;
+  update_plan_deviation(state);
+}
+
+void RiskMonitor::on_plan(const planned_trajectory_t& plan) {
+  plan_.add(plan);
+  if (last_joint_state_) update_plan_deviation(*last_joint_state_);
+}
+
+void RiskMonitor::update_plan_deviation(const joint_state_t& state) {
+  plan_deviation_.reset();
+  if (!config_.risk.plan_enabled) return;
+  const auto planned = plan_.at(state.utime);
+  if (!planned) return;  // outside the plan's time span: nothing to compare
+  const RiskConfig& r = config_.risk;
+  double worst_ratio = 0;
+  for (int i = 0; i < state.num_joints; ++i) {
+    const auto p = planned->find(state.name[i]);
+    if (p == planned->end()) continue;
+    const bool prismatic = robot_.prismatic_joints().count(state.name[i]) > 0;
+    const double deviation = std::abs(state.position[i] - p->second);
+    const double limit = prismatic ? r.plan_max_deviation_m : r.plan_max_deviation_deg / kRadToDeg;
+    if (!(deviation > limit) || deviation / limit <= worst_ratio) continue;
+    worst_ratio = deviation / limit;
+    const double scale = prismatic ? 1000.0 : kRadToDeg;
+    const std::string unit = prismatic ? " mm" : "°";
+    FrameFinding f;
+    f.cause = risk_t::CAUSE_UNCLASSIFIED;
+    f.suspect = state.name[i];
+    f.score = deviation * scale;
+    f.threshold = limit * scale;
+    f.detail = "arm left its plan (" + std::string(prismatic ? "mm" : "deg") + "): " + state.name[i] + " is " +
+               fixed(deviation * scale, 1) + unit + " from the plan (limit " + fixed(limit * scale, 1) + unit + ")";
+    plan_deviation_ = f;
+  }
 }
 
 void RiskMonitor::on_camera_pose(int64_t now_us) { touch(&camera_pose_, now_us); }
@@ -47,11 +95,11 @@ void RiskMonitor::on_heartbeat(const heartbeat_t& heartbeat, int64_t now_us) {
   if (it != heartbeats_.end()) touch(&it->second, now_us);
 }
 
-std::string RiskMonitor::check_joint_names(const joint_state_t& state) const {
-  for (int i = 0; i < state.num_joints; ++i) {
-    if (!robot_.is_movable_joint(state.name[i])) {
-      return "name[" + std::to_string(i) + "]: expected a moving joint of the robot's URDF, got '" +
-             state.name[i] + "'";
+std::string RiskMonitor::check_joint_names(const std::vector<std::string>& names, const std::string& field) const {
+  for (size_t i = 0; i < names.size(); ++i) {
+    if (!robot_.is_movable_joint(names[i])) {
+      return field + "[" + std::to_string(i) + "]: expected a moving joint of the robot's URDF, got '" + names[i] +
+             "'";
     }
   }
   return "";
@@ -105,15 +153,97 @@ std::optional<risk_t> RiskMonitor::check_deadlines(int64_t now_us) const {
   return verdict(last_frame_utime_, -1, risk_t::DANGEROUS, *f, "timeout: " + f->detail);
 }
 
-risk_t RiskMonitor::on_discrepancy(const discrepancy_t& frame, int64_t now_us) {
-  touch(&discrepancy_, now_us);
-  last_frame_utime_ = frame.utime;
-
+FrameFinding RiskMonitor::discrepancy_finding(const discrepancy_t& frame) const {
   ClassifierContext context;
   context.depth_channel = config_.channels.depth;
   context.labels_channel = config_.channels.labels;
   context.arm_moving = arm_moving_;
-  FrameFinding finding = classify_frame(frame, robot_, config_.risk, context);
+  return classify_frame(frame, robot_, config_.risk, context);
+}
+
+bool RiskMonitor::wants_estimate(const discrepancy_t& frame) const {
+  return config_.risk.estimate_enabled && is_model_mismatch(discrepancy_finding(frame).cause);
+}
+
+const motion_estimate_t* RiskMonitor::estimate_for(const discrepancy_t& frame) const {
+  for (auto it = estimates_.rbegin(); it != estimates_.rend(); ++it) {
+    if (it->seq == frame.seq && it->utime == frame.utime && it->camera_id == frame.camera_id) return &*it;
+  }
+  return nullptr;
+}
+
+risk_t RiskMonitor::on_discrepancy(const discrepancy_t& frame, int64_t now_us) {
+  touch(&discrepancy_, now_us);
+  return judge(frame, now_us, /*waited=*/false);
+}
+
+std::vector<risk_t> RiskMonitor::on_frame(const discrepancy_t& frame, int64_t now_us) {
+  touch(&discrepancy_, now_us);
+  WaitingFrame w;
+  w.frame = frame;
+  w.wants_estimate = wants_estimate(frame);
+  w.wait_until_us = now_us + ms_to_us(config_.risk.estimate_wait_ms);
+  waiting_.push_back(std::move(w));
+  return release(now_us);
+}
+
+std::vector<risk_t> RiskMonitor::on_estimate(const motion_estimate_t& estimate, int64_t now_us) {
+  estimate_stats_.received++;
+  if (std::find(judged_seqs_.begin(), judged_seqs_.end(), estimate.seq) != judged_seqs_.end()) {
+    estimate_stats_.late++;
+  }
+  estimates_.push_back(estimate);
+  while (estimates_.size() > kKeptEstimates) estimates_.pop_front();
+  return release(now_us);
+}
+
+std::vector<risk_t> RiskMonitor::release_due(int64_t now_us) { return release(now_us); }
+
+std::vector<risk_t> RiskMonitor::release(int64_t now_us) {
+  std::vector<risk_t> out;
+  while (!waiting_.empty()) {
+    const WaitingFrame& head = waiting_.front();
+    const bool has_estimate = estimate_for(head.frame) != nullptr;
+    if (head.wants_estimate && !has_estimate && now_us < head.wait_until_us) break;
+    if (head.wants_estimate && !has_estimate) {
+      estimate_stats_.missing++;
+      judged_seqs_.push_back(head.frame.seq);
+      while (judged_seqs_.size() > kKeptJudgedSeqs) judged_seqs_.pop_front();
+    }
+    out.push_back(judge(head.frame, now_us, head.wants_estimate));
+    waiting_.pop_front();
+  }
+  return out;
+}
+
+risk_t RiskMonitor::judge(const discrepancy_t& frame, int64_t now_us, bool waited) {
+  last_frame_utime_ = frame.utime;
+  FrameFinding finding = discrepancy_finding(frame);
+  // The estimate refines a model mismatch (fail safe: it replaces one
+  // finding by another, never by "safe"; without one the discrepancy rules
+  // stand).
+  if (config_.risk.estimate_enabled && is_model_mismatch(finding.cause)) {
+    if (const motion_estimate_t* estimate = estimate_for(frame)) {
+      EstimateContext context;
+      context.prismatic_joints = robot_.prismatic_joints();
+      context.near_arm_evidence = frame.near_arm_area_m2 >= config_.risk.unknown_object_min_area_m2;
+      FrameFinding refined = classify_estimate(*estimate, config_.risk, context);
+      if (refined.cause != risk_t::CAUSE_NONE) {
+        estimate_stats_.used++;
+        finding = std::move(refined);
+      } else {
+        estimate_stats_.explained_nothing++;
+        finding.detail += " (estimate explains nothing: " +
+                          (estimate->usable ? std::string(estimate->converged ? "no significant offset" : "not converged")
+                                            : "unusable, " + estimate->unusable_reason) +
+                          ")";
+      }
+    } else if (waited) {
+      finding.detail += " (no motion estimate within " + fixed(config_.risk.estimate_wait_ms, 0) + " ms)";
+    }
+  }
+  // The arm left its plan: only when nothing else is wrong with the frame.
+  if (finding.cause == risk_t::CAUSE_NONE && plan_deviation_) finding = *plan_deviation_;
   consecutive_ = finding.cause == risk_t::CAUSE_NONE ? 0 : consecutive_ + 1;
 
   if (const std::optional<FrameFinding> stale = expired(now_us)) {

@@ -8,7 +8,21 @@
 // a replayed log is judged like live data. Before anything has arrived the
 // deadlines run from the monitor's start: a chain that never starts is
 // stale, not safe.
+//
+// Motion estimates (docs/safety-chain.md, "Using the motion estimate"): with
+// risk.estimate.enabled, a frame whose discrepancy finding is a model
+// mismatch (JOINT_ERROR, CALIBRATION_ERROR, UNKNOWN_OBJECT, UNCLASSIFIED)
+// waits at most risk.estimate.wait_ms from its arrival for the estimate of
+// its seq; frames behind it wait with it, so verdicts keep frame order and
+// the debounce counts frames in order. The estimate may name the cause, the
+// suspect and the detail; it never makes a frame safer.
+//
+// The plan (risk.plan): a joint state inside the plan's time span that is
+// further from the plan than risk.plan.max_deviation_* is "the arm left its
+// plan", a finding of the frames judged while it is the newest joint state
+// (when no other rule applies).
 #include <cstdint>
+#include <deque>
 #include <map>
 #include <optional>
 #include <string>
@@ -20,6 +34,9 @@
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/heartbeat_t.hpp"
 #include "tofguard/joint_state_t.hpp"
+#include "tofguard/motion_estimate_t.hpp"
+#include "tofguard/planned_trajectory.hpp"
+#include "tofguard/planned_trajectory_t.hpp"
 #include "tofguard/risk_t.hpp"
 
 namespace tofguard::risk {
@@ -34,17 +51,43 @@ class RiskMonitor {
   void on_camera_pose(int64_t now_us);
   void on_heartbeat(const heartbeat_t& heartbeat, int64_t now_us);
 
-  // The verdict on one frame (its utime and seq). An expired deadline makes
-  // it DANGEROUS with that deadline's cause; otherwise the frame's finding,
-  // WARNING until it has held for the debounce count, then DANGEROUS.
+  // A plan that passed check_planned_trajectory and check_joint_names.
+  void on_plan(const planned_trajectory_t& plan);
+
+  // The verdict on one frame (its utime and seq), judged now, without
+  // waiting for an estimate (one already received for the frame is used).
+  // An expired deadline makes it DANGEROUS with that deadline's cause;
+  // otherwise the frame's finding, WARNING until it has held for the
+  // debounce count, then DANGEROUS.
   risk_t on_discrepancy(const discrepancy_t& frame, int64_t now_us);
+
+  // A frame arrives: the verdicts ready now, in frame order (none while
+  // this frame or one before it waits for its estimate).
+  std::vector<risk_t> on_frame(const discrepancy_t& frame, int64_t now_us);
+  // A valid estimate (check_motion_estimate, this camera, the robot's
+  // joints): the verdicts it releases.
+  std::vector<risk_t> on_estimate(const motion_estimate_t& estimate, int64_t now_us);
+  // The verdicts of frames whose wait for an estimate has ended by now_us.
+  std::vector<risk_t> release_due(int64_t now_us);
+  size_t waiting_frames() const { return waiting_.size(); }
+
+  struct EstimateStats {
+    int64_t received = 0;
+    int64_t used = 0;            // named a frame's cause
+    int64_t explained_nothing = 0;  // received in time, no finding (discrepancy rules judged)
+    int64_t missing = 0;         // a waiting frame's wait ended without one
+    int64_t late = 0;            // arrived after its frame was judged
+  };
+  const EstimateStats& estimate_stats() const { return estimate_stats_; }
 
   // The first expired deadline as a timeout verdict (seq -1, utime of the
   // last frame), or nothing while every input is fresh.
   std::optional<risk_t> check_deadlines(int64_t now_us) const;
 
-  // "" or the joint names of a joint state not in the robot's URDF.
-  std::string check_joint_names(const joint_state_t& state) const;
+  // "" or the first of `names` (field `field`) that is not a moving joint
+  // of the robot's URDF.
+  std::string check_joint_names(const std::vector<std::string>& names, const std::string& field = "name") const;
+  std::string check_joint_names(const joint_state_t& state) const { return check_joint_names(state.name); }
 
  private:
   struct Deadline {
@@ -54,7 +97,21 @@ class RiskMonitor {
     int64_t last_us;    // last arrival (or the start)
     bool ever = false;  // anything arrived yet
   };
+  struct WaitingFrame {
+    discrepancy_t frame;
+    bool wants_estimate = false;
+    int64_t wait_until_us = 0;
+  };
   std::optional<FrameFinding> expired(int64_t now_us) const;
+  // The frame's verdict now (no deadline touched).
+  risk_t judge(const discrepancy_t& frame, int64_t now_us, bool waited);
+  // True when the frame's discrepancy finding is a model mismatch and
+  // estimates are in use.
+  bool wants_estimate(const discrepancy_t& frame) const;
+  FrameFinding discrepancy_finding(const discrepancy_t& frame) const;
+  const motion_estimate_t* estimate_for(const discrepancy_t& frame) const;
+  std::vector<risk_t> release(int64_t now_us);
+  void update_plan_deviation(const joint_state_t& state);
   static void touch(Deadline* d, int64_t now_us);
 
   const Config config_;
@@ -65,6 +122,13 @@ class RiskMonitor {
   Deadline camera_pose_;
   std::map<std::string, Deadline> heartbeats_;
   bool arm_moving_ = false;
+  PlannedTrajectory plan_;
+  std::optional<joint_state_t> last_joint_state_;
+  std::optional<FrameFinding> plan_deviation_;
+  std::deque<WaitingFrame> waiting_;
+  std::deque<motion_estimate_t> estimates_;  // the newest few, by arrival
+  std::deque<int64_t> judged_seqs_;          // the newest few judged frames
+  EstimateStats estimate_stats_;
   int consecutive_ = 0;
   int64_t last_frame_utime_ = 0;
 };

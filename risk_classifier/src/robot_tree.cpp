@@ -23,6 +23,7 @@ struct RobotTree::Builder {
     for (const auto& [name, joint] : model.joints_) {
       tree.child_of_joint_[name] = joint->child_link_name;
       if (joint->type != urdf::Joint::FIXED) tree.movable_joints_.push_back(name);
+      if (joint->type == urdf::Joint::PRISMATIC) tree.prismatic_joints_.insert(name);
     }
     std::sort(tree.movable_joints_.begin(), tree.movable_joints_.end());
     return tree;

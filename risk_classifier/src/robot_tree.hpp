@@ -4,6 +4,7 @@
 // movable joint is the nearest one above a set of links. The risk
 // classifier blames the joint above the links whose mismatch it sees.
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,9 @@ class RobotTree {
   // Names of the joints that move (every type but fixed).
   const std::vector<std::string>& movable_joints() const { return movable_joints_; }
   bool is_movable_joint(const std::string& joint) const;
+  // Names of the prismatic joints (positions in metres; every other moving
+  // joint's in radians).
+  const std::set<std::string>& prismatic_joints() const { return prismatic_joints_; }
 
   // True when `link` is `ancestor` or lies below it in the tree.
   bool is_descendant_or_self(const std::string& link, const std::string& ancestor) const;
@@ -47,6 +51,7 @@ class RobotTree {
   std::map<std::string, ParentJoint> parent_joint_;
   std::map<std::string, std::string> child_of_joint_;
   std::vector<std::string> movable_joints_;
+  std::set<std::string> prismatic_joints_;
 };
 
 }  // namespace tofguard::risk

@@ -163,5 +163,52 @@ TEST(SimulatedCamera, RunTimeFaultsAndClear) {
   EXPECT_EQ(sim.capture(kT0 + 4000, 1).outcome, SimulatedCamera::Frame::Outcome::kImage);
 }
 
+TEST(SimulatedCamera, PanTiltHeadTurnsTheCameraAndReportsItsReading) {
+  CameraConfig config = camera_config();
+  // Looking along world x from 1.5 m up.
+  config.pose.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitZ())) *
+                         Eigen::Quaterniond(Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitX()));
+  FakeRenderer renderer;
+  SimulatedCamera fixed(config, &renderer, kT0);
+  EXPECT_FALSE(fixed.reported_pose(kT0).has_value()) << "no head, no reading";
+
+  config.sim.pan_tilt_enabled = true;
+  config.sim.pan_amplitude_rad = 10 * M_PI / 180;
+  config.sim.pan_period_s = 4;
+  config.sim.tilt_amplitude_rad = 4 * M_PI / 180;
+  config.sim.tilt_period_s = 8;
+  SimulatedCamera sim(config, &renderer, kT0);
+  // 1 s in: pan at its peak (+10 deg), tilt at sin(pi/4) * 4 deg.
+  const int64_t t = kT0 + 1'000'000;
+  const CameraPose truth = sim.true_pose(t);
+  const Eigen::Vector3d forward = truth.rotation * Eigen::Vector3d::UnitZ();
+  const double tilt = 4 * std::sin(M_PI / 4) * M_PI / 180;
+  // Panned left (towards +y) by 10 deg, tilted up by `tilt`.
+  EXPECT_NEAR(std::atan2(forward.y(), forward.x()), 10 * M_PI / 180, 1e-9);
+  EXPECT_NEAR(std::asin(forward.z()), tilt, 1e-9);
+  EXPECT_EQ(truth.translation_m, config.pose.translation_m);
+  // Without a fault the head reports the truth.
+  ASSERT_TRUE(sim.reported_pose(t).has_value());
+  EXPECT_LT(sim.reported_pose(t)->rotation.angularDistance(truth.rotation), 1e-12);
+  // The frame is rendered from the true pose.
+  sim.add_true_joint_state(t - 10'000, {"a1"}, {0.0});
+  sim.add_true_joint_state(t + 10'000, {"a1"}, {0.0});
+  ASSERT_EQ(sim.capture(t, 0).outcome, SimulatedCamera::Frame::Outcome::kImage);
+  EXPECT_LT(renderer.last_pose.rotation.angularDistance(truth.rotation), 1e-12);
+
+  // A pan offset of 3 deg: the reading is off, the truth unchanged.
+  ActiveSimFault offset;
+  offset.fault.kind = "pan_tilt_offset";
+  offset.fault.pan_offset_rad = 3 * M_PI / 180;
+  offset.start_utime = kT0;
+  offset.end_utime = kT0 + 10'000'000;
+  sim.inject(offset);
+  const CameraPose reported = *sim.reported_pose(t);
+  const Eigen::Vector3d reported_forward = reported.rotation * Eigen::Vector3d::UnitZ();
+  EXPECT_NEAR(std::atan2(reported_forward.y(), reported_forward.x()), 13 * M_PI / 180, 1e-9);
+  EXPECT_NEAR(std::asin(reported_forward.z()), tilt, 1e-9);
+  EXPECT_LT(sim.true_pose(t).rotation.angularDistance(truth.rotation), 1e-12);
+}
+
 }  // namespace
 }  // namespace tofguard::camera

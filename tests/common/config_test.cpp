@@ -52,6 +52,13 @@ TEST(Config, EmbeddedDefaultLoads) {
   EXPECT_EQ(config.robot.urdf_path, source_dir() + "/config/models/friend_arm.urdf");
   ASSERT_EQ(config.environment.urdf_paths.size(), 1u);
   EXPECT_DOUBLE_EQ(config.renderer.max_extrapolation_ms, 20);
+  EXPECT_FALSE(config.camera.sim.pan_tilt_enabled);
+  EXPECT_TRUE(config.risk.estimate_enabled);
+  EXPECT_DOUBLE_EQ(config.risk.estimate_wait_ms, 60);
+  EXPECT_TRUE(config.risk.plan_enabled);
+  EXPECT_TRUE(config.joints_sim.publish_plan);
+  EXPECT_TRUE(config.renderer.prediction_enabled);
+  EXPECT_DOUBLE_EQ(config.renderer.camera_pose_max_extrapolation_ms, 40);
 }
 
 TEST(Config, LcmUrlComesFromConfigThenEnvironmentThenHostLocalDefault) {
@@ -121,7 +128,14 @@ INSTANTIATE_TEST_SUITE_P(
                   {"camera.pose.rotation_wxyz", "expected a unit quaternion"}},
         BadConfig{"short-list", "translation_m: [-0.90, -0.20, 1.80]", "translation_m: [-0.90, 1.80]",
                   {"camera.pose.translation_m", "expected a list of 3 numbers", "2 entries"}},
-        BadConfig{"not-yaml", "robot:\n", "robot: [\n", {"not valid YAML"}}),
+        BadConfig{"not-yaml", "robot:\n", "robot: [\n", {"not valid YAML"}},
+        BadConfig{"pan-tilt-offset-without-head", "    faults: []\n",
+                  "    faults: [{kind: pan_tilt_offset, start_s: 1, duration_s: 1, pan_offset_deg: 3, tilt_offset_deg: 0}]\n",
+                  {"camera.sim.faults", "only with camera.sim.pan_tilt"}},
+        BadConfig{"estimate-wait-out-of-range", "    wait_ms: 60\n", "    wait_ms: 5000\n",
+                  {"risk.estimate.wait_ms", "expected a number in"}},
+        BadConfig{"plan-step-longer-than-horizon", "step_ms: 20}", "step_ms: 600}",
+                  {"joints_sim.plan.step_ms", "no longer than horizon_ms"}}),
     [](const ::testing::TestParamInfo<BadConfig>& info) {
       std::string name = info.param.name;
       for (auto& c : name) if (c == '-') c = '_';

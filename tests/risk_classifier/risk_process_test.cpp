@@ -12,6 +12,9 @@
 #include "tofguard/camera_pose_t.hpp"
 #include "tofguard/config.hpp"
 #include "tofguard/joint_state_t.hpp"
+#include "tofguard/motion_estimate_t.hpp"
+#include "tofguard/planned_trajectory_t.hpp"
+#include "synthetic_estimates.hpp"
 
 namespace tofguard::test {
 namespace {
@@ -74,6 +77,10 @@ class RiskProcess : public ::testing::Test {
     d.seq = seq_;
     d.utime = image.utime;
     bus_.safety.publish("SAFETY_DISCREPANCY", &d);
+    if (estimate_) {
+      const motion_estimate_t e = estimate_(d);
+      bus_.safety.publish("MOTION_ESTIMATE", &e);
+    }
   }
 
   const risk_t* risk_for(int64_t seq) const {
@@ -95,6 +102,9 @@ class RiskProcess : public ::testing::Test {
   discrepancy_t shifted_;
   int64_t seq_ = 0;
   int64_t last_depth_us_ = 0;
+  // When set, the estimator's answer to each frame, published right after
+  // its discrepancy.
+  std::function<motion_estimate_t(const discrepancy_t&)> estimate_;
 };
 
 TEST_F(RiskProcess, StartsDangerousBecauseNothingHasArrived) {
@@ -103,7 +113,8 @@ TEST_F(RiskProcess, StartsDangerousBecauseNothingHasArrived) {
   EXPECT_EQ(r.seq, -1);
   EXPECT_EQ(r.level, risk_t::DANGEROUS);
   EXPECT_EQ(r.cause, risk_t::CAUSE_SENSOR_FAULT);
-  EXPECT_EQ(r.suspect, "TOF_DEPTH");
+  // The first deadline to expire: joint state 100 ms (depth 150 ms).
+  EXPECT_EQ(r.suspect, "JOINT_STATE");
 }
 
 TEST_F(RiskProcess, GoodFramesAreSafeAndAJointErrorIsDangerousAfterTheDebounce) {
@@ -119,6 +130,103 @@ TEST_F(RiskProcess, GoodFramesAreSafeAndAJointErrorIsDangerousAfterTheDebounce) 
   EXPECT_EQ(risk_for(8)->level, risk_t::DANGEROUS);
   EXPECT_EQ(risk_for(8)->cause, risk_t::CAUSE_JOINT_ERROR);
   EXPECT_EQ(risk_for(8)->suspect, "a2");
+}
+
+TEST_F(RiskProcess, TheMotionEstimateNamesTheSuspectJointAndItsOffset) {
+  ASSERT_TRUE(feed_until_judged(good_, 3));
+  estimate_ = [](const discrepancy_t& d) {
+    motion_estimate_t e = estimate_for(d);
+    e.estimated_position[index_of(e, "a4")] -= 12.3 * kDeg;
+    return e;
+  };
+  ASSERT_TRUE(feed_until_judged(shifted_, 6));
+  for (int64_t seq = 4; seq <= 6; ++seq) {
+    const risk_t* r = risk_for(seq);
+    EXPECT_EQ(r->cause, risk_t::CAUSE_JOINT_ERROR);
+    EXPECT_EQ(r->suspect, "a4");  // the discrepancy rules alone say a2
+    EXPECT_EQ(r->detail.rfind("joint a4 reads 12.3° more than seen", 0), 0u) << r->detail;
+    EXPECT_NEAR(r->score, 12.3, 1e-9);
+  }
+  EXPECT_EQ(risk_for(5)->level, risk_t::WARNING);
+  EXPECT_EQ(risk_for(6)->level, risk_t::DANGEROUS);
+
+  // A camera correction instead: a calibration error.
+  estimate_ = [](const discrepancy_t& d) {
+    motion_estimate_t e = estimate_for(d);
+    e.correction_translation[1] = 0.048;
+    return e;
+  };
+  // (Frames published while the last one waited had the old estimate.)
+  const int64_t calibration_seq = seq_ + 1;
+  ASSERT_TRUE(feed_until_judged(shifted_, calibration_seq));
+  const risk_t* r = risk_for(calibration_seq);
+  EXPECT_EQ(r->cause, risk_t::CAUSE_CALIBRATION_ERROR);
+  EXPECT_EQ(r->suspect, "");
+  EXPECT_EQ(r->detail.rfind("camera pose off by 4.8 cm and 0.0° (seen vs configured", 0), 0u) << r->detail;
+  EXPECT_EQ(r->level, risk_t::DANGEROUS);
+}
+
+TEST_F(RiskProcess, WithoutAnEstimateTheDiscrepancyRulesJudgeAfterTheWait) {
+  ASSERT_TRUE(feed_until_judged(good_, 2));
+  ASSERT_TRUE(feed_until_judged(shifted_, 5));
+  for (int64_t seq = 3; seq <= 5; ++seq) {
+    EXPECT_EQ(risk_for(seq)->cause, risk_t::CAUSE_JOINT_ERROR);
+    EXPECT_EQ(risk_for(seq)->suspect, "a2");
+    EXPECT_NE(risk_for(seq)->detail.find("(no motion estimate within 60 ms)"), std::string::npos)
+        << risk_for(seq)->detail;
+  }
+  EXPECT_EQ(risk_for(5)->level, risk_t::DANGEROUS);
+  // An unusable estimate changes nothing either.
+  estimate_ = [](const discrepancy_t& d) {
+    motion_estimate_t e = estimate_for(d);
+    e.usable = false;
+    e.unusable_reason = "too few model points visible";
+    return e;
+  };
+  // (Frames published while the last one waited had no estimate.)
+  const int64_t unusable_seq = seq_ + 1;
+  ASSERT_TRUE(feed_until_judged(shifted_, unusable_seq));
+  const risk_t* r = risk_for(unusable_seq);
+  EXPECT_EQ(r->suspect, "a2");
+  EXPECT_NE(r->detail.find("estimate explains nothing: unusable, too few model points visible"), std::string::npos)
+      << r->detail;
+  EXPECT_EQ(r->level, risk_t::DANGEROUS);
+}
+
+TEST_F(RiskProcess, TheArmLeavingItsPlanIsAFinding) {
+  ASSERT_TRUE(feed_until_judged(good_, 2));
+  // The plan holds every joint at moving_arm()'s positions, but a1 0.2 rad
+  // (11.5 deg) further.
+  planned_trajectory_t plan{};
+  plan.utime = wall_utime();
+  for (int i = 1; i <= 7; ++i) plan.joint_name.push_back("a" + std::to_string(i));
+  plan.num_joints = 7;
+  plan.point_utime = {plan.utime - 1'000'000, plan.utime + 60'000'000};
+  plan.num_points = 2;
+  for (int p = 0; p < 2; ++p) {
+    plan.position.emplace_back();
+    for (int i = 1; i <= 7; ++i) plan.position.back().push_back(0.1 * i + (i == 1 ? 0.2 : 0.0));
+  }
+  bus_.safety.publish("PLANNED_TRAJECTORY", &plan);
+  ASSERT_TRUE(run_until(
+      bus_,
+      [&] {
+        return !bus_.risks.messages.empty() && bus_.risks.messages.back().level == risk_t::DANGEROUS &&
+               bus_.risks.messages.back().seq >= 0;
+      },
+      kDeadline, kFramePeriodMs, [&] { step(good_); }));
+  const risk_t& r = bus_.risks.messages.back();
+  EXPECT_EQ(r.cause, risk_t::CAUSE_UNCLASSIFIED);
+  EXPECT_EQ(r.suspect, "a1");
+  EXPECT_EQ(r.detail.rfind("arm left its plan (deg): a1 is 11.5° from the plan", 0), 0u) << r.detail;
+  // Back on the plan (a new one where the arm is): safe again.
+  for (auto& point : plan.position) point[0] = 0.1;
+  plan.utime = wall_utime();
+  plan.point_utime = {plan.utime - 1'000'000, plan.utime + 60'000'000};
+  bus_.safety.publish("PLANNED_TRAJECTORY", &plan);
+  ASSERT_TRUE(run_until(
+      bus_, [&] { return !bus_.risks.messages.empty() && bus_.risks.messages.back().level == risk_t::SAFE; },
+      kDeadline, kFramePeriodMs, [&] { step(good_); }));
 }
 
 TEST_F(RiskProcess, CameraStallTimesOutByItselfWithinTheDeadline) {
@@ -139,8 +247,8 @@ TEST_F(RiskProcess, CameraStallTimesOutByItselfWithinTheDeadline) {
   EXPECT_EQ(r.cause, risk_t::CAUSE_SENSOR_FAULT);
   EXPECT_EQ(r.suspect, "TOF_DEPTH");
   EXPECT_EQ(r.utime, depth_frame({}, 5).utime);
-  // risk.deadlines_ms.depth = 100: not before it, and well within 200 ms of it.
-  EXPECT_GE(after_us, 100'000);
+  // risk.deadlines_ms.depth = 150: not before it, and well within 200 ms of it.
+  EXPECT_GE(after_us, 150'000);
   EXPECT_LE(after_us, 300'000);
 }
 
@@ -188,6 +296,21 @@ TEST_F(RiskProcess, MalformedInputOnEveryChannelIsDroppedAndCounted) {
   heartbeat_t nameless{};
   bus_.safety.publish("SAFETY_HEARTBEAT", &nameless);
   bus_.safety.publish("SAFETY_HEARTBEAT", &pose);
+  // MOTION_ESTIMATE: NaN estimate (validation), another camera
+  // (validation). PLANNED_TRAJECTORY: times not increasing (validation).
+  motion_estimate_t estimate = estimate_for(good_);
+  estimate.estimated_position[2] = std::nan("");
+  bus_.safety.publish("MOTION_ESTIMATE", &estimate);
+  estimate = estimate_for(good_);
+  estimate.camera_id = "another-camera";
+  bus_.safety.publish("MOTION_ESTIMATE", &estimate);
+  planned_trajectory_t plan{};
+  plan.num_joints = 1;
+  plan.joint_name = {"a1"};
+  plan.num_points = 2;
+  plan.point_utime = {1000, 1000};
+  plan.position = {{0.0}, {0.1}};
+  bus_.safety.publish("PLANNED_TRAJECTORY", &plan);
 
   // Good frames are still judged, and nothing came of seq 1000.
   ASSERT_TRUE(feed_until_judged(good_, 4));
@@ -196,7 +319,7 @@ TEST_F(RiskProcess, MalformedInputOnEveryChannelIsDroppedAndCounted) {
   ASSERT_TRUE(wait_until(
       [&] {
         const heartbeat_t hb = bus_.last_heartbeat("tofguard-risk");
-        return hb.decode_errors == 3 && hb.validation_errors == 6;
+        return hb.decode_errors == 3 && hb.validation_errors == 9;
       },
       kDeadline, [&] { bus_.poll(); }))
       << "decode " << bus_.last_heartbeat("tofguard-risk").decode_errors << " validation "
@@ -204,6 +327,9 @@ TEST_F(RiskProcess, MalformedInputOnEveryChannelIsDroppedAndCounted) {
       << process_->stderr_text();
   EXPECT_TRUE(process_->running());
   EXPECT_NE(process_->stderr_text().find("JOINT_STATE: position[3] (a4): expected a finite number"), std::string::npos)
+      << process_->stderr_text();
+  EXPECT_NE(process_->stderr_text().find("MOTION_ESTIMATE: estimated_position[2] (a3): expected a finite number"),
+            std::string::npos)
       << process_->stderr_text();
 }
 

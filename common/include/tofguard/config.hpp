@@ -122,7 +122,9 @@ struct UvcCameraConfig {
 struct SimCameraFaultConfig {
   // "frozen_image" (the last image repeats), "stall" (no frames),
   // "pose_drift" (the true camera pose moves away from the calibrated one),
-  // "intruding_object" (a box appears in the scene).
+  // "intruding_object" (a box appears in the scene), "pan_tilt_offset"
+  // (the pan-tilt head's reading, published on CAMERA_POSE, is off from
+  // its true pan and tilt; needs camera.sim.pan_tilt).
   std::string kind;
   double start_s = 0;
   double duration_s = 0;
@@ -135,6 +137,9 @@ struct SimCameraFaultConfig {
   Eigen::Vector3d object_size_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d object_position_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d object_velocity_m_per_s = Eigen::Vector3d::Zero();
+  // pan_tilt_offset: reported minus true pan and tilt, radians.
+  double pan_offset_rad = 0;
+  double tilt_offset_rad = 0;
 };
 
 // The simulated ToF camera's error model (camera.sim, required when source
@@ -159,6 +164,22 @@ struct SimCameraConfig {
   double mixed_pixel_jump_m = 0;
   double mixed_pixel_probability = 0;
   std::vector<SimCameraFaultConfig> faults;
+  // Pan-tilt head (camera.sim.pan_tilt; absent: a fixed camera). The camera
+  // turns about the configured pose: pan about the pose frame's z axis
+  // (through the optical centre, right hand rule: positive turns left seen
+  // from above when z is up), then tilt about the optical x axis (positive
+  // looks up):
+  //   R(t) = Rz(pan(t)) * R_configured * Rx(tilt(t)),  translation fixed,
+  //   pan(t) = pan_amplitude * sin(2 pi t / pan_period_s),
+  //   tilt(t) = tilt_amplitude * sin(2 pi t / tilt_period_s),
+  // t seconds since the camera started. The head's reading (what
+  // CAMERA_POSE reports per frame) equals the true pan and tilt unless a
+  // pan_tilt_offset fault adds to it.
+  bool pan_tilt_enabled = false;
+  double pan_amplitude_rad = 0;
+  double pan_period_s = 1;
+  double tilt_amplitude_rad = 0;
+  double tilt_period_s = 1;
 };
 
 struct CameraConfig {
@@ -187,6 +208,27 @@ struct RendererConfig {
   // A camera frame whose utime lies further than this beyond the newest
   // joint state is marked unusable instead of extrapolated, milliseconds.
   double max_extrapolation_ms = 0;
+  // Camera poses (CAMERA_POSE) are kept per camera_id for
+  // camera_pose_history_ms and looked up at each frame's utime
+  // (CameraPoseHistory, docs/renderer.md). Two differing poses at most
+  // camera_pose_max_gap_ms apart are a motion (interpolated); a frame
+  // further than camera_pose_max_extrapolation_ms beyond a moving camera's
+  // newest pose is unusable. Poses further apart are steps (a calibration
+  // published now and then): each holds until the next.
+  double camera_pose_history_ms = 0;
+  double camera_pose_max_extrapolation_ms = 0;
+  double camera_pose_max_gap_ms = 0;
+  // Prediction from PLANNED_TRAJECTORY (docs/renderer.md): the next frame
+  // is rendered ahead at the plan's joints for its expected utime; when the
+  // frame comes and every joint interpolated at its utime is within
+  // prediction_joint_tolerance_deg (metres for prismatic joints:
+  // prediction_joint_tolerance_m) of the prediction, and its camera pose
+  // within the pose tolerances, the image rendered ahead is published.
+  bool prediction_enabled = false;
+  double prediction_joint_tolerance_deg = 0;
+  double prediction_joint_tolerance_m = 0;
+  double prediction_pose_tolerance_mm = 0;
+  double prediction_pose_tolerance_deg = 0;
 };
 
 // ---- Safety chain: discrepancy and risk (docs/safety-chain.md) ----
@@ -265,6 +307,29 @@ struct RiskConfig {
   double calibration_robot_link_fraction = 0;
   double unknown_object_min_area_m2 = 0;
   double unclassified_blob_area_m2 = 0;
+
+  // The motion estimate (MOTION_ESTIMATE, docs/safety-chain.md): a frame
+  // with a model mismatch waits at most estimate_wait_ms (monotonic, from
+  // its arrival) for the estimate of its seq, which then names the cause.
+  bool estimate_enabled = false;
+  double estimate_wait_ms = 0;
+  // A joint offset or camera correction is significant when it exceeds
+  // estimate_sigmas times its 1-sigma uncertainty and the minimum.
+  double estimate_sigmas = 0;
+  double estimate_min_joint_offset_deg = 0;
+  double estimate_min_joint_offset_m = 0;  // prismatic joints
+  double estimate_min_translation_m = 0;
+  double estimate_min_rotation_deg = 0;
+  // Neither significant, yet the residual after the estimate is above this:
+  // something the model lacks (an unknown object), millimetres.
+  double estimate_unexplained_residual_mm = 0;
+
+  // The plan (PLANNED_TRAJECTORY): a joint state inside the plan's time
+  // span further than this from the plan at its utime is "the arm left its
+  // plan" (degrees; metres for prismatic joints).
+  bool plan_enabled = false;
+  double plan_max_deviation_deg = 0;
+  double plan_max_deviation_m = 0;
 };
 
 // tofguard-estimator (docs/estimator.md): when to estimate the joint
@@ -317,6 +382,14 @@ struct JointsSimConfig {
   // Every movable joint of the URDF, in the order published.
   std::vector<JointMotion> motion;
   std::vector<EncoderFault> faults;
+  // The arm's own plan on PLANNED_TRAJECTORY (what an arm controller
+  // publishes): plan_rate_hz plans a second, each from now to
+  // plan_horizon_ms ahead in steps of plan_step_ms, in the reported
+  // (encoder) positions; a halted arm plans to stay where it is.
+  bool publish_plan = false;
+  double plan_rate_hz = 0;
+  double plan_horizon_ms = 0;
+  double plan_step_ms = 0;
 };
 
 struct InterventionConfig {
