@@ -9,6 +9,7 @@
 // deadlines run from the monitor's start: a chain that never starts is
 // stale, not safe.
 #include <cstdint>
+#include <deque>
 #include <map>
 #include <optional>
 #include <string>
@@ -64,7 +65,12 @@ class RiskMonitor {
   Deadline joint_state_;
   Deadline camera_pose_;
   std::map<std::string, Deadline> heartbeats_;
-  bool arm_moving_ = false;
+  // Whether the arm moved, by joint-state utime (ascending; the last 2 s):
+  // the frozen-image rule asks about the frame's capture time, not about
+  // whichever joint state arrived last, so that a replayed log is judged
+  // the same on every run however late the frame is processed.
+  bool arm_moving_at(int64_t utime) const;
+  std::deque<std::pair<int64_t, bool>> arm_moving_by_utime_;
   int consecutive_ = 0;
   int64_t last_frame_utime_ = 0;
 };
