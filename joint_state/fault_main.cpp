@@ -79,6 +79,7 @@ int run(const tofguard::Config& config, const std::vector<std::string>& args) {
     if (!kinds.count(kind)) return usage_error("--camera-fault: unknown kind '" + kind + "'");
     fault.kind = kinds.at(kind);
     fault.camera_id = config.camera.id;
+    if (fault.camera_id.empty()) return usage_error("--camera-fault needs --config FILE (the camera's id)");
     fault.duration_s = 1000;
     const std::map<std::string, double*> vectors = {{"--size-m", fault.object_size_m},
                                                     {"--position-m", fault.object_position_m},
