@@ -90,7 +90,9 @@ int run(const tofguard::Config& config, const std::vector<std::string>& args) {
       if (name == "--camera-fault") continue;
       if (name == "--duration-s") {
         double seconds = 0;
-        if (!parse_number(value, &seconds) || !(seconds > 0 && seconds < 1e6)) return usage_error("--duration-s: expected seconds in (0, 1e6)");
+        if (!parse_number(value, &seconds) || !(seconds > 0 && seconds < 1e6)) {
+          return usage_error("--duration-s: expected seconds in (0, 1e6)");
+        }
         fault.duration_s = seconds;
       } else if (vectors.count(name)) {
         if (!parse_vector(value, vectors.at(name))) return usage_error(name + ": expected X,Y,Z");

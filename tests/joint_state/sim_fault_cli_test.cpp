@@ -83,7 +83,8 @@ TEST(SimFaultCli, BadArgumentsAreUsageErrorsAndPublishNothing) {
   EXPECT_EQ(l.run({"--joint", "a4", "--offset-deg", "ten"}, &err), 2);
   EXPECT_EQ(l.run({"--joint", "a4"}, &err), 2);
   // Without a config there is no camera id to address.
-  const int code = run_command("sim-fault", {bin_dir() + "/tofguard-sim-fault", "--camera-fault", "stall"}, nullptr, &err);
+  const int code =
+      run_command("sim-fault", {bin_dir() + "/tofguard-sim-fault", "--camera-fault", "stall"}, nullptr, &err);
   EXPECT_EQ(code, 2);
   EXPECT_NE(err.find("needs --config"), std::string::npos) << err;
   EXPECT_FALSE(l.camera);

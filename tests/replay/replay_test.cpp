@@ -231,7 +231,9 @@ ReplayOutput read_output_log(const std::string& path, const Config& config) {
         (r->seq >= 0 ? out.verdicts : out.timeouts).push_back(v);
       }
     } else if (e->channel == config.channels.status) {
-      if (auto s = decode<safety_status_t>(*e)) out.statuses.push_back({s->motion_allowed != 0, s->cause, s->reason, e->timestamp});
+      if (auto s = decode<safety_status_t>(*e)) {
+        out.statuses.push_back({s->motion_allowed != 0, s->cause, s->reason, e->timestamp});
+      }
     }
   }
   return out;
@@ -397,7 +399,9 @@ void replay_twice(const std::string& name, const std::function<void(const InputL
     expect_every_frame_judged_once(input, out);
     check(input, replay);
     outputs.push_back(out);
-    if (::testing::Test::HasFailure()) std::cout << "verdicts:\n" << describe(out) << replay.stderr_of_all() << std::flush;
+    if (::testing::Test::HasFailure()) {
+      std::cout << "verdicts:\n" << describe(out) << replay.stderr_of_all() << std::flush;
+    }
   }
   expect_same_verdicts(input, outputs[0], outputs[1]);
 }
