@@ -26,6 +26,7 @@ grep -q "first stop: .*cause=joint error.*suspect a4" <<< "$out" || fail "the re
 grep -q '^  url: "udpm://239.255.76.67:7867?ttl=0&recv_buf_size=4194304"' "$work/replay.yaml" || fail "replay url"
 grep -q '^  image_url: "udpm://239.255.76.67:7867?ttl=0&recv_buf_size=4194304"' "$work/replay.yaml" || fail "replay image_url"
 grep -q '^  rate_hz: 10$' "$work/replay.yaml" || fail "camera rate"
+grep -q '^  pair_timeout_ms: 300$' "$work/replay.yaml" || fail "discrepancy pair timeout"
 grep -q 'deadlines_ms: {depth: 450, discrepancy: 500,' "$work/replay.yaml" || fail "risk deadlines"
 grep -q '^  risk_deadline_ms: 500$' "$work/replay.yaml" || fail "intervention risk deadline"
 grep -q '^  required_heartbeats: \[tofguard-renderer, tofguard-discrepancy\]' "$work/replay.yaml" || fail "heartbeats"
