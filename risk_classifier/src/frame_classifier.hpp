@@ -28,7 +28,8 @@ struct ClassifierContext {
   // The configured channel names and rules.
   std::string depth_channel = "TOF_DEPTH";
   std::string labels_channel = "TOF_LABELS";
-  // True when the latest joint state says some joint moves faster than
+  // True when the joint state at the frame's capture time (the newest
+  // taken at or before its utime) has a joint faster than
   // risk.sensor.moving_joint_speed_rad_s.
   bool arm_moving = false;
 };

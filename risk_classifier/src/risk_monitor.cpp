@@ -50,7 +50,11 @@ void RiskMonitor::on_joint_state(const joint_state_t& state, int64_t now_us) {
   touch(&joint_state_, now_us);
   double fastest = 0;
   for (double v : state.velocity) fastest = std::max(fastest, std::abs(v));
-  arm_moving_ = fastest >= config_.risk.moving_joint_speed_rad_s;
+  // Out-of-order joint states are not added to the by-utime record.
+  if (arm_moving_by_utime_.empty() || state.utime >= arm_moving_by_utime_.back().first) {
+    arm_moving_by_utime_.emplace_back(state.utime, fastest >= config_.risk.moving_joint_speed_rad_s);
+    while (arm_moving_by_utime_.front().first < state.utime - 2'000'000) arm_moving_by_utime_.pop_front();
+  }
   last_joint_state_ = state;
   update_plan_deviation(state);
 }
@@ -86,6 +90,15 @@ void RiskMonitor::update_plan_deviation(const joint_state_t& state) {
                fixed(deviation * scale, 1) + unit + " from the plan (limit " + fixed(limit * scale, 1) + unit + ")";
     plan_deviation_ = f;
   }
+}
+
+bool RiskMonitor::arm_moving_at(int64_t utime) const {
+  // The newest joint state taken at or before `utime`; for a frame older
+  // than all of them, the oldest.
+  for (auto it = arm_moving_by_utime_.rbegin(); it != arm_moving_by_utime_.rend(); ++it) {
+    if (it->first <= utime) return it->second;
+  }
+  return !arm_moving_by_utime_.empty() && arm_moving_by_utime_.front().second;
 }
 
 void RiskMonitor::on_camera_pose(int64_t now_us) { touch(&camera_pose_, now_us); }
@@ -157,7 +170,7 @@ FrameFinding RiskMonitor::discrepancy_finding(const discrepancy_t& frame) const 
   ClassifierContext context;
   context.depth_channel = config_.channels.depth;
   context.labels_channel = config_.channels.labels;
-  context.arm_moving = arm_moving_;
+  context.arm_moving = arm_moving_at(frame.utime);
   return classify_frame(frame, robot_, config_.risk, context);
 }
 

@@ -121,7 +121,6 @@ class RiskMonitor {
   Deadline joint_state_;
   Deadline camera_pose_;
   std::map<std::string, Deadline> heartbeats_;
-  bool arm_moving_ = false;
   PlannedTrajectory plan_;
   std::optional<joint_state_t> last_joint_state_;
   std::optional<FrameFinding> plan_deviation_;
@@ -129,6 +128,12 @@ class RiskMonitor {
   std::deque<motion_estimate_t> estimates_;  // the newest few, by arrival
   std::deque<int64_t> judged_seqs_;          // the newest few judged frames
   EstimateStats estimate_stats_;
+  // Whether the arm moved, by joint-state utime (ascending; the last 2 s):
+  // the frozen-image rule asks about the frame's capture time, not about
+  // whichever joint state arrived last, so that a replayed log is judged
+  // the same on every run however late the frame is processed.
+  bool arm_moving_at(int64_t utime) const;
+  std::deque<std::pair<int64_t, bool>> arm_moving_by_utime_;
   int consecutive_ = 0;
   int64_t last_frame_utime_ = 0;
 };

@@ -401,6 +401,35 @@ TEST(RiskMonitor, FrozenImageNeedsAMovingArm) {
   EXPECT_NE(r.detail.find("frozen"), std::string::npos);
 }
 
+// The frozen rule asks whether the arm moved when the frame was captured,
+// not what the latest joint state says: a replay judges a frame the same
+// however late it is processed.
+TEST(RiskMonitor, FrozenImageIsJudgedByTheJointStateAtTheFramesCaptureTime) {
+  constexpr int64_t kCapture = 1'700'000'000'000'000;
+  auto joints_at = [](double velocity, int64_t utime) {
+    joint_state_t s = joints(velocity);
+    s.utime = utime;
+    return s;
+  };
+  discrepancy_t frozen = summary_of(default_arm());
+  frozen.repeat_count = 3;
+  frozen.utime = kCapture;
+  {
+    RiskMonitor m(sim_config(), friend_arm(), kStart);
+    m.on_depth(kStart);
+    m.on_joint_state(joints_at(0.3, kCapture - 10 * kMs), kStart);
+    m.on_joint_state(joints_at(0.0, kCapture + 50 * kMs), kStart);  // the arm halted after the capture
+    EXPECT_EQ(m.on_discrepancy(frozen, kStart).cause, risk_t::CAUSE_SENSOR_FAULT);
+  }
+  {
+    RiskMonitor m(sim_config(), friend_arm(), kStart);
+    m.on_depth(kStart);
+    m.on_joint_state(joints_at(0.0, kCapture - 10 * kMs), kStart);
+    m.on_joint_state(joints_at(0.3, kCapture + 50 * kMs), kStart);  // it started after the capture
+    EXPECT_EQ(m.on_discrepancy(frozen, kStart).level, risk_t::SAFE);
+  }
+}
+
 TEST(RiskMonitor, JointNamesMustBeTheRobotsMovingJoints) {
   RiskMonitor m(sim_config(), friend_arm(), kStart);
   joint_state_t s = joints(0);

@@ -1,0 +1,95 @@
+// tofguard-sim-fault as a real process over real LCM (private network
+// namespace): the encoder fault and each camera fault arrive as the messages
+// the simulator takes; bad arguments are usage errors (exit 2) that publish
+// nothing.
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+
+#include <cmath>
+#include <optional>
+
+#include "test_support.hpp"
+#include "tofguard/sim_camera_fault_t.hpp"
+#include "tofguard/sim_joint_fault_t.hpp"
+
+namespace tofguard::test {
+namespace {
+
+struct Listener {
+  lcm::LCM lcm{"udpm://239.255.76.67:7667?ttl=0"};
+  std::optional<sim_joint_fault_t> joint;
+  std::optional<sim_camera_fault_t> camera;
+  Listener() {
+    lcm.subscribe("SIM_JOINT_FAULT", &Listener::on_joint, this);
+    lcm.subscribe("SIM_CAMERA_FAULT", &Listener::on_camera, this);
+  }
+  void on_joint(const lcm::ReceiveBuffer*, const std::string&, const sim_joint_fault_t* m) { joint = *m; }
+  void on_camera(const lcm::ReceiveBuffer*, const std::string&, const sim_camera_fault_t* m) { camera = *m; }
+  // Runs the tool on config/sim.yaml and handles what it published.
+  int run(const std::vector<std::string>& args, std::string* err = nullptr) {
+    std::vector<std::string> argv = {bin_dir() + "/tofguard-sim-fault", "--config", source_dir() + "/config/sim.yaml"};
+    argv.insert(argv.end(), args.begin(), args.end());
+    const int code = run_command("sim-fault", argv, nullptr, err);
+    while (lcm.handleTimeout(100) > 0) {
+    }
+    return code;
+  }
+};
+
+TEST(SimFaultCli, EncoderFault) {
+  Listener l;
+  ASSERT_EQ(l.run({"--joint", "a4", "--offset-deg", "10"}), 0);
+  ASSERT_TRUE(l.joint);
+  EXPECT_EQ(l.joint->joint, "a4");
+  EXPECT_NEAR(l.joint->offset, 0.174533, 1e-6);
+}
+
+TEST(SimFaultCli, IntrudingObjectWithItsBox) {
+  Listener l;
+  ASSERT_EQ(l.run({"--camera-fault", "intruding_object", "--size-m", "0.1,0.2,0.3", "--position-m", "1,-2,0.5",
+                   "--duration-s", "4.5"}),
+            0);
+  ASSERT_TRUE(l.camera);
+  EXPECT_EQ(l.camera->kind, sim_camera_fault_t::INTRUDING_OBJECT);
+  EXPECT_EQ(l.camera->camera_id, "tof-mast");
+  EXPECT_DOUBLE_EQ(l.camera->duration_s, 4.5);
+  EXPECT_DOUBLE_EQ(l.camera->object_size_m[1], 0.2);
+  EXPECT_DOUBLE_EQ(l.camera->object_position_m[1], -2);
+  EXPECT_DOUBLE_EQ(l.camera->object_velocity_m_per_s[0], 0);
+}
+
+TEST(SimFaultCli, PoseDriftStallAndClear) {
+  Listener l;
+  ASSERT_EQ(l.run({"--camera-fault", "pose_drift", "--duration-s", "0.01", "--drift-m-per-s", "5,0,0"}), 0);
+  ASSERT_TRUE(l.camera);
+  EXPECT_EQ(l.camera->kind, sim_camera_fault_t::POSE_DRIFT);
+  EXPECT_DOUBLE_EQ(l.camera->drift_translation_m_per_s[0], 5);
+  ASSERT_EQ(l.run({"--camera-fault", "stall"}), 0);
+  EXPECT_EQ(l.camera->kind, sim_camera_fault_t::STALL);
+  EXPECT_DOUBLE_EQ(l.camera->duration_s, 1000);
+  ASSERT_EQ(l.run({"--camera-fault", "clear"}), 0);
+  EXPECT_EQ(l.camera->kind, sim_camera_fault_t::CLEAR);
+}
+
+TEST(SimFaultCli, BadArgumentsAreUsageErrorsAndPublishNothing) {
+  Listener l;
+  std::string err;
+  EXPECT_EQ(l.run({"--camera-fault", "melted"}, &err), 2);
+  EXPECT_NE(err.find("unknown kind 'melted'"), std::string::npos) << err;
+  EXPECT_EQ(l.run({"--camera-fault", "intruding_object", "--position-m", "1,2"}, &err), 2);
+  EXPECT_NE(err.find("--position-m: expected X,Y,Z"), std::string::npos) << err;
+  EXPECT_EQ(l.run({"--camera-fault", "intruding_object"}, &err), 2);  // no box size
+  EXPECT_EQ(l.run({"--camera-fault", "stall", "--duration-s", "-1"}, &err), 2);
+  EXPECT_EQ(l.run({"--joint", "a4", "--offset-deg", "ten"}, &err), 2);
+  EXPECT_EQ(l.run({"--joint", "a4"}, &err), 2);
+  // Without a config there is no camera id to address.
+  const int code =
+      run_command("sim-fault", {bin_dir() + "/tofguard-sim-fault", "--camera-fault", "stall"}, nullptr, &err);
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(err.find("needs --config"), std::string::npos) << err;
+  EXPECT_FALSE(l.camera);
+  EXPECT_FALSE(l.joint);
+}
+
+}  // namespace
+}  // namespace tofguard::test
