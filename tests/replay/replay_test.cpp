@@ -278,6 +278,13 @@ class Replay {
     EXPECT_EQ(player_->wait(std::chrono::seconds(1)), 0) << player_->stderr_text();
     // The last frame's verdict (at most the pairing timeout later).
     wait_until([&] { return last_judged_seq_ >= last_seq; }, std::chrono::seconds(2), [&] { pump(); });
+    // lcm-logger receives on its own socket: seeing the verdict here does not
+    // mean it has written it yet. Stop it only once three heartbeats sent
+    // after the verdict (same URL, so behind it in every receiver's queue)
+    // have arrived here, i.e. at least 100 ms later.
+    const int beats_at_last_verdict = heartbeats_seen_;
+    wait_until([&] { return heartbeats_seen_ >= beats_at_last_verdict + 3 * static_cast<int>(kChain.size()); },
+               std::chrono::seconds(2), [&] { pump(); });
     logger_->signal(SIGINT);
     EXPECT_EQ(logger_->wait(std::chrono::seconds(5)), 0) << logger_->stderr_text();
     for (auto& p : chain_) p->signal(SIGTERM);
@@ -311,6 +318,7 @@ class Replay {
   }
   void on_heartbeat(const lcm::ReceiveBuffer*, const std::string&, const heartbeat_t* hb) {
     heartbeats_.insert(hb->process);
+    ++heartbeats_seen_;
   }
   void on_risk(const lcm::ReceiveBuffer*, const std::string&, const risk_t* r) {
     if (r->seq < 0) return;
@@ -327,6 +335,7 @@ class Replay {
   std::unique_ptr<Subprocess> reset_;
   std::set<std::string> heartbeats_;
   int safe_streak_ = 0;
+  int heartbeats_seen_ = 0;
   int64_t last_judged_seq_ = -1;
   bool reset_accepted_ = false;
   ReplayOutput output_;
