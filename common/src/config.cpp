@@ -272,6 +272,7 @@ RiskConfig read_risk(YamlMap map) {
     YamlMap estimate = map.map("estimate");
     r.estimate_enabled = estimate.boolean("enabled");
     r.estimate_wait_ms = estimate.number("wait_ms", 0, 1000);
+    r.estimate_max_age_ms = estimate.number("max_age_ms", 0, 10000);
     r.estimate_sigmas = estimate.number("sigmas", 0, 100);
     r.estimate_min_joint_offset_deg = estimate.number("min_joint_offset_deg", 0, 180);
     r.estimate_min_joint_offset_m = estimate.number("min_joint_offset_m", 0, 10);

@@ -178,11 +178,19 @@ bool RiskMonitor::wants_estimate(const discrepancy_t& frame) const {
   return config_.risk.estimate_enabled && is_model_mismatch(discrepancy_finding(frame).cause);
 }
 
-const motion_estimate_t* RiskMonitor::estimate_for(const discrepancy_t& frame) const {
+const motion_estimate_t* RiskMonitor::estimate_for(const discrepancy_t& frame, bool or_older) const {
   for (auto it = estimates_.rbegin(); it != estimates_.rend(); ++it) {
     if (it->seq == frame.seq && it->utime == frame.utime && it->camera_id == frame.camera_id) return &*it;
   }
-  return nullptr;
+  if (!or_older) return nullptr;
+  // Else the newest of an earlier frame within max_age (camera utimes).
+  const motion_estimate_t* newest = nullptr;
+  const int64_t max_age_us = ms_to_us(config_.risk.estimate_max_age_ms);
+  for (const motion_estimate_t& e : estimates_) {
+    if (e.camera_id != frame.camera_id || e.utime > frame.utime || frame.utime - e.utime > max_age_us) continue;
+    if (!newest || e.utime > newest->utime) newest = &e;
+  }
+  return newest;
 }
 
 risk_t RiskMonitor::on_discrepancy(const discrepancy_t& frame, int64_t now_us) {
@@ -216,7 +224,7 @@ std::vector<risk_t> RiskMonitor::release(int64_t now_us) {
   std::vector<risk_t> out;
   while (!waiting_.empty()) {
     const WaitingFrame& head = waiting_.front();
-    const bool has_estimate = estimate_for(head.frame) != nullptr;
+    const bool has_estimate = estimate_for(head.frame, /*or_older=*/false) != nullptr;
     if (head.wants_estimate && !has_estimate && now_us < head.wait_until_us) break;
     if (head.wants_estimate && !has_estimate) {
       estimate_stats_.missing++;
@@ -236,13 +244,17 @@ risk_t RiskMonitor::judge(const discrepancy_t& frame, int64_t now_us, bool waite
   // finding by another, never by "safe"; without one the discrepancy rules
   // stand).
   if (config_.risk.estimate_enabled && is_model_mismatch(finding.cause)) {
-    if (const motion_estimate_t* estimate = estimate_for(frame)) {
+    if (const motion_estimate_t* estimate = estimate_for(frame, /*or_older=*/true)) {
       EstimateContext context;
       context.prismatic_joints = robot_.prismatic_joints();
       context.near_arm_evidence = frame.near_arm_area_m2 >= config_.risk.unknown_object_min_area_m2;
       FrameFinding refined = classify_estimate(*estimate, config_.risk, context);
       if (refined.cause != risk_t::CAUSE_NONE) {
         estimate_stats_.used++;
+        if (estimate->seq != frame.seq) {
+          refined.detail += " (estimate of frame " + std::to_string(estimate->seq) + ", " +
+                            fixed((frame.utime - estimate->utime) / 1000.0, 0) + " ms earlier)";
+        }
         finding = std::move(refined);
       } else {
         estimate_stats_.explained_nothing++;

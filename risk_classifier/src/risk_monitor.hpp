@@ -109,7 +109,9 @@ class RiskMonitor {
   // estimates are in use.
   bool wants_estimate(const discrepancy_t& frame) const;
   FrameFinding discrepancy_finding(const discrepancy_t& frame) const;
-  const motion_estimate_t* estimate_for(const discrepancy_t& frame) const;
+  // The estimate of `frame` itself; with or_older, else the newest of an
+  // earlier frame of the same camera at most risk.estimate_max_age_ms older.
+  const motion_estimate_t* estimate_for(const discrepancy_t& frame, bool or_older) const;
   std::vector<risk_t> release(int64_t now_us);
   void update_plan_deviation(const joint_state_t& state);
   static void touch(Deadline* d, int64_t now_us);

@@ -223,6 +223,40 @@ TEST(EstimateWait, AMismatchFrameWaitsForItsEstimateWhichNamesTheCause) {
   EXPECT_EQ(m.estimate_stats().used, 1);
 }
 
+TEST(EstimateWait, AFrameWithoutItsOwnEstimateUsesARecentOneAfterTheWait) {
+  // The estimator takes longer than a frame period: the estimate of frame
+  // 100 serves frame 101 (33 ms later) once 101's own wait is over, but not
+  // frame 102, which is more than risk.estimate.max_age_ms after it.
+  Config config = sim_config();
+  config.risk.estimate_max_age_ms = 400;
+  RiskMonitor m(config, friend_arm(), kStart);
+  feed_all(&m, kStart);
+  discrepancy_t first = summary_of(default_arm(16), 100);
+  first.utime = 1'700'000'000'000'000;
+  EXPECT_TRUE(m.on_frame(first, kStart).empty());
+  motion_estimate_t e = estimate_for(first);
+  e.estimated_position[index_of(e, "a4")] -= 12.3 * kDeg;
+  ASSERT_EQ(m.on_estimate(e, kStart + 20 * kMs).size(), 1u);
+
+  discrepancy_t second = summary_of(default_arm(16), 101);
+  second.utime = first.utime + 33'000;
+  EXPECT_TRUE(m.on_frame(second, kStart + 33 * kMs).empty()) << "waits for its own estimate first";
+  auto out = m.release_due(kStart + 94 * kMs);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].seq, 101);
+  EXPECT_EQ(out[0].suspect, "a4");
+  EXPECT_NE(out[0].detail.find("(estimate of frame 100, 33 ms earlier)"), std::string::npos) << out[0].detail;
+
+  discrepancy_t late = summary_of(default_arm(16), 102);
+  late.utime = first.utime + 500'000;
+  feed_all(&m, kStart + 500 * kMs);
+  EXPECT_TRUE(m.on_frame(late, kStart + 500 * kMs).empty());
+  out = m.release_due(kStart + 561 * kMs);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].suspect, "a2") << "the discrepancy rules: " << out[0].detail;
+  EXPECT_NE(out[0].detail.find("no motion estimate within 60 ms"), std::string::npos) << out[0].detail;
+}
+
 TEST(EstimateWait, WithoutAnEstimateTheDiscrepancyRulesJudgeAfterTheWaitAndFramesKeepTheirOrder) {
   RiskMonitor m(sim_config(), friend_arm(), kStart);
   feed_all(&m, kStart);

@@ -313,6 +313,12 @@ struct RiskConfig {
   // its arrival) for the estimate of its seq, which then names the cause.
   bool estimate_enabled = false;
   double estimate_wait_ms = 0;
+  // The estimator takes longer than a frame period on a small CPU, so the
+  // newest estimate of an earlier frame of the same camera, at most
+  // estimate_max_age_ms older (camera utimes, not wall clock), also serves
+  // a frame whose own estimate has not come: the frame does not wait then.
+  // Fail safe either way: an estimate only renames a mismatch's cause.
+  double estimate_max_age_ms = 0;
   // A joint offset or camera correction is significant when it exceeds
   // estimate_sigmas times its 1-sigma uncertainty and the minimum.
   double estimate_sigmas = 0;
