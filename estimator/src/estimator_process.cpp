@@ -62,6 +62,7 @@ std::string check_discrepancy(const discrepancy_t& d) {
 EstimatorScheduler::EstimatorScheduler(const Config& config, const renderer::SceneModel& scene)
     : config_(config),
       scene_(scene),
+      robot_(risk::RobotTree::from_urdf_file(config.robot.urdf_path)),
       history_(static_cast<int64_t>(std::llround(config.renderer.max_extrapolation_ms * 1000.0))) {
   camera_poses_[config.camera.id] = config.camera.pose;
 }
@@ -111,8 +112,12 @@ bool EstimatorScheduler::on_depth(const depth_image_t& frame) {
 
 void EstimatorScheduler::on_discrepancy(const discrepancy_t& d) {
   if (d.camera_id != config_.camera.id || !d.usable) return;
+  // The risk classifier's own rules decide "passes the warning level" (one
+  // rule set, tofguard-risk waits for this estimate exactly then), plus the
+  // estimator's coarser thresholds.
   const bool warning = d.mismatch_fraction >= config_.estimator.warning_mismatch_fraction ||
-                       d.p95_abs_dis_mm >= config_.estimator.warning_p95_abs_dis_mm;
+                       d.p95_abs_dis_mm >= config_.estimator.warning_p95_abs_dis_mm ||
+                       risk::is_model_mismatch(risk::classify_frame(d, robot_, config_.risk, {}).cause);
   if (!warning || estimated_.count(d.seq) > 0) return;
   const auto f = frames_.find(d.seq);
   if (f != frames_.end()) {

@@ -7,6 +7,8 @@
 // Triggers (config `estimator`, docs/estimator.md):
 //   TRIGGER_WARNING  a frame whose discrepancy_t is usable and reaches
 //                    warning.mismatch_fraction or warning.p95_abs_dis_mm,
+//                    or in which the risk classifier's rules
+//                    (risk::classify_frame) find a model mismatch,
 //                    as soon as both the frame and its discrepancy are in;
 //   TRIGGER_PERIODIC the newest frame every periodic_period_ms.
 // A frame is estimated once. The joints are the JOINT_STATE history
@@ -24,6 +26,8 @@
 
 #include "estimate_message.hpp"
 #include "joint_history.hpp"
+#include "frame_classifier.hpp"
+#include "robot_tree.hpp"
 #include "motion_estimator.hpp"
 #include "scene_model.hpp"
 #include "tofguard/camera_pose_t.hpp"
@@ -93,6 +97,7 @@ class EstimatorScheduler {
 
   Config config_;
   const renderer::SceneModel& scene_;
+  risk::RobotTree robot_;
   renderer::JointHistory history_;
   std::map<std::string, CameraPose> camera_poses_;
   std::map<int64_t, depth_image_t> frames_;  // by seq

@@ -58,6 +58,11 @@ struct LinkView {
 
 }  // namespace
 
+bool is_model_mismatch(int8_t cause) {
+  return cause == risk_t::CAUSE_JOINT_ERROR || cause == risk_t::CAUSE_CALIBRATION_ERROR ||
+         cause == risk_t::CAUSE_UNKNOWN_OBJECT || cause == risk_t::CAUSE_UNCLASSIFIED;
+}
+
 bool is_fault_cause(int8_t cause) {
   return cause == risk_t::CAUSE_SENSOR_FAULT || cause == risk_t::CAUSE_COMPONENT_FAULT;
 }

@@ -44,4 +44,8 @@ std::string fixed(double value, int decimals);
 // with risk.sensor_debounce_frames).
 bool is_fault_cause(int8_t cause);
 
+// True for the causes of a model mismatch (JOINT_ERROR, CALIBRATION_ERROR,
+// UNKNOWN_OBJECT, UNCLASSIFIED): the findings a motion estimate can name.
+bool is_model_mismatch(int8_t cause);
+
 }  // namespace tofguard::risk

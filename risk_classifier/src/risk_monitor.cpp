@@ -16,11 +16,6 @@ constexpr double kRadToDeg = 180.0 / M_PI;
 constexpr size_t kKeptEstimates = 16;
 constexpr size_t kKeptJudgedSeqs = 64;
 
-bool is_model_mismatch(int8_t cause) {
-  return cause == risk_t::CAUSE_JOINT_ERROR || cause == risk_t::CAUSE_CALIBRATION_ERROR ||
-         cause == risk_t::CAUSE_UNKNOWN_OBJECT || cause == risk_t::CAUSE_UNCLASSIFIED;
-}
-
 }  // namespace
 
 RiskMonitor::RiskMonitor(const Config& config, RobotTree robot, int64_t start_us)

@@ -12,6 +12,7 @@
 #include <signal.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <deque>
 #include <map>
 #include <memory>
@@ -26,6 +27,7 @@
 #include "tofguard/clock.hpp"
 #include "tofguard/config.hpp"
 #include "tofguard/depth_image_t.hpp"
+#include "tofguard/motion_estimate_t.hpp"
 #include "tofguard/risk_names.hpp"
 #include "tofguard/risk_t.hpp"
 #include "tofguard/safety_status_t.hpp"
@@ -48,10 +50,11 @@ class Chain {
     images_.subscribe(config_.channels.depth, &Chain::on_depth, this);
     safety_.subscribe(config_.channels.joint_state, &Chain::on_joints, this);
     safety_.subscribe(config_.channels.heartbeat, &Chain::on_heartbeat, this);
+    safety_.subscribe(config_.channels.motion_estimate, &Chain::on_estimate, this);
     safety_.getFileno();
     images_.getFileno();
     for (const char* name : {"tofguard-intervene", "tofguard-risk", "tofguard-discrepancy", "tofguard-renderer",
-                             "tofguard-joints-sim", "tofguard-camera"}) {
+                             "tofguard-joints-sim", "tofguard-camera", "tofguard-estimator"}) {
       start(name);
     }
   }
@@ -114,6 +117,9 @@ class Chain {
     safety_.publish(config_.channels.reset, junk, sizeof junk);
     safety_.publish(config_.channels.sim_joint_fault, junk, sizeof junk);
     safety_.publish(config_.channels.sim_camera_fault, junk, sizeof junk);
+    safety_.publish(config_.channels.motion_estimate, junk, sizeof junk);
+    safety_.publish(config_.channels.motion_estimate, &nan_joints);
+    safety_.publish(config_.channels.planned_trajectory, junk, sizeof junk);
     ++malformed_rounds;
   }
 
@@ -160,6 +166,7 @@ class Chain {
   int64_t stop_latency_after_frame(const std::function<void()>& inject, safety_status_t* stop) {
     const int64_t injected_utime = wall_utime();
     risk_log_.clear();
+    risk_details_.clear();
     inject();
     first_affected_arrival_us_ = -1;
     affected_after_utime_ = injected_utime;
@@ -258,12 +265,26 @@ class Chain {
   }
   void on_risk(const lcm::ReceiveBuffer*, const std::string&, const risk_t* r) {
     last_risk_ = *r;
+    if (r->seq >= 0) risk_details_.push_back(r->detail);
     if (r->seq >= 0 && std::count(risk_log_.begin(), risk_log_.end(), '\n') < 12) {
       risk_log_ += "  seq " + std::to_string(r->seq) + " " + risk_level_name(r->level) + " " +
                    risk_cause_name(r->cause) + " '" + r->suspect + "': " + r->detail + "\n";
     }
     if (r->seq < 0) return;
     safe_streak_ = r->level == risk_t::SAFE ? safe_streak_ + 1 : 0;
+  }
+  void on_estimate(const lcm::ReceiveBuffer*, const std::string&, const motion_estimate_t* e) {
+    std::string line = "  estimate seq " + std::to_string(e->seq) + " trigger " + std::to_string(e->trigger) +
+                       (e->usable ? "" : " unusable: " + e->unusable_reason) + (e->converged ? " converged" : " not converged") +
+                       " it " + std::to_string(e->iterations) + " res " + std::to_string(e->residual_before_mm) + "->" +
+                       std::to_string(e->residual_after_mm) + " mm, offsets deg:";
+    for (int i = 0; i < e->num_joints; ++i) {
+      line += " " + e->joint_name[i] + "=" + std::to_string((e->estimated_position[i] - e->reported_position[i]) * 180 / M_PI) +
+              "+-" + std::to_string(e->position_sigma[i] * 180 / M_PI);
+    }
+    line += " cam " + std::to_string(e->correction_translation[0]) + "," + std::to_string(e->correction_translation[1]) + "," +
+            std::to_string(e->correction_translation[2]) + " us " + std::to_string(e->compute_us);
+    estimate_log_.push_back(line);
   }
   void on_joints(const lcm::ReceiveBuffer*, const std::string&, const joint_state_t* j) {
     for (int i = 0; i < j->num_joints; ++i) latest_joints_[j->name[i]] = j->position[i];
@@ -304,7 +325,46 @@ class Chain {
   int64_t last_pose_us_ = 0;
   renderer::JointPositions latest_joints_;
   std::string risk_log_;
+  std::vector<std::string> risk_details_;  // of frame verdicts since the last fault
+  std::vector<std::string> estimate_log_;  // one line per MOTION_ESTIMATE
+
+ public:
+  const std::vector<std::string>& estimate_log() const { return estimate_log_; }
+
+ public:
+  // Waits for a frame verdict since the last fault whose detail contains
+  // `text`; returns that detail, or "" when none came within `deadline`.
+  std::string wait_for_detail(const std::string& text, std::chrono::milliseconds deadline,
+                              const std::string& and_text = "") {
+    std::string found;
+    wait([&] {
+      for (const std::string& d : risk_details_) {
+        if (d.find(text) != std::string::npos && d.find(and_text) != std::string::npos) {
+          found = d;
+          return true;
+        }
+      }
+      return false;
+    }, deadline);
+    return found;
+  }
 };
+
+// The degrees in "joint a4 reads 10.3° more than seen", signed: positive
+// for "more" (the joint reads more than the image shows); NaN if absent.
+double reads_more_than_seen_deg(const std::string& detail, const std::string& joint) {
+  const std::string head = "joint " + joint + " reads ";
+  const size_t at = detail.find(head);
+  if (at == std::string::npos) return std::nan("");
+  const char* start = detail.c_str() + at + head.size();
+  char* end = nullptr;
+  const double deg = std::strtod(start, &end);
+  if (end == start) return std::nan("");
+  const std::string rest(end);
+  if (rest.rfind("° more than seen", 0) == 0) return deg;
+  if (rest.rfind("° less than seen", 0) == 0) return -deg;
+  return std::nan("");
+}
 
 #define EXPECT_STOP(latency_us, status, expected_cause)                                            \
   do {                                                                                             \
@@ -335,7 +395,7 @@ TEST(SafetyChainE2E, NominalMotionThenEveryFaultStopsTheArmWithItsCause) {
     EXPECT_GE(chain.malformed_rounds, 50);
     // Every process dropped and counted what it could not use, and lives.
     for (const char* name : {"tofguard-intervene", "tofguard-risk", "tofguard-discrepancy", "tofguard-renderer",
-                             "tofguard-joints-sim", "tofguard-camera"}) {
+                             "tofguard-joints-sim", "tofguard-camera", "tofguard-estimator"}) {
       ASSERT_TRUE(chain.heartbeats().count(name)) << name;
       const heartbeat_t& hb = chain.heartbeats().at(name);
       const int64_t errors = hb.decode_errors + hb.validation_errors -
@@ -351,6 +411,17 @@ TEST(SafetyChainE2E, NominalMotionThenEveryFaultStopsTheArmWithItsCause) {
     const int64_t latency = chain.stop_latency_after_frame([&] { chain.joint_fault("a4", 10 * M_PI / 180); }, &stop);
     EXPECT_STOP(latency, stop, risk_t::CAUSE_JOINT_ERROR);
     EXPECT_NE(stop.reason.find("suspect a4"), std::string::npos) << stop.reason;
+    // The motion estimate names the joint and its offset in the verdicts
+    // that follow (the first frames are judged before it comes).
+    const std::string named = chain.wait_for_detail("joint a4 reads", std::chrono::seconds(3), " than seen (estimate");
+    std::cout << "estimate-named verdict: " << named << std::endl;
+    for (const char* name : {"tofguard-estimator", "tofguard-risk"}) {
+      if (chain.heartbeats().count(name)) std::cout << name << ": " << chain.heartbeats().at(name).status << std::endl;
+    }
+    if (named.empty()) {  // what the estimator said
+      for (const auto& l : chain.estimate_log()) std::cout << l << "\n";
+    }
+    EXPECT_NEAR(reads_more_than_seen_deg(named, "a4"), 10.0, 2.5) << named;
     chain.joint_fault("a4", 0);
     chain.bring_to_motion("encoder fixed");
     if (HasFatalFailure()) return;
@@ -360,6 +431,9 @@ TEST(SafetyChainE2E, NominalMotionThenEveryFaultStopsTheArmWithItsCause) {
     const int64_t latency =
         chain.stop_latency_after_frame([&] { chain.publish_camera_pose(Eigen::Vector3d(0.05, 0, 0)); }, &stop);
     EXPECT_STOP(latency, stop, risk_t::CAUSE_CALIBRATION_ERROR);
+    const std::string named = chain.wait_for_detail("camera pose off by", std::chrono::seconds(3));
+    std::cout << "estimate-named verdict: " << named << std::endl;
+    EXPECT_NE(named, "") << "no verdict named the camera correction";
     chain.publish_camera_pose(Eigen::Vector3d::Zero());
     chain.bring_to_motion("calibration fixed");
     if (HasFatalFailure()) return;
