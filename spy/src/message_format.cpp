@@ -1,6 +1,7 @@
 #include "message_format.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <functional>
 #include <iomanip>
@@ -14,12 +15,15 @@
 #include "tofguard/heartbeat_t.hpp"
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/link_labels_t.hpp"
+#include "tofguard/motion_estimate_t.hpp"
+#include "tofguard/planned_trajectory_t.hpp"
 #include "tofguard/power_relay_t.hpp"
 #include "tofguard/reset_reply_t.hpp"
 #include "tofguard/reset_request_t.hpp"
 #include "tofguard/risk_names.hpp"
 #include "tofguard/risk_t.hpp"
 #include "tofguard/safety_status_t.hpp"
+#include "tofguard/sim_camera_fault_t.hpp"
 #include "tofguard/sim_joint_fault_t.hpp"
 
 namespace tofguard::spy {
@@ -122,6 +126,44 @@ std::string format(const sim_joint_fault_t& m) {
   return s.str();
 }
 
+// Joint offsets in degrees (estimated - reported), only the observable
+// joints; the camera correction in mm and degrees.
+std::string format(const motion_estimate_t& m) {
+  std::ostringstream s;
+  s << "utime=" << m.utime << " seq=" << m.seq << " trigger=" << static_cast<int>(m.trigger)
+    << " usable=" << yes_no(m.usable);
+  if (!m.usable) return s.str() + " (" + m.unusable_reason + ")";
+  constexpr double kDeg = 180.0 / 3.14159265358979323846;
+  s << " converged=" << yes_no(m.converged) << " iterations=" << m.iterations << std::fixed << std::setprecision(1)
+    << " residual_mm=" << m.residual_before_mm << "->" << m.residual_after_mm << " |";
+  for (int i = 0; i < m.num_joints; ++i) {
+    if (!m.observable[i]) continue;
+    s << " " << m.joint_name[i] << "=" << std::showpos << (m.estimated_position[i] - m.reported_position[i]) * kDeg
+      << std::noshowpos << "±" << m.position_sigma[i] * kDeg << "°";
+  }
+  const double w = std::min(1.0, std::abs(m.correction_rotation[0]));
+  s << " | camera_mm=" << m.correction_translation[0] * 1000 << "," << m.correction_translation[1] * 1000 << ","
+    << m.correction_translation[2] * 1000 << " camera_deg=" << 2 * std::acos(w) * kDeg
+    << " compute_ms=" << m.compute_us / 1000.0;
+  return s.str();
+}
+
+std::string format(const planned_trajectory_t& m) {
+  std::ostringstream s;
+  s << "utime=" << m.utime << " joints=" << m.num_joints << " points=" << m.num_points;
+  if (m.num_points > 0) {
+    s << " span_ms=" << std::fixed << std::setprecision(1)
+      << (m.point_utime.back() - m.point_utime.front()) / 1000.0;
+  }
+  return s.str();
+}
+
+std::string format(const sim_camera_fault_t& m) {
+  std::ostringstream s;
+  s << "camera=" << m.camera_id << " kind=" << m.kind << " duration_s=" << m.duration_s;
+  return s.str();
+}
+
 using Formatter = std::function<std::optional<std::string>(const void*, int)>;
 
 template <class T>
@@ -139,7 +181,8 @@ const std::map<int64_t, std::pair<std::string, Formatter>>& formatters() {
       entry<depth_image_t>(),   entry<joint_state_t>(),     entry<camera_pose_t>(), entry<risk_t>(),
       entry<safety_status_t>(), entry<heartbeat_t>(),       entry<link_labels_t>(), entry<reset_request_t>(),
       entry<reset_reply_t>(),   entry<power_relay_t>(),     entry<sim_joint_fault_t>(),
-      entry<discrepancy_t>(),
+      entry<discrepancy_t>(),   entry<motion_estimate_t>(), entry<planned_trajectory_t>(),
+      entry<sim_camera_fault_t>(),
   };
   return table;
 }

@@ -5,6 +5,7 @@
 #include <lcm/lcm-cpp.hpp>
 #include <signal.h>
 
+#include <cmath>
 #include <filesystem>
 #include <thread>
 
@@ -12,6 +13,7 @@
 #include "message_format.hpp"
 #include "status_board.hpp"
 #include "test_support.hpp"
+#include "tofguard/motion_estimate_t.hpp"
 
 namespace tofguard::test {
 namespace {
@@ -106,6 +108,36 @@ std::vector<std::string> spy_on_replay(const std::string& name, const std::strin
   spy.signal(SIGINT);
   EXPECT_EQ(spy.wait(std::chrono::seconds(5)), 0);
   return lines_of(spy.stdout_text());
+}
+
+TEST(Spy, MotionEstimateLineShowsOffsetsInDegreesAndTheCameraCorrection) {
+  motion_estimate_t m{};
+  m.utime = 1700000000123456;
+  m.seq = 42;
+  m.camera_id = "tof-test";
+  m.trigger = motion_estimate_t::TRIGGER_WARNING;
+  m.usable = true;
+  m.converged = true;
+  m.iterations = 7;
+  m.num_joints = 2;
+  m.joint_name = {"a4", "a5"};
+  m.reported_position = {1.0, 0.5};
+  m.estimated_position = {1.0 - 10.0 * M_PI / 180, 0.5};
+  m.position_sigma = {0.5 * M_PI / 180, 3.14};
+  m.observable = {true, false};
+  m.correction_translation[0] = 0.012;
+  m.correction_translation[1] = -0.003;
+  m.correction_translation[2] = 0;
+  m.correction_rotation[0] = 1;
+  m.correction_rotation[1] = m.correction_rotation[2] = m.correction_rotation[3] = 0;
+  m.residual_before_mm = 30;
+  m.residual_after_mm = 6;
+  m.compute_us = 41500;
+  const std::vector<uint8_t> bytes = encoded(m);
+  EXPECT_EQ(spy::format_message("MOTION_ESTIMATE", bytes.data(), static_cast<int>(bytes.size())),
+            "MOTION_ESTIMATE motion_estimate_t utime=1700000000123456 seq=42 trigger=1 usable=true converged=true "
+            "iterations=7 residual_mm=30.0->6.0 | a4=-10.0±0.5° | camera_mm=12.0,-3.0,0.0 camera_deg=0.0 "
+            "compute_ms=41.5");
 }
 
 TEST(Spy, PrintsOneDecodedLinePerReplayedMessage) {
