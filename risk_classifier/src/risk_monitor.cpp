@@ -244,9 +244,16 @@ risk_t RiskMonitor::judge(const discrepancy_t& frame, int64_t now_us, bool waite
       context.prismatic_joints = robot_.prismatic_joints();
       context.near_arm_evidence = frame.near_arm_area_m2 >= config_.risk.unknown_object_min_area_m2;
       FrameFinding refined = classify_estimate(*estimate, config_.risk, context);
+      // An earlier frame's estimate is evidence only of what it names (a
+      // joint or the camera): that it explained nothing says nothing about
+      // this frame, which may show a fault that began after it.
+      const bool own = estimate->seq == frame.seq;
+      if (!own && refined.cause != risk_t::CAUSE_JOINT_ERROR && refined.cause != risk_t::CAUSE_CALIBRATION_ERROR) {
+        refined = FrameFinding{};
+      }
       if (refined.cause != risk_t::CAUSE_NONE) {
         estimate_stats_.used++;
-        if (estimate->seq != frame.seq) {
+        if (!own) {
           refined.detail += " (estimate of frame " + std::to_string(estimate->seq) + ", " +
                             fixed((frame.utime - estimate->utime) / 1000.0, 0) + " ms earlier)";
         }

@@ -257,6 +257,32 @@ TEST(EstimateWait, AFrameWithoutItsOwnEstimateUsesARecentOneAfterTheWait) {
   EXPECT_NE(out[0].detail.find("no motion estimate within 60 ms"), std::string::npos) << out[0].detail;
 }
 
+TEST(EstimateWait, AnEarlierFramesEstimateThatNamesNoJointOrCameraSaysNothingAboutThisFrame) {
+  // An estimate of frame 100 that explains nothing and leaves a high
+  // residual would, for frame 100 itself, mean an unknown object; for frame
+  // 101 (a fault may have begun since) it is no evidence: the rules judge.
+  Config config = sim_config();
+  config.risk.estimate_max_age_ms = 400;
+  RiskMonitor m(config, friend_arm(), kStart);
+  feed_all(&m, kStart);
+  discrepancy_t first = summary_of(default_arm(16), 100);
+  first.utime = 1'700'000'000'000'000;
+  EXPECT_TRUE(m.on_frame(first, kStart).empty());
+  motion_estimate_t e = estimate_for(first);
+  e.residual_after_mm = 80;
+  const auto own = m.on_estimate(e, kStart + 20 * kMs);
+  ASSERT_EQ(own.size(), 1u);
+  EXPECT_EQ(own[0].cause, risk_t::CAUSE_UNKNOWN_OBJECT) << own[0].detail;
+
+  discrepancy_t second = summary_of(default_arm(16), 101);
+  second.utime = first.utime + 33'000;
+  EXPECT_TRUE(m.on_frame(second, kStart + 33 * kMs).empty());
+  const auto out = m.release_due(kStart + 94 * kMs);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].cause, risk_t::CAUSE_JOINT_ERROR) << out[0].detail;
+  EXPECT_EQ(out[0].suspect, "a2") << out[0].detail;
+}
+
 TEST(EstimateWait, WithoutAnEstimateTheDiscrepancyRulesJudgeAfterTheWaitAndFramesKeepTheirOrder) {
   RiskMonitor m(sim_config(), friend_arm(), kStart);
   feed_all(&m, kStart);
