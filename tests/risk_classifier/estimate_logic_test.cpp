@@ -223,23 +223,33 @@ TEST(EstimateWait, AMismatchFrameWaitsForItsEstimateWhichNamesTheCause) {
   EXPECT_EQ(m.estimate_stats().used, 1);
 }
 
+// Frame `seq` of a joint error (a2 by the discrepancy rules) captured
+// `after_us` after the first one's utime.
+discrepancy_t mismatch_frame(int64_t seq, int64_t after_us) {
+  discrepancy_t d = summary_of(default_arm(16), seq);
+  d.utime = 1'700'000'000'000'000 + after_us;
+  return d;
+}
+
+Config config_with_max_age() {
+  Config config = sim_config();
+  config.risk.estimate_max_age_ms = 400;
+  return config;
+}
+
 TEST(EstimateWait, AFrameWithoutItsOwnEstimateUsesARecentOneAfterTheWait) {
   // The estimator takes longer than a frame period: the estimate of frame
   // 100 serves frame 101 (33 ms later) once 101's own wait is over, but not
   // frame 102, which is more than risk.estimate.max_age_ms after it.
-  Config config = sim_config();
-  config.risk.estimate_max_age_ms = 400;
-  RiskMonitor m(config, friend_arm(), kStart);
+  RiskMonitor m(config_with_max_age(), friend_arm(), kStart);
   feed_all(&m, kStart);
-  discrepancy_t first = summary_of(default_arm(16), 100);
-  first.utime = 1'700'000'000'000'000;
+  const discrepancy_t first = mismatch_frame(100, 0);
   EXPECT_TRUE(m.on_frame(first, kStart).empty());
   motion_estimate_t e = estimate_for(first);
   e.estimated_position[index_of(e, "a4")] -= 12.3 * kDeg;
   ASSERT_EQ(m.on_estimate(e, kStart + 20 * kMs).size(), 1u);
 
-  discrepancy_t second = summary_of(default_arm(16), 101);
-  second.utime = first.utime + 33'000;
+  const discrepancy_t second = mismatch_frame(101, 33'000);
   EXPECT_TRUE(m.on_frame(second, kStart + 33 * kMs).empty()) << "waits for its own estimate first";
   auto out = m.release_due(kStart + 94 * kMs);
   ASSERT_EQ(out.size(), 1u);
@@ -247,8 +257,7 @@ TEST(EstimateWait, AFrameWithoutItsOwnEstimateUsesARecentOneAfterTheWait) {
   EXPECT_EQ(out[0].suspect, "a4");
   EXPECT_NE(out[0].detail.find("(estimate of frame 100, 33 ms earlier)"), std::string::npos) << out[0].detail;
 
-  discrepancy_t late = summary_of(default_arm(16), 102);
-  late.utime = first.utime + 500'000;
+  const discrepancy_t late = mismatch_frame(102, 500'000);
   feed_all(&m, kStart + 500 * kMs);
   EXPECT_TRUE(m.on_frame(late, kStart + 500 * kMs).empty());
   out = m.release_due(kStart + 561 * kMs);
@@ -261,12 +270,9 @@ TEST(EstimateWait, AnEarlierFramesEstimateThatNamesNoJointOrCameraSaysNothingAbo
   // An estimate of frame 100 that explains nothing and leaves a high
   // residual would, for frame 100 itself, mean an unknown object; for frame
   // 101 (a fault may have begun since) it is no evidence: the rules judge.
-  Config config = sim_config();
-  config.risk.estimate_max_age_ms = 400;
-  RiskMonitor m(config, friend_arm(), kStart);
+  RiskMonitor m(config_with_max_age(), friend_arm(), kStart);
   feed_all(&m, kStart);
-  discrepancy_t first = summary_of(default_arm(16), 100);
-  first.utime = 1'700'000'000'000'000;
+  const discrepancy_t first = mismatch_frame(100, 0);
   EXPECT_TRUE(m.on_frame(first, kStart).empty());
   motion_estimate_t e = estimate_for(first);
   e.residual_after_mm = 80;
@@ -274,8 +280,7 @@ TEST(EstimateWait, AnEarlierFramesEstimateThatNamesNoJointOrCameraSaysNothingAbo
   ASSERT_EQ(own.size(), 1u);
   EXPECT_EQ(own[0].cause, risk_t::CAUSE_UNKNOWN_OBJECT) << own[0].detail;
 
-  discrepancy_t second = summary_of(default_arm(16), 101);
-  second.utime = first.utime + 33'000;
+  const discrepancy_t second = mismatch_frame(101, 33'000);
   EXPECT_TRUE(m.on_frame(second, kStart + 33 * kMs).empty());
   const auto out = m.release_due(kStart + 94 * kMs);
   ASSERT_EQ(out.size(), 1u);
