@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,15 +15,18 @@ namespace {
 
 const char* kUsage =
     "usage: tofguard-calibrate-depth --captures LIST.csv --roi U0,V0,WIDTH,HEIGHT\n"
+    "                                [--intrinsics FX,FY,CX,CY]\n"
     "                                [--degree N] [--channel TOF_DEPTH]\n"
     "                                [--yaml OUT.yaml] [--plot OUT.png]\n"
     "\n"
     "Distance calibration of a ToF camera from captures of a planar target seen\n"
     "perpendicularly. LIST.csv has one line per capture: 'capture,true_distance_mm',\n"
-    "a capture being a folder of 16-bit PNGs (depth in mm) or an LCM log of\n"
-    "uncalibrated depth_image_t on --channel. Per distance it prints the mean error\n"
+    "a capture being a folder of 16-bit PNGs (depth Z in mm) or an LCM log of\n"
+    "uncalibrated depth_image_t on --channel. Per distance it prints the mean Z error\n"
     "and its standard deviation over the ROI and all frames, before and after the\n"
-    "fitted correction d - p(d) (p of degree N, default 5, d in metres), writes the\n"
+    "fitted correction d - p(d) (p of degree N, default 5, d the distance along the\n"
+    "pixel's ray in metres: Z / f with f from the intrinsics; LCM frames carry\n"
+    "theirs, PNG captures need --intrinsics in pixels), writes the\n"
     "config snippet camera.depth_calibration to --yaml and the error plot to --plot\n"
     "(default: beside LIST.csv, LIST_calibration.yaml / .png).\n"
     "Exit codes: 0 done, 2 bad input (one line on stderr).\n";
@@ -31,7 +35,8 @@ const char* kUsage =
 
 int main(int argc, char** argv) {
   using namespace tofguard::camera;
-  std::string captures_path, roi_text, channel = "TOF_DEPTH", yaml_path, plot_path;
+  std::string captures_path, roi_text, intrinsics_text, channel = "TOF_DEPTH", yaml_path,
+      plot_path;
   int degree = 5;
   const std::vector<std::string> args(argv + 1, argv + argc);
   for (size_t i = 0; i < args.size(); ++i) {
@@ -50,6 +55,8 @@ int main(int argc, char** argv) {
       captures_path = value;
     } else if (a == "--roi") {
       roi_text = value;
+    } else if (a == "--intrinsics") {
+      intrinsics_text = value;
     } else if (a == "--channel") {
       channel = value;
     } else if (a == "--yaml") {
@@ -80,9 +87,13 @@ int main(int argc, char** argv) {
   if (plot_path.empty()) plot_path = stem.string() + ".png";
   try {
     const Roi roi = parse_roi(roi_text);
+    std::optional<PixelRays> png_rays;
+    if (!intrinsics_text.empty()) png_rays = parse_pixel_rays(intrinsics_text);
     const auto captures = read_capture_list(captures_path);
     std::vector<CaptureSamples> samples;
-    for (const auto& capture : captures) samples.push_back(load_capture(capture, roi, channel));
+    for (const auto& capture : captures) {
+      samples.push_back(load_capture(capture, roi, channel, png_rays));
+    }
     const CalibrationResult result = calibrate(captures, samples, degree);
     std::cout << format_table(result);
     const std::string snippet = yaml_snippet(result);

@@ -1,6 +1,7 @@
 // tofguard-estimator: TOF_DEPTH, JOINT_STATE, CAMERA_POSE, SAFETY_DISCREPANCY
 // -> MOTION_ESTIMATE (src/estimator_process.hpp, docs/estimator.md).
 #include <cmath>
+#include <cstdlib>
 #include <iostream>
 
 #include "estimator_process.hpp"
@@ -105,5 +106,11 @@ int run(const Config& config, const std::vector<std::string>& rest) {
 }  // namespace tofguard::estimator
 
 int main(int argc, char** argv) {
+  // The estimator renders 176x144-sized images a dozen times per frame on
+  // its worker thread: llvmpipe's own render threads cost more in hand-over
+  // than they save at that size (docs/benchmarks.md, motion estimator: 36 ms
+  // per frame without them, 44 ms with). Set before the EGL display is
+  // opened; a value in the environment wins.
+  setenv("LP_NUM_THREADS", "0", /*overwrite=*/0);
   return tofguard::run_process(argc, argv, tofguard::estimator::process_info(), tofguard::estimator::run);
 }

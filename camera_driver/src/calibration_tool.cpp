@@ -62,16 +62,29 @@ void check_frame(const CaptureSpec& capture, const std::string& frame_name, int 
 }
 
 template <class Pixel>
-void take_roi(const Pixel* data, int width, const Roi& roi, CaptureSamples* samples) {
+void take_roi(const Pixel* data, int width, int height, const PixelRays& rays, const Roi& roi,
+              CaptureSamples* samples) {
+  Intrinsics intrinsics;
+  intrinsics.width = width;
+  intrinsics.height = height;
+  intrinsics.fx = rays.fx;
+  intrinsics.fy = rays.fy;
+  intrinsics.cx = rays.cx;
+  intrinsics.cy = rays.cy;
+  const RadialToZ z_per_radial(intrinsics);
   for (int v = roi.v0; v < roi.v0 + roi.height; ++v) {
     for (int u = roi.u0; u < roi.u0 + roi.width; ++u) {
       const Pixel d = data[static_cast<size_t>(v) * width + u];
-      if (d > 0) samples->depth_mm.push_back(static_cast<float>(d));
+      if (d > 0) {
+        samples->depth_mm.push_back(static_cast<float>(d));
+        samples->z_per_radial.push_back(z_per_radial.factor(u, v));
+      }
     }
   }
 }
 
-void load_png_folder(const CaptureSpec& capture, const Roi& roi, CaptureSamples* samples) {
+void load_png_folder(const CaptureSpec& capture, const Roi& roi,
+                     const std::optional<PixelRays>& rays, CaptureSamples* samples) {
   std::vector<fs::path> files;
   for (const auto& entry : fs::directory_iterator(capture.path)) {
     if (entry.is_regular_file() && entry.path().extension() == ".png") files.push_back(entry.path());
@@ -80,6 +93,11 @@ void load_png_folder(const CaptureSpec& capture, const Roi& roi, CaptureSamples*
   if (files.empty()) {
     throw CalibrationInputError(capture.where + ": folder " + capture.path +
                                 " holds no .png frames");
+  }
+  if (!rays) {
+    throw CalibrationInputError(capture.where + ": PNG frames in " + capture.path +
+                                " carry no intrinsics: give --intrinsics FX,FY,CX,CY (pixels) to "
+                                "fit the error along each pixel's ray");
   }
   for (const fs::path& file : files) {
     const cv::Mat image = cv::imread(file.string(), cv::IMREAD_UNCHANGED);
@@ -91,7 +109,7 @@ void load_png_folder(const CaptureSpec& capture, const Roi& roi, CaptureSamples*
     }
     check_frame(capture, file.string(), image.cols, image.rows, roi, samples);
     const cv::Mat continuous = image.isContinuous() ? image : image.clone();
-    take_roi(continuous.ptr<uint16_t>(), image.cols, roi, samples);
+    take_roi(continuous.ptr<uint16_t>(), image.cols, image.rows, *rays, roi, samples);
   }
 }
 
@@ -125,7 +143,8 @@ void load_lcm_log(const CaptureSpec& capture, const Roi& roi, const std::string&
           ": calibrated is true; record calibration captures without camera.depth_calibration");
     }
     check_frame(capture, name, frame.width, frame.height, roi, samples);
-    take_roi(frame.depth_mm.data(), frame.width, roi, samples);
+    take_roi(frame.depth_mm.data(), frame.width, frame.height,
+             PixelRays{frame.fx, frame.fy, frame.cx, frame.cy}, roi, samples);
   }
   if (samples->frames == 0) {
     throw CalibrationInputError(capture.where + ": LCM log " + capture.path +
@@ -183,10 +202,24 @@ Roi parse_roi(const std::string& text) {
   return roi;
 }
 
-CaptureSamples load_capture(const CaptureSpec& capture, const Roi& roi, const std::string& channel) {
+PixelRays parse_pixel_rays(const std::string& text) {
+  PixelRays rays;
+  char c1 = 0, c2 = 0, c3 = 0;
+  std::istringstream in(text);
+  in >> rays.fx >> c1 >> rays.fy >> c2 >> rays.cx >> c3 >> rays.cy;
+  if (in.fail() || !in.eof() || c1 != ',' || c2 != ',' || c3 != ',' || !(rays.fx > 0) ||
+      !(rays.fy > 0) || !std::isfinite(rays.cx) || !std::isfinite(rays.cy)) {
+    throw CalibrationInputError(
+        "--intrinsics: expected FX,FY,CX,CY in pixels (fx, fy > 0), got \"" + text + "\"");
+  }
+  return rays;
+}
+
+CaptureSamples load_capture(const CaptureSpec& capture, const Roi& roi, const std::string& channel,
+                            const std::optional<PixelRays>& png_rays) {
   CaptureSamples samples;
   if (fs::is_directory(capture.path)) {
-    load_png_folder(capture, roi, &samples);
+    load_png_folder(capture, roi, png_rays, &samples);
   } else {
     load_lcm_log(capture, roi, channel, &samples);
   }
@@ -209,7 +242,7 @@ CalibrationResult calibrate(const std::vector<CaptureSpec>& captures,
                                 std::to_string(distinct.size()));
   }
   // Captures at the same distance are pooled.
-  std::vector<double> measured_m, error_m;
+  std::vector<double> measured_radial_m, radial_error_m;
   std::vector<std::vector<size_t>> groups;
   for (double d : distinct) {
     groups.emplace_back();
@@ -217,13 +250,14 @@ CalibrationResult calibrate(const std::vector<CaptureSpec>& captures,
       if (captures[i].true_distance_mm == d) groups.back().push_back(i);
     }
   }
-  auto stats = [&](const std::vector<size_t>& group, double truth_mm, auto transform,
+  // Mean and standard deviation of calibrated_z(Z, f) - true Z over a group.
+  auto stats = [&](const std::vector<size_t>& group, double truth_mm, auto calibrated_z,
                    double* mean_error, double* std_dev) {
     double sum = 0, sum2 = 0;
     int64_t n = 0;
     for (size_t i : group) {
-      for (float d : samples[i].depth_mm) {
-        const double e = transform(d) - truth_mm;
+      for (size_t k = 0; k < samples[i].depth_mm.size(); ++k) {
+        const double e = calibrated_z(samples[i].depth_mm[k], samples[i].z_per_radial[k]) - truth_mm;
         sum += e;
         sum2 += e * e;
         ++n;
@@ -236,19 +270,32 @@ CalibrationResult calibrate(const std::vector<CaptureSpec>& captures,
   for (const auto& group : groups) {
     DistanceStats row;
     row.true_distance_mm = captures[group.front()].true_distance_mm;
-    row.samples = stats(group, row.true_distance_mm, [](double d) { return d; }, &row.mean_error_mm,
-                        &row.std_mm);
+    row.samples = stats(group, row.true_distance_mm, [](double z, double) { return z; },
+                        &row.mean_error_mm, &row.std_mm);
     row.mean_measured_mm = row.true_distance_mm + row.mean_error_mm;
-    measured_m.push_back(row.mean_measured_mm * 1e-3);
-    error_m.push_back(row.mean_error_mm * 1e-3);
+    // Along the rays: the plane at true Z lies at true Z / f on each ray.
+    double radial_sum_mm = 0, radial_error_sum_mm = 0;
+    int64_t n = 0;
+    for (size_t i : group) {
+      for (size_t k = 0; k < samples[i].depth_mm.size(); ++k) {
+        const double f = samples[i].z_per_radial[k];
+        radial_sum_mm += samples[i].depth_mm[k] / f;
+        radial_error_sum_mm += (samples[i].depth_mm[k] - row.true_distance_mm) / f;
+        ++n;
+      }
+    }
+    measured_radial_m.push_back(radial_sum_mm / n * 1e-3);
+    radial_error_m.push_back(radial_error_sum_mm / n * 1e-3);
     result.rows.push_back(row);
   }
-  result.coefficients_m = fit_polynomial(measured_m, error_m, degree);
+  result.coefficients_m = fit_polynomial(measured_radial_m, radial_error_m, degree);
   const DepthCalibration calibration(result.coefficients_m);
   for (size_t g = 0; g < groups.size(); ++g) {
     DistanceStats& row = result.rows[g];
     stats(groups[g], row.true_distance_mm,
-          [&](double d_mm) { return 1e3 * (d_mm * 1e-3 - calibration.error_m(d_mm * 1e-3)); },
+          [&](double z_mm, double f) {
+            return 1e3 * calibration.apply_z(static_cast<float>(z_mm * 1e-3), static_cast<float>(f));
+          },
           &row.mean_error_after_mm, &row.std_after_mm);
   }
   return result;
@@ -270,7 +317,8 @@ std::string yaml_snippet(const CalibrationResult& result) {
   std::ostringstream out;
   out << std::setprecision(9);
   out << "  # Fitted by tofguard-calibrate-depth: d_calibrated = d - p(d),\n"
-      << "  # p(d) = sum_i c_i d^i, d the measured Z in metres, p in metres.\n"
+      << "  # p(d) = sum_i c_i d^i, d the measured distance along the pixel's ray\n"
+      << "  # (radial, not Z) in metres, p in metres.\n"
       << "  depth_calibration:\n"
       << "    degree: " << result.degree << "\n"
       << "    coefficients_m: [";

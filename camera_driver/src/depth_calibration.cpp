@@ -41,4 +41,12 @@ std::vector<double> fit_polynomial(const std::vector<double>& x, const std::vect
   return std::vector<double>(c.data(), c.data() + c.size());
 }
 
+void DepthCalibration::apply_z(std::vector<float>* z_m, const RadialToZ& rays) const {
+  if (z_m->size() != rays.pixel_count()) {
+    throw std::invalid_argument("DepthCalibration: image of " + std::to_string(z_m->size()) +
+                                " pixels, expected " + std::to_string(rays.pixel_count()));
+  }
+  for (size_t i = 0; i < z_m->size(); ++i) (*z_m)[i] = apply_z((*z_m)[i], rays.factor(i));
+}
+
 }  // namespace tofguard::camera

@@ -40,6 +40,9 @@ class RadialToZ {
   void apply(std::vector<float>* distance_m) const;
   // Z / r for pixel (u, v).
   float factor(int u, int v) const { return factor_[static_cast<size_t>(v) * width_ + u]; }
+  // Z / r for the pixel at row-major index i (v * width + u).
+  float factor(size_t i) const { return factor_[i]; }
+  size_t pixel_count() const { return factor_.size(); }
 
  private:
   int width_;

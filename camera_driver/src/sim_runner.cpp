@@ -111,6 +111,7 @@ int run_sim_camera(const Config& config) {
   LcmNode node(config, "tofguard-camera");
   SimulatedCamera sim(camera_config, scene.get(), wall_utime());
   const DepthCalibration calibration(camera_config.depth_calibration.coefficients_m);
+  const RadialToZ rays(camera_config.intrinsics);
   const bool calibrated = camera_config.depth_calibration.enabled;
 
   node.subscribe<joint_state_t>(
@@ -170,7 +171,7 @@ int run_sim_camera(const Config& config) {
       return;
     }
     std::vector<float> depth_m = frame.image.depth_m;
-    if (calibrated) calibration.apply(&depth_m);
+    if (calibrated) calibration.apply_z(&depth_m, rays);
     const depth_image_t image = make_depth_image(camera_config, capture_utime, slot, calibrated,
                                                  depth_m, frame.image.amplitude);
     node.images().publish(config.channels.depth, &image);

@@ -42,7 +42,10 @@ int run_uvc_camera(const Config& config) {
   std::cerr << "tofguard-camera: " << message << std::endl;
 
   LcmNode node(config, "tofguard-camera");
+  // The frames come as Z (a radial camera's are converted by UvcCamera);
+  // the calibration corrects each pixel's distance along its ray.
   const DepthCalibration calibration(camera_config.depth_calibration.coefficients_m);
+  const RadialToZ rays(camera_config.intrinsics);
   const bool calibrated = camera_config.depth_calibration.enabled;
   const int64_t period_us = static_cast<int64_t>(1e6 / camera_config.rate_hz);
   // No frame for this long: the camera is gone (unplugged, crashed).
@@ -72,7 +75,7 @@ int run_uvc_camera(const Config& config) {
     if (frame) {
       node.counters().frames_in++;
       last_frame_us = now_us;
-      if (calibrated) calibration.apply(&frame->depth_m);
+      if (calibrated) calibration.apply_z(&frame->depth_m, rays);
       const depth_image_t image = make_depth_image(camera_config, frame->utime,
                                                    frame->frame_number, calibrated, frame->depth_m, {});
       node.images().publish(config.channels.depth, &image);

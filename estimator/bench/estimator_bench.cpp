@@ -5,6 +5,7 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <cstdlib>
 
 #include "motion_estimator.hpp"
 #include "simulated_frames.hpp"
@@ -27,6 +28,9 @@ Intrinsics scaled(const Intrinsics& in, int width, int height) {
 }
 
 void BM_EstimateFrame(benchmark::State& state) {
+  // As tofguard-estimator runs (estimator/main.cpp): no llvmpipe render
+  // threads, unless the environment says otherwise.
+  setenv("LP_NUM_THREADS", "0", /*overwrite=*/0);
   const Config config = load_config(std::string(TOFGUARD_SOURCE_DIR) + "/config/sim.yaml", nullptr);
   testing::SimulatedFrames frames(config);
   EstimatorOptions options;

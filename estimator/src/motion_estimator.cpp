@@ -41,7 +41,61 @@ struct MotionEstimator::Linearization {
   int num_contour_points = 0;
   int num_contour_inliers = 0;
 
+  // Residual rows not yet in the normal equations (row-major, one row of
+  // num_joints + kExtraParams per residual), their weights and values:
+  // folded in by one matrix product (flush), much faster than a rank-1
+  // update per residual.
+  std::vector<double> pending_rows;
+  std::vector<double> pending_weights;
+  std::vector<double> pending_residuals;
+
+  // Residuals that move no joint touch only the kExtraParams (camera and
+  // depth offset): most of the image (the environment), so they go into a
+  // small fixed-size block.
+  using StaticRow = Eigen::Matrix<double, kExtraParams, 1>;
+  Eigen::Matrix<double, kExtraParams, kExtraParams> static_hessian = Eigen::Matrix<double, 7, 7>::Zero();
+  StaticRow static_gradient = StaticRow::Zero();
+  void add_static(const StaticRow& row, double weight, double residual) {
+    static_hessian.noalias() += (weight * row) * row.transpose();
+    static_gradient += (weight * residual) * row;
+    weighted_sq += weight * residual * residual;
+  }
+
+  // A zeroed row for one more residual.
+  double* add_row(double weight, double residual) {
+    const size_t width = static_cast<size_t>(gradient.size());
+    pending_rows.resize(pending_rows.size() + width, 0.0);
+    pending_weights.push_back(weight);
+    pending_residuals.push_back(residual);
+    return pending_rows.data() + pending_rows.size() - width;
+  }
+  void flush() {
+    const int first_static = static_cast<int>(gradient.size()) - kExtraParams;
+    hessian.block<kExtraParams, kExtraParams>(first_static, first_static) += static_hessian;
+    gradient.segment<kExtraParams>(first_static) += static_gradient;
+    static_hessian.setZero();
+    static_gradient.setZero();
+    const Eigen::Index count = static_cast<Eigen::Index>(pending_weights.size());
+    if (count == 0) return;
+    using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+    const Eigen::Map<const RowMajor> rows(pending_rows.data(), count, gradient.size());
+    const Eigen::Map<const Eigen::VectorXd> w(pending_weights.data(), count);
+    const Eigen::Map<const Eigen::VectorXd> r(pending_residuals.data(), count);
+    const Eigen::MatrixXd weighted_transpose = rows.transpose() * w.asDiagonal();
+    hessian.noalias() += weighted_transpose * rows;
+    gradient.noalias() += weighted_transpose * r;
+    weighted_sq += (w.array() * r.array().square()).sum();
+    pending_rows.clear();
+    pending_weights.clear();
+    pending_residuals.clear();
+  }
+
   void reset(int num_joints) {
+    pending_rows.clear();
+    pending_weights.clear();
+    pending_residuals.clear();
+    static_hessian.setZero();
+    static_gradient.setZero();
     hessian = Eigen::MatrixXd::Zero(num_joints + kExtraParams, num_joints + kExtraParams);
     gradient = Eigen::VectorXd::Zero(num_joints + kExtraParams);
     weighted_sq = 0;
@@ -62,6 +116,12 @@ struct MotionEstimator::Sample {
 };
 
 namespace {
+
+// The joint search scores at most about this many distal points per joint.
+constexpr size_t kSearchPoints = 500;
+
+// A robust scale level past the end of any schedule (the final scale).
+constexpr int kFinalLevel = 1000;
 
 int64_t now_us() {
   return std::chrono::duration_cast<std::chrono::microseconds>(
@@ -118,7 +178,7 @@ MotionEstimator::MotionEstimator(const renderer::SceneModel& scene, renderer::De
   const EstimatorOptions& o = options_;
   if (o.pixel_stride < 1 || !(o.final_robust_scale_m > 0) || !(o.initial_robust_scale_m >= o.final_robust_scale_m) ||
       !(o.robust_scale_factor > 0 && o.robust_scale_factor < 1) || !(o.gate_scales >= 1) ||
-      o.max_iterations < 1 || !(o.final_damping >= 0) || o.max_camera_iterations < 1 || !(o.step_tolerance > 0) ||
+      o.max_iterations < 1 || !(o.final_damping >= 0) || o.max_working_pixels < 64 || o.coarse_pixel_stride < 1 || !(o.coarse_skip_step >= 0) || o.max_camera_iterations < 1 || !(o.step_tolerance > 0) ||
       !(o.joint_search_step_rad > 0) || !(o.joint_search_range_rad >= 0) || o.joint_search_rounds < 0 ||
       o.min_joint_points < 1 || !(o.max_joint_sigma > 0) || !(o.sigma_scale > 0) || !(o.residual_clip_m > 0) ||
       !(o.noise_sigma_at_0m_m > 0) || !(o.model_sigma_m >= 0) || !(o.noise_sigma_per_m2_m >= 0) || !(o.normal_jump_m > 0) || !(o.contour_jump_fraction > 0) ||
@@ -251,7 +311,7 @@ const MotionEstimator::MeasuredEdges& MotionEstimator::edges_of(const EstimatorF
   return edges;
 }
 
-std::string MotionEstimator::linearize(const EstimatorFrame& frame, const State& state, double scale,
+std::string MotionEstimator::linearize(const EstimatorFrame& frame, const State& state, double scale, int stride,
                                        PointSet points, bool joints_free, Linearization* lin,
                                        std::vector<Sample>* samples) {
   const renderer::LinkPoses poses = renderer::forward_kinematics(scene_, joints_at(scene_, frame, state.joint_offsets));
@@ -266,7 +326,6 @@ std::string MotionEstimator::linearize(const EstimatorFrame& frame, const State&
   const Intrinsics& in = frame.intrinsics;
   const int width = in.width;
   const int height = in.height;
-  const int stride = options_.pixel_stride;
   const int n = num_params_;
   const double gate = options_.gate_scales * scale;
   const double clip = options_.residual_clip_m;
@@ -279,13 +338,19 @@ std::string MotionEstimator::linearize(const EstimatorFrame& frame, const State&
   auto back_project = [&](int u, int v, double z) {
     return Eigen::Vector3d((u - in.cx) * z / in.fx, (v - in.cy) * z / in.fy, z);
   };
-  Eigen::VectorXd row(n + kExtraParams);
   // Adds one residual whose derivative with respect to the model point
   // (seen optical frame) is `g`.
   auto add = [&](const std::vector<ChainJoint>& chain, const Eigen::Vector3d& m, const Eigen::Vector3d& world,
                  const Eigen::Vector3d& g, double residual, double weight, bool count_joint_points,
                  double d_depth_offset) {
-    row.setZero();
+    const Eigen::Vector3d g_cross_m = g.cross(m);
+    if (chain.empty() || !joints_free) {
+      Linearization::StaticRow row;
+      row << -g, g_cross_m, d_depth_offset;
+      lin->add_static(row, weight, residual);
+      return;
+    }
+    double* row = lin->add_row(weight, residual);
     row[n + 6] = d_depth_offset;
     if (joints_free) {
       for (const ChainJoint& c : chain) {
@@ -298,11 +363,10 @@ std::string MotionEstimator::linearize(const EstimatorFrame& frame, const State&
       }
     }
     // The seen frame moved by the twist (v, w): m' = m - v - w x m.
-    row.segment<3>(n) = -g;
-    row.segment<3>(n + 3) = g.cross(m);
-    lin->hessian.selfadjointView<Eigen::Upper>().rankUpdate(row, weight);
-    lin->gradient += weight * residual * row;
-    lin->weighted_sq += weight * residual * residual;
+    for (int k = 0; k < 3; ++k) {
+      row[n + k] = -g[k];
+      row[n + 3 + k] = g_cross_m[k];
+    }
   };
 
   for (int v = 1; v + 1 < height; ++v) {
@@ -348,7 +412,8 @@ std::string MotionEstimator::linearize(const EstimatorFrame& frame, const State&
       // measured point on the same pixel, with the rendered surface's
       // normal from the neighbouring pixels of the same link; none on a
       // silhouette.
-      if (u % stride != 0 || v % stride != 0) continue;
+      const int point_stride = chain.empty() ? stride : std::min(stride, options_.pixel_stride);
+      if (u % point_stride != 0 || v % point_stride != 0) continue;
       const double z_measured = frame.depth_m[i];
       if (!(z_measured > 0) || !std::isfinite(z_measured)) continue;
       bool smooth = true;
@@ -385,11 +450,15 @@ std::string MotionEstimator::linearize(const EstimatorFrame& frame, const State&
       const double sigma = options_.noise_sigma_at_0m_m + options_.noise_sigma_per_m2_m * z_measured * z_measured;
       ++lin->num_inliers;
       add(chain, m, world, normal, residual,
-          tukey * sigma_1m * sigma_1m / (sigma * sigma + options_.model_sigma_m * options_.model_sigma_m), true,
+          // (A strided pixel stands for point_stride^2 pixels, so that
+          // the depth and contour terms keep their balance.)
+          point_stride * point_stride * tukey * sigma_1m * sigma_1m /
+              (sigma * sigma + options_.model_sigma_m * options_.model_sigma_m),
+          true,
           robot ? -normal.dot(ray) : 0.0);
     }
   }
-  lin->hessian.triangularView<Eigen::StrictlyLower>() = lin->hessian.transpose().triangularView<Eigen::StrictlyLower>();
+  lin->flush();
   return "";
 }
 
@@ -421,13 +490,21 @@ std::string MotionEstimator::solve(const std::vector<const EstimatorFrame*>& fra
   const int n = num_params_;
   *converged = false;
   Linearization lin;
-  for (int it = 0; it < max_iterations; ++it) {
+  // The coarse iterations (robust scale above the final one) only bring
+  // the estimate into the final scale's basin: every coarse_pixel_stride-th
+  // pixel's depth residual of what no joint moves (most of the image: the
+  // environment) is enough for them; the links a joint moves keep every
+  // pixel (the small ones would fall below min_joint_points).
+  const int coarse_stride = std::max(options_.pixel_stride, options_.coarse_pixel_stride);
+  int level = 0;  // the robust scale's step in its schedule
+  for (int it = 0; it < max_iterations; ++it, ++level) {
     const double scale = std::max(options_.final_robust_scale_m,
-                                  options_.initial_robust_scale_m * std::pow(options_.robust_scale_factor, it));
+                                  options_.initial_robust_scale_m * std::pow(options_.robust_scale_factor, level));
     const bool final_scale = scale <= options_.final_robust_scale_m * (1 + 1e-9);
     lin.reset(n);
     for (const EstimatorFrame* frame : frames) {
-      const std::string error = linearize(*frame, *state, scale, points, joints_free, &lin, nullptr);
+      const std::string error = linearize(*frame, *state, scale, final_scale ? options_.pixel_stride : coarse_stride,
+                                          points, joints_free, &lin, nullptr);
       if (!error.empty()) return error;
     }
     ++*iterations;
@@ -476,6 +553,11 @@ std::string MotionEstimator::solve(const std::vector<const EstimatorFrame*>& fra
       *converged = true;
       return "";
     }
+    // The camera alone already in the basin (a small first step: the
+    // static links agree with the reported pose): on to the final scale at
+    // once. (Not with the joints: their coarse iterations,
+    // undamped, also carry them most of the way after the search.)
+    if (!joints_free && it == 0 && largest < options_.coarse_skip_step) level = kFinalLevel;
   }
   return "";
 }
@@ -495,7 +577,8 @@ int MotionEstimator::search_joints(const EstimatorFrame& frame, State* state, st
     std::vector<Sample> samples;
     Linearization scratch;
     scratch.reset(num_params_);
-    *error = linearize(frame, *state, options_.final_robust_scale_m, PointSet::kAll, false, &scratch, &samples);
+    *error = linearize(frame, *state, options_.final_robust_scale_m, options_.pixel_stride, PointSet::kAll, false,
+                       &scratch, &samples);
     if (!error->empty()) return moves;
     const renderer::LinkPoses base = renderer::forward_kinematics(scene_, joints_at(scene_, frame, state->joint_offsets));
     const Eigen::Isometry3d optical_from_world = (frame.world_from_optical * state->correction).inverse();
@@ -540,6 +623,15 @@ int MotionEstimator::search_joints(const EstimatorFrame& frame, State* state, st
         }
       }
       if (static_cast<int>(distal.size()) < options_.min_joint_points) continue;
+      // Scoring every distal point of a large link for 30 offsets costs
+      // more than a render; a few hundred points, spread over the links,
+      // score as well.
+      const size_t every = (distal.size() + kSearchPoints - 1) / kSearchPoints;
+      if (every > 1) {
+        size_t kept = 0;
+        for (size_t i = 0; i < distal.size(); i += every) distal[kept++] = distal[i];
+        distal.resize(kept);
+      }
       std::fill(moved.begin(), moved.end(), Eigen::Isometry3d::Identity());
       const int base_score = score(distal, moved);
       for (double offset : grid) {
@@ -550,8 +642,9 @@ int MotionEstimator::search_joints(const EstimatorFrame& frame, State* state, st
         for (size_t l = 0; l < moved.size(); ++l) {
           moved[l] = poses.world_from_link[l] * base.world_from_link[l].inverse();
         }
-        const int gain = score(distal, moved) - base_score;
-        const double fraction = static_cast<double>(gain) / distal.size();
+        const int scored_gain = score(distal, moved) - base_score;
+        const int gain = scored_gain * static_cast<int>(every);  // in all distal points
+        const double fraction = static_cast<double>(scored_gain) / distal.size();
         if (gain >= options_.min_joint_points && fraction >= options_.min_search_gain_fraction &&
             fraction > best_gain_fraction) {
           best_gain_fraction = fraction;
@@ -617,18 +710,45 @@ EstimateResult MotionEstimator::finish(const EstimatorFrame& frame, const State&
   return result;
 }
 
-EstimateResult MotionEstimator::estimate(const EstimatorFrame& frame) {
+EstimateResult MotionEstimator::estimate(const EstimatorFrame& full_frame) {
   const int64_t start = now_us();
   auto fail = [&](const std::string& why) { return unusable_result(why, start); };
-  const std::string problem = check_frame(frame);
+  const std::string problem = check_frame(full_frame);
   if (!problem.empty()) return fail(problem);
   edges_.clear();
+  // A large image is estimated at a working resolution: every k-th pixel
+  // in u and v (no averaging, which would make mixed pixels of every
+  // silhouette), with the intrinsics scaled to match.
+  const Intrinsics& full = full_frame.intrinsics;
+  int k = 1;
+  while (static_cast<int64_t>(full.width / k) * (full.height / k) > options_.max_working_pixels) ++k;
+  EstimatorFrame reduced;
+  if (k > 1) {
+    reduced.reported_joints = full_frame.reported_joints;
+    reduced.world_from_optical = full_frame.world_from_optical;
+    reduced.intrinsics = full;
+    reduced.intrinsics.width = full.width / k;
+    reduced.intrinsics.height = full.height / k;
+    reduced.intrinsics.fx = full.fx / k;
+    reduced.intrinsics.fy = full.fy / k;
+    reduced.intrinsics.cx = full.cx / k;
+    reduced.intrinsics.cy = full.cy / k;
+    reduced.depth_m.resize(static_cast<size_t>(reduced.intrinsics.width) * reduced.intrinsics.height);
+    for (int v = 0; v < reduced.intrinsics.height; ++v) {
+      for (int u = 0; u < reduced.intrinsics.width; ++u) {
+        reduced.depth_m[static_cast<size_t>(v) * reduced.intrinsics.width + u] =
+            full_frame.depth_m[static_cast<size_t>(v * k) * full.width + u * k];
+      }
+    }
+  }
+  const EstimatorFrame& frame = k > 1 ? reduced : full_frame;
 
   State state;
   state.joint_offsets.assign(num_params_, 0.0);
   Linearization before;
   before.reset(num_params_);
-  std::string error = linearize(frame, state, options_.final_robust_scale_m, PointSet::kAll, false, &before, nullptr);
+  std::string error = linearize(frame, state, options_.final_robust_scale_m, options_.pixel_stride, PointSet::kAll,
+                                false, &before, nullptr);
   if (!error.empty()) return fail(error);
 
   const bool joints_free = options_.estimate_joints;
@@ -682,7 +802,8 @@ EstimateResult MotionEstimator::estimate_camera(const std::vector<EstimatorFrame
   before.reset(num_params_);
   for (const EstimatorFrame* frame : pointers) {
     const std::string error =
-        linearize(*frame, state, options_.final_robust_scale_m, PointSet::kAll, false, &before, nullptr);
+        linearize(*frame, state, options_.final_robust_scale_m, options_.pixel_stride, PointSet::kAll, false, &before,
+                  nullptr);
     if (!error.empty()) return fail(error);
   }
   Linearization lin = before;

@@ -48,6 +48,14 @@ struct EstimatorOptions {
   // Every pixel_stride-th pixel in u and v takes part (the model is always
   // rendered at the frame's full size: the normals need neighbours).
   int pixel_stride = 1;
+  // A frame of more pixels is estimated at a working resolution: every
+  // k-th pixel in u and v, k the smallest integer that brings it to at most
+  // this many (30000: 176x144 as it is, 320x240 as 160x120). The time per
+  // frame then hardly grows with the camera's resolution.
+  int64_t max_working_pixels = 30000;
+  // The same for the static links' pixels (the environment) in the
+  // iterations at a coarse robust scale (not the final one).
+  int coarse_pixel_stride = 2;
   // Camera noise sigma(Z) = noise_sigma_at_0m_m + noise_sigma_per_m2_m * Z^2,
   // metres: residuals are weighted by (sigma(1 m) / sigma(Z))^2.
   double noise_sigma_at_0m_m = 0.004;
@@ -75,6 +83,9 @@ struct EstimatorOptions {
   // Converged when, at the final scale, no parameter moves more than this
   // (radians / metres) in one step.
   double step_tolerance = 1e-3;
+  // A step smaller than this (rad / m) at a coarse robust scale moves on
+  // to the final scale at once: the estimate is already in its basin.
+  double coarse_skip_step = 5e-3;
   // Levenberg-Marquardt damping (relative to the diagonal) at the final
   // scale: contour associations move in whole pixels, and a weakly seen
   // joint would otherwise swing about its optimum.
@@ -194,7 +205,8 @@ class MotionEstimator {
   MotionEstimator(const renderer::SceneModel& scene, renderer::DepthRenderer* renderer,
                   const EstimatorOptions& options);
 
-  // Estimates what `frame` shows, with the options' free parameters.
+  // Estimates what `frame` shows, with the options' free parameters (at
+  // the working resolution, EstimatorOptions::max_working_pixels).
   // Never throws for bad input: the result is then unusable.
   EstimateResult estimate(const EstimatorFrame& frame);
 
@@ -227,7 +239,7 @@ class MotionEstimator {
   std::string check_frame(const EstimatorFrame& frame) const;
   // Renders `frame` at `state` and adds its residuals to `lin`. Returns ""
   // or why the frame cannot be rendered.
-  std::string linearize(const EstimatorFrame& frame, const State& state, double scale, PointSet points,
+  std::string linearize(const EstimatorFrame& frame, const State& state, double scale, int stride, PointSet points,
                         bool joints_free, Linearization* lin, std::vector<Sample>* samples);
   // Gauss-Newton stage over `frames`; returns "" or an unusable reason.
   std::string solve(const std::vector<const EstimatorFrame*>& frames, bool joints_free, bool camera_free,

@@ -24,7 +24,7 @@ std::vector<float> SimulatedFrames::capture(const renderer::JointPositions& true
   if (!rendered.usable) throw std::runtime_error(rendered.unusable_reason);
   const camera::TofErrorModel model(config_.camera.sim, intrinsics);
   camera::TofImage image = model.apply(rendered.depth_m, frame_index);
-  calibration_.apply(&image.depth_m);
+  calibration_.apply_z(&image.depth_m, camera::RadialToZ(intrinsics));
   return image.depth_m;
 }
 

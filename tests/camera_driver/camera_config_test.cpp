@@ -29,8 +29,8 @@ TEST(CameraConfig, EmbeddedDefaultHasTheSimCamera) {
   EXPECT_EQ(c.camera.sim.systematic_error_m.size(), 6u);
   EXPECT_DOUBLE_EQ(c.camera.sim.noise_sigma0_mm, 4.75);
   EXPECT_TRUE(c.camera.depth_calibration.enabled);
-  EXPECT_EQ(c.camera.depth_calibration.degree, 5);
-  EXPECT_EQ(c.camera.depth_calibration.coefficients_m.size(), 6u);
+  EXPECT_EQ(c.camera.depth_calibration.degree, 7);
+  EXPECT_EQ(c.camera.depth_calibration.coefficients_m.size(), 8u);
 }
 
 TEST(CameraConfig, UvcSection) {
@@ -67,8 +67,8 @@ TEST(CameraConfig, RejectsBadCameraKeys) {
             std::string::npos)
       << range;
   const std::string degree =
-      error_of(variant("cal_degree", "    degree: 5", "    degree: 4"));
-  EXPECT_NE(degree.find("camera.depth_calibration.coefficients_m: expected a list of 5 numbers"),
+      error_of(variant("cal_degree", "    degree: 7", "    degree: 6"));
+  EXPECT_NE(degree.find("camera.depth_calibration.coefficients_m: expected a list of 7 numbers"),
             std::string::npos)
       << degree;
   const std::string fault = error_of(

@@ -27,7 +27,9 @@ bool wait_until(const std::function<bool()>& condition, std::chrono::millisecond
 class Subprocess {
  public:
   // Starts argv[0] (a path) with argv; `name` names the output files in
-  // output_dir().
+  // output_dir(). The child gets SIGKILL when the thread that started it
+  // ends (PR_SET_PDEATHSIG), so a test that is killed leaves nothing
+  // running: start Subprocesses from the test's own thread.
   Subprocess(const std::string& name, const std::vector<std::string>& argv);
   ~Subprocess();  // kills the child (SIGKILL) if it still runs
   Subprocess(const Subprocess&) = delete;

@@ -90,8 +90,10 @@ struct EnvironmentConfig {
 
 // Distance calibration applied by tofguard-camera before publishing:
 //   d_calibrated = d - p(d),  p(d) = sum_i coefficients_m[i] * d^i,
-// with d the measured Z (along the optical axis) in metres and p(d) in
-// metres. Fitted by tofguard-calibrate-depth.
+// with d the measured distance along the pixel's ray (radial, not Z) in
+// metres and p(d) in metres; a Z image is corrected per pixel through its
+// ray (camera_driver/src/depth_calibration.hpp). Fitted by
+// tofguard-calibrate-depth.
 struct DepthCalibrationConfig {
   // false when the config has no camera.depth_calibration: frames are then
   // published with calibrated = false.
