@@ -4,6 +4,9 @@
 #include <cstdlib>
 #include <iostream>
 
+#include <unistd.h>
+#include <cerrno>
+#include <cstring>
 #include "estimator_process.hpp"
 #include "tofguard/clock.hpp"
 #include "tofguard/config_error.hpp"
@@ -112,5 +115,13 @@ int main(int argc, char** argv) {
   // per frame without them, 44 ms with). Set before the EGL display is
   // opened; a value in the environment wins.
   setenv("LP_NUM_THREADS", "0", /*overwrite=*/0);
+  // The estimate is a diagnosis, not part of the stop path: on a small CPU
+  // it must never take time from the renderer, discrepancy and risk, whose
+  // deadlines stop the arm. Niceness +10 for the process and every thread
+  // it starts (set before any thread exists).
+  errno = 0;
+  if (nice(10) == -1 && errno != 0) {
+    std::cerr << "tofguard-estimator: cannot lower its priority (nice 10): " << std::strerror(errno) << "\n";
+  }
   return tofguard::run_process(argc, argv, tofguard::estimator::process_info(), tofguard::estimator::run);
 }

@@ -212,6 +212,7 @@ EstimatorConfig read_estimator(YamlMap map) {
     YamlMap warning = map.map("warning");
     e.warning_mismatch_fraction = warning.number("mismatch_fraction", 0, 1);
     e.warning_p95_abs_dis_mm = warning.number("p95_abs_dis_mm", 0, 32767);
+    e.warning_min_interval_ms = warning.number("min_interval_ms", 0, 60000);
     warning.finish();
   }
   e.periodic_period_ms = map.number("periodic_period_ms", 10, 3600000);

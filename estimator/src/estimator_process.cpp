@@ -119,6 +119,11 @@ void EstimatorScheduler::on_discrepancy(const discrepancy_t& d) {
                        d.p95_abs_dis_mm >= config_.estimator.warning_p95_abs_dis_mm ||
                        risk::is_model_mismatch(risk::classify_frame(d, robot_, config_.risk, {}).cause);
   if (!warning || estimated_.count(d.seq) > 0) return;
+  const int64_t min_interval_us = static_cast<int64_t>(config_.estimator.warning_min_interval_ms * 1000);
+  if (last_warning_utime_ > 0 && d.utime >= last_warning_utime_ && d.utime - last_warning_utime_ < min_interval_us) {
+    return;  // rate limit (camera time)
+  }
+  last_warning_utime_ = d.utime;
   const auto f = frames_.find(d.seq);
   if (f != frames_.end()) {
     ready_.push_back(build(f->second, motion_estimate_t::TRIGGER_WARNING));

@@ -103,6 +103,7 @@ class EstimatorScheduler {
   std::map<int64_t, depth_image_t> frames_;  // by seq
   std::map<int64_t, int8_t> wanted_;          // seq -> trigger
   std::set<int64_t> estimated_;
+  int64_t last_warning_utime_ = 0;  // utime of the last warning-triggered frame
   std::vector<ScheduledWork> ready_;
   int64_t missed_ = 0;
 };

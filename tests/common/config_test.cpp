@@ -54,7 +54,7 @@ TEST(Config, EmbeddedDefaultLoads) {
   EXPECT_DOUBLE_EQ(config.renderer.max_extrapolation_ms, 20);
   EXPECT_FALSE(config.camera.sim.pan_tilt_enabled);
   EXPECT_TRUE(config.risk.estimate_enabled);
-  EXPECT_DOUBLE_EQ(config.risk.estimate_wait_ms, 60);
+  EXPECT_DOUBLE_EQ(config.risk.estimate_wait_ms, 0);
   EXPECT_TRUE(config.risk.plan_enabled);
   EXPECT_TRUE(config.joints_sim.publish_plan);
   EXPECT_TRUE(config.renderer.prediction_enabled);
@@ -132,7 +132,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadConfig{"pan-tilt-offset-without-head", "    faults: []\n",
                   "    faults: [{kind: pan_tilt_offset, start_s: 1, duration_s: 1, pan_offset_deg: 3, tilt_offset_deg: 0}]\n",
                   {"camera.sim.faults", "only with camera.sim.pan_tilt"}},
-        BadConfig{"estimate-wait-out-of-range", "    wait_ms: 60\n", "    wait_ms: 5000\n",
+        BadConfig{"estimate-wait-out-of-range", "    wait_ms: 0\n", "    wait_ms: 5000\n",
                   {"risk.estimate.wait_ms", "expected a number in"}},
         BadConfig{"plan-step-longer-than-horizon", "step_ms: 20}", "step_ms: 600}",
                   {"joints_sim.plan.step_ms", "no longer than horizon_ms"}}),

@@ -29,8 +29,14 @@ using risk::RobotTree;
 constexpr int64_t kStart = 5'000'000'000;  // monotonic
 constexpr int64_t kMs = 1000;
 
+// config/sim.yaml with a 60 ms wait for a frame's own estimate (sim.yaml
+// waits 0 ms; these tests are about the wait).
 const Config& sim_config() {
-  static const Config config = load_config(source_dir() + "/config/sim.yaml", nullptr);
+  static const Config config = [] {
+    Config c = load_config(source_dir() + "/config/sim.yaml", nullptr);
+    c.risk.estimate_wait_ms = 60;
+    return c;
+  }();
   return config;
 }
 

@@ -351,6 +351,10 @@ struct EstimatorConfig {
   // its p95_abs_dis_mm reaches warning_p95_abs_dis_mm.
   double warning_mismatch_fraction = 0;
   double warning_p95_abs_dis_mm = 0;
+  // At most one warning-triggered frame per warning_min_interval_ms of
+  // camera time (frame utimes): on a small CPU the estimator shares the
+  // cores with the renderer, whose deadline stops the arm.
+  double warning_min_interval_ms = 0;
   // And the newest frame every periodic_period_ms (TRIGGER_PERIODIC),
   // milliseconds.
   double periodic_period_ms = 0;
