@@ -10,6 +10,7 @@
 //       --benchmark_report_aggregates_only=true   (one command line)
 #include <benchmark/benchmark.h>
 
+#include "depth_message.hpp"
 #include "renderer_process.hpp"
 #include "tofguard/config.hpp"
 
@@ -41,23 +42,11 @@ joint_state_t joints_at(int64_t utime) {
   return s;
 }
 
+// A flat wall 1.5 m away filling the frame (what it shows does not matter).
 depth_image_t frame_at(int64_t utime, int64_t seq) {
-  const Intrinsics& k = sim_config().camera.intrinsics;
-  depth_image_t f;
-  f.utime = utime;
-  f.seq = seq;
-  f.camera_id = sim_config().camera.id;
-  f.width = k.width;
-  f.height = k.height;
-  f.fx = k.fx;
-  f.fy = k.fy;
-  f.cx = k.cx;
-  f.cy = k.cy;
-  f.calibrated = true;
-  f.num_pixels = k.width * k.height;
-  f.depth_mm.assign(f.num_pixels, 1500);
-  f.num_amplitude = 0;
-  return f;
+  const CameraConfig& camera = sim_config().camera;
+  return camera::make_depth_image(camera, utime, seq, /*calibrated=*/true,
+                                  std::vector<float>(camera.intrinsics.width * camera.intrinsics.height, 1.5f), {});
 }
 
 planned_trajectory_t hold_plan() {

@@ -10,6 +10,7 @@
 #include <optional>
 #include <regex>
 
+#include "depth_message.hpp"
 #include "depth_renderer.hpp"
 #include "renderer_process.hpp"
 #include "test_support.hpp"
@@ -81,20 +82,8 @@ struct Bench {
   }
   int64_t publish_frame(int64_t utime) {
     const Intrinsics& k = config.camera.intrinsics;
-    depth_image_t f;
-    f.utime = utime;
-    f.seq = ++seq;
-    f.camera_id = config.camera.id;
-    f.width = k.width;
-    f.height = k.height;
-    f.fx = k.fx;
-    f.fy = k.fy;
-    f.cx = k.cx;
-    f.cy = k.cy;
-    f.calibrated = true;
-    f.num_pixels = k.width * k.height;
-    f.depth_mm.assign(f.num_pixels, 1500);
-    f.num_amplitude = 0;
+    const depth_image_t f = camera::make_depth_image(config.camera, utime, ++seq, /*calibrated=*/true,
+                                                     std::vector<float>(k.width * k.height, 1.5f), {});
     images.publish(config.channels.depth, &f);
     return f.seq;
   }
