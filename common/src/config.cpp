@@ -217,6 +217,7 @@ EstimatorConfig read_estimator(YamlMap map) {
   }
   e.periodic_period_ms = map.number("periodic_period_ms", 10, 3600000);
   e.max_pending_frames = static_cast<int>(map.integer("max_pending_frames", 1, 100));
+  e.frames_per_estimate = static_cast<int>(map.integer("frames_per_estimate", 1, e.max_pending_frames));
   e.max_iterations = static_cast<int>(map.integer("max_iterations", 1, 100));
   e.pixel_stride = static_cast<int>(map.integer("pixel_stride", 1, 8));
   map.finish();

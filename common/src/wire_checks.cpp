@@ -158,6 +158,7 @@ std::string check_motion_estimate(const motion_estimate_t& e) {
     if (e.unusable_reason.empty()) return "unusable_reason: expected a reason for an unusable estimate, got an empty string";
     return "";
   }
+  if (e.num_frames < 1) return expected("num_frames", "a count of frames >= 1", e.num_frames);
   if (e.num_joints < 0) return expected("num_joints", "a count >= 0", e.num_joints);
   if (auto problem = check_names(e.joint_name, "joint_name"); !problem.empty()) return problem;
   for (int i = 0; i < e.num_joints; ++i) {

@@ -29,6 +29,7 @@ motion_estimate_t base_message(const EstimateContext& context) {
   m.usable = false;
   m.converged = false;
   m.iterations = 0;
+  m.num_frames = 0;
   m.num_joints = 0;
   set_pose(Eigen::Isometry3d::Identity(), m.correction_translation, m.correction_rotation);
   m.correction_translation_sigma_m = 0;
@@ -71,6 +72,7 @@ motion_estimate_t to_message(const EstimateResult& result, const EstimateContext
   m.usable = true;
   m.converged = result.converged;
   m.iterations = result.iterations;
+  m.num_frames = result.num_frames;
   m.num_joints = static_cast<int32_t>(result.joints.size());
   for (const JointEstimate& j : result.joints) {
     m.joint_name.push_back(j.name);

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "depth_renderer.hpp"
+#include "tofguard/camera_pose_message.hpp"
 #include "kinematics.hpp"
 
 namespace tofguard::estimator {
@@ -63,8 +64,11 @@ EstimatorScheduler::EstimatorScheduler(const Config& config, const renderer::Sce
     : config_(config),
       scene_(scene),
       robot_(risk::RobotTree::from_urdf_file(config.robot.urdf_path)),
-      history_(static_cast<int64_t>(std::llround(config.renderer.max_extrapolation_ms * 1000.0))) {
-  camera_poses_[config.camera.id] = config.camera.pose;
+      history_(static_cast<int64_t>(std::llround(config.renderer.max_extrapolation_ms * 1000.0))),
+      camera_poses_(static_cast<int64_t>(std::llround(config.renderer.camera_pose_history_ms * 1000.0)),
+                    static_cast<int64_t>(std::llround(config.renderer.camera_pose_max_extrapolation_ms * 1000.0)),
+                    static_cast<int64_t>(std::llround(config.renderer.camera_pose_max_gap_ms * 1000.0))) {
+  camera_poses_.set_static(config.camera.id, config.camera.pose);
 }
 
 bool EstimatorScheduler::on_joint_state(const joint_state_t& state) {
@@ -77,11 +81,7 @@ bool EstimatorScheduler::on_joint_state(const joint_state_t& state) {
 }
 
 void EstimatorScheduler::on_camera_pose(const camera_pose_t& message) {
-  CameraPose pose;
-  pose.frame_id = message.frame_id;
-  pose.translation_m = Eigen::Vector3d(message.translation[0], message.translation[1], message.translation[2]);
-  pose.rotation = Eigen::Quaterniond(message.rotation[0], message.rotation[1], message.rotation[2], message.rotation[3]);
-  camera_poses_[message.camera_id] = pose;
+  camera_poses_.add(message.camera_id, message.utime, from_camera_pose_message(message));
 }
 
 bool EstimatorScheduler::on_depth(const depth_image_t& frame) {
@@ -94,6 +94,9 @@ bool EstimatorScheduler::on_depth(const depth_image_t& frame) {
       ++missed_;
     }
     frames_.erase(frames_.begin());
+  }
+  while (!warning_seqs_.empty() && *warning_seqs_.begin() < frames_.begin()->first) {
+    warning_seqs_.erase(warning_seqs_.begin());
   }
   // Wanted seqs older than every kept frame will never come.
   while (!wanted_.empty() && wanted_.begin()->first < frames_.begin()->first) {
@@ -110,14 +113,19 @@ bool EstimatorScheduler::on_depth(const depth_image_t& frame) {
   return true;
 }
 
-void EstimatorScheduler::on_discrepancy(const discrepancy_t& d) {
-  if (d.camera_id != config_.camera.id || !d.usable) return;
+bool EstimatorScheduler::passes_warning(const discrepancy_t& d) const {
   // The risk classifier's own rules decide "passes the warning level" (one
   // rule set, tofguard-risk waits for this estimate exactly then), plus the
   // estimator's coarser thresholds.
-  const bool warning = d.mismatch_fraction >= config_.estimator.warning_mismatch_fraction ||
-                       d.p95_abs_dis_mm >= config_.estimator.warning_p95_abs_dis_mm ||
-                       risk::is_model_mismatch(risk::classify_frame(d, robot_, config_.risk, {}).cause);
+  return d.mismatch_fraction >= config_.estimator.warning_mismatch_fraction ||
+         d.p95_abs_dis_mm >= config_.estimator.warning_p95_abs_dis_mm ||
+         risk::is_model_mismatch(risk::classify_frame(d, robot_, config_.risk, {}).cause);
+}
+
+void EstimatorScheduler::on_discrepancy(const discrepancy_t& d) {
+  if (d.camera_id != config_.camera.id || !d.usable) return;
+  const bool warning = passes_warning(d);
+  if (warning && (frames_.empty() || d.seq >= frames_.begin()->first)) warning_seqs_.insert(d.seq);
   if (!warning || estimated_.count(d.seq) > 0) return;
   const int64_t min_interval_us = static_cast<int64_t>(config_.estimator.warning_min_interval_ms * 1000);
   if (last_warning_utime_ > 0 && d.utime >= last_warning_utime_ && d.utime - last_warning_utime_ < min_interval_us) {
@@ -149,6 +157,52 @@ std::vector<ScheduledWork> EstimatorScheduler::take_ready() {
   return out;
 }
 
+std::optional<EstimatorFrame> EstimatorScheduler::estimator_frame(const depth_image_t& frame,
+                                                                  const std::string& frame_id,
+                                                                  std::string* why) const {
+  const renderer::JointsAtTime joints = history_.at(frame.utime);
+  if (!joints.usable) {
+    *why = "joint state: " + joints.unusable_reason;
+    return std::nullopt;
+  }
+  const renderer::PoseAtTime pose = camera_poses_.at(frame.camera_id, frame.utime);
+  if (!pose.usable) {
+    *why = "camera pose: " + pose.unusable_reason;
+    return std::nullopt;
+  }
+  if (pose.pose.frame_id != frame_id) {
+    *why = "camera pose frame changed from '" + frame_id + "' to '" + pose.pose.frame_id + "'";
+    return std::nullopt;
+  }
+  const int frame_link = scene_.find_link(frame_id);
+  if (frame_link < 0) {
+    *why = "camera pose frame '" + frame_id + "' is not a model link";
+    return std::nullopt;
+  }
+  // A camera on a moving link would move with the joints being estimated:
+  // not modelled.
+  const std::string moving = moving_joint_of(scene_, frame_link);
+  if (!moving.empty()) {
+    *why = "camera pose frame '" + frame_id + "' moves with joint '" + moving +
+           "': a camera on the arm is not supported by the estimator";
+    return std::nullopt;
+  }
+  const renderer::LinkPoses poses = renderer::forward_kinematics(scene_, joints.joints);
+  if (!poses.usable) {
+    *why = poses.unusable_reason;
+    return std::nullopt;
+  }
+  Eigen::Isometry3d frame_from_optical = Eigen::Isometry3d::Identity();
+  frame_from_optical.linear() = pose.pose.rotation.normalized().toRotationMatrix();
+  frame_from_optical.translation() = pose.pose.translation_m;
+  EstimatorFrame out;
+  out.intrinsics = Intrinsics{frame.width, frame.height, frame.fx, frame.fy, frame.cx, frame.cy};
+  out.reported_joints = joints.joints;
+  out.world_from_optical = poses.world_from_link[frame_link] * frame_from_optical;
+  out.depth_m = depth_in_metres(frame);
+  return out;
+}
+
 ScheduledWork EstimatorScheduler::build(const depth_image_t& frame, int8_t trigger) const {
   ScheduledWork work;
   EstimateContext context;
@@ -157,49 +211,39 @@ ScheduledWork EstimatorScheduler::build(const depth_image_t& frame, int8_t trigg
   context.camera_id = frame.camera_id;
   context.trigger = trigger;
   context.joint_names = scene_.actuated_joint_names;
-  const auto pose = camera_poses_.find(frame.camera_id);
-  if (pose != camera_poses_.end()) {
-    context.frame_id = pose->second.frame_id;
-    context.frame_from_optical.linear() = pose->second.rotation.normalized().toRotationMatrix();
-    context.frame_from_optical.translation() = pose->second.translation_m;
+  const renderer::PoseAtTime pose = camera_poses_.at(frame.camera_id, frame.utime);
+  if (pose.usable) {
+    context.frame_id = pose.pose.frame_id;
+    context.frame_from_optical.linear() = pose.pose.rotation.normalized().toRotationMatrix();
+    context.frame_from_optical.translation() = pose.pose.translation_m;
   }
   const renderer::JointsAtTime joints = history_.at(frame.utime);
   for (const std::string& name : context.joint_names) {
     const auto found = joints.joints.find(name);
     context.reported_positions.push_back(found != joints.joints.end() ? found->second : 0.0);
   }
-  if (!joints.usable) {
-    work.unusable = unusable_message(context, "joint state: " + joints.unusable_reason);
-    return work;
-  }
-  if (pose == camera_poses_.end()) {
-    work.unusable = unusable_message(context, "no camera pose for camera '" + frame.camera_id + "'");
-    return work;
-  }
-  const int frame_link = scene_.find_link(context.frame_id);
-  if (frame_link < 0) {
-    work.unusable = unusable_message(context, "camera pose frame '" + context.frame_id + "' is not a model link");
-    return work;
-  }
-  // A camera on a moving link would move with the joints being estimated:
-  // not modelled.
-  const std::string moving = moving_joint_of(scene_, frame_link);
-  if (!moving.empty()) {
-    work.unusable = unusable_message(context, "camera pose frame '" + context.frame_id + "' moves with joint '" +
-                                                  moving + "': a camera on the arm is not supported by the estimator");
-    return work;
-  }
-  const renderer::LinkPoses poses = renderer::forward_kinematics(scene_, joints.joints);
-  if (!poses.usable) {
-    work.unusable = unusable_message(context, poses.unusable_reason);
+  std::string why;
+  std::optional<EstimatorFrame> first = estimator_frame(frame, context.frame_id, &why);
+  if (!first) {
+    work.unusable = unusable_message(context, why);
     return work;
   }
   EstimateJob job;
   job.context = context;
-  job.frame.intrinsics = Intrinsics{frame.width, frame.height, frame.fx, frame.fy, frame.cx, frame.cy};
-  job.frame.reported_joints = joints.joints;
-  job.frame.world_from_optical = poses.world_from_link[frame_link] * context.frame_from_optical;
-  job.frame.depth_m = depth_in_metres(frame);
+  job.frames.push_back(std::move(*first));
+  // The kept frames just before it, newest first, that can be estimated
+  // with it: on the same side of a fault's onset (warning or not), joints
+  // and pose known, same size and pose frame.
+  const bool warning = trigger == motion_estimate_t::TRIGGER_WARNING || warning_seqs_.count(frame.seq) > 0;
+  for (auto it = frames_.lower_bound(frame.seq);
+       it != frames_.begin() && static_cast<int>(job.frames.size()) < config_.estimator.frames_per_estimate;) {
+    --it;
+    const depth_image_t& earlier = it->second;
+    if ((warning_seqs_.count(it->first) > 0) != warning) continue;
+    if (earlier.width != frame.width || earlier.height != frame.height) continue;
+    std::optional<EstimatorFrame> f = estimator_frame(earlier, context.frame_id, &why);
+    if (f) job.frames.push_back(std::move(*f));
+  }
   work.job = std::move(job);
   return work;
 }
@@ -276,7 +320,7 @@ void EstimatorWorker::run() {
       pending_.reset();
       working_ = true;
     }
-    const EstimateResult result = estimator->estimate(job.frame);
+    const EstimateResult result = estimator->estimate(job.frames);
     motion_estimate_t message = to_message(result, job.context);
     std::lock_guard<std::mutex> lock(mutex_);
     results_.push_back(std::move(message));

@@ -11,10 +11,18 @@
 //                    (risk::classify_frame) find a model mismatch,
 //                    as soon as both the frame and its discrepancy are in;
 //   TRIGGER_PERIODIC the newest frame every periodic_period_ms.
-// A frame is estimated once. The joints are the JOINT_STATE history
-// interpolated at the frame's utime (renderer's JointHistory, the
-// renderer's extrapolation limit); the camera pose the newest CAMERA_POSE
-// for the frame's camera, else the config's static pose.
+// A frame is estimated once, jointly with up to frames_per_estimate - 1
+// kept frames just before it (MotionEstimator::estimate(frames)) that are
+// on the same side of a fault's onset: for a frame whose discrepancy passed
+// the warning level, earlier frames whose discrepancy passed it too; for
+// any other frame, earlier frames whose discrepancy did not (or has not
+// come). An offset that began between two frames is not averaged with the
+// frames before it. The
+// joints are the JOINT_STATE history interpolated at each frame's utime
+// (renderer's JointHistory, the renderer's extrapolation limit); the
+// camera pose is CAMERA_POSE at the frame's utime (renderer's
+// CameraPoseHistory, with the renderer's limits), else the config's static
+// pose.
 #include <condition_variable>
 #include <deque>
 #include <map>
@@ -24,6 +32,7 @@
 #include <string>
 #include <thread>
 
+#include "camera_pose_history.hpp"
 #include "estimate_message.hpp"
 #include "joint_history.hpp"
 #include "frame_classifier.hpp"
@@ -62,7 +71,9 @@ std::vector<float> depth_in_metres(const depth_image_t& frame);
 std::string check_discrepancy(const discrepancy_t& d);
 
 struct EstimateJob {
-  EstimatorFrame frame;
+  // frames[0] is the frame the estimate is about, the others the frames
+  // just before it (newest first).
+  std::vector<EstimatorFrame> frames;
   EstimateContext context;
 };
 
@@ -94,15 +105,23 @@ class EstimatorScheduler {
 
  private:
   ScheduledWork build(const depth_image_t& frame, int8_t trigger) const;
+  // The discrepancy passed the warning level (estimator.warning, or the
+  // risk rules' model mismatch).
+  bool passes_warning(const discrepancy_t& d) const;
+  // The frame with its reported joints and camera pose (for `context`'s
+  // camera frame_id), or "" and the reason it cannot be estimated.
+  std::optional<EstimatorFrame> estimator_frame(const depth_image_t& frame, const std::string& frame_id,
+                                                std::string* why) const;
 
   Config config_;
   const renderer::SceneModel& scene_;
   risk::RobotTree robot_;
   renderer::JointHistory history_;
-  std::map<std::string, CameraPose> camera_poses_;
+  renderer::CameraPoseHistory camera_poses_;
   std::map<int64_t, depth_image_t> frames_;  // by seq
   std::map<int64_t, int8_t> wanted_;          // seq -> trigger
   std::set<int64_t> estimated_;
+  std::set<int64_t> warning_seqs_;  // kept frames whose discrepancy passed the warning level
   int64_t last_warning_utime_ = 0;  // utime of the last warning-triggered frame
   std::vector<ScheduledWork> ready_;
   int64_t missed_ = 0;

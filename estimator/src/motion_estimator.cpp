@@ -710,41 +710,69 @@ EstimateResult MotionEstimator::finish(const EstimatorFrame& frame, const State&
   return result;
 }
 
-EstimateResult MotionEstimator::estimate(const EstimatorFrame& full_frame) {
-  const int64_t start = now_us();
-  auto fail = [&](const std::string& why) { return unusable_result(why, start); };
-  const std::string problem = check_frame(full_frame);
-  if (!problem.empty()) return fail(problem);
-  edges_.clear();
-  // A large image is estimated at a working resolution: every k-th pixel
-  // in u and v (no averaging, which would make mixed pixels of every
-  // silhouette), with the intrinsics scaled to match.
-  const Intrinsics& full = full_frame.intrinsics;
-  int k = 1;
-  while (static_cast<int64_t>(full.width / k) * (full.height / k) > options_.max_working_pixels) ++k;
+EstimateResult MotionEstimator::estimate(const EstimatorFrame& frame) {
+  return estimate(std::vector<EstimatorFrame>{frame});
+}
+
+namespace {
+
+// `full` at a working resolution of every k-th pixel in u and v (no
+// averaging, which would make mixed pixels of every silhouette), with the
+// intrinsics scaled to match.
+EstimatorFrame working_frame(const EstimatorFrame& full, int k) {
   EstimatorFrame reduced;
-  if (k > 1) {
-    reduced.reported_joints = full_frame.reported_joints;
-    reduced.world_from_optical = full_frame.world_from_optical;
-    reduced.intrinsics = full;
-    reduced.intrinsics.width = full.width / k;
-    reduced.intrinsics.height = full.height / k;
-    reduced.intrinsics.fx = full.fx / k;
-    reduced.intrinsics.fy = full.fy / k;
-    reduced.intrinsics.cx = full.cx / k;
-    reduced.intrinsics.cy = full.cy / k;
-    reduced.depth_m.resize(static_cast<size_t>(reduced.intrinsics.width) * reduced.intrinsics.height);
-    for (int v = 0; v < reduced.intrinsics.height; ++v) {
-      for (int u = 0; u < reduced.intrinsics.width; ++u) {
-        reduced.depth_m[static_cast<size_t>(v) * reduced.intrinsics.width + u] =
-            full_frame.depth_m[static_cast<size_t>(v * k) * full.width + u * k];
-      }
+  reduced.reported_joints = full.reported_joints;
+  reduced.world_from_optical = full.world_from_optical;
+  const Intrinsics& in = full.intrinsics;
+  reduced.intrinsics = in;
+  reduced.intrinsics.width = in.width / k;
+  reduced.intrinsics.height = in.height / k;
+  reduced.intrinsics.fx = in.fx / k;
+  reduced.intrinsics.fy = in.fy / k;
+  reduced.intrinsics.cx = in.cx / k;
+  reduced.intrinsics.cy = in.cy / k;
+  reduced.depth_m.resize(static_cast<size_t>(reduced.intrinsics.width) * reduced.intrinsics.height);
+  for (int v = 0; v < reduced.intrinsics.height; ++v) {
+    for (int u = 0; u < reduced.intrinsics.width; ++u) {
+      reduced.depth_m[static_cast<size_t>(v) * reduced.intrinsics.width + u] =
+          full.depth_m[static_cast<size_t>(v * k) * in.width + u * k];
     }
   }
-  const EstimatorFrame& frame = k > 1 ? reduced : full_frame;
+  return reduced;
+}
+
+}  // namespace
+
+EstimateResult MotionEstimator::estimate(const std::vector<EstimatorFrame>& full_frames) {
+  const int64_t start = now_us();
+  auto fail = [&](const std::string& why) { return unusable_result(why, start); };
+  if (full_frames.empty()) return fail("no frames");
+  for (size_t f = 0; f < full_frames.size(); ++f) {
+    const std::string problem = check_frame(full_frames[f]);
+    if (!problem.empty()) return fail(full_frames.size() > 1 ? "frame " + std::to_string(f) + ": " + problem : problem);
+    if (full_frames[f].intrinsics.width != full_frames[0].intrinsics.width ||
+        full_frames[f].intrinsics.height != full_frames[0].intrinsics.height) {
+      return fail("frame " + std::to_string(f) + ": image size differs from frame 0's");
+    }
+  }
+  edges_.clear();
+  // A large image is estimated at a working resolution (options:
+  // max_working_pixels).
+  const Intrinsics& full = full_frames[0].intrinsics;
+  int k = 1;
+  while (static_cast<int64_t>(full.width / k) * (full.height / k) > options_.max_working_pixels) ++k;
+  std::vector<EstimatorFrame> reduced;
+  if (k > 1) {
+    for (const EstimatorFrame& f : full_frames) reduced.push_back(working_frame(f, k));
+  }
+  const std::vector<EstimatorFrame>& working = k > 1 ? reduced : full_frames;
+  const EstimatorFrame& frame = working[0];
+  std::vector<const EstimatorFrame*> frames;
+  for (const EstimatorFrame& f : working) frames.push_back(&f);
 
   State state;
   state.joint_offsets.assign(num_params_, 0.0);
+  // The residual before: the estimate's own frame at the reported values.
   Linearization before;
   before.reset(num_params_);
   std::string error = linearize(frame, state, options_.final_robust_scale_m, options_.pixel_stride, PointSet::kAll,
@@ -753,7 +781,6 @@ EstimateResult MotionEstimator::estimate(const EstimatorFrame& full_frame) {
 
   const bool joints_free = options_.estimate_joints;
   const bool camera_free = options_.estimate_camera;
-  const std::vector<const EstimatorFrame*> frames{&frame};
   int iterations = 0;
   bool converged = true;
   Linearization lin = before;
@@ -765,6 +792,8 @@ EstimateResult MotionEstimator::estimate(const EstimatorFrame& full_frame) {
   }
   int moves = 0;
   if (joints_free) {
+    // The search on the estimate's own frame: the offsets it finds are
+    // every frame's (an encoder offset does not change in 100 ms).
     moves = search_joints(frame, &state, &error);
     if (!error.empty()) return fail("joint search: " + error);
   }
@@ -777,6 +806,7 @@ EstimateResult MotionEstimator::estimate(const EstimatorFrame& full_frame) {
   result.converged = converged;
   result.iterations = iterations;
   result.search_moves = moves;
+  result.num_frames = static_cast<int>(frames.size());
   result.residual_before_m = before.clipped_rms_m();
   result.compute_us = now_us() - start;
   return result;

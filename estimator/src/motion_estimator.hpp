@@ -110,7 +110,7 @@ struct EstimatorOptions {
   double max_joint_sigma = 0.05;
   // Neighbouring pixels' residuals are correlated (the same surface, the
   // same model error): the least-squares sigmas are multiplied by this.
-  double sigma_scale = 3.0;
+  double sigma_scale = 2.5;
   // residual_before/after: RMS of the point-to-plane residuals with each
   // residual (and each gated-out point) counted as at most this, metres.
   double residual_clip_m = 0.1;
@@ -122,7 +122,13 @@ struct EstimatorOptions {
   // sees (sliding along a surface).
   double contour_jump_fraction = 0.1;
   double final_contour_scale_px = 3.0;
-  double contour_sigma_px = 0.5;
+  // 2 px: a ToF camera's mixed pixels (a silhouette pixel measuring a
+  // distance between the two surfaces) move a measured contour by up to a
+  // pixel, and not evenly: with 0.5 px the contours outweighed the depth
+  // residuals and biased the wrist joints (a5, a7) by 2-3 degrees on the
+  // simulated camera; at 2 px the bias is below 1 degree and the sigmas
+  // match the errors seen (docs/estimator.md).
+  double contour_sigma_px = 2.0;
   // Neighbouring rendered pixels further apart in depth than this are a
   // silhouette (no normal there), metres.
   double normal_jump_m = 0.03;
@@ -168,6 +174,8 @@ struct EstimateResult {
   // moves.
   int iterations = 0;
   int search_moves = 0;
+  // Camera frames estimated jointly (estimate(frames)); 1 for one frame.
+  int num_frames = 1;
   // Per actuated joint, in URDF order (SceneModel::actuated_joint_names).
   std::vector<JointEstimate> joints;
   // reported optical <- seen optical (identity when not estimated).
@@ -209,6 +217,18 @@ class MotionEstimator {
   // the working resolution, EstimatorOptions::max_working_pixels).
   // Never throws for bad input: the result is then unusable.
   EstimateResult estimate(const EstimatorFrame& frame);
+
+  // The same jointly over several frames of one camera: frames[0] is the
+  // frame the estimate is about, the others are frames just before it
+  // (each with its own reported joints and camera pose: the arm and a
+  // pan-tilt head may move between them). The joint offsets and the camera
+  // correction (in the optical frame) are common to all frames: an encoder
+  // offset or a calibration error does not change within a few frames.
+  // The camera's noise and mixed pixels differ from frame to frame, so the
+  // estimate's random error shrinks about as 1/sqrt(frames). The joint
+  // search runs on frames[0]; residual_before is frames[0]'s, the
+  // result's joints are frames[0]'s. Frames must have the same image size.
+  EstimateResult estimate(const std::vector<EstimatorFrame>& frames);
 
   // Camera pose only, jointly over several frames of one static camera
   // whose joint positions are exact (extrinsic calibration). Every frame's

@@ -134,7 +134,7 @@ std::string format(const motion_estimate_t& m) {
     << " usable=" << yes_no(m.usable);
   if (!m.usable) return s.str() + " (" + m.unusable_reason + ")";
   constexpr double kDeg = 180.0 / 3.14159265358979323846;
-  s << " converged=" << yes_no(m.converged) << " iterations=" << m.iterations << std::fixed << std::setprecision(1)
+  s << " converged=" << yes_no(m.converged) << " iterations=" << m.iterations << " frames=" << m.num_frames << std::fixed << std::setprecision(1)
     << " residual_mm=" << m.residual_before_mm << "->" << m.residual_after_mm << " |";
   for (int i = 0; i < m.num_joints; ++i) {
     if (!m.observable[i]) continue;

@@ -108,6 +108,9 @@ TEST(EstimatorProcess, NamesAnEncoderOffsetOnRealFrames) {
   EXPECT_LT(std::abs(offset_deg(*clean, "a4")), 3.0);
   EXPECT_GT(clean->num_points, 1000);
   EXPECT_GT(clean->compute_us, 0);
+  // Made of the frame and the ones just before it (no discrepancy process
+  // here: no frame is known to be past the warning level).
+  EXPECT_EQ(clean->num_frames, rig.config.estimator.frames_per_estimate);
 
   // a4 reads 10 degrees more than it is.
   ASSERT_EQ(run_command("estimator-fault", {bin_dir() + "/tofguard-sim-fault", "--config", rig.config_path, "--joint",

@@ -44,30 +44,48 @@ class MotionEstimatorTest : public ::testing::Test {
 Config* MotionEstimatorTest::config_ = nullptr;
 testing::SimulatedFrames* MotionEstimatorTest::frames_ = nullptr;
 
+// The frames an estimate is made of (estimator.frames_per_estimate in
+// config/sim.yaml): the frame at `truth` and the ones 33 and 67 ms before
+// it (30 Hz), the arm moving meanwhile (every joint 0.5 degrees a frame),
+// each reporting its joints with the same encoder offset on `joint`.
+std::vector<EstimatorFrame> frames_with_offset(testing::SimulatedFrames* frames, const Config& config,
+                                               const renderer::JointPositions& truth, const std::string& joint,
+                                               double offset_rad, int num_frames, uint64_t* index) {
+  std::vector<EstimatorFrame> out;
+  for (int k = 0; k < num_frames; ++k) {
+    renderer::JointPositions at = truth;
+    for (auto& [name, position] : at) position -= k * deg(0.5);
+    EstimatorFrame frame;
+    frame.intrinsics = config.camera.intrinsics;
+    frame.depth_m = frames->capture(at, test::pose_of(config.camera.pose), frame.intrinsics, ++*index);
+    frame.reported_joints = at;
+    frame.reported_joints[joint] += offset_rad;
+    frame.world_from_optical = test::pose_of(config.camera.pose);
+    out.push_back(std::move(frame));
+  }
+  return out;
+}
+
 // Encoder offsets of 5, 10 and 20 degrees on each joint in turn (the
 // joint reports more than it is at), arm in the side-reach pose where every
-// link is seen. Issue 7: the suspect is right in >= 95 % of the cases and
-// the estimated offset within 1.5 degrees or 25 %. Measured (2026-11-22):
-// suspect right 21/21; offset accurate 19/21: a5 +5 is estimated -3.5
-// (1.54 degrees off) and a7 +5 -8.1 (3.1 off), the a5/a7 mixed-pixel bias
-// above. Issue 7's 95 % would be 20 of 21: 19 is asserted.
+// link is seen, each estimate made of 3 frames like tofguard-estimator's.
+// Issue 7: the suspect is right in >= 95 % of the cases and the estimated
+// offset within 1.5 degrees or 25 %. Measured (2026-11-22, 3 frames):
+// suspect right 21/21, offset accurate 21/21 (largest error 1.0 degree,
+// a5); see docs/estimator.md for single frames.
 TEST_F(MotionEstimatorTest, EncoderOffsets) {
   MotionEstimator estimator(frames_->scene(), &frames_->renderer(), options());
-  const Eigen::Isometry3d camera = test::pose_of(config_->camera.pose);
-  const Intrinsics& in = config_->camera.intrinsics;
+  const int num_frames = config_->estimator.frames_per_estimate;
+  ASSERT_EQ(num_frames, 3);
   uint64_t index = 0;
   int right = 0, accurate = 0, cases = 0;
+  double largest_error_deg = 0;
   for (const char* joint : {"a1", "a2", "a3", "a4", "a5", "a6", "a7"}) {
     for (double offset_deg : {5.0, 10.0, 20.0}) {
-      const renderer::JointPositions truth = test::side_reach_pose();
-      EstimatorFrame frame;
-      frame.intrinsics = in;
-      frame.depth_m = frames_->capture(truth, camera, in, ++index);
-      frame.reported_joints = truth;
-      frame.reported_joints[joint] += deg(offset_deg);
-      frame.world_from_optical = camera;
-      const EstimateResult r = estimator.estimate(frame);
+      const EstimateResult r = estimator.estimate(
+          frames_with_offset(frames_, *config_, test::side_reach_pose(), joint, deg(offset_deg), num_frames, &index));
       ASSERT_TRUE(r.usable) << r.unusable_reason;
+      EXPECT_EQ(r.num_frames, num_frames);
       ++cases;
       const int suspect = suspect_joint(r, deg(kSignificantOffsetDeg), kSignificantSigmas);
       const int k = joint[1] - '1';
@@ -76,15 +94,45 @@ TEST_F(MotionEstimatorTest, EncoderOffsets) {
       const bool is_accurate = std::abs(error_deg) <= std::max(1.5, 0.25 * offset_deg);
       right += is_right;
       accurate += is_accurate;
-      std::cout << joint << " +" << offset_deg << " deg: estimated " << to_deg(r.joints[k].offset())
-                << (is_right ? ", suspect right" : ", SUSPECT WRONG") << (is_accurate ? "" : ", INACCURATE")
-                << "; iterations " << r.iterations << ", residual " << r.residual_before_m * 1000 << " -> "
-                << r.residual_after_m * 1000 << " mm, " << r.compute_us / 1000 << " ms\n";
+      largest_error_deg = std::max(largest_error_deg, std::abs(error_deg));
+      std::cout << joint << " +" << offset_deg << " deg: estimated " << to_deg(r.joints[k].offset()) << " (sigma "
+                << to_deg(r.joints[k].sigma) << ")" << (is_right ? ", suspect right" : ", SUSPECT WRONG")
+                << (is_accurate ? "" : ", INACCURATE") << "; iterations " << r.iterations << ", residual "
+                << r.residual_before_m * 1000 << " -> " << r.residual_after_m * 1000 << " mm, "
+                << r.compute_us / 1000 << " ms\n";
     }
   }
-  std::cout << "suspect right " << right << ", offset accurate " << accurate << " of " << cases << "\n";
+  std::cout << "suspect right " << right << ", offset accurate " << accurate << " of " << cases
+            << ", largest offset error " << largest_error_deg << " deg\n";
   EXPECT_GE(right, 20);     // issue 7: >= 95 %
-  EXPECT_GE(accurate, 19);  // issue 7 asks 20 (95 %); see above
+  EXPECT_GE(accurate, 20);  // issue 7: >= 95 %
+}
+
+// One frame alone (the library's estimate(frame)): the same cases, for the
+// record of what a single frame achieves (docs/estimator.md). The camera's
+// mixed pixels and noise leave the wrist joints (a5, a7) a little over a
+// degree off on some frames; the suspect is still right.
+TEST_F(MotionEstimatorTest, EncoderOffsetsFromOneFrame) {
+  MotionEstimator estimator(frames_->scene(), &frames_->renderer(), options());
+  uint64_t index = 500;
+  int right = 0, accurate = 0, cases = 0;
+  for (const char* joint : {"a1", "a2", "a3", "a4", "a5", "a6", "a7"}) {
+    for (double offset_deg : {5.0, 10.0, 20.0}) {
+      const EstimateResult r = estimator.estimate(
+          frames_with_offset(frames_, *config_, test::side_reach_pose(), joint, deg(offset_deg), 1, &index)[0]);
+      ASSERT_TRUE(r.usable) << r.unusable_reason;
+      ++cases;
+      const int k = joint[1] - '1';
+      const double error_deg = to_deg(r.joints[k].offset()) + offset_deg;
+      right += suspect_joint(r, deg(kSignificantOffsetDeg), kSignificantSigmas) == k;
+      accurate += std::abs(error_deg) <= std::max(1.5, 0.25 * offset_deg);
+      std::cout << joint << " +" << offset_deg << " deg, one frame: estimated " << to_deg(r.joints[k].offset())
+                << " (sigma " << to_deg(r.joints[k].sigma) << ")\n";
+    }
+  }
+  std::cout << "one frame: suspect right " << right << ", offset accurate " << accurate << " of " << cases << "\n";
+  EXPECT_GE(right, 18);
+  EXPECT_GE(accurate, 18);
 }
 
 // The reported camera pose is off by 5 cm or 3 degrees; the joints are

@@ -23,6 +23,7 @@ inline motion_estimate_t estimate_for(const discrepancy_t& frame) {
   e.usable = true;
   e.converged = true;
   e.iterations = 6;
+  e.num_frames = 1;
   e.joint_name = {"a1", "a2", "a3", "a4", "a5", "a6", "a7"};
   e.num_joints = 7;
   e.reported_position.assign(7, 0.3);

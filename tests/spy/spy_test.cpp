@@ -119,6 +119,7 @@ TEST(Spy, MotionEstimateLineShowsOffsetsInDegreesAndTheCameraCorrection) {
   m.usable = true;
   m.converged = true;
   m.iterations = 7;
+  m.num_frames = 3;
   m.num_joints = 2;
   m.joint_name = {"a4", "a5"};
   m.reported_position = {1.0, 0.5};
@@ -136,7 +137,7 @@ TEST(Spy, MotionEstimateLineShowsOffsetsInDegreesAndTheCameraCorrection) {
   const std::vector<uint8_t> bytes = encoded(m);
   EXPECT_EQ(spy::format_message("MOTION_ESTIMATE", bytes.data(), static_cast<int>(bytes.size())),
             "MOTION_ESTIMATE motion_estimate_t utime=1700000000123456 seq=42 trigger=1 usable=true converged=true "
-            "iterations=7 residual_mm=30.0->6.0 | a4=-10.0±0.5° | camera_mm=12.0,-3.0,0.0 camera_deg=0.0 "
+            "iterations=7 frames=3 residual_mm=30.0->6.0 | a4=-10.0±0.5° | camera_mm=12.0,-3.0,0.0 camera_deg=0.0 "
             "compute_ms=41.5");
 }
 

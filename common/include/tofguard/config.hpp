@@ -360,6 +360,10 @@ struct EstimatorConfig {
   double periodic_period_ms = 0;
   // Camera frames kept (by seq) until their discrepancy arrives.
   int max_pending_frames = 0;
+  // Frames estimated jointly (MotionEstimator::estimate(frames)): the
+  // triggering frame and up to frames_per_estimate - 1 kept frames just
+  // before it (at most max_pending_frames in all).
+  int frames_per_estimate = 0;
   // Gauss-Newton iterations (one render each) of the joints-and-camera
   // stage, and every pixel_stride-th pixel's depth residual.
   int max_iterations = 0;

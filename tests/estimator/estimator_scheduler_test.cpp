@@ -1,0 +1,135 @@
+// tofguard-estimator's scheduler without LCM or rendering: which frames an
+// estimate is made of (estimator.frames_per_estimate, docs/estimator.md).
+#include <gtest/gtest.h>
+
+#include "estimator_process.hpp"
+#include "estimator_test_support.hpp"
+
+namespace tofguard::estimator {
+namespace {
+
+constexpr int64_t kStartUtime = 1'000'000'000;
+constexpr int64_t kFramePeriodUs = 33'333;
+
+constexpr double kA4RadPerS = 0.5;
+double a4_at(int64_t utime) { return test::side_reach_pose().at("a4") + kA4RadPerS * (utime - kStartUtime) * 1e-6; }
+
+class SchedulerTest : public ::testing::Test {
+ protected:
+  SchedulerTest() : config_(test::sim_config()), scene_(load_estimator_scene(config_)), scheduler_(config_, scene_) {
+    // Joint states every 10 ms over the whole test, a4 turning at
+    // kA4RadPerS.
+    for (int64_t t = kStartUtime - 100'000; t <= kStartUtime + 20 * kFramePeriodUs; t += 10'000) {
+      joint_state_t s{};
+      s.utime = t;
+      s.robot_id = config_.robot.id;
+      for (const auto& [name, position] : test::side_reach_pose()) {
+        s.name.push_back(name);
+        s.position.push_back(name == "a4" ? a4_at(t) : position);
+        s.velocity.push_back(0);
+      }
+      s.num_joints = static_cast<int32_t>(s.name.size());
+      EXPECT_TRUE(scheduler_.on_joint_state(s));
+    }
+  }
+
+  depth_image_t frame(int64_t seq) const {
+    const Intrinsics& in = config_.camera.intrinsics;
+    depth_image_t f{};
+    f.utime = kStartUtime + seq * kFramePeriodUs;
+    f.seq = seq;
+    f.camera_id = config_.camera.id;
+    f.width = in.width;
+    f.height = in.height;
+    f.fx = in.fx;
+    f.fy = in.fy;
+    f.cx = in.cx;
+    f.cy = in.cy;
+    f.calibrated = true;
+    f.num_pixels = in.width * in.height;
+    f.depth_mm.assign(f.num_pixels, static_cast<int16_t>(1000 + seq));  // tells the frames apart
+    f.num_amplitude = 0;
+    return f;
+  }
+
+  discrepancy_t discrepancy(int64_t seq, bool warning) const {
+    discrepancy_t d{};
+    d.utime = kStartUtime + seq * kFramePeriodUs;
+    d.seq = seq;
+    d.camera_id = config_.camera.id;
+    d.usable = true;
+    d.mismatch_fraction = warning ? 0.5 : 0.0;
+    d.p95_abs_dis_mm = warning ? 200 : 5;
+    return d;
+  }
+
+  // The seqs of the frames of the one job ready now (by their depth).
+  std::vector<int> job_seqs() {
+    std::vector<ScheduledWork> ready = scheduler_.take_ready();
+    EXPECT_EQ(ready.size(), 1u);
+    std::vector<int> seqs;
+    if (ready.empty() || !ready[0].job) return seqs;
+    for (const EstimatorFrame& f : ready[0].job->frames) seqs.push_back(static_cast<int>(std::lround(f.depth_m[0] * 1000)) - 1000);
+    return seqs;
+  }
+
+  Config config_;
+  renderer::SceneModel scene_;
+  EstimatorScheduler scheduler_;
+};
+
+TEST_F(SchedulerTest, APeriodicEstimateTakesTheFramesJustBefore) {
+  ASSERT_EQ(config_.estimator.frames_per_estimate, 3);
+  for (int seq = 1; seq <= 5; ++seq) {
+    ASSERT_TRUE(scheduler_.on_depth(frame(seq)));
+    scheduler_.on_discrepancy(discrepancy(seq, false));
+  }
+  EXPECT_TRUE(scheduler_.take_ready().empty());
+  scheduler_.request_newest();
+  EXPECT_EQ(job_seqs(), (std::vector<int>{5, 4, 3}));
+}
+
+// A fault begins at frame 4: the first warning frame is estimated alone,
+// the next with the warning frames before it, never with frames 1..3.
+TEST_F(SchedulerTest, AWarningEstimateDoesNotTakeFramesFromBeforeTheFault) {
+  for (int seq = 1; seq <= 3; ++seq) {
+    ASSERT_TRUE(scheduler_.on_depth(frame(seq)));
+    scheduler_.on_discrepancy(discrepancy(seq, false));
+  }
+  EXPECT_TRUE(scheduler_.take_ready().empty());
+  ASSERT_TRUE(scheduler_.on_depth(frame(4)));
+  scheduler_.on_discrepancy(discrepancy(4, true));
+  EXPECT_EQ(job_seqs(), (std::vector<int>{4}));
+  // (The default warning rate limit, 200 ms of camera time, lets the next
+  // warning frame be estimated 7 frames later.)
+  for (int seq = 5; seq <= 11; ++seq) {
+    ASSERT_TRUE(scheduler_.on_depth(frame(seq)));
+    scheduler_.on_discrepancy(discrepancy(seq, true));
+  }
+  EXPECT_EQ(job_seqs(), (std::vector<int>{11, 10, 9}));
+  // Back to normal: a periodic estimate takes no warning frame.
+  ASSERT_TRUE(scheduler_.on_depth(frame(12)));
+  scheduler_.on_discrepancy(discrepancy(12, false));
+  ASSERT_TRUE(scheduler_.on_depth(frame(13)));
+  scheduler_.on_discrepancy(discrepancy(13, false));
+  scheduler_.request_newest();
+  EXPECT_EQ(job_seqs(), (std::vector<int>{13, 12}));
+}
+
+// Each frame carries the joints interpolated at its own utime.
+TEST_F(SchedulerTest, EachFrameHasItsOwnReportedJoints) {
+  for (int seq = 1; seq <= 3; ++seq) ASSERT_TRUE(scheduler_.on_depth(frame(seq)));
+  scheduler_.request_newest();
+  std::vector<ScheduledWork> ready = scheduler_.take_ready();
+  ASSERT_EQ(ready.size(), 1u);
+  ASSERT_TRUE(ready[0].job.has_value());
+  ASSERT_EQ(ready[0].job->frames.size(), 3u);
+  int64_t seq = 3;
+  for (const EstimatorFrame& f : ready[0].job->frames) {
+    EXPECT_NEAR(f.reported_joints.at("a4"), a4_at(kStartUtime + seq-- * kFramePeriodUs), 1e-9);
+    EXPECT_TRUE(f.world_from_optical.isApprox(test::pose_of(config_.camera.pose), 1e-9));
+  }
+}
+
+}  // namespace
+}  // namespace tofguard::estimator
