@@ -1,11 +1,13 @@
-// Estimation time per frame (tofguard-estimator's work) for the default arm
-// in the side-reach pose with a 10 degree encoder offset on a4, joints and
-// camera free, at 176x144 (the embedded default) and 320x240 (the same
-// field of view). Frames from the simulated ToF camera.
+// Estimation time (tofguard-estimator's work) for the default arm in the
+// side-reach pose with a 10 degree encoder offset on a4, joints and camera
+// free, at 176x144 (the embedded default) and 320x240 (the same field of
+// view), on one frame and on the 3 frames an estimate is made of
+// (config/sim.yaml). Frames from the simulated ToF camera.
 #include <benchmark/benchmark.h>
 
 #include <cmath>
 #include <cstdlib>
+#include <vector>
 
 #include "motion_estimator.hpp"
 #include "simulated_frames.hpp"
@@ -27,7 +29,10 @@ Intrinsics scaled(const Intrinsics& in, int width, int height) {
   return out;
 }
 
-void BM_EstimateFrame(benchmark::State& state) {
+// state.range(0) x state.range(1) pixels; state.range(2) frames estimated
+// jointly (estimator.frames_per_estimate: the frame and the ones 33 and 67
+// ms before it, the arm moving 0.5 degrees a frame per joint).
+void BM_Estimate(benchmark::State& state) {
   // As tofguard-estimator runs (estimator/main.cpp): no llvmpipe render
   // threads, unless the environment says otherwise.
   setenv("LP_NUM_THREADS", "0", /*overwrite=*/0);
@@ -42,15 +47,23 @@ void BM_EstimateFrame(benchmark::State& state) {
   Eigen::Isometry3d camera = Eigen::Isometry3d::Identity();
   camera.linear() = config.camera.pose.rotation.normalized().toRotationMatrix();
   camera.translation() = config.camera.pose.translation_m;
-  EstimatorFrame frame;
-  frame.intrinsics = scaled(config.camera.intrinsics, static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
-  frame.depth_m = frames.capture(truth, camera, frame.intrinsics, 1);
-  frame.reported_joints = truth;
-  frame.reported_joints["a4"] += 10 * M_PI / 180;
-  frame.world_from_optical = camera;
+  const Intrinsics intrinsics =
+      scaled(config.camera.intrinsics, static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  std::vector<EstimatorFrame> estimated;
+  for (int k = 0; k < state.range(2); ++k) {
+    renderer::JointPositions at = truth;
+    for (auto& [name, position] : at) position -= k * 0.5 * M_PI / 180;
+    EstimatorFrame frame;
+    frame.intrinsics = intrinsics;
+    frame.depth_m = frames.capture(at, camera, frame.intrinsics, 1 + k);
+    frame.reported_joints = at;
+    frame.reported_joints["a4"] += 10 * M_PI / 180;
+    frame.world_from_optical = camera;
+    estimated.push_back(std::move(frame));
+  }
   double iterations = 0, offset = 0;
   for (auto _ : state) {
-    const EstimateResult r = estimator.estimate(frame);
+    const EstimateResult r = estimator.estimate(estimated);
     if (!r.usable) state.SkipWithError(r.unusable_reason.c_str());
     iterations = r.iterations;
     offset = r.joints[3].offset() * 180 / M_PI;
@@ -58,7 +71,14 @@ void BM_EstimateFrame(benchmark::State& state) {
   state.counters["gn_iterations"] = iterations;
   state.counters["a4_offset_deg"] = offset;
 }
-BENCHMARK(BM_EstimateFrame)->Args({176, 144})->Args({320, 240})->Unit(benchmark::kMillisecond)->MinTime(3.0);
+BENCHMARK(BM_Estimate)
+    ->ArgNames({"width", "height", "frames"})
+    ->Args({176, 144, 1})
+    ->Args({320, 240, 1})
+    ->Args({176, 144, 3})
+    ->Args({320, 240, 3})
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(3.0);
 
 }  // namespace
 }  // namespace tofguard::estimator

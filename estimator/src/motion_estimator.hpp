@@ -100,7 +100,7 @@ struct EstimatorOptions {
   // joint's distal points more than the current estimate, and at least
   // min_joint_points.
   double joint_search_range_rad = 0.52;  // 30 degrees
-  double joint_search_step_rad = 0.035;  // 2 degrees
+  double joint_search_step_rad = 0.07;  // 4 degrees
   int joint_search_rounds = 2;
   double min_search_gain_fraction = 0.08;
   // A joint is observable (and estimated) when at least this many model

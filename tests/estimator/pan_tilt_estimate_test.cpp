@@ -7,6 +7,8 @@
 // mixed and invalid pixels, calibration).
 #include <gtest/gtest.h>
 
+#include <iostream>
+
 #include "estimate_finding.hpp"
 #include "estimate_message.hpp"
 #include "estimator_process.hpp"
@@ -97,6 +99,8 @@ void expect_calibration_error_after_the_fault(const Config& config, testing::Sim
     const PanTiltCase bad = estimate_at(config, frames, t_us, index++);
     EXPECT_NEAR(bad.reading_error_deg, 3, 1e-6);
     ASSERT_TRUE(bad.message.usable) << bad.message.unusable_reason;
+    std::cout << "reading 3 deg off at " << t_us / kSecond << " s: correction " << correction_deg(bad.message)
+              << " deg, converged " << static_cast<int>(bad.message.converged) << "\n";
     EXPECT_NEAR(correction_deg(bad.message), 3, 0.5);
     const risk::FrameFinding flagged = risk::classify_estimate(bad.message, config.risk);
     EXPECT_EQ(flagged.cause, tofguard::risk_t::CAUSE_CALIBRATION_ERROR) << flagged.detail;
