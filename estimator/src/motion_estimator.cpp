@@ -610,7 +610,11 @@ int MotionEstimator::search_joints(const EstimatorFrame& frame, State* state, st
 
     int best_param = -1;
     double best_offset = 0;
-    double best_gain_fraction = 0;
+    // The joint whose move explains the most points (in all, not as a
+    // fraction of its own distal points: a wrist joint swung far can
+    // realign a large share of the few points it moves when the error is
+    // at the shoulder, which moves them all).
+    int best_gain = 0;
     std::vector<Eigen::Isometry3d> moved(scene_.links.size(), Eigen::Isometry3d::Identity());
     for (int k = 0; k < num_params_; ++k) {
       std::vector<const Sample*> distal;
@@ -646,8 +650,8 @@ int MotionEstimator::search_joints(const EstimatorFrame& frame, State* state, st
         const int gain = scored_gain * static_cast<int>(every);  // in all distal points
         const double fraction = static_cast<double>(scored_gain) / distal.size();
         if (gain >= options_.min_joint_points && fraction >= options_.min_search_gain_fraction &&
-            fraction > best_gain_fraction) {
-          best_gain_fraction = fraction;
+            gain > best_gain) {
+          best_gain = gain;
           best_param = k;
           best_offset = offset;
         }
