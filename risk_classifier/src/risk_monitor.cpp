@@ -43,28 +43,33 @@ void RiskMonitor::on_depth(int64_t now_us) { touch(&depth_, now_us); }
 
 void RiskMonitor::on_joint_state(const joint_state_t& state, int64_t now_us) {
   touch(&joint_state_, now_us);
-  double fastest = 0;
-  for (double v : state.velocity) fastest = std::max(fastest, std::abs(v));
   // Out-of-order joint states are not added to the by-utime record.
-  if (arm_moving_by_utime_.empty() || state.utime >= arm_moving_by_utime_.back().first) {
-    arm_moving_by_utime_.emplace_back(state.utime, fastest >= config_.risk.moving_joint_speed_rad_s);
-    while (arm_moving_by_utime_.front().first < state.utime - 2'000'000) arm_moving_by_utime_.pop_front();
+  if (joint_states_by_utime_.empty() || state.utime >= joint_states_by_utime_.back().utime) {
+    joint_states_by_utime_.push_back(state);
+    while (joint_states_by_utime_.front().utime < state.utime - 2'000'000) joint_states_by_utime_.pop_front();
   }
-  last_joint_state_ = state;
-  update_plan_deviation(state);
 }
 
-void RiskMonitor::on_plan(const planned_trajectory_t& plan) {
-  plan_.add(plan);
-  if (last_joint_state_) update_plan_deviation(*last_joint_state_);
+void RiskMonitor::on_plan(const planned_trajectory_t& plan) { plan_.add(plan); }
+
+const joint_state_t* RiskMonitor::joint_state_at(int64_t utime) const {
+  // The newest joint state taken at or before `utime`; for a frame older
+  // than all of them, the oldest.
+  for (auto it = joint_states_by_utime_.rbegin(); it != joint_states_by_utime_.rend(); ++it) {
+    if (it->utime <= utime) return &*it;
+  }
+  return joint_states_by_utime_.empty() ? nullptr : &joint_states_by_utime_.front();
 }
 
-void RiskMonitor::update_plan_deviation(const joint_state_t& state) {
-  plan_deviation_.reset();
-  if (!config_.risk.plan_enabled) return;
+std::optional<FrameFinding> RiskMonitor::plan_deviation_at(int64_t utime) const {
+  if (!config_.risk.plan_enabled) return std::nullopt;
+  const joint_state_t* found = joint_state_at(utime);
+  if (found == nullptr) return std::nullopt;
+  const joint_state_t& state = *found;
   const auto planned = plan_.at(state.utime);
-  if (!planned) return;  // outside the plan's time span: nothing to compare
+  if (!planned) return std::nullopt;  // outside the plan's time span: nothing to compare
   const RiskConfig& r = config_.risk;
+  std::optional<FrameFinding> deviation_finding;
   double worst_ratio = 0;
   for (int i = 0; i < state.num_joints; ++i) {
     const auto p = planned->find(state.name[i]);
@@ -83,17 +88,17 @@ void RiskMonitor::update_plan_deviation(const joint_state_t& state) {
     f.threshold = limit * scale;
     f.detail = "arm left its plan (" + std::string(prismatic ? "mm" : "deg") + "): " + state.name[i] + " is " +
                fixed(deviation * scale, 1) + unit + " from the plan (limit " + fixed(limit * scale, 1) + unit + ")";
-    plan_deviation_ = f;
+    deviation_finding = f;
   }
+  return deviation_finding;
 }
 
 bool RiskMonitor::arm_moving_at(int64_t utime) const {
-  // The newest joint state taken at or before `utime`; for a frame older
-  // than all of them, the oldest.
-  for (auto it = arm_moving_by_utime_.rbegin(); it != arm_moving_by_utime_.rend(); ++it) {
-    if (it->first <= utime) return it->second;
-  }
-  return !arm_moving_by_utime_.empty() && arm_moving_by_utime_.front().second;
+  const joint_state_t* state = joint_state_at(utime);
+  if (state == nullptr) return false;
+  double fastest = 0;
+  for (double v : state->velocity) fastest = std::max(fastest, std::abs(v));
+  return fastest >= config_.risk.moving_joint_speed_rad_s;
 }
 
 void RiskMonitor::on_camera_pose(int64_t now_us) { touch(&camera_pose_, now_us); }
@@ -270,7 +275,11 @@ risk_t RiskMonitor::judge(const discrepancy_t& frame, int64_t now_us, bool waite
     }
   }
   // The arm left its plan: only when nothing else is wrong with the frame.
-  if (finding.cause == risk_t::CAUSE_NONE && plan_deviation_) finding = *plan_deviation_;
+  // (The joint state at the frame's capture time: a replayed log is judged
+  // the same on every run however late the frame is processed.)
+  if (finding.cause == risk_t::CAUSE_NONE) {
+    if (std::optional<FrameFinding> deviation = plan_deviation_at(frame.utime)) finding = std::move(*deviation);
+  }
   consecutive_ = finding.cause == risk_t::CAUSE_NONE ? 0 : consecutive_ + 1;
 
   if (const std::optional<FrameFinding> stale = expired(now_us)) {

@@ -113,7 +113,9 @@ class RiskMonitor {
   // earlier frame of the same camera at most risk.estimate_max_age_ms older.
   const motion_estimate_t* estimate_for(const discrepancy_t& frame, bool or_older) const;
   std::vector<risk_t> release(int64_t now_us);
-  void update_plan_deviation(const joint_state_t& state);
+  // The arm left its plan at `utime`: the joint state at that time
+  // (joint_state_at) against the plan at the joint state's utime.
+  std::optional<FrameFinding> plan_deviation_at(int64_t utime) const;
   static void touch(Deadline* d, int64_t now_us);
 
   const Config config_;
@@ -124,18 +126,19 @@ class RiskMonitor {
   Deadline camera_pose_;
   std::map<std::string, Deadline> heartbeats_;
   PlannedTrajectory plan_;
-  std::optional<joint_state_t> last_joint_state_;
-  std::optional<FrameFinding> plan_deviation_;
   std::deque<WaitingFrame> waiting_;
   std::deque<motion_estimate_t> estimates_;  // the newest few, by arrival
   std::deque<int64_t> judged_seqs_;          // the newest few judged frames
   EstimateStats estimate_stats_;
-  // Whether the arm moved, by joint-state utime (ascending; the last 2 s):
-  // the frozen-image rule asks about the frame's capture time, not about
-  // whichever joint state arrived last, so that a replayed log is judged
-  // the same on every run however late the frame is processed.
+  // The joint states by utime (ascending; the last 2 s): the frozen-image
+  // and plan rules ask about the frame's capture time, not about whichever
+  // joint state arrived last, so that a replayed log is judged the same on
+  // every run however late the frame is processed. joint_state_at: the
+  // newest at or before `utime` (the oldest for an older frame), nullptr
+  // when there is none.
+  const joint_state_t* joint_state_at(int64_t utime) const;
   bool arm_moving_at(int64_t utime) const;
-  std::deque<std::pair<int64_t, bool>> arm_moving_by_utime_;
+  std::deque<joint_state_t> joint_states_by_utime_;
   int consecutive_ = 0;
   int64_t last_frame_utime_ = 0;
 };

@@ -390,23 +390,30 @@ planned_trajectory_t plan_a1(int64_t from_utime, double from_rad, int64_t to_uti
   return p;
 }
 
-TEST(PlanDeviation, AJointStateAwayFromThePlanAtItsUtimeIsAFindingDebouncedLikeTheOthers) {
+// Each frame is judged with the joint state of its capture time (the
+// newest at or before its utime), whenever it is processed.
+TEST(PlanDeviation, TheJointStateAtTheFramesUtimeAwayFromThePlanIsAFindingDebouncedLikeTheOthers) {
   RiskMonitor m(sim_config(), friend_arm(), kStart);
   const int64_t t0 = 1'700'000'000'000'000;
   feed_all(&m, kStart);
   // a1 planned from 0 to 0.5 rad over 500 ms.
   m.on_plan(plan_a1(t0, 0.0, t0 + 500'000, 0.5));
-  const discrepancy_t good = summary_of(default_arm(), 101);
+  int64_t seq = 101;
+  auto frame_at = [&](int64_t utime) {
+    discrepancy_t d = summary_of(default_arm(), seq++);
+    d.utime = utime;
+    return d;
+  };
 
   // On the plan at t0 + 200 ms (0.2 rad), within 5 deg.
   m.on_joint_state(joints_at(t0 + 200'000, 0.2 + 4.9 * kDeg), kStart);
-  EXPECT_EQ(m.on_discrepancy(good, kStart).level, risk_t::SAFE);
+  EXPECT_EQ(m.on_discrepancy(frame_at(t0 + 205'000), kStart).level, risk_t::SAFE);
 
-  // 7.2 deg off.
+  // 7.2 deg off from t0 + 210 ms on.
   std::vector<int8_t> levels;
   for (int i = 0; i < 3; ++i) {
     m.on_joint_state(joints_at(t0 + 210'000 + i * 10'000, 0.21 + i * 0.01 - 7.2 * kDeg), kStart);
-    const risk_t r = m.on_discrepancy(good, kStart);
+    const risk_t r = m.on_discrepancy(frame_at(t0 + 215'000 + i * 10'000), kStart);
     EXPECT_EQ(r.cause, risk_t::CAUSE_UNCLASSIFIED);
     EXPECT_EQ(r.suspect, "a1");
     EXPECT_NEAR(r.score, 7.2, 1e-6);
@@ -416,14 +423,24 @@ TEST(PlanDeviation, AJointStateAwayFromThePlanAtItsUtimeIsAFindingDebouncedLikeT
   }
   EXPECT_EQ(levels, (std::vector<int8_t>{risk_t::WARNING, risk_t::WARNING, risk_t::DANGEROUS}));
 
+  // A frame captured before the deviation, judged late (after the deviating
+  // joint states came): judged with the joint state of its own time.
+  RiskMonitor late(sim_config(), friend_arm(), kStart);
+  feed_all(&late, kStart);
+  late.on_plan(plan_a1(t0, 0.0, t0 + 500'000, 0.5));
+  late.on_joint_state(joints_at(t0 + 200'000, 0.2), kStart);
+  late.on_joint_state(joints_at(t0 + 300'000, 0.3 - 7.2 * kDeg), kStart);
+  EXPECT_EQ(late.on_discrepancy(frame_at(t0 + 250'000), kStart).level, risk_t::SAFE);
+  EXPECT_EQ(late.on_discrepancy(frame_at(t0 + 310'000), kStart).cause, risk_t::CAUSE_UNCLASSIFIED);
+
   // Beyond the plan's end there is nothing to compare with.
   m.on_joint_state(joints_at(t0 + 600'000, 3.0), kStart);
-  EXPECT_EQ(m.on_discrepancy(good, kStart).level, risk_t::SAFE);
+  EXPECT_EQ(m.on_discrepancy(frame_at(t0 + 605'000), kStart).level, risk_t::SAFE);
 
   // A new plan replaces the old one from its first point on.
   m.on_plan(plan_a1(t0 + 550'000, 2.9, t0 + 900'000, 3.2));
   m.on_joint_state(joints_at(t0 + 610'000, 2.95), kStart);
-  EXPECT_EQ(m.on_discrepancy(good, kStart).level, risk_t::SAFE);
+  EXPECT_EQ(m.on_discrepancy(frame_at(t0 + 615'000), kStart).level, risk_t::SAFE);
 
   Config off = sim_config();
   off.risk.plan_enabled = false;
@@ -431,7 +448,7 @@ TEST(PlanDeviation, AJointStateAwayFromThePlanAtItsUtimeIsAFindingDebouncedLikeT
   feed_all(&without, kStart);
   without.on_plan(plan_a1(t0, 0.0, t0 + 500'000, 0.5));
   without.on_joint_state(joints_at(t0 + 200'000, 1.0), kStart);
-  EXPECT_EQ(without.on_discrepancy(good, kStart).level, risk_t::SAFE);
+  EXPECT_EQ(without.on_discrepancy(frame_at(t0 + 205'000), kStart).level, risk_t::SAFE);
 }
 
 TEST(PlannedTrajectory, InterpolatesInsideItsSpanAndKeepsTheOldPlanBeforeANewOne) {
