@@ -27,10 +27,11 @@ struct Bench {
   std::vector<safety_status_t> statuses;
   power_relay_t last_power;
   int power_messages = 0;
-  // What the fake risk classifier and arm keep sending while the test waits.
+  // What the fake risk classifier and arm keep sending while the test waits
+  // (atomic: the reset feeder thread reads them too).
   bool send_risk = true;
-  int8_t risk_level = risk_t::SAFE;
-  int8_t risk_cause = risk_t::CAUSE_NONE;
+  std::atomic<int8_t> risk_level{risk_t::SAFE};
+  std::atomic<int8_t> risk_cause{risk_t::CAUSE_NONE};
   int64_t last_feed_us = 0;
 
   Bench() {
@@ -109,6 +110,10 @@ TEST(InterveneProcess, LatchedStopResetAndRestart) {
   std::string out;
   // tofguard-reset blocks; keep the feed going from a thread of its own.
   std::atomic<bool> resetting{true};
+  // Risks the feeder sent with the DANGEROUS level: once one went out, none
+  // of its earlier SAFE ones can arrive after the stop (one socket, in
+  // order).
+  std::atomic<int> feeder_dangerous_sent{0};
   std::thread feeder([&] {
     lcm::LCM lcm(kSafetyUrl);
     while (resetting) {
@@ -120,6 +125,7 @@ TEST(InterveneProcess, LatchedStopResetAndRestart) {
       r.score = 0;
       r.threshold = 0;
       lcm.publish("SAFETY_RISK", &r);
+      if (r.level == risk_t::DANGEROUS) ++feeder_dangerous_sent;
       joint_state_t j;
       j.utime = wall_utime();
       j.num_joints = 1;
@@ -135,8 +141,8 @@ TEST(InterveneProcess, LatchedStopResetAndRestart) {
   ASSERT_TRUE(bench.wait_for([](const safety_status_t& s) { return s.motion_allowed; }, std::chrono::seconds(2)));
 
   // DANGEROUS -> motion withdrawn well within 200 ms of the risk.
+  bench.risk_cause = risk_t::CAUSE_JOINT_ERROR;  // (the cause first: the feeder reads both)
   bench.risk_level = risk_t::DANGEROUS;
-  bench.risk_cause = risk_t::CAUSE_JOINT_ERROR;
   bench.last_feed_us = 0;  // send it now
   const int64_t danger_sent_us = monotonic_us();
   ASSERT_TRUE(bench.wait_for([](const safety_status_t& s) { return !s.motion_allowed; }, std::chrono::seconds(2)));
@@ -146,7 +152,10 @@ TEST(InterveneProcess, LatchedStopResetAndRestart) {
   EXPECT_EQ(stopped.stop, safety_status_t::STOP_SOFTWARE);
   EXPECT_TRUE(stopped.latched);
 
-  // A reset while DANGEROUS is refused, with the reason.
+  // A reset while DANGEROUS is refused, with the reason. (Not before the
+  // feeder thread's stream says DANGEROUS too: a SAFE it read just before
+  // the change could otherwise be tofguard-intervene's newest risk.)
+  ASSERT_TRUE(wait_until([&] { return feeder_dangerous_sent > 0; }, std::chrono::seconds(2), [&] { bench.pump(); }));
   EXPECT_EQ(reset("reset-refused", &out), 1) << out;
   EXPECT_NE(out.find("refused: current risk is DANGEROUS: joint error"), std::string::npos) << out;
   resetting = false;
