@@ -49,18 +49,9 @@ void BM_Estimate(benchmark::State& state) {
   camera.translation() = config.camera.pose.translation_m;
   const Intrinsics intrinsics =
       scaled(config.camera.intrinsics, static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
-  std::vector<EstimatorFrame> estimated;
-  for (int k = 0; k < state.range(2); ++k) {
-    renderer::JointPositions at = truth;
-    for (auto& [name, position] : at) position -= k * 0.5 * M_PI / 180;
-    EstimatorFrame frame;
-    frame.intrinsics = intrinsics;
-    frame.depth_m = frames.capture(at, camera, frame.intrinsics, 1 + k);
-    frame.reported_joints = at;
-    frame.reported_joints["a4"] += 10 * M_PI / 180;
-    frame.world_from_optical = camera;
-    estimated.push_back(std::move(frame));
-  }
+  uint64_t frame_index = 0;
+  const std::vector<EstimatorFrame> estimated = frames.frames_with_offset(
+      truth, camera, intrinsics, "a4", 10 * M_PI / 180, static_cast<int>(state.range(2)), &frame_index);
   double iterations = 0, offset = 0;
   for (auto _ : state) {
     const EstimateResult r = estimator.estimate(estimated);

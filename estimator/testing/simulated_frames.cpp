@@ -28,4 +28,25 @@ std::vector<float> SimulatedFrames::capture(const renderer::JointPositions& true
   return image.depth_m;
 }
 
+std::vector<EstimatorFrame> SimulatedFrames::frames_with_offset(const renderer::JointPositions& true_joints,
+                                                                const Eigen::Isometry3d& world_from_optical,
+                                                                const Intrinsics& intrinsics, const std::string& joint,
+                                                                double offset_rad, int num_frames,
+                                                                uint64_t* frame_index) {
+  constexpr double kJointStepRad = 0.5 * 3.141592653589793 / 180;  // per frame
+  std::vector<EstimatorFrame> frames;
+  for (int k = 0; k < num_frames; ++k) {
+    renderer::JointPositions at = true_joints;
+    for (auto& [name, position] : at) position -= k * kJointStepRad;
+    EstimatorFrame frame;
+    frame.intrinsics = intrinsics;
+    frame.depth_m = capture(at, world_from_optical, intrinsics, ++*frame_index);
+    frame.reported_joints = at;
+    frame.reported_joints[joint] += offset_rad;
+    frame.world_from_optical = world_from_optical;
+    frames.push_back(std::move(frame));
+  }
+  return frames;
+}
+
 }  // namespace tofguard::estimator::testing

@@ -11,6 +11,7 @@
 #include <Eigen/Geometry>
 
 #include "depth_calibration.hpp"
+#include "motion_estimator.hpp"
 #include "depth_renderer.hpp"
 #include "scene_model.hpp"
 #include "tof_error_model.hpp"
@@ -30,6 +31,17 @@ class SimulatedFrames {
   std::vector<float> capture(const renderer::JointPositions& true_joints,
                              const Eigen::Isometry3d& true_world_from_optical, const Intrinsics& intrinsics,
                              uint64_t frame_index, const std::vector<renderer::ExtraObject>& objects = {});
+
+  // The frames an estimate is made of (estimator.frames_per_estimate):
+  // the frame at `true_joints` (index `*frame_index + 1`) and the
+  // num_frames - 1 frames before it at 30 Hz, the arm moving meanwhile
+  // (every joint 0.5 degrees a frame), each reporting its joints with
+  // `offset_rad` added to `joint` (an encoder offset; 0: none) and the
+  // camera where it is. Advances *frame_index by num_frames.
+  std::vector<EstimatorFrame> frames_with_offset(const renderer::JointPositions& true_joints,
+                                                 const Eigen::Isometry3d& world_from_optical,
+                                                 const Intrinsics& intrinsics, const std::string& joint,
+                                                 double offset_rad, int num_frames, uint64_t* frame_index);
 
   const renderer::SceneModel& scene() const { return scene_; }
   // The renderer, to share with an estimator on the same thread.

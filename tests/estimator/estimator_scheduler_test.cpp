@@ -2,6 +2,7 @@
 // estimate is made of (estimator.frames_per_estimate, docs/estimator.md).
 #include <gtest/gtest.h>
 
+#include "depth_message.hpp"
 #include "estimator_process.hpp"
 #include "estimator_test_support.hpp"
 
@@ -35,21 +36,9 @@ class SchedulerTest : public ::testing::Test {
 
   depth_image_t frame(int64_t seq) const {
     const Intrinsics& in = config_.camera.intrinsics;
-    depth_image_t f{};
-    f.utime = kStartUtime + seq * kFramePeriodUs;
-    f.seq = seq;
-    f.camera_id = config_.camera.id;
-    f.width = in.width;
-    f.height = in.height;
-    f.fx = in.fx;
-    f.fy = in.fy;
-    f.cx = in.cx;
-    f.cy = in.cy;
-    f.calibrated = true;
-    f.num_pixels = in.width * in.height;
-    f.depth_mm.assign(f.num_pixels, static_cast<int16_t>(1000 + seq));  // tells the frames apart
-    f.num_amplitude = 0;
-    return f;
+    // Every pixel at 1000 + seq mm: tells the frames apart.
+    const std::vector<float> depth_m(static_cast<size_t>(in.width) * in.height, (1000.0f + seq) / 1000.0f);
+    return camera::make_depth_image(config_.camera, kStartUtime + seq * kFramePeriodUs, seq, true, depth_m, {});
   }
 
   discrepancy_t discrepancy(int64_t seq, bool warning) const {

@@ -60,26 +60,13 @@ class MotionEstimatorTest : public ::testing::Test {
 Config* MotionEstimatorTest::config_ = nullptr;
 testing::SimulatedFrames* MotionEstimatorTest::frames_ = nullptr;
 
-// The frames an estimate is made of (estimator.frames_per_estimate in
-// config/sim.yaml): the frame at `truth` and the ones 33 and 67 ms before
-// it (30 Hz), the arm moving meanwhile (every joint 0.5 degrees a frame),
-// each reporting its joints with the same encoder offset on `joint`.
+// The frames of an estimate with an encoder offset on `joint`
+// (SimulatedFrames::frames_with_offset): the sim camera where configured.
 std::vector<EstimatorFrame> frames_with_offset(testing::SimulatedFrames* frames, const Config& config,
                                                const renderer::JointPositions& truth, const std::string& joint,
                                                double offset_rad, int num_frames, uint64_t* index) {
-  std::vector<EstimatorFrame> out;
-  for (int k = 0; k < num_frames; ++k) {
-    renderer::JointPositions at = truth;
-    for (auto& [name, position] : at) position -= k * deg(0.5);
-    EstimatorFrame frame;
-    frame.intrinsics = config.camera.intrinsics;
-    frame.depth_m = frames->capture(at, test::pose_of(config.camera.pose), frame.intrinsics, ++*index);
-    frame.reported_joints = at;
-    frame.reported_joints[joint] += offset_rad;
-    frame.world_from_optical = test::pose_of(config.camera.pose);
-    out.push_back(std::move(frame));
-  }
-  return out;
+  return frames->frames_with_offset(truth, test::pose_of(config.camera.pose), config.camera.intrinsics, joint,
+                                    offset_rad, num_frames, index);
 }
 
 // Encoder offsets of 5, 10 and 20 degrees on each joint in turn (the
