@@ -4,8 +4,8 @@
 #include <cmath>
 
 #include "depth_renderer.hpp"
-#include "tofguard/camera_pose_message.hpp"
 #include "kinematics.hpp"
+#include "tofguard/camera_pose_message.hpp"
 
 namespace tofguard::estimator {
 
