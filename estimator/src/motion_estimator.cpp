@@ -714,8 +714,12 @@ EstimateResult MotionEstimator::finish(const EstimatorFrame& frame, const State&
   return result;
 }
 
-EstimateResult MotionEstimator::estimate(const EstimatorFrame& frame) {
-  return estimate(std::vector<EstimatorFrame>{frame});
+EstimateResult MotionEstimator::estimate(const EstimatorFrame& frame) { return estimate_frames({&frame}); }
+
+EstimateResult MotionEstimator::estimate(const std::vector<EstimatorFrame>& frames) {
+  std::vector<const EstimatorFrame*> pointers;
+  for (const EstimatorFrame& f : frames) pointers.push_back(&f);
+  return estimate_frames(pointers);
 }
 
 namespace {
@@ -747,32 +751,34 @@ EstimatorFrame working_frame(const EstimatorFrame& full, int k) {
 
 }  // namespace
 
-EstimateResult MotionEstimator::estimate(const std::vector<EstimatorFrame>& full_frames) {
+EstimateResult MotionEstimator::estimate_frames(const std::vector<const EstimatorFrame*>& full_frames) {
   const int64_t start = now_us();
   auto fail = [&](const std::string& why) { return unusable_result(why, start); };
   if (full_frames.empty()) return fail("no frames");
   for (size_t f = 0; f < full_frames.size(); ++f) {
-    const std::string problem = check_frame(full_frames[f]);
+    const std::string problem = check_frame(*full_frames[f]);
     if (!problem.empty()) return fail(full_frames.size() > 1 ? "frame " + std::to_string(f) + ": " + problem : problem);
-    if (full_frames[f].intrinsics.width != full_frames[0].intrinsics.width ||
-        full_frames[f].intrinsics.height != full_frames[0].intrinsics.height) {
+    if (full_frames[f]->intrinsics.width != full_frames[0]->intrinsics.width ||
+        full_frames[f]->intrinsics.height != full_frames[0]->intrinsics.height) {
       return fail("frame " + std::to_string(f) + ": image size differs from frame 0's");
     }
   }
   edges_.clear();
   // A large image is estimated at a working resolution (options:
   // max_working_pixels).
-  const Intrinsics& full = full_frames[0].intrinsics;
+  const Intrinsics& full = full_frames[0]->intrinsics;
   int k = 1;
   while (static_cast<int64_t>(full.width / k) * (full.height / k) > options_.max_working_pixels) ++k;
   std::vector<EstimatorFrame> reduced;
+  std::vector<const EstimatorFrame*> frames = full_frames;
   if (k > 1) {
-    for (const EstimatorFrame& f : full_frames) reduced.push_back(working_frame(f, k));
+    reduced.reserve(full_frames.size());  // (frames points into it)
+    for (size_t f = 0; f < full_frames.size(); ++f) {
+      reduced.push_back(working_frame(*full_frames[f], k));
+      frames[f] = &reduced.back();
+    }
   }
-  const std::vector<EstimatorFrame>& working = k > 1 ? reduced : full_frames;
-  const EstimatorFrame& frame = working[0];
-  std::vector<const EstimatorFrame*> frames;
-  for (const EstimatorFrame& f : working) frames.push_back(&f);
+  const EstimatorFrame& frame = *frames[0];
 
   State state;
   state.joint_offsets.assign(num_params_, 0.0);

@@ -256,6 +256,8 @@ class MotionEstimator {
   const MeasuredEdges& edges_of(const EstimatorFrame& frame);
   enum class PointSet { kAll, kStatic };
 
+  // Both estimate()s: frames[0] the estimate's own frame.
+  EstimateResult estimate_frames(const std::vector<const EstimatorFrame*>& frames);
   std::string check_frame(const EstimatorFrame& frame) const;
   // Renders `frame` at `state` and adds its residuals to `lin`. Returns ""
   // or why the frame cannot be rendered.
