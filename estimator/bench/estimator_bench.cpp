@@ -44,9 +44,7 @@ void BM_Estimate(benchmark::State& state) {
   MotionEstimator estimator(frames.scene(), &frames.renderer(), options);
   const renderer::JointPositions truth = {{"a1", -0.6}, {"a2", 1.3}, {"a3", -0.4}, {"a4", 1.2},
                                           {"a5", 0.6},  {"a6", 1.0}, {"a7", -0.4}};
-  Eigen::Isometry3d camera = Eigen::Isometry3d::Identity();
-  camera.linear() = config.camera.pose.rotation.normalized().toRotationMatrix();
-  camera.translation() = config.camera.pose.translation_m;
+  const Eigen::Isometry3d camera = config.camera.pose.frame_from_optical();
   const Intrinsics intrinsics =
       scaled(config.camera.intrinsics, static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
   uint64_t frame_index = 0;

@@ -192,13 +192,10 @@ std::optional<EstimatorFrame> EstimatorScheduler::estimator_frame(const depth_im
     *why = poses.unusable_reason;
     return std::nullopt;
   }
-  Eigen::Isometry3d frame_from_optical = Eigen::Isometry3d::Identity();
-  frame_from_optical.linear() = pose.pose.rotation.normalized().toRotationMatrix();
-  frame_from_optical.translation() = pose.pose.translation_m;
   EstimatorFrame out;
   out.intrinsics = Intrinsics{frame.width, frame.height, frame.fx, frame.fy, frame.cx, frame.cy};
   out.reported_joints = joints.joints;
-  out.world_from_optical = poses.world_from_link[frame_link] * frame_from_optical;
+  out.world_from_optical = poses.world_from_link[frame_link] * pose.pose.frame_from_optical();
   out.depth_m = depth_in_metres(frame);
   return out;
 }
@@ -214,8 +211,7 @@ ScheduledWork EstimatorScheduler::build(const depth_image_t& frame, int8_t trigg
   const renderer::PoseAtTime pose = camera_poses_.at(frame.camera_id, frame.utime);
   if (pose.usable) {
     context.frame_id = pose.pose.frame_id;
-    context.frame_from_optical.linear() = pose.pose.rotation.normalized().toRotationMatrix();
-    context.frame_from_optical.translation() = pose.pose.translation_m;
+    context.frame_from_optical = pose.pose.frame_from_optical();
   }
   const renderer::JointsAtTime joints = history_.at(frame.utime);
   for (const std::string& name : context.joint_names) {

@@ -131,9 +131,7 @@ CalibrationResult calibrate_extrinsics(const Config& config, const std::string& 
     result.error = static_poses.unusable_reason;
     return result;
   }
-  Eigen::Isometry3d frame_from_optical = Eigen::Isometry3d::Identity();
-  frame_from_optical.linear() = config.camera.pose.rotation.normalized().toRotationMatrix();
-  frame_from_optical.translation() = config.camera.pose.translation_m;
+  const Eigen::Isometry3d frame_from_optical = config.camera.pose.frame_from_optical();
   const Eigen::Isometry3d world_from_optical = static_poses.world_from_link[frame_link] * frame_from_optical;
 
   std::vector<EstimatorFrame> estimator_frames;

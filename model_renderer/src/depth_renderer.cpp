@@ -369,10 +369,7 @@ RenderResult DepthRenderer::render(const JointPositions& joints, const CameraPos
       // Normalising a rotation far from unit would hide a fault upstream.
       poses = {false, "camera pose must be finite with a unit quaternion (norm " + std::to_string(norm) + ")", {}};
     } else {
-      Eigen::Isometry3d frame_from_optical = Eigen::Isometry3d::Identity();
-      frame_from_optical.translation() = camera_pose.translation_m;
-      frame_from_optical.linear() = camera_pose.rotation.normalized().toRotationMatrix();
-      world_from_optical = poses.world_from_link[frame] * frame_from_optical;
+      world_from_optical = poses.world_from_link[frame] * camera_pose.frame_from_optical();
     }
   }
   return impl_->render_at(poses, world_from_optical, intrinsics, extra_objects);

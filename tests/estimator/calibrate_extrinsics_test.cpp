@@ -117,9 +117,7 @@ TEST(CalibrateExtrinsics, ConvergesFromFiveCentimetresAndFiveDegrees) {
 
   const CalibrationResult result = calibrate_extrinsics(config, log, CalibrationOptions());
   ASSERT_EQ(result.error, "");
-  Eigen::Isometry3d estimated = Eigen::Isometry3d::Identity();
-  estimated.linear() = result.pose.rotation.normalized().toRotationMatrix();
-  estimated.translation() = result.pose.translation_m;
+  const Eigen::Isometry3d estimated = result.pose.frame_from_optical();
   const Eigen::Isometry3d error = truth.inverse() * estimated;
   const double error_mm = error.translation().norm() * 1000;
   const double error_deg = to_deg(Eigen::AngleAxisd(error.linear()).angle());

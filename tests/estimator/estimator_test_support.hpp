@@ -19,12 +19,7 @@ inline Config sim_config() {
   return load_config(tofguard::test::source_dir() + "/config/sim.yaml", nullptr);
 }
 
-inline Eigen::Isometry3d pose_of(const CameraPose& pose) {
-  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-  t.linear() = pose.rotation.normalized().toRotationMatrix();
-  t.translation() = pose.translation_m;
-  return t;
-}
+inline Eigen::Isometry3d pose_of(const CameraPose& pose) { return pose.frame_from_optical(); }
 
 // The arm's test poses (radians), joints a1..a7. Each keeps every joint's
 // distal links in view and bent away from the joint's axis (a3, a5 and a7

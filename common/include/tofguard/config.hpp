@@ -72,6 +72,15 @@ struct CameraPose {
   std::string frame_id;
   Eigen::Vector3d translation_m = Eigen::Vector3d::Zero();
   Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
+
+  // The optical frame's pose in frame_id as a transform:
+  // p_frame = frame_from_optical() * p_optical (rotation normalised).
+  Eigen::Isometry3d frame_from_optical() const {
+    Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+    t.linear() = rotation.normalized().toRotationMatrix();
+    t.translation() = translation_m;
+    return t;
+  }
 };
 
 struct RobotConfig {
