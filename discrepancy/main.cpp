@@ -2,7 +2,7 @@
 #include <exception>
 #include <iostream>
 
-#include "discrepancy_process.hpp"
+#include "tofguard/discrepancy/discrepancy_process.hpp"
 
 int main(int argc, char** argv) {
   const tofguard::ProcessInfo info = tofguard::discrepancy::process_info();

@@ -3,8 +3,8 @@
 #include <fstream>
 #include <iostream>
 
-#include "extrinsics_calibration.hpp"
-#include "tofguard/process.hpp"
+#include "tofguard/estimator/extrinsics_calibration.hpp"
+#include "tofguard/common/process.hpp"
 
 int main(int argc, char** argv) {
   const tofguard::ProcessInfo info{

@@ -7,11 +7,11 @@
 #include <unistd.h>
 #include <cerrno>
 #include <cstring>
-#include "estimator_process.hpp"
-#include "tofguard/clock.hpp"
-#include "tofguard/config_error.hpp"
-#include "tofguard/lcm_node.hpp"
-#include "tofguard/wire_checks.hpp"
+#include "tofguard/estimator/estimator_process.hpp"
+#include "tofguard/common/clock.hpp"
+#include "tofguard/common/config_error.hpp"
+#include "tofguard/common/lcm_node.hpp"
+#include "tofguard/common/wire_checks.hpp"
 
 namespace tofguard::estimator {
 namespace {

@@ -10,11 +10,11 @@
 #include <iostream>
 #include <regex>
 
-#include "message_format.hpp"
-#include "status_board.hpp"
-#include "tofguard/clock.hpp"
-#include "tofguard/lcm_node.hpp"
-#include "tofguard/process.hpp"
+#include "tofguard/spy/message_format.hpp"
+#include "tofguard/spy/status_board.hpp"
+#include "tofguard/common/clock.hpp"
+#include "tofguard/common/lcm_node.hpp"
+#include "tofguard/common/process.hpp"
 
 namespace tofguard::spy {
 namespace {

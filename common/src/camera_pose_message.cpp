@@ -1,4 +1,4 @@
-#include "tofguard/camera_pose_message.hpp"
+#include "tofguard/common/camera_pose_message.hpp"
 
 namespace tofguard {
 

@@ -1,4 +1,4 @@
-#include "tofguard/clock.hpp"
+#include "tofguard/common/clock.hpp"
 
 #include <chrono>
 

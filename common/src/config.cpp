@@ -1,10 +1,10 @@
-#include "tofguard/config.hpp"
+#include "tofguard/common/config.hpp"
 
 #include <cmath>
 #include <cstdint>
 #include <regex>
 
-#include "tofguard/yaml_reader.hpp"
+#include "tofguard/common/yaml_reader.hpp"
 
 namespace tofguard {
 namespace {

@@ -1,8 +1,8 @@
-#include "tofguard/error_log.hpp"
+#include "tofguard/common/error_log.hpp"
 
 #include <iostream>
 
-#include "tofguard/clock.hpp"
+#include "tofguard/common/clock.hpp"
 
 namespace tofguard {
 

@@ -1,10 +1,10 @@
-#include "tofguard/heartbeat.hpp"
+#include "tofguard/common/heartbeat.hpp"
 
 #include <unistd.h>
 
 #include <algorithm>
 
-#include "tofguard/clock.hpp"
+#include "tofguard/common/clock.hpp"
 #include "tofguard/heartbeat_t.hpp"
 
 namespace tofguard {

@@ -1,4 +1,4 @@
-#include "tofguard/lcm_node.hpp"
+#include "tofguard/common/lcm_node.hpp"
 
 #include <poll.h>
 #include <signal.h>
@@ -7,7 +7,7 @@
 #include <atomic>
 #include <stdexcept>
 
-#include "tofguard/clock.hpp"
+#include "tofguard/common/clock.hpp"
 
 namespace tofguard {
 namespace {

@@ -1,4 +1,4 @@
-#include "tofguard/planned_trajectory.hpp"
+#include "tofguard/common/planned_trajectory.hpp"
 
 #include <algorithm>
 

@@ -1,9 +1,9 @@
-#include "tofguard/process.hpp"
+#include "tofguard/common/process.hpp"
 
 #include <cstdlib>
 #include <iostream>
 
-#include "tofguard/lcm_node.hpp"
+#include "tofguard/common/lcm_node.hpp"
 
 namespace tofguard {
 

@@ -1,4 +1,4 @@
-#include "tofguard/risk_names.hpp"
+#include "tofguard/common/risk_names.hpp"
 
 #include "tofguard/risk_t.hpp"
 #include "tofguard/safety_status_t.hpp"

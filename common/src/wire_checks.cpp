@@ -1,4 +1,4 @@
-#include "tofguard/wire_checks.hpp"
+#include "tofguard/common/wire_checks.hpp"
 
 #include <cmath>
 #include <set>

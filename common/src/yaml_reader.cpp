@@ -1,4 +1,4 @@
-#include "tofguard/yaml_reader.hpp"
+#include "tofguard/common/yaml_reader.hpp"
 
 #include <cmath>
 #include <filesystem>

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <random>
 
-#include "discrepancy_image.hpp"
+#include "tofguard/discrepancy/discrepancy_image.hpp"
 
 namespace {
 

@@ -1,4 +1,4 @@
-#include "discrepancy_image.hpp"
+#include "tofguard/discrepancy/discrepancy_image.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,12 +1,12 @@
-#include "discrepancy_process.hpp"
+#include "tofguard/discrepancy/discrepancy_process.hpp"
 
 #include <algorithm>
 
-#include "discrepancy_image.hpp"
-#include "frame_pairer.hpp"
-#include "tofguard/clock.hpp"
-#include "tofguard/lcm_node.hpp"
-#include "tofguard/wire_checks.hpp"
+#include "tofguard/discrepancy/discrepancy_image.hpp"
+#include "tofguard/discrepancy/frame_pairer.hpp"
+#include "tofguard/common/clock.hpp"
+#include "tofguard/common/lcm_node.hpp"
+#include "tofguard/common/wire_checks.hpp"
 
 namespace tofguard::discrepancy {
 

@@ -1,4 +1,4 @@
-#include "frame_pairer.hpp"
+#include "tofguard/discrepancy/frame_pairer.hpp"
 
 #include <algorithm>
 

@@ -9,9 +9,9 @@
 #include <cstdlib>
 #include <vector>
 
-#include "motion_estimator.hpp"
+#include "tofguard/estimator/motion_estimator.hpp"
 #include "simulated_frames.hpp"
-#include "tofguard/config.hpp"
+#include "tofguard/common/config.hpp"
 
 namespace tofguard::estimator {
 namespace {
@@ -37,7 +37,7 @@ void BM_Estimate(benchmark::State& state) {
   // threads, unless the environment says otherwise.
   setenv("LP_NUM_THREADS", "0", /*overwrite=*/0);
   const Config config = load_config(std::string(TOFGUARD_SOURCE_DIR) + "/config/sim.yaml", nullptr);
-  testing::SimulatedFrames frames(config);
+  tofguard::test::SimulatedFrames frames(config);
   EstimatorOptions options;
   options.noise_sigma_at_0m_m = config.discrepancy.noise_sigma_at_0m_mm / 1000;
   options.noise_sigma_per_m2_m = config.discrepancy.noise_sigma_per_m2_mm / 1000;

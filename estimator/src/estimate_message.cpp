@@ -1,4 +1,4 @@
-#include "estimate_message.hpp"
+#include "tofguard/estimator/estimate_message.hpp"
 
 #include <algorithm>
 #include <limits>

@@ -1,11 +1,11 @@
-#include "estimator_process.hpp"
+#include "tofguard/estimator/estimator_process.hpp"
 
 #include <chrono>
 #include <cmath>
 
-#include "depth_renderer.hpp"
-#include "kinematics.hpp"
-#include "tofguard/camera_pose_message.hpp"
+#include "tofguard/renderer/depth_renderer.hpp"
+#include "tofguard/renderer/kinematics.hpp"
+#include "tofguard/common/camera_pose_message.hpp"
 
 namespace tofguard::estimator {
 

@@ -1,4 +1,4 @@
-#include "extrinsics_calibration.hpp"
+#include "tofguard/estimator/extrinsics_calibration.hpp"
 
 #include <lcm/lcm-cpp.hpp>
 
@@ -8,13 +8,13 @@
 #include <memory>
 #include <sstream>
 
-#include "depth_renderer.hpp"
-#include "estimator_process.hpp"
-#include "joint_history.hpp"
-#include "tofguard/decode.hpp"
+#include "tofguard/renderer/depth_renderer.hpp"
+#include "tofguard/estimator/estimator_process.hpp"
+#include "tofguard/renderer/joint_history.hpp"
+#include "tofguard/common/decode.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/joint_state_t.hpp"
-#include "tofguard/wire_checks.hpp"
+#include "tofguard/common/wire_checks.hpp"
 
 namespace tofguard::estimator {
 

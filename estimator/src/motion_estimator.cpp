@@ -1,4 +1,4 @@
-#include "motion_estimator.hpp"
+#include "tofguard/estimator/motion_estimator.hpp"
 
 #include <algorithm>
 #include <chrono>

@@ -1,4 +1,4 @@
-#include "message_format.hpp"
+#include "tofguard/spy/message_format.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "tofguard/camera_pose_t.hpp"
-#include "tofguard/decode.hpp"
+#include "tofguard/common/decode.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/heartbeat_t.hpp"
@@ -20,7 +20,7 @@
 #include "tofguard/power_relay_t.hpp"
 #include "tofguard/reset_reply_t.hpp"
 #include "tofguard/reset_request_t.hpp"
-#include "tofguard/risk_names.hpp"
+#include "tofguard/common/risk_names.hpp"
 #include "tofguard/risk_t.hpp"
 #include "tofguard/safety_status_t.hpp"
 #include "tofguard/sim_camera_fault_t.hpp"

@@ -1,13 +1,13 @@
-#include "status_board.hpp"
+#include "tofguard/spy/status_board.hpp"
 
 #include <iomanip>
 #include <sstream>
 
-#include "message_format.hpp"
-#include "tofguard/decode.hpp"
+#include "tofguard/spy/message_format.hpp"
+#include "tofguard/common/decode.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/link_labels_t.hpp"
-#include "tofguard/risk_names.hpp"
+#include "tofguard/common/risk_names.hpp"
 
 namespace tofguard::spy {
 namespace {

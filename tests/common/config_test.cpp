@@ -5,7 +5,7 @@
 #include <string>
 
 #include "test_support.hpp"
-#include "tofguard/config.hpp"
+#include "tofguard/common/config.hpp"
 
 namespace tofguard::test {
 namespace {

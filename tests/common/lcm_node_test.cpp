@@ -3,12 +3,12 @@
 // the counters; timers fire by themselves.
 #include <gtest/gtest.h>
 
-#include "../wire_contract/sample_messages.hpp"
+#include "sample_messages.hpp"
 #include "test_support.hpp"
-#include "tofguard/clock.hpp"
-#include "tofguard/config.hpp"
-#include "tofguard/lcm_node.hpp"
-#include "tofguard/wire_checks.hpp"
+#include "tofguard/common/clock.hpp"
+#include "tofguard/common/config.hpp"
+#include "tofguard/common/lcm_node.hpp"
+#include "tofguard/common/wire_checks.hpp"
 
 namespace tofguard::test {
 namespace {

@@ -1,7 +1,7 @@
 // The discrepancy image on synthetic frames whose every count is known.
 #include <gtest/gtest.h>
 
-#include "discrepancy_image.hpp"
+#include "tofguard/discrepancy/discrepancy_image.hpp"
 #include "synthetic_frames.hpp"
 
 namespace tofguard::test {

@@ -1,7 +1,7 @@
 // Pairing camera, rendered and label frames by seq with a bounded wait.
 #include <gtest/gtest.h>
 
-#include "frame_pairer.hpp"
+#include "tofguard/discrepancy/frame_pairer.hpp"
 #include "synthetic_frames.hpp"
 
 namespace tofguard::test {

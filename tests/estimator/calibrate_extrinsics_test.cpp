@@ -2,7 +2,7 @@
 // (noise, mixed pixels, calibration) with a known pose while the arm moves
 // through known poses: from a config pose 5 cm and 5 degrees wrong, the
 // estimate comes back to the true pose. And its one-line errors.
-#include "extrinsics_calibration.hpp"
+#include "tofguard/estimator/extrinsics_calibration.hpp"
 
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
@@ -12,7 +12,7 @@
 #include <iostream>
 #include <sstream>
 
-#include "depth_message.hpp"
+#include "tofguard/camera/depth_message.hpp"
 #include "estimator_test_support.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/joint_state_t.hpp"
@@ -45,7 +45,7 @@ std::string write_log(const std::string& name, const Config& config, const std::
   const std::string path = dir + "/" + name;
   std::filesystem::remove(path);
   lcm::LogFile log(path, "w");
-  testing::SimulatedFrames frames(config);
+  tofguard::test::SimulatedFrames frames(config);
   const Eigen::Isometry3d camera = test::pose_of(config.camera.pose);
   const Intrinsics& in = config.camera.intrinsics;
   int64_t utime = 1700000000000000;

@@ -13,8 +13,8 @@
 #include <optional>
 
 #include "test_support.hpp"
-#include "tofguard/clock.hpp"
-#include "tofguard/config.hpp"
+#include "tofguard/common/clock.hpp"
+#include "tofguard/common/config.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/heartbeat_t.hpp"

@@ -2,8 +2,8 @@
 // estimate is made of (estimator.frames_per_estimate, docs/estimator.md).
 #include <gtest/gtest.h>
 
-#include "depth_message.hpp"
-#include "estimator_process.hpp"
+#include "tofguard/camera/depth_message.hpp"
+#include "tofguard/estimator/estimator_process.hpp"
 #include "estimator_test_support.hpp"
 
 namespace tofguard::estimator {

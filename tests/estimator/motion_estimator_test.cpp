@@ -1,13 +1,13 @@
 // The motion estimator on frames of the simulated ToF camera: encoder
 // offsets on each joint, camera pose errors, an object beside the arm.
-#include "motion_estimator.hpp"
+#include "tofguard/estimator/motion_estimator.hpp"
 
 #include <gtest/gtest.h>
 
 #include <iostream>
 
-#include "estimate_finding.hpp"
-#include "estimate_message.hpp"
+#include "tofguard/risk/estimate_finding.hpp"
+#include "tofguard/estimator/estimate_message.hpp"
 #include "estimator_test_support.hpp"
 #include "tofguard/risk_t.hpp"
 
@@ -42,7 +42,7 @@ class MotionEstimatorTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     config_ = new Config(test::sim_config());
-    frames_ = new testing::SimulatedFrames(*config_);
+    frames_ = new tofguard::test::SimulatedFrames(*config_);
   }
   static void TearDownTestSuite() {
     delete frames_;
@@ -55,14 +55,14 @@ class MotionEstimatorTest : public ::testing::Test {
     return o;
   }
   static Config* config_;
-  static testing::SimulatedFrames* frames_;
+  static tofguard::test::SimulatedFrames* frames_;
 };
 Config* MotionEstimatorTest::config_ = nullptr;
-testing::SimulatedFrames* MotionEstimatorTest::frames_ = nullptr;
+tofguard::test::SimulatedFrames* MotionEstimatorTest::frames_ = nullptr;
 
 // The frames of an estimate with an encoder offset on `joint`
 // (SimulatedFrames::frames_with_offset): the sim camera where configured.
-std::vector<EstimatorFrame> frames_with_offset(testing::SimulatedFrames* frames, const Config& config,
+std::vector<EstimatorFrame> frames_with_offset(tofguard::test::SimulatedFrames* frames, const Config& config,
                                                const renderer::JointPositions& truth, const std::string& joint,
                                                double offset_rad, int num_frames, uint64_t* index) {
   return frames->frames_with_offset(truth, test::pose_of(config.camera.pose), config.camera.intrinsics, joint,

@@ -2,18 +2,18 @@
 // CAMERA_POSE reports) disagrees with where it really looks is flagged by
 // the estimator's camera correction, and the risk classifier calls it a
 // calibration error (issue 7, item 4). The simulated camera's own pan-tilt model
-// (camera_driver's SimulatedCamera: true and reported pose at a time) with
+// (sim's SimulatedCamera: true and reported pose at a time) with
 // a pan_tilt_offset fault; frames from the simulated ToF camera (noise,
 // mixed and invalid pixels, calibration).
 #include <gtest/gtest.h>
 
 #include <iostream>
 
-#include "estimate_finding.hpp"
-#include "estimate_message.hpp"
-#include "estimator_process.hpp"
+#include "tofguard/risk/estimate_finding.hpp"
+#include "tofguard/estimator/estimate_message.hpp"
+#include "tofguard/estimator/estimator_process.hpp"
 #include "estimator_test_support.hpp"
-#include "sim_camera.hpp"
+#include "tofguard/sim/sim_camera.hpp"
 #include "tofguard/risk_t.hpp"
 
 namespace tofguard::estimator {
@@ -48,8 +48,8 @@ struct PanTiltCase {
   double reading_error_deg = 0;  // angle between true and reported pose
 };
 
-PanTiltCase estimate_at(const Config& config, testing::SimulatedFrames* frames, int64_t t_us, uint64_t index) {
-  camera::SimulatedCamera head(config.camera, nullptr, 0);
+PanTiltCase estimate_at(const Config& config, tofguard::test::SimulatedFrames* frames, int64_t t_us, uint64_t index) {
+  sim::SimulatedCamera head(config.camera, nullptr, 0);
   const CameraPose true_pose = head.true_pose(t_us);
   const std::optional<CameraPose> reading = head.reported_pose(t_us);
   EXPECT_TRUE(reading.has_value());
@@ -82,7 +82,7 @@ double correction_deg(const motion_estimate_t& m) {
 
 // Before the fault the head turns (pan 10 deg at 3 s) and its reading is
 // right: nothing to correct, no finding.
-void expect_no_finding_before_the_fault(const Config& config, testing::SimulatedFrames* frames) {
+void expect_no_finding_before_the_fault(const Config& config, tofguard::test::SimulatedFrames* frames) {
   const PanTiltCase good = estimate_at(config, frames, 3 * kSecond, 1);
   EXPECT_NEAR(good.reading_error_deg, 0, 1e-9);
   ASSERT_TRUE(good.message.usable) << good.message.unusable_reason;
@@ -93,7 +93,7 @@ void expect_no_finding_before_the_fault(const Config& config, testing::Simulated
 
 // After it the head's reading is 3 deg off: the correction finds it (at
 // 8 s and 10 s, the head in other positions).
-void expect_calibration_error_after_the_fault(const Config& config, testing::SimulatedFrames* frames) {
+void expect_calibration_error_after_the_fault(const Config& config, tofguard::test::SimulatedFrames* frames) {
   uint64_t index = 2;
   for (int64_t t_us : {8 * kSecond, 10 * kSecond}) {
     const PanTiltCase bad = estimate_at(config, frames, t_us, index++);
@@ -110,7 +110,7 @@ void expect_calibration_error_after_the_fault(const Config& config, testing::Sim
 
 TEST(PanTilt, ATiltReadingThatDisagreesWithTheImageIsACalibrationError) {
   const Config config = pan_tilt_config(0, test::deg(3));
-  testing::SimulatedFrames frames(config);
+  tofguard::test::SimulatedFrames frames(config);
   expect_no_finding_before_the_fault(config, &frames);
   expect_calibration_error_after_the_fault(config, &frames);
 }
@@ -120,7 +120,7 @@ TEST(PanTilt, ATiltReadingThatDisagreesWithTheImageIsACalibrationError) {
 // (docs/estimator.md).
 TEST(PanTilt, APanReadingThatDisagreesWithTheImageIsACalibrationError) {
   const Config config = pan_tilt_config(test::deg(3), 0);
-  testing::SimulatedFrames frames(config);
+  tofguard::test::SimulatedFrames frames(config);
   expect_no_finding_before_the_fault(config, &frames);
   expect_calibration_error_after_the_fault(config, &frames);
 }

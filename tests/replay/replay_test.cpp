@@ -32,10 +32,10 @@
 #include <string_view>
 
 #include "test_support.hpp"
-#include "tofguard/config.hpp"
+#include "tofguard/common/config.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/heartbeat_t.hpp"
-#include "tofguard/risk_names.hpp"
+#include "tofguard/common/risk_names.hpp"
 #include "tofguard/risk_t.hpp"
 #include "tofguard/safety_status_t.hpp"
 #include "tofguard/sim_camera_fault_t.hpp"

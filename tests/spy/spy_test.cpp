@@ -9,9 +9,9 @@
 #include <filesystem>
 #include <thread>
 
-#include "../wire_contract/sample_messages.hpp"
-#include "message_format.hpp"
-#include "status_board.hpp"
+#include "sample_messages.hpp"
+#include "tofguard/spy/message_format.hpp"
+#include "tofguard/spy/status_board.hpp"
 #include "test_support.hpp"
 #include "tofguard/motion_estimate_t.hpp"
 

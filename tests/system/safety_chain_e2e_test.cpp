@@ -19,17 +19,17 @@
 #include <memory>
 #include <thread>
 
-#include "kinematics.hpp"
-#include "scene_model.hpp"
+#include "tofguard/renderer/kinematics.hpp"
+#include "tofguard/renderer/scene_model.hpp"
 #include "test_support.hpp"
 #include "tofguard/heartbeat_t.hpp"
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/camera_pose_t.hpp"
-#include "tofguard/clock.hpp"
-#include "tofguard/config.hpp"
+#include "tofguard/common/clock.hpp"
+#include "tofguard/common/config.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/motion_estimate_t.hpp"
-#include "tofguard/risk_names.hpp"
+#include "tofguard/common/risk_names.hpp"
 #include "tofguard/risk_t.hpp"
 #include "tofguard/safety_status_t.hpp"
 #include "tofguard/sim_camera_fault_t.hpp"

@@ -1,0 +1,17 @@
+#pragma once
+// CameraPose (config.hpp) to and from the wire's camera_pose_t: the same
+// convention (the optical frame's pose in frame_id, p_frame = R * p_optical
+// + t, quaternion w, x, y, z).
+#include <cstdint>
+#include <string>
+
+#include "tofguard/camera_pose_t.hpp"
+#include "tofguard/common/config.hpp"
+
+namespace tofguard {
+
+camera_pose_t to_camera_pose_message(const std::string& camera_id, int64_t utime, const CameraPose& pose);
+// The rotation is normalised (check_camera_pose allows a norm within 1e-3 of 1).
+CameraPose from_camera_pose_message(const camera_pose_t& message);
+
+}  // namespace tofguard

@@ -1,0 +1,104 @@
+#pragma once
+// The discrepancy image of one camera frame: I_dis = I_gen - I_ToF per pixel
+// (the seed's formula 4.1), in millimetres, with I_gen the depth rendered
+// from the model at the reported joint angles and I_ToF the camera's. Every
+// pixel is classified (discrepancy_t::PIXEL_*), counted per model link
+// through the label image, and the frame is scored (docs/safety-chain.md).
+//
+// Pure computation: no LCM, no clocks. Images are row-major (v*width + u),
+// depth is Z along the camera's optical axis in millimetres, <= 0 = none.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "tofguard/common/config.hpp"
+#include "tofguard/depth_image_t.hpp"
+#include "tofguard/discrepancy_image_t.hpp"
+#include "tofguard/discrepancy_t.hpp"
+#include "tofguard/link_labels_t.hpp"
+
+namespace tofguard::discrepancy {
+
+// When |I_dis| is a mismatch rather than camera noise.
+struct Tolerance {
+  // sigma(d) = sigma_at_0m_mm + sigma_per_m2_mm * d^2, d in metres.
+  double sigma_at_0m_mm = 4.0;
+  double sigma_per_m2_mm = 1.2;
+  double sigmas = 4.0;
+  // Added to k*sigma: the model's own inaccuracy, millimetres.
+  double model_mm = 15.0;
+
+  // Largest |I_dis| still a match at camera depth `depth_mm`, millimetres.
+  double at(double depth_mm) const {
+    const double d_m = depth_mm * 1e-3;
+    return sigmas * (sigma_at_0m_mm + sigma_per_m2_mm * d_m * d_m) + model_mm;
+  }
+};
+
+struct Parameters {
+  Tolerance tolerance;
+  // Radius of the square opening of the mismatch masks, pixels (0 = none).
+  int opening_radius_px = 1;
+  // Rendered depth steps over this (and the model's outline) are
+  // silhouettes, where ToF pixels mix both surfaces: the pixels beside them
+  // are left out of link counts and blobs, mm. 0 = no silhouettes.
+  double silhouette_jump_mm = 0;
+  // Distance from the modelled arm within which nearer surfaces count, m.
+  double near_arm_m = 0.2;
+  // Logical maximum of |I_dis| per pixel for the normalised seed score, mm.
+  double max_depth_mm = 8000;
+};
+
+Parameters parameters_from(const DiscrepancyConfig& config);
+
+// The result for one frame: the summary that goes on the wire, and the
+// images (for the colour image and for tests).
+struct DiscrepancyFrame {
+  discrepancy_t summary;
+  // discrepancy_t::PIXEL_* per pixel (CV_8U), empty when unusable.
+  cv::Mat1b pixel_class;
+  // I_dis in millimetres where both images have a surface, 0 elsewhere.
+  cv::Mat1i dis_mm;
+};
+
+// Compares a camera frame with its rendered frame and labels. The messages
+// have passed their wire checks. When the labels are unusable, or the three
+// do not fit each other (size, intrinsics, camera, label values), the
+// summary is unusable and says why; `rendered` is not read when the labels
+// are unusable.
+DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_image_t& rendered,
+                                     const link_labels_t& labels, const Parameters& parameters);
+
+// The summary of a camera frame that cannot be compared (`kind` is one of
+// discrepancy_t::UNUSABLE_*): identity, calibrated flag and invalid pixels
+// filled in, everything else zero (depth_hash and repeat_count are the
+// caller's).
+discrepancy_t unusable_summary(const depth_image_t& camera, int8_t kind, const std::string& reason);
+
+// FNV-1a 64-bit hash of a depth array's bytes (little-endian int16).
+int64_t depth_hash(const std::vector<int16_t>& depth_mm);
+
+// Counts how many camera frames in a row repeated the previous image.
+class RepeatCounter {
+ public:
+  // The number of frames immediately before this one with the same hash.
+  int32_t update(int64_t hash);
+
+ private:
+  bool has_previous_ = false;
+  int64_t previous_ = 0;
+  int32_t repeats_ = 0;
+};
+
+// The colour discrepancy image: red where I_dis > 0 (the camera sees
+// nearer than the model: something is there that the model does not
+// have), blue where I_dis < 0 (the camera sees farther: the model's surface
+// is missing), black where the pixel matches or is not compared;
+// brightness |I_dis| / full_scale_mm, saturating at 255. (The tofguard
+// issues disagree on the sign convention; this follows the one with a
+// physical definition and a test: "nearer in the camera is red".)
+discrepancy_image_t colour_image(const DiscrepancyFrame& frame, double full_scale_mm);
+
+}  // namespace tofguard::discrepancy

@@ -1,0 +1,162 @@
+#pragma once
+// tofguard-estimator's logic apart from LCM: which camera frames to
+// estimate and with what reported values (EstimatorScheduler), and the
+// worker thread that estimates them without ever blocking the LCM loop
+// (EstimatorWorker).
+//
+// Triggers (config `estimator`, docs/estimator.md):
+//   TRIGGER_WARNING  a frame whose discrepancy_t is usable and reaches
+//                    warning.mismatch_fraction or warning.p95_abs_dis_mm,
+//                    or in which the risk classifier's rules
+//                    (risk::classify_frame) find a model mismatch,
+//                    as soon as both the frame and its discrepancy are in;
+//   TRIGGER_PERIODIC the newest frame every periodic_period_ms.
+// A frame is estimated once, jointly with up to frames_per_estimate - 1
+// kept frames just before it (MotionEstimator::estimate(frames)) that are
+// on the same side of a fault's onset: for a frame whose discrepancy passed
+// the warning level, earlier frames whose discrepancy passed it too; for
+// any other frame, earlier frames whose discrepancy did not (or has not
+// come). An offset that began between two frames is not averaged with the
+// frames before it. The
+// joints are the JOINT_STATE history interpolated at each frame's utime
+// (renderer's JointHistory, the renderer's extrapolation limit); the
+// camera pose is CAMERA_POSE at the frame's utime (renderer's
+// CameraPoseHistory, with the renderer's limits), else the config's static
+// pose.
+#include <condition_variable>
+#include <deque>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <set>
+#include <string>
+#include <thread>
+
+#include "tofguard/renderer/camera_pose_history.hpp"
+#include "tofguard/estimator/estimate_message.hpp"
+#include "tofguard/renderer/joint_history.hpp"
+#include "tofguard/risk/frame_classifier.hpp"
+#include "tofguard/risk/robot_tree.hpp"
+#include "tofguard/estimator/motion_estimator.hpp"
+#include "tofguard/renderer/scene_model.hpp"
+#include "tofguard/camera_pose_t.hpp"
+#include "tofguard/common/config.hpp"
+#include "tofguard/depth_image_t.hpp"
+#include "tofguard/discrepancy_t.hpp"
+#include "tofguard/joint_state_t.hpp"
+#include "tofguard/motion_estimate_t.hpp"
+#include "tofguard/common/process.hpp"
+
+namespace tofguard::estimator {
+
+ProcessInfo process_info();
+
+// The estimator's options from the config (noise model from
+// `discrepancy`, iterations and stride from `estimator`).
+EstimatorOptions options_from_config(const Config& config);
+
+// The scene the estimator compares with the camera: the robot and the
+// environment as the camera sees them (visual geometry, no padding).
+renderer::SceneModel load_estimator_scene(const Config& config);
+
+// The name of a joint that moves `link` (the nearest one up the chain), ""
+// for a static link.
+std::string moving_joint_of(const renderer::SceneModel& scene, int link);
+
+// A depth_image_t's depth in metres (0 = no return), row-major.
+std::vector<float> depth_in_metres(const depth_image_t& frame);
+
+// "" for a discrepancy_t the trigger may use, else one line naming the
+// field.
+std::string check_discrepancy(const discrepancy_t& d);
+
+struct EstimateJob {
+  // frames[0] is the frame the estimate is about, the others the frames
+  // just before it (newest first).
+  std::vector<EstimatorFrame> frames;
+  EstimateContext context;
+};
+
+// A frame to estimate, or an estimate that could not even be started.
+struct ScheduledWork {
+  std::optional<EstimateJob> job;
+  std::optional<motion_estimate_t> unusable;
+};
+
+class EstimatorScheduler {
+ public:
+  EstimatorScheduler(const Config& config, const renderer::SceneModel& scene);
+
+  // False (ignored) for another robot's state or one not newer than the
+  // last.
+  bool on_joint_state(const joint_state_t& state);
+  void on_camera_pose(const camera_pose_t& pose);
+  // Frames of other cameras are ignored (false).
+  bool on_depth(const depth_image_t& frame);
+  void on_discrepancy(const discrepancy_t& discrepancy);
+  // Asks for the newest frame (periodic trigger).
+  void request_newest();
+  // The work that became ready (frame and trigger both in), oldest first.
+  std::vector<ScheduledWork> take_ready();
+
+  // Frames whose discrepancy asked for an estimate but which left the
+  // window before (or never arrived).
+  int64_t missed() const { return missed_; }
+
+ private:
+  ScheduledWork build(const depth_image_t& frame, int8_t trigger) const;
+  // The discrepancy passed the warning level (estimator.warning, or the
+  // risk rules' model mismatch).
+  bool passes_warning(const discrepancy_t& d) const;
+  // The frame with its reported joints and camera pose (for `context`'s
+  // camera frame_id), or "" and the reason it cannot be estimated.
+  std::optional<EstimatorFrame> estimator_frame(const depth_image_t& frame, const std::string& frame_id,
+                                                std::string* why) const;
+
+  Config config_;
+  const renderer::SceneModel& scene_;
+  risk::RobotTree robot_;
+  renderer::JointHistory history_;
+  renderer::CameraPoseHistory camera_poses_;
+  std::map<int64_t, depth_image_t> frames_;  // by seq
+  std::map<int64_t, int8_t> wanted_;          // seq -> trigger
+  std::set<int64_t> estimated_;
+  std::set<int64_t> warning_seqs_;  // kept frames whose discrepancy passed the warning level
+  int64_t last_warning_utime_ = 0;  // utime of the last warning-triggered frame
+  std::vector<ScheduledWork> ready_;
+  int64_t missed_ = 0;
+};
+
+// Estimates jobs on its own thread (its own renderer and EGL context). One
+// job waits at most: a newer one replaces it and counts as dropped.
+class EstimatorWorker {
+ public:
+  EstimatorWorker(const renderer::SceneModel& scene, const Config& config);
+  ~EstimatorWorker();
+  EstimatorWorker(const EstimatorWorker&) = delete;
+  EstimatorWorker& operator=(const EstimatorWorker&) = delete;
+
+  // Waits (up to 30 s) until the worker's renderer is up; "" or why not.
+  std::string wait_ready();
+  // Returns true when a waiting job was replaced (dropped).
+  bool post(EstimateJob job);
+  std::vector<motion_estimate_t> take_results();
+  bool busy();
+
+ private:
+  void run();
+
+  const renderer::SceneModel& scene_;
+  Config config_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  bool started_ = false;
+  std::string start_error_;
+  bool stop_ = false;
+  bool working_ = false;
+  std::optional<EstimateJob> pending_;
+  std::vector<motion_estimate_t> results_;
+  std::thread thread_;
+};
+
+}  // namespace tofguard::estimator

@@ -1,0 +1,230 @@
+#include "tofguard/renderer/renderer_process.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+#include "tofguard/common/camera_pose_message.hpp"
+
+namespace tofguard::renderer {
+
+ProcessInfo process_info() {
+  return {"tofguard-renderer",
+          "Renders the arm's model at the reported joint angles from the camera's pose: TOF_DEPTH, JOINT_STATE, "
+          "CAMERA_POSE, PLANNED_TRAJECTORY (rendering the next frame ahead) -> TOF_RENDERED, TOF_LABELS.\n"
+          "Also: tofguard-renderer render --help (one image to PNG files)."};
+}
+
+SceneOptions scene_options(const Config& config) {
+  SceneOptions options;
+  options.geometry = parse_geometry_source(config.renderer.geometry);
+  options.padding_m = config.renderer.padding_m;
+  options.package_paths = config.robot.package_paths;
+  return options;
+}
+
+namespace {
+
+std::unique_ptr<DepthRenderer> make_renderer(const SceneModel& scene, const RendererConfig& config) {
+  if (config.far_m > kMaxFarM) {
+    throw std::invalid_argument("renderer.far_m must be at most " + std::to_string(kMaxFarM) +
+                                " m (depth_mm is int16 millimetres), got " + std::to_string(config.far_m));
+  }
+  return std::make_unique<DepthRenderer>(scene, config.near_m, config.far_m);
+}
+
+}  // namespace
+
+RendererService::RendererService(const Config& config)
+    : config_(config),
+      scene_(load_scene(config.robot.urdf_path, config.environment.urdf_paths, scene_options(config))),
+      renderer_(make_renderer(scene_, config.renderer)),
+      history_(static_cast<int64_t>(std::llround(config.renderer.max_extrapolation_ms * 1000.0))),
+      camera_poses_(static_cast<int64_t>(std::llround(config.renderer.camera_pose_history_ms * 1000.0)),
+                    static_cast<int64_t>(std::llround(config.renderer.camera_pose_max_extrapolation_ms * 1000.0)),
+                    static_cast<int64_t>(std::llround(config.renderer.camera_pose_max_gap_ms * 1000.0))) {
+  camera_poses_.set_static(config.camera.id, config.camera.pose);
+  for (const Joint& joint : scene_.joints) {
+    if (joint.type == JointType::kPrismatic) prismatic_joints_.insert(joint.name);
+  }
+}
+
+bool RendererService::on_joint_state(const joint_state_t& state) {
+  if (state.robot_id != config_.robot.id) return false;
+  JointPositions positions;
+  for (int i = 0; i < state.num_joints; ++i) positions[state.name[i]] = state.position[i];
+  return history_.add(state.utime, positions);
+}
+
+bool RendererService::on_camera_pose(const camera_pose_t& message) {
+  return camera_poses_.add(message.camera_id, message.utime, from_camera_pose_message(message));
+}
+
+bool RendererService::on_depth(const depth_image_t& frame) {
+  const bool dropped = pending_.has_value();
+  pending_ = frame;
+  return dropped;
+}
+
+std::optional<RenderedFrame> RendererService::render_pending() {
+  if (!pending_) return std::nullopt;
+  const depth_image_t frame = std::move(*pending_);
+  pending_.reset();
+  return render(frame);
+}
+
+namespace {
+
+constexpr double kDegToRad = M_PI / 180.0;
+// Frame intervals kept to learn the camera period (their median).
+constexpr size_t kKeptIntervals = 9;
+// After this many misses in a row, predict only every kProbeEveryFrames-th
+// frame until a hit.
+constexpr int kMissesBeforeProbing = 5;
+constexpr int kProbeEveryFrames = 8;
+
+}  // namespace
+
+void RendererService::on_plan(const planned_trajectory_t& plan) { plan_.add(plan); }
+
+int64_t RendererService::frame_period_us() const {
+  if (frame_intervals_us_.empty()) return 0;
+  std::vector<int64_t> sorted(frame_intervals_us_.begin(), frame_intervals_us_.end());
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  return sorted[sorted.size() / 2];
+}
+
+void RendererService::learn_period(const depth_image_t& frame) {
+  if (last_frame_utime_ && frame.utime > *last_frame_utime_) {
+    frame_intervals_us_.push_back(frame.utime - *last_frame_utime_);
+    while (frame_intervals_us_.size() > kKeptIntervals) frame_intervals_us_.pop_front();
+  }
+  last_frame_utime_ = frame.utime;
+}
+
+void RendererService::plan_prediction(const depth_image_t& frame) {
+  prediction_.reset();
+  const int64_t period_us = frame_period_us();
+  if (!config_.renderer.prediction_enabled || period_us <= 0) return;
+  if (consecutive_misses_ >= kMissesBeforeProbing && ++frames_since_probe_ < kProbeEveryFrames) return;
+  frames_since_probe_ = 0;
+  const int64_t utime = frame.utime + period_us;
+  const auto planned = plan_.at(utime);
+  if (!planned) return;
+  Prediction p;
+  p.camera_id = frame.camera_id;
+  p.utime = utime;
+  p.intrinsics = Intrinsics{frame.width, frame.height, frame.fx, frame.fy, frame.cx, frame.cy};
+  for (const std::string& joint : scene_.actuated_joint_names) {
+    const auto value = planned->find(joint);
+    if (value == planned->end()) return;  // the plan does not cover the model
+    p.joints[joint] = value->second;
+  }
+  // The pose for that time now; a moving camera's later reading may differ
+  // (then the frame is a miss).
+  const PoseAtTime pose = camera_poses_.at(frame.camera_id, utime);
+  if (!pose.usable) return;
+  p.pose = pose.pose;
+  prediction_ = std::move(p);
+}
+
+bool RendererService::has_prediction_to_render() const { return prediction_ && !prediction_->rendered; }
+
+void RendererService::render_prediction() {
+  if (!has_prediction_to_render()) return;
+  prediction_->result = renderer_->render(prediction_->joints, prediction_->pose, prediction_->intrinsics);
+  prediction_->rendered = true;
+  prediction_stats_.rendered++;
+}
+
+bool RendererService::prediction_matches(const depth_image_t& frame, const JointPositions& joints,
+                                         const CameraPose& pose) const {
+  const Prediction& p = *prediction_;
+  if (!p.rendered || !p.result.usable || p.camera_id != frame.camera_id || p.intrinsics.width != frame.width ||
+      p.intrinsics.height != frame.height || p.intrinsics.fx != frame.fx || p.intrinsics.fy != frame.fy ||
+      p.intrinsics.cx != frame.cx || p.intrinsics.cy != frame.cy) {
+    return false;
+  }
+  const RendererConfig& r = config_.renderer;
+  for (const auto& [joint, predicted] : p.joints) {
+    const auto actual = joints.find(joint);
+    if (actual == joints.end()) return false;
+    const double tolerance = prismatic_joints_.count(joint) ? r.prediction_joint_tolerance_m
+                                                            : r.prediction_joint_tolerance_deg * kDegToRad;
+    if (!(std::abs(actual->second - predicted) <= tolerance)) return false;
+  }
+  return pose.frame_id == p.pose.frame_id &&
+         (pose.translation_m - p.pose.translation_m).norm() <= r.prediction_pose_tolerance_mm / 1000.0 &&
+         pose.rotation.angularDistance(p.pose.rotation) <= r.prediction_pose_tolerance_deg * kDegToRad;
+}
+
+RenderedFrame RendererService::render(const depth_image_t& frame) {
+  learn_period(frame);
+  const JointsAtTime joints = history_.at(frame.utime);
+  const PoseAtTime pose = camera_poses_.at(frame.camera_id, frame.utime);
+  RenderResult result;
+  if (!joints.usable) {
+    result.unusable_reason = joints.unusable_reason;
+  } else if (!pose.usable) {
+    result.unusable_reason = pose.unusable_reason;
+  } else if (prediction_ && prediction_matches(frame, joints.joints, pose.pose)) {
+    prediction_stats_.hits++;
+    consecutive_misses_ = 0;
+    result = std::move(prediction_->result);
+  } else {
+    const bool missed = prediction_ && prediction_->rendered;
+    (missed ? prediction_stats_.misses : prediction_stats_.without)++;
+    if (missed) ++consecutive_misses_;
+    const Intrinsics intrinsics{frame.width, frame.height, frame.fx, frame.fy, frame.cx, frame.cy};
+    result = renderer_->render(joints.joints, pose.pose, intrinsics);
+  }
+  RenderedFrame out = make_output(frame, std::move(result));
+  plan_prediction(frame);
+  return out;
+}
+
+RenderedFrame RendererService::make_output(const depth_image_t& frame, RenderResult result) const {
+  RenderedFrame out;
+  link_labels_t& labels = out.labels;
+  labels.utime = frame.utime;
+  labels.seq = frame.seq;
+  labels.camera_id = frame.camera_id;
+  labels.width = frame.width;
+  labels.height = frame.height;
+  labels.num_robot_links = scene_.num_robot_links;
+  labels.link_name = scene_.link_names();
+  labels.num_links = static_cast<int32_t>(labels.link_name.size());
+  labels.num_pixels = 0;
+  labels.usable = false;
+  if (!result.usable) {
+    labels.unusable_reason = result.unusable_reason;
+    return out;
+  }
+  labels.usable = true;
+  labels.num_pixels = static_cast<int32_t>(result.labels.size());
+  labels.label = std::move(result.labels);
+
+  depth_image_t depth;
+  depth.utime = frame.utime;
+  depth.seq = frame.seq;
+  depth.camera_id = frame.camera_id;
+  depth.width = frame.width;
+  depth.height = frame.height;
+  depth.fx = frame.fx;
+  depth.fy = frame.fy;
+  depth.cx = frame.cx;
+  depth.cy = frame.cy;
+  depth.calibrated = true;
+  depth.num_pixels = static_cast<int32_t>(result.depth_m.size());
+  depth.depth_mm.resize(result.depth_m.size());
+  for (size_t i = 0; i < result.depth_m.size(); ++i) {
+    const double mm = std::round(static_cast<double>(result.depth_m[i]) * 1000.0);
+    depth.depth_mm[i] = static_cast<int16_t>(mm > 0 && mm <= 32767 ? mm : 0);
+  }
+  depth.num_amplitude = 0;
+  out.depth = std::move(depth);
+  return out;
+}
+
+}  // namespace tofguard::renderer

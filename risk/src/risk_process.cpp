@@ -1,0 +1,122 @@
+#include "tofguard/risk/risk_process.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "tofguard/risk/risk_monitor.hpp"
+#include "tofguard/camera_pose_t.hpp"
+#include "tofguard/common/clock.hpp"
+#include "tofguard/common/lcm_node.hpp"
+#include "tofguard/common/wire_checks.hpp"
+
+namespace tofguard::risk {
+namespace {
+
+// The summary's own consistency (the decoder already sized the arrays).
+std::string check_discrepancy(const discrepancy_t& d) {
+  if (d.utime <= 0) return "utime: expected a capture time > 0, got " + std::to_string(d.utime);
+  if (d.seq < 0) return "seq: expected a frame number >= 0, got " + std::to_string(d.seq);
+  if (d.num_robot_links < 0 || d.num_robot_links > d.num_links) {
+    return "num_robot_links: expected 0..num_links = " + std::to_string(d.num_links) + ", got " +
+           std::to_string(d.num_robot_links);
+  }
+  if (!(d.invalid_fraction >= 0 && d.invalid_fraction <= 1)) {
+    return "invalid_fraction: expected a fraction in [0, 1], got " + std::to_string(d.invalid_fraction);
+  }
+  for (int i = 0; i < d.num_links; ++i) {
+    if (d.link_compared[i] < 0 || d.link_match[i] < 0 || d.link_farther[i] < 0 || d.link_match[i] > d.link_compared[i] ||
+        d.link_farther[i] > d.link_compared[i]) {
+      return "link_compared[" + std::to_string(i) + "]: expected counts with 0 <= match, farther <= compared";
+    }
+  }
+  if (!std::isfinite(d.near_arm_area_m2) || !std::isfinite(d.largest_blob_area_m2)) {
+    return "near_arm_area_m2 / largest_blob_area_m2: expected finite areas";
+  }
+  return "";
+}
+
+std::string check_heartbeat(const heartbeat_t& hb) {
+  if (hb.process.empty()) return "process: expected a process name, got an empty string";
+  return "";
+}
+
+}  // namespace
+
+ProcessInfo process_info() {
+  return {"tofguard-risk",
+          "Classifies the risk of every frame and fires deadlines: SAFETY_DISCREPANCY, TOF_DEPTH, JOINT_STATE, "
+          "CAMERA_POSE, SAFETY_HEARTBEAT, MOTION_ESTIMATE, PLANNED_TRAJECTORY -> SAFETY_RISK (risk_t)."};
+}
+
+int run_risk(const Config& config) {
+  install_stop_signal_handlers();
+  RiskMonitor monitor(config, RobotTree::from_urdf_file(config.robot.urdf_path), monotonic_us());
+  const std::string camera_id = config.camera.id;
+  LcmNode node(config, process_info().name);
+  int64_t dangerous = 0;
+
+  auto publish = [&](const risk_t& r) {
+    node.safety().publish(config.channels.risk, &r);
+    node.counters().frames_out++;
+    if (r.seq >= 0) node.heartbeat().set_last_frame_utime(r.utime);
+    if (r.level == risk_t::DANGEROUS) ++dangerous;
+    const RiskMonitor::EstimateStats& e = monitor.estimate_stats();
+    node.heartbeat().set_status("last verdict: level " + std::to_string(r.level) + " cause " +
+                                std::to_string(r.cause) + " (" + r.detail + "); " + std::to_string(dangerous) +
+                                " dangerous so far; estimates: " + std::to_string(e.received) + " received, " +
+                                std::to_string(e.used) + " used, " + std::to_string(e.explained_nothing) +
+                                " explained nothing, " + std::to_string(e.missing) + " missing, " +
+                                std::to_string(e.late) + " late");
+  };
+
+  auto publish_all = [&](const std::vector<risk_t>& verdicts) {
+    for (const risk_t& r : verdicts) publish(r);
+  };
+  node.subscribe<discrepancy_t>(
+      node.safety(), config.channels.discrepancy,
+      [&](const discrepancy_t& d) { publish_all(monitor.on_frame(d, monotonic_us())); }, check_discrepancy);
+  node.subscribe<motion_estimate_t>(
+      node.safety(), config.channels.motion_estimate,
+      [&](const motion_estimate_t& e) { publish_all(monitor.on_estimate(e, monotonic_us())); },
+      [&](const motion_estimate_t& e) {
+        std::string problem = check_motion_estimate(e);
+        if (problem.empty() && e.camera_id != camera_id) {
+          problem = "camera_id: expected '" + camera_id + "', got '" + e.camera_id + "'";
+        }
+        if (problem.empty() && e.usable) problem = monitor.check_joint_names(e.joint_name, "joint_name");
+        return problem;
+      });
+  node.subscribe<planned_trajectory_t>(
+      node.safety(), config.channels.planned_trajectory, [&](const planned_trajectory_t& p) { monitor.on_plan(p); },
+      [&](const planned_trajectory_t& p) {
+        std::string problem = check_planned_trajectory(p);
+        if (problem.empty()) problem = monitor.check_joint_names(p.joint_name, "joint_name");
+        return problem;
+      });
+  node.subscribe<depth_image_t>(
+      node.images(), config.channels.depth, [&](const depth_image_t&) { monitor.on_depth(monotonic_us()); },
+      [camera_id](const depth_image_t& image) { return check_depth_image_from(image, camera_id); });
+  node.subscribe<joint_state_t>(
+      node.safety(), config.channels.joint_state,
+      [&](const joint_state_t& s) { monitor.on_joint_state(s, monotonic_us()); },
+      [&](const joint_state_t& s) {
+        std::string problem = check_joint_state(s);
+        if (problem.empty()) problem = monitor.check_joint_names(s);
+        return problem;
+      });
+  node.subscribe<camera_pose_t>(
+      node.safety(), config.channels.camera_pose, [&](const camera_pose_t&) { monitor.on_camera_pose(monotonic_us()); },
+      check_camera_pose);
+  node.subscribe<heartbeat_t>(
+      node.safety(), config.channels.heartbeat,
+      [&](const heartbeat_t& hb) { monitor.on_heartbeat(hb, monotonic_us()); }, check_heartbeat);
+  node.add_timer(static_cast<int64_t>(config.risk.check_period_ms * 1000), [&] {
+    publish_all(monitor.release_due(monotonic_us()));
+    if (const auto timeout = monitor.check_deadlines(monotonic_us())) publish(*timeout);
+  });
+  node.heartbeat().set_status("ok: waiting for frames");
+  node.run();
+  return 0;
+}
+
+}  // namespace tofguard::risk

@@ -1,0 +1,70 @@
+#pragma once
+// The simulated arm behind tofguard-joints-sim: every movable joint follows
+// its periodic motion from the config, the arm halts (velocity 0, position
+// held) whenever it has no permission to move, and encoder faults make the
+// *reported* position differ from the *true* one.
+//
+// Units: positions in rad (m for prismatic joints), velocities in rad/s
+// (m/s), times in seconds.
+#include <map>
+#include <string>
+#include <vector>
+
+#include "tofguard/common/config.hpp"
+
+namespace tofguard::sim {
+
+struct ArmState {
+  std::vector<std::string> name;
+  std::vector<double> position;
+  std::vector<double> velocity;
+};
+
+// The movable (non-fixed) joints of a URDF, in file order; throws
+// ConfigError naming the file when it cannot be parsed.
+std::vector<std::string> movable_joints(const std::string& urdf_path);
+
+class SimulatedArm {
+ public:
+  // Throws ConfigError (naming `config_file` and the joints_sim key) when
+  // the motion does not cover exactly the URDF's movable joints or a fault
+  // names an unknown joint.
+  SimulatedArm(const JointsSimConfig& config, const std::vector<std::string>& urdf_joints,
+               const std::string& config_file);
+
+  // Advances by dt_s of process time. The motion time advances only while
+  // `motion_allowed`, so a halted arm resumes where it stopped.
+  void step(double dt_s, bool motion_allowed);
+
+  // Sets joint `joint`'s encoder offset (0 clears it); false if unknown.
+  bool set_encoder_offset(const std::string& joint, double offset);
+
+  const ArmState& true_state() const { return true_state_; }
+  // The arm's plan: the reported (encoder) positions `ahead_s` seconds of
+  // process time from now, assuming it keeps its current permission: the
+  // periodic motion while moving, where it is while halted. What a
+  // controller following its encoders plans (an encoder offset is in the
+  // plan, so a faulty encoder does not make the arm "leave its plan").
+  std::vector<double> planned_reported_positions(double ahead_s) const;
+  // What the encoders report: true position + offset; velocity as true.
+  ArmState reported_state() const;
+  double elapsed_s() const { return elapsed_s_; }
+  // Counts changes of the encoder offsets (a controller replans when its
+  // encoders jump).
+  int offsets_version() const { return offsets_version_; }
+  bool moving() const { return moving_; }
+
+ private:
+  void update_state(bool moving);
+
+  std::vector<JointMotion> motion_;  // in URDF order
+  std::vector<EncoderFault> scheduled_faults_;
+  std::map<std::string, double> offsets_;
+  double elapsed_s_ = 0;
+  int offsets_version_ = 0;
+  double motion_time_s_ = 0;
+  bool moving_ = false;
+  ArmState true_state_;
+};
+
+}  // namespace tofguard::sim

@@ -1,0 +1,265 @@
+// tofguard-intervene as a real process over real LCM (private network
+// namespace), driven through its wire contract and tofguard-reset.
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+#include <signal.h>
+
+#include <atomic>
+#include <cmath>
+#include <filesystem>
+#include <thread>
+
+#include "test_support.hpp"
+#include "tofguard/common/clock.hpp"
+#include "tofguard/heartbeat_t.hpp"
+#include "tofguard/joint_state_t.hpp"
+#include "tofguard/power_relay_t.hpp"
+#include "tofguard/risk_t.hpp"
+#include "tofguard/safety_status_t.hpp"
+
+namespace tofguard::test {
+namespace {
+
+constexpr const char* kSafetyUrl = "udpm://239.255.76.67:7667?ttl=0";
+
+struct Bench {
+  lcm::LCM lcm{kSafetyUrl};
+  std::vector<safety_status_t> statuses;
+  power_relay_t last_power;
+  int power_messages = 0;
+  // What the fake risk classifier and arm keep sending while the test waits
+  // (atomic: the reset feeder thread reads them too).
+  bool send_risk = true;
+  std::atomic<int8_t> risk_level{risk_t::SAFE};
+  std::atomic<int8_t> risk_cause{risk_t::CAUSE_NONE};
+  int64_t last_feed_us = 0;
+
+  Bench() {
+    lcm.subscribe("SAFETY_STATUS", &Bench::on_status, this);
+    lcm.subscribe("SAFETY_POWER", &Bench::on_power, this);
+  }
+  void on_status(const lcm::ReceiveBuffer*, const std::string&, const safety_status_t* s) {
+    statuses.push_back(*s);
+  }
+  void on_power(const lcm::ReceiveBuffer*, const std::string&, const power_relay_t* p) {
+    last_power = *p;
+    ++power_messages;
+  }
+  // Feeds risk (every 20 ms) and a still arm, and handles what arrives.
+  void pump() {
+    const int64_t now = monotonic_us();
+    if (now - last_feed_us >= 20000) {
+      last_feed_us = now;
+      if (send_risk) {
+        risk_t r;
+        r.utime = wall_utime();
+        r.seq = 1;
+        r.level = risk_level;
+        r.cause = risk_cause;
+        r.suspect = risk_cause == risk_t::CAUSE_JOINT_ERROR ? "a4" : "";
+        r.score = 0;
+        r.threshold = 0;
+        r.detail = "from the test";
+        lcm.publish("SAFETY_RISK", &r);
+      }
+      joint_state_t j;
+      j.utime = wall_utime();
+      j.robot_id = "test";
+      j.num_joints = 1;
+      j.name = {"a1"};
+      j.position = {0};
+      j.velocity = {0};
+      lcm.publish("JOINT_STATE", &j);
+    }
+    lcm.handleTimeout(5);
+  }
+  bool wait_for(const std::function<bool(const safety_status_t&)>& condition, std::chrono::milliseconds deadline) {
+    statuses.clear();
+    return wait_until(
+        [&] {
+          for (const auto& s : statuses) {
+            if (condition(s)) return true;
+          }
+          return false;
+        },
+        deadline, [&] { pump(); });
+  }
+};
+
+std::vector<std::string> intervene_argv() {
+  return {bin_dir() + "/tofguard-intervene", "--config", source_dir() + "/config/sim.yaml"};
+}
+
+int reset(const std::string& name, std::string* out) {
+  return run_command(name, {bin_dir() + "/tofguard-reset", "--who", "test", "--why", "checked"}, out);
+}
+
+TEST(InterveneProcess, LatchedStopResetAndRestart) {
+  ASSERT_TRUE(std::filesystem::exists(bin_dir() + "/tofguard-reset"));
+  Bench bench;
+  auto intervene = std::make_unique<Subprocess>("intervene-1", intervene_argv());
+
+  // Comes up stopped and latched.
+  ASSERT_TRUE(bench.wait_for([](const safety_status_t&) { return true; }, std::chrono::seconds(5)))
+      << intervene->stderr_text();
+  EXPECT_FALSE(bench.statuses.front().motion_allowed);
+  EXPECT_TRUE(bench.statuses.front().latched);
+
+  // A reset while the risk is SAFE is accepted; motion becomes allowed.
+  ASSERT_TRUE(wait_until([&] { return bench.power_messages > 3; }, std::chrono::seconds(5), [&] { bench.pump(); }));
+  std::string out;
+  // tofguard-reset blocks; keep the feed going from a thread of its own.
+  std::atomic<bool> resetting{true};
+  // Risks the feeder sent with the DANGEROUS level: once one went out, none
+  // of its earlier SAFE ones can arrive after the stop (one socket, in
+  // order).
+  std::atomic<int> feeder_dangerous_sent{0};
+  std::thread feeder([&] {
+    lcm::LCM lcm(kSafetyUrl);
+    while (resetting) {
+      risk_t r;
+      r.utime = wall_utime();
+      r.seq = 1;
+      r.level = bench.risk_level;
+      r.cause = bench.risk_cause;
+      r.score = 0;
+      r.threshold = 0;
+      lcm.publish("SAFETY_RISK", &r);
+      if (r.level == risk_t::DANGEROUS) ++feeder_dangerous_sent;
+      joint_state_t j;
+      j.utime = wall_utime();
+      j.num_joints = 1;
+      j.name = {"a1"};
+      j.position = {0};
+      j.velocity = {0};
+      lcm.publish("JOINT_STATE", &j);
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));  // the feed's period
+    }
+  });
+  EXPECT_EQ(reset("reset-accepted", &out), 0) << out;
+  EXPECT_NE(out.find("reset accepted"), std::string::npos) << out;
+  ASSERT_TRUE(bench.wait_for([](const safety_status_t& s) { return s.motion_allowed; }, std::chrono::seconds(2)));
+
+  // DANGEROUS -> motion withdrawn well within 200 ms of the risk.
+  bench.risk_cause = risk_t::CAUSE_JOINT_ERROR;  // (the cause first: the feeder reads both)
+  bench.risk_level = risk_t::DANGEROUS;
+  bench.last_feed_us = 0;  // send it now
+  const int64_t danger_sent_us = monotonic_us();
+  ASSERT_TRUE(bench.wait_for([](const safety_status_t& s) { return !s.motion_allowed; }, std::chrono::seconds(2)));
+  EXPECT_LT(monotonic_us() - danger_sent_us, 200000);
+  const safety_status_t stopped = bench.statuses.back();
+  EXPECT_EQ(stopped.cause, risk_t::CAUSE_JOINT_ERROR);
+  EXPECT_EQ(stopped.stop, safety_status_t::STOP_SOFTWARE);
+  EXPECT_TRUE(stopped.latched);
+
+  // A reset while DANGEROUS is refused, with the reason. (Not before the
+  // feeder thread's stream says DANGEROUS too: a SAFE it read just before
+  // the change could otherwise be tofguard-intervene's newest risk.)
+  ASSERT_TRUE(wait_until([&] { return feeder_dangerous_sent > 0; }, std::chrono::seconds(2), [&] { bench.pump(); }));
+  EXPECT_EQ(reset("reset-refused", &out), 1) << out;
+  EXPECT_NE(out.find("refused: current risk is DANGEROUS: joint error"), std::string::npos) << out;
+  resetting = false;
+  feeder.join();
+
+  // The risk stream dies -> power cut.
+  bench.send_risk = false;
+  ASSERT_TRUE(bench.wait_for([](const safety_status_t& s) { return s.stop == safety_status_t::STOP_POWER_CUT; },
+                             std::chrono::seconds(2)));
+  EXPECT_FALSE(bench.last_power.power_enabled);
+  EXPECT_EQ(bench.statuses.back().reason.rfind("SAFETY_RISK stale", 0), 0u) << bench.statuses.back().reason;
+  EXPECT_EQ(bench.statuses.back().cause, risk_t::CAUSE_JOINT_ERROR);  // the first cause stays
+
+  // Killed and restarted: comes up stopped.
+  intervene->signal(SIGKILL);
+  intervene->wait(std::chrono::seconds(5));
+  intervene = std::make_unique<Subprocess>("intervene-2", intervene_argv());
+  bench.send_risk = true;
+  bench.risk_level = risk_t::SAFE;
+  ASSERT_TRUE(bench.wait_for([](const safety_status_t&) { return true; }, std::chrono::seconds(5)));
+  EXPECT_FALSE(bench.statuses.front().motion_allowed);
+  EXPECT_TRUE(bench.statuses.front().latched);
+
+  // SIGTERM: a last "stopped" status, exit code 0.
+  intervene->signal(SIGTERM);
+  EXPECT_EQ(intervene->wait(std::chrono::seconds(5)), 0);
+}
+
+}  // namespace
+}  // namespace tofguard::test
+
+namespace tofguard::test {
+namespace {
+
+struct HeartbeatOf {
+  std::string process;
+  heartbeat_t last;
+  bool seen = false;
+  void on(const lcm::ReceiveBuffer*, const std::string&, const heartbeat_t* hb) {
+    if (hb->process == process) {
+      last = *hb;
+      seen = true;
+    }
+  }
+};
+
+TEST(InterveneProcess, MalformedInputIsDroppedCountedAndTheGoodRisksStillJudged) {
+  Bench bench;
+  HeartbeatOf heartbeat;
+  heartbeat.process = "tofguard-intervene";
+  bench.lcm.subscribe("SAFETY_HEARTBEAT", &HeartbeatOf::on, &heartbeat);
+  Subprocess intervene("intervene-malformed", intervene_argv());
+  ASSERT_TRUE(wait_until([&] { return heartbeat.seen; }, std::chrono::seconds(5), [&] { bench.pump(); }))
+      << intervene.stderr_text();
+
+  // Wrong fingerprint and truncated bytes on SAFETY_RISK; a risk level that
+  // does not exist; a joint state with NaN; a reset that is not one.
+  joint_state_t wrong_type;
+  wrong_type.num_joints = 0;
+  bench.lcm.publish("SAFETY_RISK", &wrong_type);
+  const uint8_t truncated[5] = {1, 2, 3, 4, 5};
+  bench.lcm.publish("SAFETY_RISK", truncated, sizeof truncated);
+  risk_t impossible{};
+  impossible.utime = wall_utime();
+  impossible.level = 9;
+  bench.lcm.publish("SAFETY_RISK", &impossible);
+  joint_state_t nan_joint;
+  nan_joint.utime = wall_utime();
+  nan_joint.num_joints = 1;
+  nan_joint.name = {"a1"};
+  nan_joint.position = {std::nan("")};
+  nan_joint.velocity = {0};
+  bench.lcm.publish("JOINT_STATE", &nan_joint);
+  bench.lcm.publish("SAFETY_RESET", truncated, sizeof truncated);
+
+  ASSERT_TRUE(wait_until(
+      [&] { return heartbeat.last.decode_errors >= 3 && heartbeat.last.validation_errors >= 2; },
+      std::chrono::seconds(5), [&] { bench.pump(); }))
+      << "decode " << heartbeat.last.decode_errors << " validation " << heartbeat.last.validation_errors;
+  EXPECT_EQ(heartbeat.last.decode_errors, 3);
+  EXPECT_EQ(heartbeat.last.validation_errors, 2);
+  EXPECT_TRUE(intervene.running());
+
+  // The good SAFE risks keep coming (pump): a reset is accepted, and a
+  // DANGEROUS one still stops the arm.
+  std::string out;
+  std::atomic<bool> feeding{true};
+  std::thread feeder([&] {
+    lcm::LCM lcm(kSafetyUrl);
+    while (feeding) {
+      risk_t r{};
+      r.utime = wall_utime();
+      r.level = risk_t::SAFE;
+      lcm.publish("SAFETY_RISK", &r);
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));  // the feed's period
+    }
+  });
+  EXPECT_EQ(reset("reset-after-malformed", &out), 0) << out;
+  feeding = false;
+  feeder.join();
+  bench.risk_level = risk_t::DANGEROUS;
+  bench.risk_cause = risk_t::CAUSE_UNKNOWN_OBJECT;
+  EXPECT_TRUE(bench.wait_for([](const safety_status_t& s) { return !s.motion_allowed; }, std::chrono::seconds(2)));
+}
+
+}  // namespace
+}  // namespace tofguard::test

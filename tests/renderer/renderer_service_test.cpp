@@ -1,0 +1,178 @@
+// tofguard-renderer's logic without LCM: the published numbers, unusable
+// frames, frame dropping, camera poses by camera id.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "tofguard/renderer/renderer_process.hpp"
+#include "test_support.hpp"
+
+namespace tofguard::renderer {
+namespace {
+
+Config sim_config() { return load_config(tofguard::test::source_dir() + "/config/sim.yaml", nullptr); }
+
+joint_state_t joint_state(int64_t utime, const JointPositions& positions, const std::string& robot = "friend-sim") {
+  joint_state_t m;
+  m.utime = utime;
+  m.robot_id = robot;
+  for (const auto& [name, value] : positions) {
+    m.name.push_back(name);
+    m.position.push_back(value);
+    m.velocity.push_back(0);
+  }
+  m.num_joints = static_cast<int32_t>(m.name.size());
+  return m;
+}
+
+depth_image_t frame(int64_t utime, int64_t seq, const Intrinsics& k) {
+  depth_image_t f;
+  f.utime = utime;
+  f.seq = seq;
+  f.camera_id = "tof-mast";
+  f.width = k.width;
+  f.height = k.height;
+  f.fx = k.fx;
+  f.fy = k.fy;
+  f.cx = k.cx;
+  f.cy = k.cy;
+  f.num_pixels = k.width * k.height;
+  f.depth_mm.assign(f.num_pixels, 1234);
+  f.calibrated = true;
+  f.num_amplitude = 0;
+  return f;
+}
+
+JointPositions arm(double s) {
+  JointPositions q;
+  for (int i = 1; i <= 7; ++i) q["a" + std::to_string(i)] = 0.1 * i * s;
+  return q;
+}
+
+TEST(RendererService, PublishesTheModelAtTheInterpolatedJointsInMillimetres) {
+  const Config config = sim_config();
+  RendererService service(config);
+  ASSERT_TRUE(service.on_joint_state(joint_state(1'000'000, arm(1.0))));
+  ASSERT_TRUE(service.on_joint_state(joint_state(1'010'000, arm(2.0))));
+  const Intrinsics k = config.camera.intrinsics;
+  const RenderedFrame out = service.render(frame(1'002'500, 42, k));
+  ASSERT_TRUE(out.labels.usable) << out.labels.unusable_reason;
+  ASSERT_TRUE(out.depth.has_value());
+  EXPECT_EQ(out.depth->utime, 1'002'500);
+  EXPECT_EQ(out.depth->seq, 42);
+  EXPECT_EQ(out.depth->camera_id, "tof-mast");
+  EXPECT_EQ(out.labels.seq, 42);
+  EXPECT_EQ(out.depth->num_pixels, k.width * k.height);
+  EXPECT_EQ(out.depth->fx, k.fx);
+  EXPECT_EQ(out.depth->cy, k.cy);
+  EXPECT_EQ(out.labels.num_robot_links, 10);
+  EXPECT_EQ(out.labels.num_links, static_cast<int>(out.labels.link_name.size()));
+
+  // The same as the library at arm(1.25), rounded to millimetres.
+  const SceneModel scene = load_scene(config.robot.urdf_path, config.environment.urdf_paths, scene_options(config));
+  DepthRenderer renderer(scene, config.renderer.near_m, config.renderer.far_m);
+  const RenderResult expected = renderer.render(arm(1.25), config.camera.pose, k);
+  ASSERT_TRUE(expected.usable);
+  int robot_pixels = 0;
+  for (size_t i = 0; i < expected.depth_m.size(); ++i) {
+    // Rounded to the nearest millimetre; the service interpolates the
+    // joints (arm(1.25) up to the last bit), so a depth that lies on a half
+    // millimetre may round either way.
+    ASSERT_LE(std::abs(out.depth->depth_mm[i] - expected.depth_m[i] * 1000), 0.5 + 1e-3) << "pixel " << i;
+    ASSERT_EQ(out.labels.label[i], expected.labels[i]);
+    robot_pixels += expected.labels[i] > 0 && expected.labels[i] < kLabelEnvironmentFirst;
+  }
+  EXPECT_GT(robot_pixels, 1000);
+  // And different from the arm at either bracketing message.
+  EXPECT_NE(renderer.render(arm(1.0), config.camera.pose, k).depth_m, expected.depth_m);
+}
+
+TEST(RendererService, UnusableFramesPublishOnlyLabelsWithTheReason) {
+  const Config config = sim_config();
+  RendererService service(config);
+  const Intrinsics k = config.camera.intrinsics;
+  RenderedFrame out = service.render(frame(1'000'000, 1, k));
+  EXPECT_FALSE(out.labels.usable);
+  EXPECT_EQ(out.labels.unusable_reason, "no joint state received yet");
+  EXPECT_FALSE(out.depth.has_value());
+  EXPECT_EQ(out.labels.num_pixels, 0);
+
+  JointPositions without_a4 = arm(1.0);
+  without_a4.erase("a4");
+  service.on_joint_state(joint_state(1'000'000, without_a4));
+  out = service.render(frame(1'000'000, 2, k));
+  EXPECT_FALSE(out.labels.usable);
+  EXPECT_EQ(out.labels.unusable_reason, "joint 'a4' missing from the joint state");
+
+  service.on_joint_state(joint_state(1'010'000, arm(1.0)));
+  service.on_joint_state(joint_state(1'020'000, arm(1.0)));
+  out = service.render(frame(1'050'000, 3, k));  // 30 ms beyond the newest, limit 20 ms
+  EXPECT_FALSE(out.labels.usable);
+  EXPECT_EQ(out.labels.unusable_reason.rfind("newest joint state is 30.000000 ms older than the frame", 0), 0u)
+      << out.labels.unusable_reason;
+
+  depth_image_t other_camera = frame(1'015'000, 4, k);
+  other_camera.camera_id = "tof-elsewhere";
+  out = service.render(other_camera);
+  EXPECT_EQ(out.labels.unusable_reason, "no camera pose for camera 'tof-elsewhere'");
+  EXPECT_TRUE(service.render(frame(1'015'000, 5, k)).labels.usable);
+}
+
+TEST(RendererService, CameraPoseMessagesReplaceTheStaticPoseOfThatCamera) {
+  const Config config = sim_config();
+  RendererService service(config);
+  service.on_joint_state(joint_state(1'000'000, arm(1.0)));
+  const Intrinsics k = config.camera.intrinsics;
+  const RenderedFrame before = service.render(frame(1'000'000, 1, k));
+  camera_pose_t pose;
+  pose.utime = 1'000'000;
+  pose.camera_id = "tof-mast";
+  pose.frame_id = "world";
+  // 10 cm further back along the optical axis (rotation as in sim.yaml).
+  const Eigen::Vector3d back = config.camera.pose.translation_m -
+                               0.1 * (config.camera.pose.rotation * Eigen::Vector3d::UnitZ());
+  for (int i = 0; i < 3; ++i) pose.translation[i] = back[i];
+  pose.rotation[0] = config.camera.pose.rotation.w();
+  pose.rotation[1] = config.camera.pose.rotation.x();
+  pose.rotation[2] = config.camera.pose.rotation.y();
+  pose.rotation[3] = config.camera.pose.rotation.z();
+  service.on_camera_pose(pose);
+  const RenderedFrame after = service.render(frame(1'000'000, 2, k));
+  ASSERT_TRUE(before.depth && after.depth);
+  // Moving back along the optical axis adds 100 mm to every Z; the pixel
+  // nearest the principal point sees (almost) the same point as before.
+  const size_t centre = static_cast<size_t>(std::lround(k.cy)) * k.width + static_cast<size_t>(std::lround(k.cx));
+  ASSERT_NE(before.labels.label[centre], 0);
+  EXPECT_EQ(before.labels.label[centre], after.labels.label[centre]);
+  EXPECT_NEAR(after.depth->depth_mm[centre] - before.depth->depth_mm[centre], 100, 5);
+  EXPECT_NE(before.depth->depth_mm, after.depth->depth_mm);
+}
+
+TEST(RendererService, KeepsOnlyTheNewestPendingFrameAndCountsDrops) {
+  const Config config = sim_config();
+  RendererService service(config);
+  service.on_joint_state(joint_state(1'000'000, arm(1.0)));
+  const Intrinsics k = config.camera.intrinsics;
+  EXPECT_FALSE(service.has_pending());
+  EXPECT_FALSE(service.on_depth(frame(1'000'000, 1, k)));
+  EXPECT_TRUE(service.on_depth(frame(1'000'000, 2, k)));
+  EXPECT_TRUE(service.on_depth(frame(1'000'000, 3, k)));
+  const std::optional<RenderedFrame> out = service.render_pending();
+  ASSERT_TRUE(out.has_value());
+  EXPECT_EQ(out->labels.seq, 3);
+  EXPECT_FALSE(service.has_pending());
+  EXPECT_FALSE(service.render_pending().has_value());
+}
+
+TEST(RendererService, IgnoresOtherRobotsAndRefusesFarBeyondInt16) {
+  Config config = sim_config();
+  RendererService service(config);
+  EXPECT_FALSE(service.on_joint_state(joint_state(1'000'000, arm(1.0), "another-robot")));
+  EXPECT_EQ(service.render(frame(1'000'000, 1, config.camera.intrinsics)).labels.unusable_reason,
+            "no joint state received yet");
+  config.renderer.far_m = 40;
+  EXPECT_THROW(RendererService{config}, std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace tofguard::renderer

@@ -1,0 +1,442 @@
+// The risk classifier's logic: the robot tree from the URDF, the frame
+// rules (on summaries computed from synthetic images), debouncing and
+// deadlines on an explicit monotonic clock.
+#include <gtest/gtest.h>
+
+#include "synthetic_frames.hpp"
+#include "tofguard/discrepancy/discrepancy_image.hpp"
+#include "tofguard/risk/frame_classifier.hpp"
+#include "tofguard/risk/risk_monitor.hpp"
+#include "tofguard/risk/robot_tree.hpp"
+#include "test_support.hpp"
+#include "tofguard/common/config.hpp"
+
+namespace tofguard::test {
+namespace {
+
+using risk::ClassifierContext;
+using risk::classify_frame;
+using risk::FrameFinding;
+using risk::RiskMonitor;
+using risk::RobotTree;
+
+const Config& sim_config() {
+  static const Config config = load_config(source_dir() + "/config/sim.yaml", nullptr);
+  return config;
+}
+
+// The deadline tests below count on one deadline for the camera and the
+// joint states (sim.yaml's depth deadline is 150 ms since issue 6).
+const Config& config_depth_100ms() {
+  static const Config config = [] {
+    Config c = sim_config();
+    c.risk.depth_deadline_ms = 100;
+    return c;
+  }();
+  return config;
+}
+
+const RobotTree& friend_arm() {
+  static const RobotTree tree = RobotTree::from_urdf_file(sim_config().robot.urdf_path);
+  return tree;
+}
+
+// Summary of a synthetic camera scene against the default model (links
+// base_link, link1, link2 of the FRIEND arm, and a floor).
+discrepancy_t summary_of(const std::vector<Box>& camera_scene, int64_t seq = 7, uint32_t noise_seed = 1) {
+  const SyntheticImage model = draw(default_arm());
+  const SyntheticImage seen = draw(camera_scene);
+  return discrepancy::compute_discrepancy(depth_frame(with_noise(seen.depth_mm, noise_seed), seq),
+                                          depth_frame(model.depth_mm, seq), labels_frame(model.label, seq),
+                                          discrepancy::parameters_from(sim_config().discrepancy))
+      .summary;
+}
+
+FrameFinding classify(const discrepancy_t& d, bool arm_moving = false) {
+  ClassifierContext context;
+  context.arm_moving = arm_moving;
+  return classify_frame(d, friend_arm(), sim_config().risk, context);
+}
+
+TEST(RobotTree, FriendArmJointsAndDistalLinks) {
+  const RobotTree& tree = friend_arm();
+  EXPECT_EQ(tree.movable_joints(), (std::vector<std::string>{"a1", "a2", "a3", "a4", "a5", "a6", "a7"}));
+  EXPECT_EQ(tree.nearest_movable_joint_above("link4"), "a4");
+  // The gripper hangs on a fixed joint below link7.
+  EXPECT_EQ(tree.nearest_movable_joint_above("gripper"), "a7");
+  EXPECT_EQ(tree.nearest_movable_joint_above("base_link"), "");
+  EXPECT_EQ(tree.lowest_common_ancestor({"gripper", "link5", "link6"}), "link5");
+  EXPECT_EQ(tree.lowest_common_ancestor({"link7"}), "link7");
+  EXPECT_TRUE(tree.is_descendant_or_self("gripper", "link2"));
+  EXPECT_FALSE(tree.is_descendant_or_self("link1", "link2"));
+  EXPECT_EQ(tree.child_link("a3"), "link3");
+  EXPECT_THROW(RobotTree::from_urdf_string("<robot name='x'><link name='a'/><oops/>"), std::runtime_error);
+}
+
+TEST(FrameClassifier, NoiseOnlyFramesAreSafe) {
+  for (uint32_t seed = 1; seed <= 10; ++seed) {
+    const FrameFinding f = classify(summary_of(default_arm(), 7, seed), /*arm_moving=*/true);
+    EXPECT_EQ(f.cause, risk_t::CAUSE_NONE) << f.detail;
+  }
+}
+
+TEST(FrameClassifier, ShiftedLinkIsAJointErrorOfTheJointAboveIt) {
+  // link2 (40 x 20 px) seen 16 px off. Its silhouette pixels do not count
+  // (top and bottom rows and its right column border the floor; its left
+  // column borders link1 at the same depth): missing on 16 x 18 of 39 x 18
+  // counted pixels. a2 moves it.
+  const FrameFinding f = classify(summary_of(default_arm(16)));
+  EXPECT_EQ(f.cause, risk_t::CAUSE_JOINT_ERROR) << f.detail;
+  EXPECT_EQ(f.suspect, "a2");
+  EXPECT_NEAR(f.score, 16.0 / 39.0, 1e-9);
+  EXPECT_DOUBLE_EQ(f.threshold, sim_config().risk.joint_link_missing_fraction);
+  EXPECT_NE(f.detail.find("link2"), std::string::npos) << f.detail;
+}
+
+TEST(FrameClassifier, MismatchOnSeveralLinksBlamesTheJointAboveAllOfThem) {
+  // link1 and link2 both displaced: their common ancestor link1 hangs on a1.
+  std::vector<Box> scene = {{40, 100, 60, 140, kArmMm, 1}, {50, 60, 70, 100, kArmMm, 2}, {76, 60, 116, 80, kArmMm, 3}};
+  const FrameFinding f = classify(summary_of(scene));
+  EXPECT_EQ(f.cause, risk_t::CAUSE_JOINT_ERROR) << f.detail;
+  EXPECT_EQ(f.suspect, "a1");
+}
+
+TEST(FrameClassifier, WholeArmShiftedWithTheFixedBaseIsACalibrationError) {
+  // The camera a few centimetres off: the near arm (base_link included,
+  // which no joint can move) shifts 8 px, the distant floor stays within
+  // tolerance.
+  std::vector<Box> scene = default_arm();
+  for (Box& b : scene) {
+    b.u0 += 8;
+    b.u1 += 8;
+  }
+  const FrameFinding f = classify(summary_of(scene));
+  EXPECT_EQ(f.cause, risk_t::CAUSE_CALIBRATION_ERROR) << f.detail;
+  EXPECT_NE(f.detail.find("the fixed base_link among them"), std::string::npos) << f.detail;
+}
+
+TEST(FrameClassifier, LinkSeenNearerWithSurfacesBesideItIsAJointErrorNotAnObject) {
+  // link2 moved towards the camera (1.3 m instead of 1.5 m): it is seen
+  // nearer, never missing, and its end shows up beside the model.
+  std::vector<Box> scene = default_arm();
+  scene[2].depth_mm = 1300;
+  scene.push_back({100, 60, 110, 80, 1300, 0});
+  const discrepancy_t d = summary_of(scene);
+  ASSERT_GE(d.near_arm_area_m2, sim_config().risk.unknown_object_min_area_m2);
+  const FrameFinding f = classify(d);
+  EXPECT_EQ(f.cause, risk_t::CAUSE_JOINT_ERROR) << f.detail;
+  EXPECT_EQ(f.suspect, "a2");
+  EXPECT_NE(f.detail.find("link2 mismatch"), std::string::npos) << f.detail;
+}
+
+TEST(FrameClassifier, ObjectInFrontOfTheArmIsAnUnknownObject) {
+  std::vector<Box> scene = default_arm();
+  scene.push_back({30, 110, 50, 130, 1400, 0});  // 0.1 m in front of base_link
+  const discrepancy_t d = summary_of(scene);
+  const FrameFinding f = classify(d);
+  EXPECT_EQ(f.cause, risk_t::CAUSE_UNKNOWN_OBJECT) << f.detail;
+  EXPECT_NEAR(f.score, d.near_arm_area_m2, 1e-9);
+  // 20 x 20 px at 1.4 m, less the two columns beside base_link's modelled
+  // outline (u = 39, 40: silhouette pixels).
+  EXPECT_NEAR(f.score, (400 - 2 * 20) * (1.4 / 200) * (1.4 / 200), 1e-4);
+  EXPECT_DOUBLE_EQ(f.threshold, 0.0015);
+}
+
+TEST(FrameClassifier, SmallObjectFarFromTheArmIsSafe) {
+  std::vector<Box> scene = default_arm();
+  scene.push_back({140, 10, 150, 20, 1900, 0});  // 10x10 px, 0.5 m away
+  EXPECT_EQ(classify(summary_of(scene)).cause, risk_t::CAUSE_NONE);
+}
+
+TEST(FrameClassifier, LargeUnexplainedMismatchFarFromTheArmIsUnclassified) {
+  std::vector<Box> scene = default_arm();
+  scene.push_back({110, 0, 176, 50, 1900, 0});  // 66x50 px at 1.9 m: 0.30 m^2
+  const FrameFinding f = classify(summary_of(scene));
+  EXPECT_EQ(f.cause, risk_t::CAUSE_UNCLASSIFIED) << f.detail;
+  EXPECT_NEAR(f.score, 3300 * (1.9 / 200) * (1.9 / 200), 1e-3);
+}
+
+TEST(FrameClassifier, ShiftOverArmAndEnvironmentIsACalibrationError) {
+  // Everything seen 80 mm farther: the camera pose is off along its axis
+  // (the tolerance at 2 m is 4 * 8.8 + 15 = 50 mm).
+  std::vector<Box> scene = default_arm();
+  for (Box& b : scene) b.depth_mm = static_cast<int16_t>(b.depth_mm + 80);
+  const SyntheticImage model = draw(default_arm());
+  SyntheticImage seen = draw(scene);
+  for (int i = 0; i < kWidth * kHeight; ++i) {
+    if (seen.label[i] == link_labels_t::ENVIRONMENT_FIRST) seen.depth_mm[i] = kFloorMm + 80;
+  }
+  const discrepancy_t d = discrepancy::compute_discrepancy(depth_frame(with_noise(seen.depth_mm, 2), 1),
+                                                           depth_frame(model.depth_mm, 1), labels_frame(model.label, 1),
+                                                           discrepancy::parameters_from(sim_config().discrepancy))
+                              .summary;
+  const FrameFinding f = classify(d);
+  EXPECT_EQ(f.cause, risk_t::CAUSE_CALIBRATION_ERROR) << f.detail;
+  EXPECT_GT(f.score, 0.95);
+  EXPECT_NEAR(d.environment_median_dis_mm, -80, 3);
+  EXPECT_NEAR(d.robot_median_dis_mm, -80, 3);
+}
+
+TEST(FrameClassifier, SensorFaultsComeFirst) {
+  discrepancy_t d = summary_of(default_arm());
+  // Frozen: the same image again while the arm moves; not while it rests.
+  d.repeat_count = 2;
+  EXPECT_EQ(classify(d, /*arm_moving=*/true).cause, risk_t::CAUSE_SENSOR_FAULT);
+  EXPECT_EQ(classify(d, true).suspect, "TOF_DEPTH");
+  EXPECT_EQ(classify(d, false).cause, risk_t::CAUSE_NONE);
+  d.repeat_count = 1;
+  EXPECT_EQ(classify(d, true).cause, risk_t::CAUSE_NONE);
+
+  d.calibrated = false;
+  EXPECT_EQ(classify(d).cause, risk_t::CAUSE_SENSOR_FAULT);
+  EXPECT_NE(classify(d).detail.find("calibrated"), std::string::npos);
+  d.calibrated = true;
+
+  d.invalid_fraction = 0.51f;
+  FrameFinding f = classify(d);
+  EXPECT_EQ(f.cause, risk_t::CAUSE_SENSOR_FAULT);
+  EXPECT_FLOAT_EQ(static_cast<float>(f.score), 0.51f);
+  EXPECT_DOUBLE_EQ(f.threshold, 0.5);
+  d.invalid_fraction = 0;
+
+  d.usable = false;
+  d.unusable_kind = discrepancy_t::UNUSABLE_RENDERER;
+  d.unusable_reason = "renderer: joint state too old";
+  f = classify(d);
+  EXPECT_EQ(f.cause, risk_t::CAUSE_SENSOR_FAULT);
+  EXPECT_EQ(f.suspect, "TOF_LABELS");
+  EXPECT_NE(f.detail.find("joint state too old"), std::string::npos);
+
+  d.unusable_kind = discrepancy_t::UNUSABLE_NO_RENDERING;
+  f = classify(d);
+  EXPECT_EQ(f.cause, risk_t::CAUSE_COMPONENT_FAULT);
+  EXPECT_EQ(f.suspect, "tofguard-renderer");
+}
+
+TEST(FrameClassifier, LinkUnknownToTheUrdfIsNeverJudgedSafe) {
+  discrepancy_t d = summary_of(default_arm(16));
+  d.link_name[2] = "elbow_of_another_robot";
+  const FrameFinding f = classify(d);
+  EXPECT_EQ(f.cause, risk_t::CAUSE_UNCLASSIFIED) << f.detail;
+  EXPECT_EQ(f.suspect, "elbow_of_another_robot");
+}
+
+// ---- RiskMonitor: debouncing and deadlines on an explicit clock ----
+
+constexpr int64_t kStart = 5'000'000'000;  // monotonic, unrelated to any utime
+constexpr int64_t kMs = 1000;
+
+heartbeat_t heartbeat(const std::string& process) {
+  heartbeat_t hb{};
+  hb.process = process;
+  return hb;
+}
+
+joint_state_t joints(double velocity) {
+  joint_state_t s{};
+  s.num_joints = 1;
+  s.name = {"a1"};
+  s.position = {0};
+  s.velocity = {velocity};
+  return s;
+}
+
+// Everything fresh at `now`.
+void feed_all(RiskMonitor* m, int64_t now) {
+  m->on_depth(now);
+  m->on_joint_state(joints(0.5), now);
+  for (const char* p : {"tofguard-camera", "tofguard-renderer", "tofguard-discrepancy"}) {
+    m->on_heartbeat(heartbeat(p), now);
+  }
+}
+
+TEST(RiskMonitor, NothingArrivedIsStaleAfterTheFirstDeadline) {
+  RiskMonitor m(config_depth_100ms(), friend_arm(), kStart);
+  EXPECT_FALSE(m.check_deadlines(kStart + 100 * kMs).has_value());
+  const auto r = m.check_deadlines(kStart + 101 * kMs);
+  ASSERT_TRUE(r.has_value());
+  EXPECT_EQ(r->seq, -1);
+  EXPECT_EQ(r->utime, 0);
+  EXPECT_EQ(r->level, risk_t::DANGEROUS);
+  EXPECT_EQ(r->cause, risk_t::CAUSE_SENSOR_FAULT);
+  EXPECT_EQ(r->suspect, "TOF_DEPTH");
+  EXPECT_DOUBLE_EQ(r->score, 101);
+  EXPECT_DOUBLE_EQ(r->threshold, 100);
+  EXPECT_NE(r->detail.find("nothing since start"), std::string::npos) << r->detail;
+}
+
+TEST(RiskMonitor, EachInputHasItsOwnDeadlineAndCause) {
+  RiskMonitor m(config_depth_100ms(), friend_arm(), kStart);
+  int64_t now = kStart;
+  feed_all(&m, now);
+  discrepancy_t d = summary_of(default_arm(), 40);
+  EXPECT_EQ(m.on_discrepancy(d, now).level, risk_t::SAFE);
+  EXPECT_FALSE(m.check_deadlines(now + 100 * kMs).has_value());
+
+  // Camera stalls: TOF_DEPTH 100 ms.
+  now += 90 * kMs;
+  feed_all(&m, now);
+  m.on_discrepancy(d, now);
+  now += 101 * kMs;
+  m.on_joint_state(joints(0.5), now);
+  for (const char* p : {"tofguard-camera", "tofguard-renderer", "tofguard-discrepancy"}) m.on_heartbeat(heartbeat(p), now);
+  auto r = m.check_deadlines(now);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->suspect, "TOF_DEPTH");
+  EXPECT_EQ(r->utime, d.utime);  // the last frame's utime, however old
+
+  // Joint state stalls: 100 ms.
+  feed_all(&m, now);
+  m.on_discrepancy(d, now);
+  now += 101 * kMs;
+  m.on_depth(now);
+  for (const char* p : {"tofguard-camera", "tofguard-renderer", "tofguard-discrepancy"}) m.on_heartbeat(heartbeat(p), now);
+  m.on_discrepancy(d, now);
+  r = m.check_deadlines(now);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->cause, risk_t::CAUSE_SENSOR_FAULT);
+  EXPECT_EQ(r->suspect, "JOINT_STATE");
+  // A frame judged meanwhile is dangerous too, with its own seq.
+  const risk_t frame = m.on_discrepancy(d, now);
+  EXPECT_EQ(frame.level, risk_t::DANGEROUS);
+  EXPECT_EQ(frame.seq, 40);
+  EXPECT_EQ(frame.suspect, "JOINT_STATE");
+
+  // A heartbeat stops: 250 ms -> component fault naming the process.
+  feed_all(&m, now);
+  for (int i = 0; i < 6; ++i) {
+    now += 50 * kMs;
+    m.on_depth(now);
+    m.on_joint_state(joints(0.5), now);
+    m.on_discrepancy(d, now);
+    m.on_heartbeat(heartbeat("tofguard-camera"), now);
+    m.on_heartbeat(heartbeat("tofguard-discrepancy"), now);
+  }
+  r = m.check_deadlines(now);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->cause, risk_t::CAUSE_COMPONENT_FAULT);
+  EXPECT_EQ(r->suspect, "tofguard-renderer");
+  EXPECT_DOUBLE_EQ(r->score, 300);
+
+  // The discrepancy stream stops while the camera is fresh: 200 ms.
+  feed_all(&m, now);
+  m.on_discrepancy(d, now);
+  for (int i = 0; i < 5; ++i) {
+    now += 50 * kMs;
+    feed_all(&m, now);
+  }
+  r = m.check_deadlines(now);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->cause, risk_t::CAUSE_COMPONENT_FAULT);
+  EXPECT_EQ(r->suspect, "SAFETY_DISCREPANCY");
+}
+
+TEST(RiskMonitor, CameraPoseIsWatchedOnlyWhenRequired) {
+  Config config = sim_config();
+  RiskMonitor optional(config, friend_arm(), kStart);
+  feed_all(&optional, kStart + 2000 * kMs);
+  optional.on_discrepancy(summary_of(default_arm()), kStart + 2000 * kMs);
+  EXPECT_FALSE(optional.check_deadlines(kStart + 2000 * kMs).has_value());
+
+  config.risk.camera_pose_required = true;
+  RiskMonitor required(config, friend_arm(), kStart);
+  feed_all(&required, kStart + 2000 * kMs);
+  required.on_discrepancy(summary_of(default_arm()), kStart + 2000 * kMs);
+  const auto r = required.check_deadlines(kStart + 2000 * kMs);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->suspect, "CAMERA_POSE");
+  required.on_camera_pose(kStart + 2000 * kMs);
+  EXPECT_FALSE(required.check_deadlines(kStart + 2000 * kMs).has_value());
+}
+
+TEST(RiskMonitor, MismatchIsWarningUntilDebouncedThenDangerousAndClearsOnAGoodFrame) {
+  RiskMonitor m(sim_config(), friend_arm(), kStart);
+  const discrepancy_t bad = summary_of(default_arm(16), 100);
+  const discrepancy_t good = summary_of(default_arm(), 104);
+  int64_t now = kStart;
+  std::vector<int8_t> levels;
+  for (int i = 0; i < 4; ++i) {
+    now += 33 * kMs;
+    feed_all(&m, now);
+    const risk_t r = m.on_discrepancy(bad, now);
+    EXPECT_EQ(r.cause, risk_t::CAUSE_JOINT_ERROR);
+    EXPECT_EQ(r.suspect, "a2");
+    EXPECT_EQ(r.seq, 100);
+    EXPECT_EQ(r.utime, bad.utime);
+    levels.push_back(r.level);
+  }
+  // debounce_frames = 3.
+  EXPECT_EQ(levels, (std::vector<int8_t>{risk_t::WARNING, risk_t::WARNING, risk_t::DANGEROUS, risk_t::DANGEROUS}));
+  now += 33 * kMs;
+  feed_all(&m, now);
+  const risk_t r = m.on_discrepancy(good, now);
+  EXPECT_EQ(r.level, risk_t::SAFE);
+  EXPECT_EQ(r.cause, risk_t::CAUSE_NONE);
+  now += 33 * kMs;
+  feed_all(&m, now);
+  EXPECT_EQ(m.on_discrepancy(bad, now).level, risk_t::WARNING);
+}
+
+TEST(RiskMonitor, SensorFaultsUseTheirOwnDebounce) {
+  RiskMonitor m(sim_config(), friend_arm(), kStart);
+  discrepancy_t unusable = summary_of(default_arm());
+  unusable.usable = false;
+  unusable.unusable_kind = discrepancy_t::UNUSABLE_RENDERER;
+  unusable.unusable_reason = "renderer: joint a3 missing";
+  feed_all(&m, kStart);
+  EXPECT_EQ(m.on_discrepancy(unusable, kStart).level, risk_t::WARNING);
+  EXPECT_EQ(m.on_discrepancy(unusable, kStart).level, risk_t::DANGEROUS);  // sensor_debounce_frames = 2
+}
+
+TEST(RiskMonitor, FrozenImageNeedsAMovingArm) {
+  RiskMonitor m(sim_config(), friend_arm(), kStart);
+  discrepancy_t frozen = summary_of(default_arm());
+  frozen.repeat_count = 3;
+  m.on_depth(kStart);
+  m.on_joint_state(joints(0.0), kStart);
+  EXPECT_EQ(m.on_discrepancy(frozen, kStart).level, risk_t::SAFE);
+  m.on_joint_state(joints(-0.3), kStart);
+  const risk_t r = m.on_discrepancy(frozen, kStart);
+  EXPECT_EQ(r.cause, risk_t::CAUSE_SENSOR_FAULT);
+  EXPECT_NE(r.detail.find("frozen"), std::string::npos);
+}
+
+// The frozen rule asks whether the arm moved when the frame was captured,
+// not what the latest joint state says: a replay judges a frame the same
+// however late it is processed.
+TEST(RiskMonitor, FrozenImageIsJudgedByTheJointStateAtTheFramesCaptureTime) {
+  constexpr int64_t kCapture = 1'700'000'000'000'000;
+  auto joints_at = [](double velocity, int64_t utime) {
+    joint_state_t s = joints(velocity);
+    s.utime = utime;
+    return s;
+  };
+  discrepancy_t frozen = summary_of(default_arm());
+  frozen.repeat_count = 3;
+  frozen.utime = kCapture;
+  {
+    RiskMonitor m(sim_config(), friend_arm(), kStart);
+    m.on_depth(kStart);
+    m.on_joint_state(joints_at(0.3, kCapture - 10 * kMs), kStart);
+    m.on_joint_state(joints_at(0.0, kCapture + 50 * kMs), kStart);  // the arm halted after the capture
+    EXPECT_EQ(m.on_discrepancy(frozen, kStart).cause, risk_t::CAUSE_SENSOR_FAULT);
+  }
+  {
+    RiskMonitor m(sim_config(), friend_arm(), kStart);
+    m.on_depth(kStart);
+    m.on_joint_state(joints_at(0.0, kCapture - 10 * kMs), kStart);
+    m.on_joint_state(joints_at(0.3, kCapture + 50 * kMs), kStart);  // it started after the capture
+    EXPECT_EQ(m.on_discrepancy(frozen, kStart).level, risk_t::SAFE);
+  }
+}
+
+TEST(RiskMonitor, JointNamesMustBeTheRobotsMovingJoints) {
+  RiskMonitor m(sim_config(), friend_arm(), kStart);
+  joint_state_t s = joints(0);
+  EXPECT_EQ(m.check_joint_names(s), "");
+  s.name = {"mount"};
+  EXPECT_EQ(m.check_joint_names(s), "name[0]: expected a moving joint of the robot's URDF, got 'mount'");
+}
+
+}  // namespace
+}  // namespace tofguard::test

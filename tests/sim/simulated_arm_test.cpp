@@ -1,0 +1,83 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "tofguard/sim/simulated_arm.hpp"
+#include "test_support.hpp"
+#include "tofguard/common/config.hpp"
+
+namespace tofguard::sim {
+namespace {
+
+JointsSimConfig two_joints() {
+  JointsSimConfig c;
+  c.rate_hz = 100;
+  c.status_deadline_ms = 100;
+  c.motion = {{"j2", 0.5, 0.2, 4.0, 0.0}, {"j1", -1.0, 0.0, 1.0, 0.0}};
+  c.faults = {{"j2", 0.1745, 2.0}};
+  return c;
+}
+
+TEST(SimulatedArm, MovableJointsOfTheDefaultArmInOrder) {
+  const auto joints = movable_joints(test::source_dir() + "/config/models/friend_arm.urdf");
+  EXPECT_EQ(joints, (std::vector<std::string>{"a1", "a2", "a3", "a4", "a5", "a6", "a7"}));
+}
+
+TEST(SimulatedArm, FollowsItsMotionOnlyWhileAllowed) {
+  SimulatedArm arm(two_joints(), {"j1", "j2"}, "test.yaml");
+  // URDF order, not config order.
+  EXPECT_EQ(arm.true_state().name, (std::vector<std::string>{"j1", "j2"}));
+  EXPECT_DOUBLE_EQ(arm.true_state().position[1], 0.5);
+  arm.step(1.0, true);  // a quarter period: at the top of the sine, velocity 0
+  EXPECT_NEAR(arm.true_state().position[1], 0.7, 1e-12);
+  EXPECT_NEAR(arm.true_state().velocity[1], 0.0, 1e-12);
+  arm.step(1.0, true);  // half a period: back at the centre, fastest downwards
+  EXPECT_NEAR(arm.true_state().position[1], 0.5, 1e-12);
+  EXPECT_NEAR(arm.true_state().velocity[1], -0.2 * 2 * M_PI / 4.0, 1e-12);
+  EXPECT_DOUBLE_EQ(arm.true_state().position[0], -1.0);
+
+  // Halted: position held, velocity 0, motion time stands still.
+  arm.step(0.5, false);
+  EXPECT_NEAR(arm.true_state().position[1], 0.5, 1e-12);
+  EXPECT_EQ(arm.true_state().velocity[1], 0.0);
+  EXPECT_FALSE(arm.moving());
+  arm.step(1.0, true);  // resumes where it stopped: three quarters -> bottom
+  EXPECT_NEAR(arm.true_state().position[1], 0.3, 1e-12);
+}
+
+TEST(SimulatedArm, EncoderFaultsChangeOnlyTheReportedPosition) {
+  SimulatedArm arm(two_joints(), {"j1", "j2"}, "test.yaml");
+  arm.step(1.99, false);
+  EXPECT_DOUBLE_EQ(arm.reported_state().position[1], arm.true_state().position[1]);
+  arm.step(0.02, false);  // the scheduled fault at 2 s
+  EXPECT_NEAR(arm.reported_state().position[1] - arm.true_state().position[1], 0.1745, 1e-12);
+  EXPECT_DOUBLE_EQ(arm.reported_state().position[0], arm.true_state().position[0]);
+  EXPECT_TRUE(arm.set_encoder_offset("j1", -0.05));
+  EXPECT_NEAR(arm.reported_state().position[0] - arm.true_state().position[0], -0.05, 1e-12);
+  EXPECT_TRUE(arm.set_encoder_offset("j2", 0.0));
+  EXPECT_DOUBLE_EQ(arm.reported_state().position[1], arm.true_state().position[1]);
+  EXPECT_FALSE(arm.set_encoder_offset("j9", 1.0));
+}
+
+TEST(SimulatedArm, MotionMustCoverExactlyTheUrdfJoints) {
+  auto message = [](const JointsSimConfig& c, const std::vector<std::string>& joints) {
+    try {
+      SimulatedArm arm(c, joints, "cfg.yaml");
+    } catch (const ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_EQ(message(two_joints(), {"j1", "j2", "j3"}),
+            "cfg.yaml: joints_sim.motion: expected an entry for every movable joint of the URDF (j1, j2, j3), "
+            "missing j3");
+  EXPECT_EQ(message(two_joints(), {"j2"}),
+            "cfg.yaml: joints_sim.motion.j1: unknown joint, expected one of the URDF's movable joints: j2");
+  JointsSimConfig bad_fault = two_joints();
+  bad_fault.faults[0].joint = "j7";
+  EXPECT_EQ(message(bad_fault, {"j1", "j2"}),
+            "cfg.yaml: joints_sim.faults: unknown joint 'j7', expected one of: j1, j2");
+}
+
+}  // namespace
+}  // namespace tofguard::sim

@@ -1,0 +1,155 @@
+// tofguard-view --log --out: one PNG per camera frame, with the colour
+// convention checked on pixels whose discrepancy is known.
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+
+#include <filesystem>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "test_support.hpp"
+#include "tofguard/depth_image_t.hpp"
+#include "tofguard/link_labels_t.hpp"
+#include "tofguard/risk_t.hpp"
+#include "tofguard/view/view_compose.hpp"
+
+namespace tofguard::test {
+namespace {
+
+constexpr int kW = 176;
+constexpr int kH = 144;
+
+depth_image_t frame(int64_t seq, bool camera) {
+  depth_image_t m;
+  m.utime = 1700000000000000 + seq * 33333;
+  m.seq = seq;
+  m.camera_id = "tof-mast";
+  m.width = kW;
+  m.height = kH;
+  m.fx = 221.0;
+  m.fy = 220.5;
+  m.cx = 87.3;
+  m.cy = 71.8;
+  m.calibrated = true;
+  m.num_pixels = kW * kH;
+  m.depth_mm.assign(m.num_pixels, 2000);  // the floor
+  for (int v = 40; v < 100; ++v) {
+    for (int u = 40; u < 70; ++u) m.depth_mm[v * kW + u] = 1000;  // the arm
+  }
+  if (camera) {
+    // Something nearer than the modelled floor: I_dis = 2000 - 1200 > 0.
+    for (int v = 50; v < 90; ++v) {
+      for (int u = 110; u < 140; ++u) m.depth_mm[v * kW + u] = 1200;
+    }
+    // The arm's top missing, the camera sees the floor: I_dis = 1000 - 2000 < 0.
+    for (int v = 40; v < 60; ++v) {
+      for (int u = 40; u < 70; ++u) m.depth_mm[v * kW + u] = 2000;
+    }
+  }
+  m.num_amplitude = 0;
+  return m;
+}
+
+link_labels_t labels(int64_t seq) {
+  link_labels_t m;
+  m.utime = 1700000000000000 + seq * 33333;
+  m.seq = seq;
+  m.camera_id = "tof-mast";
+  m.usable = true;
+  m.width = kW;
+  m.height = kH;
+  m.num_robot_links = 1;
+  m.num_links = 2;
+  m.link_name = {"link1", "floor"};
+  m.num_pixels = kW * kH;
+  m.label.assign(m.num_pixels, link_labels_t::ENVIRONMENT_FIRST);
+  for (int v = 40; v < 100; ++v) {
+    for (int u = 40; u < 70; ++u) m.label[v * kW + u] = link_labels_t::ROBOT_FIRST;
+  }
+  return m;
+}
+
+template <class T>
+void write(lcm::LogFile& log, const std::string& channel, const T& message, int64_t timestamp) {
+  std::vector<uint8_t> bytes(message.getEncodedSize());
+  message.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  lcm::LogEvent event;
+  event.eventnum = 0;
+  event.timestamp = timestamp;
+  event.channel = channel;
+  event.datalen = static_cast<int32_t>(bytes.size());
+  event.data = bytes.data();
+  log.writeEvent(&event);
+}
+
+TEST(Viewer, ExportsOnePngPerCameraFrameWithNearerRedAndFartherBlue) {
+  const std::string log_path = output_dir() + "/viewer.lcmlog";
+  const std::string out = output_dir() + "/viewer-frames";
+  std::filesystem::remove(log_path);
+  std::filesystem::remove_all(out);
+  {
+    lcm::LogFile log(log_path, "w");
+    for (int64_t seq = 10; seq < 13; ++seq) {
+      const int64_t t = 1700000000000000 + seq * 33333;
+      write(log, "TOF_DEPTH", frame(seq, true), t);
+      if (seq == 12) continue;  // the last frame never got its rendering
+      write(log, "TOF_RENDERED", frame(seq, false), t + 5000);
+      write(log, "TOF_LABELS", labels(seq), t + 5000);
+      risk_t risk;
+      risk.utime = t;
+      risk.seq = seq;
+      risk.level = risk_t::DANGEROUS;
+      risk.cause = risk_t::CAUSE_UNKNOWN_OBJECT;
+      risk.score = 1;
+      risk.threshold = 0.5;
+      risk.detail = "test";
+      write(log, "SAFETY_RISK", risk, t + 9000);
+    }
+  }
+  std::string stdout_text, stderr_text;
+  ASSERT_EQ(run_command("viewer-export",
+                        {bin_dir() + "/tofguard-view", "--config", source_dir() + "/config/sim.yaml", "--log",
+                         log_path, "--out", out},
+                        &stdout_text, &stderr_text),
+            0)
+      << stderr_text;
+  EXPECT_NE(stdout_text.find("3 camera frames"), std::string::npos) << stdout_text;
+  std::vector<std::string> files;
+  for (const auto& e : std::filesystem::directory_iterator(out)) files.push_back(e.path().filename().string());
+  std::sort(files.begin(), files.end());
+  ASSERT_EQ(files, (std::vector<std::string>{"frame_00000010.png", "frame_00000011.png", "frame_00000012.png"}));
+
+  const cv::Mat3b view = cv::imread(out + "/frame_00000010.png", cv::IMREAD_COLOR);
+  const int scale = view::panel_scale(kW);
+  ASSERT_EQ(view.cols, 3 * kW * scale);
+  const int banner = view.rows - kH * scale;
+  auto discrepancy_pixel = [&](int u, int v) {
+    return view(banner + v * scale + scale / 2, 2 * kW * scale + u * scale + scale / 2);  // BGR
+  };
+  const cv::Vec3b nearer = discrepancy_pixel(125, 70);
+  EXPECT_GT(nearer[2], 100) << "camera nearer than the model must be red";
+  EXPECT_EQ(nearer[0], 0);
+  const cv::Vec3b farther = discrepancy_pixel(55, 50);
+  EXPECT_GT(farther[0], 100) << "camera farther than the model must be blue";
+  EXPECT_EQ(farther[2], 0);
+  const cv::Vec3b match = discrepancy_pixel(10, 10);
+  EXPECT_EQ(match, cv::Vec3b(0, 0, 0));
+  EXPECT_EQ(discrepancy_pixel(55, 80), cv::Vec3b(0, 0, 0)) << "the arm's matching part";
+}
+
+TEST(Viewer, VerdictText) {
+  view::FrameSet set;
+  set.camera = frame(42, true);
+  EXPECT_EQ(view::verdict_text(set), "seq 42  no verdict");
+  risk_t risk;
+  risk.seq = 42;
+  risk.level = risk_t::DANGEROUS;
+  risk.cause = risk_t::CAUSE_JOINT_ERROR;
+  risk.suspect = "a4";
+  risk.detail = "a4 off";
+  set.risk = risk;
+  EXPECT_EQ(view::verdict_text(set), "seq 42  DANGEROUS joint error, suspect a4 | a4 off");
+}
+
+}  // namespace
+}  // namespace tofguard::test

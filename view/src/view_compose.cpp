@@ -1,0 +1,135 @@
+#include "tofguard/view/view_compose.hpp"
+
+#include <lcm/lcm-cpp.hpp>
+
+#include <type_traits>
+
+#include <opencv2/imgproc.hpp>
+
+#include "tofguard/common/decode.hpp"
+#include "tofguard/common/risk_names.hpp"
+#include "tofguard/common/wire_checks.hpp"
+
+namespace tofguard::view {
+namespace {
+
+cv::Mat3b depth_panel(const depth_image_t& image, double max_depth_mm, int scale) {
+  cv::Mat1b grey(image.height, image.width, uchar(0));
+  cv::Mat1b valid(image.height, image.width, uchar(0));
+  for (int i = 0; i < image.width * image.height; ++i) {
+    const int16_t d = image.depth_mm[i];
+    if (d <= 0) continue;
+    grey(i / image.width, i % image.width) = cv::saturate_cast<uchar>(255.0 * (1.0 - d / max_depth_mm));
+    valid(i / image.width, i % image.width) = 255;
+  }
+  cv::Mat3b colour;
+  cv::applyColorMap(grey, colour, cv::COLORMAP_VIRIDIS);
+  colour.setTo(cv::Vec3b(0, 0, 0), valid == 0);
+  cv::Mat3b scaled;
+  cv::resize(colour, scaled, cv::Size(), scale, scale, cv::INTER_NEAREST);
+  return scaled;
+}
+
+cv::Mat3b blank_panel(int width, int height, int scale, const std::string& text) {
+  cv::Mat3b panel(height * scale, width * scale, cv::Vec3b(40, 40, 40));
+  cv::putText(panel, text, cv::Point(8, panel.rows / 2), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 1,
+              cv::LINE_AA);
+  return panel;
+}
+
+}  // namespace
+
+int panel_scale(int width) { return std::max(1, (320 + width - 1) / width); }
+
+std::string verdict_text(const FrameSet& frames) {
+  std::string text = "seq " + std::to_string(frames.camera.seq) + "  ";
+  if (!frames.risk) return text + "no verdict";
+  const risk_t& r = *frames.risk;
+  text += risk_level_name(r.level);
+  if (r.cause != risk_t::CAUSE_NONE) text += " " + risk_cause_name(r.cause);
+  if (!r.suspect.empty()) text += ", suspect " + r.suspect;
+  if (!r.detail.empty()) text += " | " + r.detail;
+  return text;
+}
+
+cv::Mat3b compose_view(const FrameSet& frames, const discrepancy::Parameters& parameters, double max_depth_mm,
+                       double full_scale_mm) {
+  const int w = frames.camera.width;
+  const int h = frames.camera.height;
+  const int scale = panel_scale(w);
+  cv::Mat3b camera = depth_panel(frames.camera, max_depth_mm, scale);
+  cv::Mat3b rendered = frames.rendered ? depth_panel(*frames.rendered, max_depth_mm, scale)
+                                       : blank_panel(w, h, scale, "no rendered frame");
+  cv::Mat3b dis = blank_panel(w, h, scale, "no comparison");
+  if (frames.rendered && frames.labels) {
+    const auto frame = discrepancy::compute_discrepancy(frames.camera, *frames.rendered, *frames.labels, parameters);
+    if (frame.summary.usable) {
+      const discrepancy_image_t colour = discrepancy::colour_image(frame, full_scale_mm);
+      // RGB on the wire, BGR in OpenCV.
+      cv::Mat3b rgb(h, w, reinterpret_cast<cv::Vec3b*>(const_cast<uint8_t*>(colour.rgb.data())));
+      cv::Mat3b bgr;
+      cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
+      cv::resize(bgr, dis, cv::Size(), scale, scale, cv::INTER_NEAREST);
+    } else {
+      dis = blank_panel(w, h, scale, "unusable: " + frame.summary.unusable_reason.substr(0, 40));
+    }
+  }
+  const int banner = 28;
+  cv::Mat3b view(banner + camera.rows, 3 * camera.cols, cv::Vec3b(0, 0, 0));
+  camera.copyTo(view(cv::Rect(0, banner, camera.cols, camera.rows)));
+  rendered.copyTo(view(cv::Rect(camera.cols, banner, camera.cols, camera.rows)));
+  dis.copyTo(view(cv::Rect(2 * camera.cols, banner, camera.cols, camera.rows)));
+  cv::Scalar colour(200, 200, 200);
+  if (frames.risk && frames.risk->level == risk_t::DANGEROUS) colour = cv::Scalar(60, 60, 255);
+  if (frames.risk && frames.risk->level == risk_t::WARNING) colour = cv::Scalar(0, 200, 255);
+  if (frames.risk && frames.risk->level == risk_t::SAFE) colour = cv::Scalar(80, 220, 80);
+  cv::putText(view, verdict_text(frames).substr(0, 110), cv::Point(6, 19), cv::FONT_HERSHEY_SIMPLEX, 0.5, colour, 1,
+              cv::LINE_AA);
+  return view;
+}
+
+LogFrames read_log_frames(const std::string& path, const ChannelNames& channels, std::string* error) {
+  LogFrames result;
+  lcm::LogFile log(path, "r");
+  if (!log.good()) {
+    *error = path + ": cannot read the LCM log";
+    return result;
+  }
+  std::map<int64_t, depth_image_t> rendered;
+  std::map<int64_t, link_labels_t> labels;
+  std::map<int64_t, risk_t> risks;
+  // Decodes the event as the type of *message; counts it as skipped if it
+  // is not one.
+  auto decode = [&](const lcm::LogEvent* event, auto* message) {
+    using T = std::remove_pointer_t<decltype(message)>;
+    if (auto m = decode_message<T>(event->data, event->datalen)) {
+      *message = *m;
+      return true;
+    }
+    result.skipped++;
+    return false;
+  };
+  while (const lcm::LogEvent* event = log.readNextEvent()) {
+    if (event->channel == channels.depth) {
+      depth_image_t m;
+      if (decode(event, &m) && check_depth_image(m).empty()) result.by_seq[m.seq].camera = m;
+    } else if (event->channel == channels.rendered) {
+      depth_image_t m;
+      if (decode(event, &m) && check_depth_image(m).empty()) rendered[m.seq] = m;
+    } else if (event->channel == channels.labels) {
+      link_labels_t m;
+      if (decode(event, &m) && check_link_labels(m).empty()) labels[m.seq] = m;
+    } else if (event->channel == channels.risk) {
+      risk_t m;
+      if (decode(event, &m) && m.seq >= 0) risks[m.seq] = m;
+    }
+  }
+  for (auto& [seq, frames] : result.by_seq) {
+    if (auto it = rendered.find(seq); it != rendered.end()) frames.rendered = it->second;
+    if (auto it = labels.find(seq); it != labels.end()) frames.labels = it->second;
+    if (auto it = risks.find(seq); it != risks.end()) frames.risk = it->second;
+  }
+  return result;
+}
+
+}  // namespace tofguard::view
