@@ -263,6 +263,21 @@ class MotionEstimator {
   // or why the frame cannot be rendered.
   std::string linearize(const EstimatorFrame& frame, const State& state, double scale, int stride, PointSet points,
                         bool joints_free, Linearization* lin, std::vector<Sample>* samples);
+  // linearize's stages, per rendered pixel of a link (`chain`: its movable
+  // joints up to the root): the contour term (distance in pixels from a
+  // rendered occluding contour to the nearest measured one) and the depth
+  // term (point-to-plane distance in metres to the measured point), each
+  // adding its residual through add_residual.
+  struct RenderedView;
+  void add_contour_term(const RenderedView& view, const std::vector<ChainJoint>& chain, int u, int v,
+                        Linearization* lin) const;
+  void add_depth_term(const RenderedView& view, const std::vector<ChainJoint>& chain, int link, int u, int v,
+                      Linearization* lin, std::vector<Sample>* samples) const;
+  // One residual whose derivative with respect to the model point (seen
+  // optical frame) is `g`.
+  void add_residual(const RenderedView& view, const std::vector<ChainJoint>& chain, const Eigen::Vector3d& m,
+                    const Eigen::Vector3d& world, const Eigen::Vector3d& g, double residual, double weight,
+                    bool count_joint_points, double d_depth_offset, Linearization* lin) const;
   // Gauss-Newton stage over `frames`; returns "" or an unusable reason.
   std::string solve(const std::vector<const EstimatorFrame*>& frames, bool joints_free, bool camera_free,
                     PointSet points, int max_iterations, State* state, Linearization* final_lin,
