@@ -3,7 +3,8 @@
 // first (unusable frame, invalid pixels, uncalibrated, frozen while the arm
 // moves), then what the mismatch looks like: CALIBRATION_ERROR, JOINT_ERROR,
 // UNKNOWN_OBJECT or UNCLASSIFIED. docs/safety-chain.md gives the rules.
-// Pure logic; the debouncing into WARNING / DANGEROUS is RiskMonitor's.
+// Pure logic; the debouncing into WARNING / DANGEROUS is DecisionRule's
+// (decision_rule.hpp).
 #include <cstdint>
 #include <string>
 #include <vector>
