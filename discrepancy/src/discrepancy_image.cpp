@@ -7,6 +7,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "tofguard/common/demand.hpp"
+
 namespace tofguard::discrepancy {
 namespace {
 
@@ -461,6 +463,16 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
     frame.summary = unusable_summary(camera, discrepancy_t::UNUSABLE_MISMATCHED, why);
     return frame;
   }
+  // Every stage below reads the three images through raw pointers up to
+  // width * height pixels. The wire checks (num_pixels == width * height,
+  // decoded arrays of num_pixels) and mismatch_reason (same sizes) guarantee
+  // it; a caller that skipped them would read past the end.
+  const int num_pixels = camera.width * camera.height;
+  TOFGUARD_DEMAND(camera.depth_mm.size() == static_cast<size_t>(num_pixels) &&
+                      rendered.depth_mm.size() == static_cast<size_t>(num_pixels) &&
+                      labels.label.size() == static_cast<size_t>(num_pixels),
+                  "frame seq " + std::to_string(camera.seq) + ": image arrays do not hold width*height = " +
+                      std::to_string(num_pixels) + " pixels");
   if (const std::string why = check_labels(labels); !why.empty()) {
     frame.summary = unusable_summary(camera, discrepancy_t::UNUSABLE_MISMATCHED, why);
     return frame;
@@ -490,7 +502,6 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
   classify_pixels(camera, rendered, labels, silhouette, parameters.tolerance, &frame, &classes);
 
   // The seed's score and the class counts.
-  const int num_pixels = camera.width * camera.height;
   s.num_match = classes.count[discrepancy_t::PIXEL_MATCH];
   s.num_robot_missing = classes.count[discrepancy_t::PIXEL_ROBOT_MISSING];
   s.num_occluded = classes.count[discrepancy_t::PIXEL_OCCLUDED];
@@ -540,6 +551,11 @@ discrepancy_image_t colour_image(const DiscrepancyFrame& frame, double full_scal
   image.num_bytes = 3 * num_pixels;
   image.rgb.assign(image.num_bytes, 0);
   if (frame.pixel_class.empty()) return image;
+  // The class and I_dis images were made with the summary's size.
+  TOFGUARD_DEMAND(frame.pixel_class.total() == static_cast<size_t>(num_pixels) &&
+                      frame.dis_mm.total() == static_cast<size_t>(num_pixels),
+                  "discrepancy images do not match the summary's " + std::to_string(image.width) + "x" +
+                      std::to_string(image.height));
   const uint8_t* pixel_class = frame.pixel_class.ptr<uint8_t>();
   const int32_t* dis = frame.dis_mm.ptr<int32_t>();
   for (int i = 0; i < num_pixels; ++i) {

@@ -6,6 +6,7 @@
 #include <sstream>
 #include <vector>
 
+#include "tofguard/common/demand.hpp"
 #include "tofguard/risk_t.hpp"
 
 namespace tofguard::risk {
@@ -27,6 +28,17 @@ bool is_fault_cause(int8_t cause) {
 void FrameEvidence::build_link_views() const {
   if (built_) return;
   built_ = true;
+  // The loop below indexes six per-link arrays by i < num_links and splits
+  // robot from environment links at num_robot_links; a discrepancy that
+  // passed its wire check has them consistent. (Checked here, after the
+  // sensor rules: an unusable frame carries no per-link arrays.)
+  TOFGUARD_DEMAND(frame.num_robot_links >= 0 && frame.num_robot_links <= frame.num_links && frame.num_links >= 0 &&
+                      frame.link_name.size() == static_cast<size_t>(frame.num_links) &&
+                      frame.link_compared.size() == static_cast<size_t>(frame.num_links) &&
+                      frame.link_match.size() == static_cast<size_t>(frame.num_links) &&
+                      frame.link_farther.size() == static_cast<size_t>(frame.num_links),
+                  "discrepancy seq " + std::to_string(frame.seq) + ": per-link arrays do not match num_links " +
+                      std::to_string(frame.num_links));
   for (int i = 0; i < frame.num_links; ++i) {
     if (i >= frame.num_robot_links) {
       environment_compared_ += frame.link_compared[i];
