@@ -59,15 +59,6 @@ struct LinkView {
 
 }  // namespace
 
-bool is_model_mismatch(int8_t cause) {
-  return cause == risk_t::CAUSE_JOINT_ERROR || cause == risk_t::CAUSE_CALIBRATION_ERROR ||
-         cause == risk_t::CAUSE_UNKNOWN_OBJECT || cause == risk_t::CAUSE_UNCLASSIFIED;
-}
-
-bool is_fault_cause(int8_t cause) {
-  return cause == risk_t::CAUSE_SENSOR_FAULT || cause == risk_t::CAUSE_COMPONENT_FAULT;
-}
-
 FrameFinding classify_frame(const discrepancy_t& f, const RobotTree& robot, const RiskConfig& config,
                             const ClassifierContext& context) {
   if (FrameFinding sensor = sensor_finding(f, config, context); sensor.cause != risk_t::CAUSE_NONE) {
