@@ -1,5 +1,5 @@
-// tofguard-estimator: TOF_DEPTH, JOINT_STATE, CAMERA_POSE, SAFETY_DISCREPANCY
-// -> MOTION_ESTIMATE (src/estimator_process.hpp, docs/estimator.md).
+// tofguard-estimator: TOF_DEPTH, JOINT_STATE, CAMERA_POSE, SAFETY_DISCREPANCY,
+// SAFETY_RISK -> MOTION_ESTIMATE (estimator_process.hpp, docs/estimator.md).
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
@@ -86,6 +86,13 @@ int run(const Config& config, const std::vector<std::string>& rest) {
         dispatch();
       },
       check_discrepancy);
+  node.subscribe<risk_t>(
+      node.safety(), config.channels.risk,
+      [&](const risk_t& r) {
+        scheduler.on_risk(r);
+        dispatch();
+      },
+      check_risk);
   node.add_timer(static_cast<int64_t>(std::llround(config.estimator.periodic_period_ms * 1000)), [&] {
     scheduler.request_newest();
     dispatch();

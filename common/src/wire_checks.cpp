@@ -220,4 +220,61 @@ std::string check_planned_trajectory(const planned_trajectory_t& plan) {
   return "";
 }
 
+std::string check_discrepancy(const discrepancy_t& d) {
+  if (d.utime <= 0) return expected("utime", "a capture time > 0", static_cast<double>(d.utime));
+  if (d.seq < 0) return expected("seq", "a frame number >= 0", static_cast<double>(d.seq));
+  if (d.num_robot_links < 0 || d.num_robot_links > d.num_links) {
+    return expected("num_robot_links", "0..num_links = " + std::to_string(d.num_links), d.num_robot_links);
+  }
+  if (!(d.invalid_fraction >= 0 && d.invalid_fraction <= 1)) {
+    return expected("invalid_fraction", "a fraction in [0, 1]", d.invalid_fraction);
+  }
+  if (!(d.mismatch_fraction >= 0 && d.mismatch_fraction <= 1)) {
+    return expected("mismatch_fraction", "a fraction in [0, 1]", d.mismatch_fraction);
+  }
+  if (!std::isfinite(d.p95_abs_dis_mm) || d.p95_abs_dis_mm < 0) {
+    return expected("p95_abs_dis_mm", "a finite value >= 0 mm", d.p95_abs_dis_mm);
+  }
+  for (int i = 0; i < d.num_links; ++i) {
+    if (d.link_compared[i] < 0 || d.link_match[i] < 0 || d.link_farther[i] < 0 ||
+        d.link_match[i] > d.link_compared[i] || d.link_farther[i] > d.link_compared[i]) {
+      return "link_compared[" + std::to_string(i) + "]: expected counts with 0 <= match, farther <= compared";
+    }
+  }
+  if (!std::isfinite(d.near_arm_area_m2) || !std::isfinite(d.largest_blob_area_m2)) {
+    return "near_arm_area_m2 / largest_blob_area_m2: expected finite areas";
+  }
+  return "";
+}
+
+std::string check_heartbeat(const heartbeat_t& hb) {
+  if (hb.process.empty()) return "process: expected a process name, got an empty string";
+  return "";
+}
+
+std::string check_sim_camera_fault(const sim_camera_fault_t& f) {
+  auto finite3 = [](const double v[3]) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); };
+  if (f.kind < sim_camera_fault_t::CLEAR || f.kind > sim_camera_fault_t::INTRUDING_OBJECT) {
+    return "kind: expected 0..4, got " + std::to_string(f.kind);
+  }
+  if (f.kind != sim_camera_fault_t::CLEAR && !(f.duration_s > 0 && f.duration_s < 1e6)) {
+    return "duration_s: expected a duration in (0, 1e6) s, got " + std::to_string(f.duration_s);
+  }
+  if (!finite3(f.drift_translation_m_per_s) || !finite3(f.drift_rotation_rad_per_s) || !finite3(f.object_size_m) ||
+      !finite3(f.object_position_m) || !finite3(f.object_velocity_m_per_s)) {
+    return "vectors: expected finite numbers";
+  }
+  if (f.kind == sim_camera_fault_t::INTRUDING_OBJECT &&
+      !(f.object_size_m[0] > 0 && f.object_size_m[1] > 0 && f.object_size_m[2] > 0)) {
+    return "object_size_m: expected 3 sizes > 0";
+  }
+  return "";
+}
+
+std::string check_sim_joint_fault(const sim_joint_fault_t& f) {
+  if (f.joint.empty()) return "joint: expected a joint name, got an empty string";
+  if (!std::isfinite(f.offset)) return expected("offset", "a finite offset (rad, or m for a prismatic joint)", f.offset);
+  return "";
+}
+
 }  // namespace tofguard

@@ -95,42 +95,22 @@ cv::Mat1b opened(const cv::Mat1b& mask, int radius_px) {
 
 // ---- The stages of compute_discrepancy, in order ----
 
-// Stage 1, label decoding. The link index of a label value: robot links
-// 0..num_robot_links-1, then the environment's, in link_labels_t order; -1
-// where nothing is modelled, kBadLabel for a value out of range.
-constexpr int kBadLabel = -2;
-
-class LinkOfLabel {
- public:
-  explicit LinkOfLabel(const link_labels_t& labels)
-      : num_robot_links_(labels.num_robot_links), num_environment_links_(labels.num_links - labels.num_robot_links) {}
-  int operator()(int l) const {
-    if (l >= link_labels_t::ROBOT_FIRST && l < link_labels_t::ROBOT_FIRST + num_robot_links_) {
-      return l - link_labels_t::ROBOT_FIRST;
-    }
-    if (l >= link_labels_t::ENVIRONMENT_FIRST && l < link_labels_t::ENVIRONMENT_FIRST + num_environment_links_) {
-      return num_robot_links_ + l - link_labels_t::ENVIRONMENT_FIRST;
-    }
-    return l == link_labels_t::NOTHING ? -1 : kBadLabel;
-  }
-
- private:
-  int num_robot_links_;
-  int num_environment_links_;
-};
-
-// "" when every label value names a link or nothing, else why not (the
-// first bad pixel). Decoded again per pixel by the later stages: one lookup
+// Stage 1, label decoding: "" when every label value names a link or
+// nothing (link_of_label, common/depth_frame.hpp), else why not (the first
+// bad pixel). The later stages decode each pixel's label again: one lookup
 // costs less than a per-pixel link buffer (see per_link_statistics on heap
 // churn).
 std::string check_labels(const link_labels_t& labels) {
-  const LinkOfLabel link_of(labels);
+  const int num_robot_links = labels.num_robot_links;
+  const int num_links = labels.num_links;
   const int num_pixels = labels.width * labels.height;
   for (int i = 0; i < num_pixels; ++i) {
-    if (link_of(labels.label[i]) != kBadLabel) continue;
+    const int l = labels.label[i];
+    if (l == kLabelNothing || link_of_label(l, num_robot_links, num_links) >= 0) continue;
     std::ostringstream why;
-    why << "label[" << i << "]: expected 0, 1.." << labels.num_robot_links << " or 1000.."
-        << 999 + labels.num_links - labels.num_robot_links << ", got " << labels.label[i];
+    why << "label[" << i << "]: expected " << kLabelNothing << ", " << kLabelRobotFirst << ".."
+        << kLabelRobotFirst + num_robot_links - 1 << " or " << kLabelEnvironmentFirst << ".."
+        << kLabelEnvironmentFirst + (num_links - num_robot_links) - 1 << ", got " << l;
     return why.str();
   }
   return "";
@@ -191,7 +171,7 @@ void classify_pixels(const depth_image_t& camera, const depth_image_t& rendered,
                      const std::vector<uint8_t>& silhouette, const Tolerance& tolerance, DiscrepancyFrame* frame,
                      PixelClasses* classes) {
   PixelClasses& p = *classes;
-  const LinkOfLabel link_of(labels);
+  const int num_links = labels.num_links;
   const int num_robot_links = labels.num_robot_links;
   const int16_t* label = labels.label.data();
   const int width = camera.width;
@@ -206,7 +186,7 @@ void classify_pixels(const depth_image_t& camera, const depth_image_t& rendered,
   uint8_t* nearer = p.nearer_mask.ptr<uint8_t>();
   uint8_t* robot_free = p.not_robot.ptr<uint8_t>();
   for (int i = 0; i < num_pixels; ++i) {
-    const int link = link_of(label[i]);
+    const int link = link_of_label(label[i], labels.num_robot_links, num_links);
     const int t = tof[i];
     const int g = gen[i];
     const bool modelled = g > 0;
@@ -267,7 +247,6 @@ struct DisHistograms {
 DisHistograms per_link_statistics(const DiscrepancyFrame& frame, const depth_image_t& camera,
                                   const depth_image_t& rendered, const link_labels_t& labels,
                                   const std::vector<uint8_t>& silhouette, discrepancy_t* s) {
-  const LinkOfLabel link_of(labels);
   const int16_t* label = labels.label.data();
   const int num_links = s->num_links;
   const int num_robot_links = s->num_robot_links;
@@ -280,7 +259,7 @@ DisHistograms per_link_statistics(const DiscrepancyFrame& frame, const depth_ima
   std::vector<Histogram>& link_dis = h.per_link;
   link_dis.resize(num_links + 1);
   for (int i = 0; i < num_pixels; ++i) {
-    const int link = link_of(label[i]);
+    const int link = link_of_label(label[i], labels.num_robot_links, num_links);
     const bool modelled = gen[i] > 0;
     if (tof[i] <= 0) {
       if (link >= 0 && modelled) s->link_invalid[link]++;
@@ -322,7 +301,7 @@ class PixelFootprint {
   PixelFootprint(const depth_image_t& camera, const depth_image_t& rendered)
       : tof_(camera.depth_mm.data()), gen_(rendered.depth_mm.data()), inv_fx_fy_(1.0 / (camera.fx * camera.fy)) {}
   double m2(int i) const {
-    const double z_m = (tof_[i] > 0 ? tof_[i] : gen_[i]) * 1e-3;
+    const double z_m = metres_from_mm(tof_[i] > 0 ? tof_[i] : gen_[i]);
     return z_m * z_m * inv_fx_fy_;
   }
 
@@ -391,7 +370,7 @@ void near_arm_surfaces(const depth_image_t& camera, const depth_image_t& rendere
   }
   // The camera-frame point (optical frame, m) of pixel i at depth_mm.
   auto point_m = [&](int i, int depth_mm) {
-    const double z = depth_mm * 1e-3;
+    const double z = metres_from_mm(depth_mm);
     return cv::Point3d((i % width - camera.cx) * z / camera.fx, (i / width - camera.cy) * z / camera.fy, z);
   };
   const uint8_t* candidate = candidates.ptr<uint8_t>();
@@ -401,7 +380,7 @@ void near_arm_surfaces(const depth_image_t& camera, const depth_image_t& rendere
     if (candidate[i] == 0) continue;
     double distance_m;
     if (pixel_class[i] == discrepancy_t::PIXEL_OCCLUDED) {
-      distance_m = (gen[i] - tof[i]) * 1e-3;
+      distance_m = metres_from_mm(gen[i] - tof[i]);
     } else {
       const int k = nearest_label[i];
       const int arm = k < static_cast<int>(pixel_of_label.size()) ? pixel_of_label[k] : -1;

@@ -271,9 +271,8 @@ struct DepthRenderer::Impl {
 
     const Eigen::Isometry3d optical_from_world = world_from_optical.inverse();
     for (const Shape& shape : scene.shapes) {
-      const Link& link = scene.links[shape.link_index];
-      const int label = link.is_environment ? kLabelEnvironmentFirst + (shape.link_index - scene.num_robot_links)
-                                            : kLabelRobotFirst + shape.link_index;
+      // SceneModel::links: the robot's first, then the environment's.
+      const int label = label_of_link(shape.link_index, scene.num_robot_links);
       const Eigen::Matrix4d optical_from_mesh = (optical_from_world * poses.world_from_link[shape.link_index] *
                                                  shape.link_from_shape)
                                                     .matrix() *
@@ -344,8 +343,8 @@ DepthRenderer::DepthRenderer(const SceneModel& scene, double near_m, double far_
     throw std::invalid_argument("DepthRenderer: need 0 < near_m < far_m, got near_m " + std::to_string(near_m) +
                                 ", far_m " + std::to_string(far_m));
   }
-  if (scene.num_robot_links >= kLabelEnvironmentFirst - kLabelRobotFirst ||
-      static_cast<int>(scene.links.size()) - scene.num_robot_links >= kLabelExtraObjectFirst - kLabelEnvironmentFirst) {
+  if (scene.num_robot_links >= kMaxLabelledRobotLinks ||
+      static_cast<int>(scene.links.size()) - scene.num_robot_links >= kMaxLabelledEnvironmentLinks) {
     throw std::invalid_argument("DepthRenderer: at most 999 robot links and 1000 environment links can be labelled");
   }
   impl_ = std::make_unique<Impl>(scene, near_m, far_m, platform);

@@ -146,8 +146,8 @@ int run_render_cli(const std::vector<std::string>& args, std::ostream& out, std:
         const double mm = std::round(result.depth_m[i] * 1000.0);
         depth_mm.at<uint16_t>(v, u) = static_cast<uint16_t>(mm > 0 && mm <= 65535 ? mm : 0);
         labels.at<uint16_t>(v, u) = static_cast<uint16_t>(result.labels[i]);
-        robot_pixels += result.labels[i] >= kLabelRobotFirst && result.labels[i] < kLabelEnvironmentFirst;
-        environment_pixels += result.labels[i] >= kLabelEnvironmentFirst;
+        robot_pixels += is_robot_label(result.labels[i]);
+        environment_pixels += is_environment_label(result.labels[i]);
       }
     }
     if (!cv::imwrite(out_path, depth_mm)) {

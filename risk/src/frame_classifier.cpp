@@ -16,15 +16,6 @@ std::string fixed(double value, int decimals) {
   return s.str();
 }
 
-bool is_model_mismatch(int8_t cause) {
-  return cause == risk_t::CAUSE_JOINT_ERROR || cause == risk_t::CAUSE_CALIBRATION_ERROR ||
-         cause == risk_t::CAUSE_UNKNOWN_OBJECT || cause == risk_t::CAUSE_UNCLASSIFIED;
-}
-
-bool is_fault_cause(int8_t cause) {
-  return cause == risk_t::CAUSE_SENSOR_FAULT || cause == risk_t::CAUSE_COMPONENT_FAULT;
-}
-
 void FrameEvidence::build_link_views() const {
   if (built_) return;
   built_ = true;
