@@ -35,16 +35,10 @@ std::string check_names(const std::vector<std::string>& names, const std::string
   return "";
 }
 
+// The rule is UnitQuaternion::check (camera_geometry.hpp).
 std::string check_unit_quaternion(const double q[4], const std::string& field) {
-  double norm2 = 0;
-  for (int i = 0; i < 4; ++i) {
-    if (!std::isfinite(q[i])) return expected(field + "[" + std::to_string(i) + "]", "a finite number", q[i]);
-    norm2 += q[i] * q[i];
-  }
-  if (std::abs(std::sqrt(norm2) - 1.0) > 1e-3) {
-    return expected(field, "a unit quaternion w,x,y,z (norm 1 within 1e-3), norm", std::sqrt(norm2));
-  }
-  return "";
+  const auto v = UnitQuaternion::check(Eigen::Quaterniond(q[0], q[1], q[2], q[3]), kWireQuaternionTolerance, field);
+  return v ? v->line() : "";
 }
 
 }  // namespace
@@ -62,10 +56,7 @@ std::string check_depth_image(const depth_image_t& image) {
     return expected("num_amplitude", "0 or width*height = " + std::to_string(pixels),
                     image.num_amplitude);
   }
-  if (!std::isfinite(image.fx) || image.fx <= 0) return expected("fx", "a focal length > 0 px", image.fx);
-  if (!std::isfinite(image.fy) || image.fy <= 0) return expected("fy", "a focal length > 0 px", image.fy);
-  if (!std::isfinite(image.cx)) return expected("cx", "a finite principal point", image.cx);
-  if (!std::isfinite(image.cy)) return expected("cy", "a finite principal point", image.cy);
+  if (auto v = Intrinsics::check(image.width, image.height, image.fx, image.fy, image.cx, image.cy)) return v->line();
   return "";
 }
 
@@ -93,14 +84,11 @@ std::string check_joint_state(const joint_state_t& state) {
 }
 
 std::string check_camera_pose(const camera_pose_t& pose) {
-  if (pose.frame_id.empty()) return "frame_id: expected a URDF link name, got an empty string";
-  for (int i = 0; i < 3; ++i) {
-    if (!std::isfinite(pose.translation[i])) {
-      return expected("translation[" + std::to_string(i) + "]", "a finite number of metres",
-                      pose.translation[i]);
-    }
-  }
-  return check_unit_quaternion(pose.rotation, "rotation");
+  const auto v = CameraPose::check(
+      pose.frame_id, Eigen::Vector3d(pose.translation[0], pose.translation[1], pose.translation[2]),
+      Eigen::Quaterniond(pose.rotation[0], pose.rotation[1], pose.rotation[2], pose.rotation[3]),
+      kWireQuaternionTolerance);
+  return v ? v->line() : "";
 }
 
 std::string check_link_labels(const link_labels_t& labels) {

@@ -7,6 +7,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "tofguard/common/demand.hpp"
+
 namespace tofguard::discrepancy {
 namespace {
 
@@ -141,6 +143,15 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
   const int width = camera.width;
   const int height = camera.height;
   const int num_pixels = width * height;
+  // Every loop below reads the three images through raw pointers up to
+  // num_pixels. The wire checks (num_pixels == width * height, decoded
+  // arrays of num_pixels) and mismatch_reason (same sizes) guarantee it; a
+  // caller that skipped them would read past the end.
+  TOFGUARD_DEMAND(camera.depth_mm.size() == static_cast<size_t>(num_pixels) &&
+                      rendered.depth_mm.size() == static_cast<size_t>(num_pixels) &&
+                      labels.label.size() == static_cast<size_t>(num_pixels),
+                  "frame seq " + std::to_string(camera.seq) + ": image arrays do not hold width*height = " +
+                      std::to_string(num_pixels) + " pixels");
   const int num_links = labels.num_links;
   const int num_robot_links = labels.num_robot_links;
   const int num_environment_links = num_links - num_robot_links;
@@ -413,6 +424,11 @@ discrepancy_image_t colour_image(const DiscrepancyFrame& frame, double full_scal
   image.num_bytes = 3 * num_pixels;
   image.rgb.assign(image.num_bytes, 0);
   if (frame.pixel_class.empty()) return image;
+  // The class and I_dis images were made with the summary's size.
+  TOFGUARD_DEMAND(frame.pixel_class.total() == static_cast<size_t>(num_pixels) &&
+                      frame.dis_mm.total() == static_cast<size_t>(num_pixels),
+                  "discrepancy images do not match the summary's " + std::to_string(image.width) + "x" +
+                      std::to_string(image.height));
   const uint8_t* pixel_class = frame.pixel_class.ptr<uint8_t>();
   const int32_t* dis = frame.dis_mm.ptr<int32_t>();
   for (int i = 0; i < num_pixels; ++i) {

@@ -211,8 +211,7 @@ MotionEstimator::MotionEstimator(const robot_model::SceneModel& scene, renderer:
 }
 
 std::string MotionEstimator::check_frame(const EstimatorFrame& frame) const {
-  const std::string intrinsics = renderer::check_intrinsics(frame.intrinsics);
-  if (!intrinsics.empty()) return "intrinsics: " + intrinsics;
+  if (const auto v = frame.intrinsics.check()) return "intrinsics: " + v->line();
   const size_t pixels = static_cast<size_t>(frame.intrinsics.width) * frame.intrinsics.height;
   if (frame.depth_m.size() != pixels) {
     return "depth image: expected " + std::to_string(pixels) + " pixels, got " + std::to_string(frame.depth_m.size());

@@ -118,7 +118,7 @@ int run_render_cli(const std::vector<std::string>& args, std::ostream& out, std:
     if (!have_pose) throw UsageError("--camera-pose is required");
     if (!have_intrinsics) throw UsageError("--intrinsics is required");
     if (out_path.empty()) throw UsageError("--out is required");
-    if (const std::string why = check_intrinsics(intrinsics); !why.empty()) throw UsageError(why);
+    if (const auto v = intrinsics.check()) throw UsageError("--intrinsics: " + v->line());
     if (!(near_m > 0 && far_m > near_m)) throw UsageError("need 0 < --near < --far");
   } catch (const UsageError& e) {
     err << "tofguard-renderer render: " << e.what() << "\n" << render_cli_usage();

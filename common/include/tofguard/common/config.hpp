@@ -13,6 +13,7 @@
 
 #include <Eigen/Geometry>
 
+#include "tofguard/common/camera_geometry.hpp"
 #include "tofguard/common/config_error.hpp"
 
 namespace tofguard {
@@ -53,34 +54,6 @@ struct ChannelNames {
   std::string sim_joint_fault = "SIM_JOINT_FAULT";
   // Simulation only: run-time fault injection into the simulated camera.
   std::string sim_camera_fault = "SIM_CAMERA_FAULT";
-};
-
-// Pinhole intrinsics, OpenCV convention (pixel (u, v) has its centre at
-// (u, v), u right, v down), in pixels.
-struct Intrinsics {
-  int width = 0;
-  int height = 0;
-  double fx = 0;
-  double fy = 0;
-  double cx = 0;
-  double cy = 0;
-};
-
-// Pose of the camera's optical frame (x right, y down, z forward) in URDF
-// link `frame_id`: p_frame = rotation * p_optical + translation_m.
-struct CameraPose {
-  std::string frame_id;
-  Eigen::Vector3d translation_m = Eigen::Vector3d::Zero();
-  Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
-
-  // The optical frame's pose in frame_id as a transform:
-  // p_frame = frame_from_optical() * p_optical (rotation normalised).
-  Eigen::Isometry3d frame_from_optical() const {
-    Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-    t.linear() = rotation.normalized().toRotationMatrix();
-    t.translation() = translation_m;
-    return t;
-  }
 };
 
 struct RobotConfig {

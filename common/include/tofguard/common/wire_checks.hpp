@@ -6,6 +6,7 @@
 #include <string>
 
 #include "tofguard/camera_pose_t.hpp"
+#include "tofguard/common/camera_geometry.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/link_labels_t.hpp"
@@ -16,14 +17,13 @@
 
 namespace tofguard {
 
-// Largest image side accepted, pixels.
-constexpr int kMaxImageSide = 8192;
-
+// The intrinsics by Intrinsics::check (camera_geometry.hpp).
 std::string check_depth_image(const depth_image_t& image);
 // check_depth_image, and the frame must come from camera `camera_id`.
 std::string check_depth_image_from(const depth_image_t& image, const std::string& camera_id);
 std::string check_joint_state(const joint_state_t& state);
-// The rotation must be a unit quaternion within 1e-3.
+// CameraPose::check with kWireQuaternionTolerance (a unit quaternion within
+// 1e-3, normalised by from_camera_pose_message).
 std::string check_camera_pose(const camera_pose_t& pose);
 std::string check_link_labels(const link_labels_t& labels);
 // level and cause must be one of risk_t's constants.

@@ -113,8 +113,4 @@ class DepthRenderer {
   std::unique_ptr<Impl> impl_;
 };
 
-// Checks intrinsics for rendering: "" when usable, else one line naming the
-// field (sizes 1..8192, fx, fy > 0 and finite, cx, cy finite).
-std::string check_intrinsics(const Intrinsics& intrinsics);
-
 }  // namespace tofguard::renderer
