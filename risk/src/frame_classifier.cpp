@@ -59,7 +59,7 @@ struct LinkView {
 
 }  // namespace
 
-FrameFinding classify_frame(const discrepancy_t& f, const RobotTree& robot, const RiskConfig& config,
+FrameFinding classify_frame(const discrepancy_t& f, const robot_model::KinematicTree& robot, const RiskConfig& config,
                             const ClassifierContext& context) {
   if (FrameFinding sensor = sensor_finding(f, config, context); sensor.cause != risk_t::CAUSE_NONE) {
     return sensor;
@@ -109,7 +109,7 @@ FrameFinding classify_frame(const discrepancy_t& f, const RobotTree& robot, cons
     // far more than a distant floor, which may stay within tolerance.)
     std::string fixed_link_mismatching;
     for (const LinkView& link : visible) {
-      if (link.mismatch >= config.link_mismatch_fraction && robot.has_link(link.name) &&
+      if (link.mismatch >= config.link_mismatch_fraction && robot.is_robot_link(link.name) &&
           robot.nearest_movable_joint_above(link.name).empty()) {
         fixed_link_mismatching = link.name;
       }
@@ -142,7 +142,7 @@ FrameFinding classify_frame(const discrepancy_t& f, const RobotTree& robot, cons
       // Only a displaced arm is missing where the model has it: an object
       // can hide a link (nearer) but never make the camera see farther.
       if (link.missing < config.joint_link_missing_fraction) continue;
-      if (!robot.has_link(link.name)) {
+      if (!robot.is_robot_link(link.name)) {
         unknown = link.name;
         continue;
       }
@@ -193,7 +193,7 @@ FrameFinding classify_frame(const discrepancy_t& f, const RobotTree& robot, cons
     int64_t mismatching = 0;
     int64_t compared = 0;
     for (const LinkView& link : visible) {
-      if (!robot.has_link(link.name)) continue;
+      if (!robot.is_robot_link(link.name)) continue;
       if (link.mismatch < config.joint_link_affected_fraction ||
           link.mismatch * link.compared < config.joint_link_affected_min_pixels) {
         continue;

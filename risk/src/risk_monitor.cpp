@@ -18,7 +18,7 @@ constexpr size_t kKeptJudgedSeqs = 64;
 
 }  // namespace
 
-RiskMonitor::RiskMonitor(const Config& config, RobotTree robot, int64_t start_us)
+RiskMonitor::RiskMonitor(const Config& config, robot_model::KinematicTree robot, int64_t start_us)
     : config_(config),
       robot_(std::move(robot)),
       depth_{config.channels.depth, risk_t::CAUSE_SENSOR_FAULT, ms_to_us(config.risk.depth_deadline_ms), start_us},
@@ -74,7 +74,7 @@ std::optional<FrameFinding> RiskMonitor::plan_deviation_at(int64_t utime) const 
   for (int i = 0; i < state.num_joints; ++i) {
     const auto p = planned->find(state.name[i]);
     if (p == planned->end()) continue;
-    const bool prismatic = robot_.prismatic_joints().count(state.name[i]) > 0;
+    const bool prismatic = robot_.is_prismatic_joint(state.name[i]);
     const double deviation = std::abs(state.position[i] - p->second);
     const double limit = prismatic ? r.plan_max_deviation_m : r.plan_max_deviation_deg / kRadToDeg;
     if (!(deviation > limit) || deviation / limit <= worst_ratio) continue;
@@ -246,7 +246,7 @@ risk_t RiskMonitor::judge(const discrepancy_t& frame, int64_t now_us, bool waite
   if (config_.risk.estimate_enabled && is_model_mismatch(finding.cause)) {
     if (const motion_estimate_t* estimate = estimate_for(frame, /*or_older=*/true)) {
       EstimateContext context;
-      context.prismatic_joints = robot_.prismatic_joints();
+      context.prismatic_joints = robot_.prismatic_joint_names;
       context.near_arm_evidence = frame.near_arm_area_m2 >= config_.risk.unknown_object_min_area_m2;
       FrameFinding refined = classify_estimate(*estimate, config_.risk, context);
       // An earlier frame's estimate is evidence only of what it names (a

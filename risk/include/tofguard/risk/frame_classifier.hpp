@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <string>
 
-#include "tofguard/risk/robot_tree.hpp"
+#include "tofguard/robot_model/kinematic_tree.hpp"
 #include "tofguard/common/config.hpp"
 #include "tofguard/common/risk_names.hpp"
 #include "tofguard/discrepancy_t.hpp"
@@ -35,7 +35,7 @@ struct ClassifierContext {
   bool arm_moving = false;
 };
 
-FrameFinding classify_frame(const discrepancy_t& frame, const RobotTree& robot, const RiskConfig& config,
+FrameFinding classify_frame(const discrepancy_t& frame, const robot_model::KinematicTree& robot, const RiskConfig& config,
                             const ClassifierContext& context);
 
 // `value` with `decimals` digits after the point, for detail lines.

@@ -29,7 +29,7 @@
 #include <vector>
 
 #include "tofguard/risk/frame_classifier.hpp"
-#include "tofguard/risk/robot_tree.hpp"
+#include "tofguard/robot_model/kinematic_tree.hpp"
 #include "tofguard/common/config.hpp"
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/heartbeat_t.hpp"
@@ -43,7 +43,7 @@ namespace tofguard::risk {
 
 class RiskMonitor {
  public:
-  RiskMonitor(const Config& config, RobotTree robot, int64_t start_us);
+  RiskMonitor(const Config& config, robot_model::KinematicTree robot, int64_t start_us);
 
   // Arrivals of valid messages.
   void on_depth(int64_t now_us);
@@ -119,7 +119,7 @@ class RiskMonitor {
   static void touch(Deadline* d, int64_t now_us);
 
   const Config config_;
-  RobotTree robot_;
+  robot_model::KinematicTree robot_;
   Deadline depth_;
   Deadline discrepancy_;
   Deadline joint_state_;
