@@ -22,7 +22,7 @@ int run(const Config& config, const std::vector<std::string>& rest) {
     std::cerr << name << ": unknown argument '" << rest[0] << "'\n";
     return kConfigErrorExitCode;
   }
-  renderer::SceneModel scene;
+  robot_model::SceneModel scene;
   try {
     scene = load_estimator_scene(config);
   } catch (const std::exception& e) {

@@ -6,6 +6,7 @@
 // takes encoder faults from the config and from SIM_JOINT_FAULT.
 #include <iostream>
 
+#include "tofguard/robot_model/kinematic_tree.hpp"
 #include "tofguard/sim/simulated_arm.hpp"
 #include "tofguard/common/clock.hpp"
 #include "tofguard/joint_state_t.hpp"
@@ -37,9 +38,13 @@ int run(const Config& config, const std::vector<std::string>& rest) {
   }
   std::unique_ptr<SimulatedArm> arm;
   try {
-    arm = std::make_unique<SimulatedArm>(config.joints_sim, movable_joints(config.robot.urdf_path),
-                                         config.file);
+    arm = std::make_unique<SimulatedArm>(
+        config.joints_sim, robot_model::load_kinematic_tree(config.robot.urdf_path).actuated_joint_names, config.file);
   } catch (const ConfigError& e) {
+    std::cerr << "tofguard-joints-sim: config error: " << e.what() << "\n";
+    return kConfigErrorExitCode;
+  } catch (const robot_model::ModelError& e) {
+    // The robot's URDF is part of the configuration.
     std::cerr << "tofguard-joints-sim: config error: " << e.what() << "\n";
     return kConfigErrorExitCode;
   }

@@ -13,7 +13,7 @@
 
 namespace tofguard::estimator {
 
-using renderer::JointType;
+using robot_model::JointType;
 
 // The current estimate: joint offsets (added to each frame's reported
 // positions, actuated order) and the camera correction.
@@ -157,7 +157,7 @@ double correction_angle_rad(const EstimateResult& result) {
   return Eigen::AngleAxisd(result.correction.linear()).angle();
 }
 
-MotionEstimator::MotionEstimator(const renderer::SceneModel& scene, renderer::DepthRenderer* renderer,
+MotionEstimator::MotionEstimator(const robot_model::SceneModel& scene, renderer::DepthRenderer* renderer,
                                  const EstimatorOptions& options)
     : scene_(scene), renderer_(renderer), options_(options) {
   if (renderer_ == nullptr) throw std::invalid_argument("MotionEstimator: renderer is null");
@@ -178,7 +178,7 @@ MotionEstimator::MotionEstimator(const renderer::SceneModel& scene, renderer::De
   for (size_t l = 0; l < scene_.links.size(); ++l) {
     int joint_index = scene_.links[l].parent_joint;
     while (joint_index >= 0) {
-      const renderer::Joint& joint = scene_.joints[joint_index];
+      const robot_model::Joint& joint = scene_.joints[joint_index];
       if (joint.type != JointType::kFixed) {
         // A mimic joint moves with its leader: d(value)/d(leader) is the
         // product of the multipliers down the mimic chain.
@@ -213,9 +213,9 @@ std::string MotionEstimator::check_frame(const EstimatorFrame& frame) const {
 
 namespace {
 
-renderer::JointPositions joints_at(const renderer::SceneModel& scene, const EstimatorFrame& frame,
+robot_model::JointPositions joints_at(const robot_model::SceneModel& scene, const EstimatorFrame& frame,
                                    const std::vector<double>& offsets) {
-  renderer::JointPositions joints = frame.reported_joints;
+  robot_model::JointPositions joints = frame.reported_joints;
   for (size_t k = 0; k < offsets.size(); ++k) joints[scene.actuated_joint_names[k]] += offsets[k];
   return joints;
 }
@@ -225,10 +225,10 @@ struct JointAxis {
   Eigen::Vector3d origin_world;
 };
 
-std::vector<JointAxis> joint_axes(const renderer::SceneModel& scene, const renderer::LinkPoses& poses) {
+std::vector<JointAxis> joint_axes(const robot_model::SceneModel& scene, const robot_model::LinkPoses& poses) {
   std::vector<JointAxis> axes(scene.joints.size());
   for (size_t j = 0; j < scene.joints.size(); ++j) {
-    const renderer::Joint& joint = scene.joints[j];
+    const robot_model::Joint& joint = scene.joints[j];
     const Eigen::Isometry3d world_from_joint = poses.world_from_link[joint.parent_link] * joint.parent_from_joint;
     axes[j].axis_world = world_from_joint.linear() * joint.axis;
     axes[j].origin_world = world_from_joint.translation();
@@ -434,7 +434,7 @@ void MotionEstimator::add_depth_term(const RenderedView& view, const std::vector
 std::string MotionEstimator::linearize(const EstimatorFrame& frame, const State& state, double scale, int stride,
                                        PointSet points, bool joints_free, Linearization* lin,
                                        std::vector<Sample>* samples) {
-  const renderer::LinkPoses poses = renderer::forward_kinematics(scene_, joints_at(scene_, frame, state.joint_offsets));
+  const robot_model::LinkPoses poses = robot_model::forward_kinematics(scene_, joints_at(scene_, frame, state.joint_offsets));
   if (!poses.usable) return poses.unusable_reason;
   const Eigen::Isometry3d world_from_optical = frame.world_from_optical * state.correction;
   const renderer::RenderResult rendered = renderer_->render_at(poses, world_from_optical, frame.intrinsics);
@@ -601,7 +601,7 @@ int MotionEstimator::search_joints(const EstimatorFrame& frame, State* state, st
     *error = linearize(frame, *state, options_.final_robust_scale_m, options_.pixel_stride, PointSet::kAll, false,
                        &scratch, &samples);
     if (!error->empty()) return moves;
-    const renderer::LinkPoses base = renderer::forward_kinematics(scene_, joints_at(scene_, frame, state->joint_offsets));
+    const robot_model::LinkPoses base = robot_model::forward_kinematics(scene_, joints_at(scene_, frame, state->joint_offsets));
     const Eigen::Isometry3d optical_from_world = (frame.world_from_optical * state->correction).inverse();
 
     // +1 for a point the camera sees where the model puts it, -1 for one
@@ -662,7 +662,7 @@ int MotionEstimator::search_joints(const EstimatorFrame& frame, State* state, st
       for (double offset : grid) {
         std::vector<double> offsets = state->joint_offsets;
         offsets[k] += offset;
-        const renderer::LinkPoses poses = renderer::forward_kinematics(scene_, joints_at(scene_, frame, offsets));
+        const robot_model::LinkPoses poses = robot_model::forward_kinematics(scene_, joints_at(scene_, frame, offsets));
         if (!poses.usable) continue;
         for (size_t l = 0; l < moved.size(); ++l) {
           moved[l] = poses.world_from_link[l] * base.world_from_link[l].inverse();

@@ -129,7 +129,7 @@ FrameFinding calibration_error(const FrameEvidence& e) {
   // far more than a distant floor, which may stay within tolerance.)
   std::string fixed_link_mismatching;
   for (const LinkView& link : visible) {
-    if (link.mismatch >= config.link_mismatch_fraction && e.robot.has_link(link.name) &&
+    if (link.mismatch >= config.link_mismatch_fraction && e.robot.is_robot_link(link.name) &&
         e.robot.nearest_movable_joint_above(link.name).empty()) {
       fixed_link_mismatching = link.name;
     }
@@ -155,7 +155,7 @@ FrameFinding calibration_error(const FrameEvidence& e) {
 // URDF does not know is UNCLASSIFIED (never judged safe).
 FrameFinding joint_error_missing_links(const FrameEvidence& e) {
   const RiskConfig& config = e.config;
-  const RobotTree& robot = e.robot;
+  const robot_model::KinematicTree& robot = e.robot;
   const std::vector<LinkView>& visible = e.visible_links();
   std::vector<std::string> missing_links;
   int64_t missing_pixels = 0;
@@ -165,7 +165,7 @@ FrameFinding joint_error_missing_links(const FrameEvidence& e) {
     // Only a displaced arm is missing where the model has it: an object
     // can hide a link (nearer) but never make the camera see farther.
     if (link.missing < config.joint_link_missing_fraction) continue;
-    if (!robot.has_link(link.name)) {
+    if (!robot.is_robot_link(link.name)) {
       unknown = link.name;
       continue;
     }
@@ -214,13 +214,13 @@ FrameFinding joint_error_missing_links(const FrameEvidence& e) {
 // here too: either way the arm stops.)
 FrameFinding joint_error_beside_unexplained_surfaces(const FrameEvidence& e) {
   const RiskConfig& config = e.config;
-  const RobotTree& robot = e.robot;
+  const robot_model::KinematicTree& robot = e.robot;
   if (!(e.frame.near_arm_area_m2 >= config.unknown_object_min_area_m2)) return {};
   std::vector<std::string> affected;
   int64_t mismatching = 0;
   int64_t compared = 0;
   for (const LinkView& link : e.visible_links()) {
-    if (!robot.has_link(link.name)) continue;
+    if (!robot.is_robot_link(link.name)) continue;
     if (link.mismatch < config.joint_link_affected_fraction ||
         link.mismatch * link.compared < config.joint_link_affected_min_pixels) {
       continue;
@@ -283,7 +283,7 @@ const std::vector<FrameRule>& frame_rules() {
   return rules;
 }
 
-FrameFinding classify_frame(const discrepancy_t& frame, const RobotTree& robot, const RiskConfig& config,
+FrameFinding classify_frame(const discrepancy_t& frame, const robot_model::KinematicTree& robot, const RiskConfig& config,
                             const ClassifierContext& context) {
   const FrameEvidence evidence(frame, robot, config, context);
   for (const FrameRule& rule : frame_rules()) {

@@ -15,13 +15,13 @@ ClassifierContext classifier_context(const ChannelNames& channels) {
 
 }  // namespace
 
-RiskMonitor::RiskMonitor(const Config& config, RobotTree robot, int64_t start_us)
+RiskMonitor::RiskMonitor(const Config& config, robot_model::KinematicTree robot, int64_t start_us)
     : risk_config_(config.risk),
       classifier_context_(classifier_context(config.channels)),
       robot_(std::move(robot)),
       deadlines_(config.risk, config.channels, start_us),
-      plan_(config.risk, robot_.prismatic_joints()),
-      gate_(config.risk, robot_.prismatic_joints()),
+      plan_(config.risk, robot_.prismatic_joint_names),
+      gate_(config.risk, robot_.prismatic_joint_names),
       decision_(config.risk) {}
 
 void RiskMonitor::on_joint_state(const joint_state_t& state, int64_t now_us) {

@@ -19,7 +19,7 @@ ProcessInfo process_info() {
 
 int run_risk(const Config& config) {
   install_stop_signal_handlers();
-  RiskMonitor monitor(config, RobotTree::from_urdf_file(config.robot.urdf_path), monotonic_us());
+  RiskMonitor monitor(config, robot_model::load_kinematic_tree(config.robot.urdf_path), monotonic_us());
   const std::string camera_id = config.camera.id;
   LcmNode node(config, process_info().name);
   int64_t dangerous = 0;

@@ -63,7 +63,7 @@ class SchedulerTest : public ::testing::Test {
   }
 
   Config config_;
-  renderer::SceneModel scene_;
+  robot_model::SceneModel scene_;
   EstimatorScheduler scheduler_;
 };
 

@@ -10,7 +10,7 @@
 #include "tofguard/discrepancy/discrepancy_image.hpp"
 #include "tofguard/risk/estimate_finding.hpp"
 #include "tofguard/risk/risk_monitor.hpp"
-#include "tofguard/risk/robot_tree.hpp"
+#include "tofguard/robot_model/kinematic_tree.hpp"
 #include "synthetic_estimates.hpp"
 #include "test_support.hpp"
 #include "tofguard/common/config.hpp"
@@ -24,7 +24,6 @@ using risk::classify_estimate;
 using risk::EstimateContext;
 using risk::FrameFinding;
 using risk::RiskMonitor;
-using risk::RobotTree;
 
 constexpr int64_t kStart = 5'000'000'000;  // monotonic
 constexpr int64_t kMs = 1000;
@@ -40,8 +39,8 @@ const Config& sim_config() {
   return config;
 }
 
-const RobotTree& friend_arm() {
-  static const RobotTree tree = RobotTree::from_urdf_file(sim_config().robot.urdf_path);
+const robot_model::KinematicTree& friend_arm() {
+  static const robot_model::KinematicTree tree = robot_model::load_kinematic_tree(sim_config().robot.urdf_path);
   return tree;
 }
 

@@ -1,13 +1,13 @@
-// The risk classifier's logic: the robot tree from the URDF, the frame
-// rules (on summaries computed from synthetic images), debouncing and
-// deadlines on an explicit monotonic clock.
+// The risk classifier's logic: the frame rules (on summaries computed from
+// synthetic images; the robot's tree is robot_model's, tested there),
+// debouncing and deadlines on an explicit monotonic clock.
 #include <gtest/gtest.h>
 
 #include "synthetic_frames.hpp"
 #include "tofguard/discrepancy/discrepancy_image.hpp"
 #include "tofguard/risk/frame_classifier.hpp"
 #include "tofguard/risk/risk_monitor.hpp"
-#include "tofguard/risk/robot_tree.hpp"
+#include "tofguard/robot_model/kinematic_tree.hpp"
 #include "test_support.hpp"
 #include "tofguard/common/config.hpp"
 
@@ -18,7 +18,6 @@ using risk::ClassifierContext;
 using risk::classify_frame;
 using risk::FrameFinding;
 using risk::RiskMonitor;
-using risk::RobotTree;
 
 const Config& sim_config() {
   static const Config config = load_config(source_dir() + "/config/sim.yaml", nullptr);
@@ -36,8 +35,8 @@ const Config& config_depth_100ms() {
   return config;
 }
 
-const RobotTree& friend_arm() {
-  static const RobotTree tree = RobotTree::from_urdf_file(sim_config().robot.urdf_path);
+const robot_model::KinematicTree& friend_arm() {
+  static const robot_model::KinematicTree tree = robot_model::load_kinematic_tree(sim_config().robot.urdf_path);
   return tree;
 }
 
@@ -56,21 +55,6 @@ FrameFinding classify(const discrepancy_t& d, bool arm_moving = false) {
   ClassifierContext context;
   context.arm_moving = arm_moving;
   return classify_frame(d, friend_arm(), sim_config().risk, context);
-}
-
-TEST(RobotTree, FriendArmJointsAndDistalLinks) {
-  const RobotTree& tree = friend_arm();
-  EXPECT_EQ(tree.movable_joints(), (std::vector<std::string>{"a1", "a2", "a3", "a4", "a5", "a6", "a7"}));
-  EXPECT_EQ(tree.nearest_movable_joint_above("link4"), "a4");
-  // The gripper hangs on a fixed joint below link7.
-  EXPECT_EQ(tree.nearest_movable_joint_above("gripper"), "a7");
-  EXPECT_EQ(tree.nearest_movable_joint_above("base_link"), "");
-  EXPECT_EQ(tree.lowest_common_ancestor({"gripper", "link5", "link6"}), "link5");
-  EXPECT_EQ(tree.lowest_common_ancestor({"link7"}), "link7");
-  EXPECT_TRUE(tree.is_descendant_or_self("gripper", "link2"));
-  EXPECT_FALSE(tree.is_descendant_or_self("link1", "link2"));
-  EXPECT_EQ(tree.child_link("a3"), "link3");
-  EXPECT_THROW(RobotTree::from_urdf_string("<robot name='x'><link name='a'/><oops/>"), std::runtime_error);
 }
 
 // The frame rules are one ordered table (docs/safety-chain.md, "Frame

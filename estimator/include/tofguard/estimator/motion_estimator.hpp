@@ -35,8 +35,8 @@
 #include <Eigen/Geometry>
 
 #include "tofguard/renderer/depth_renderer.hpp"
-#include "tofguard/renderer/kinematics.hpp"
-#include "tofguard/renderer/scene_model.hpp"
+#include "tofguard/robot_model/kinematics.hpp"
+#include "tofguard/robot_model/scene_model.hpp"
 #include "tofguard/common/config.hpp"
 
 namespace tofguard::estimator {
@@ -141,7 +141,7 @@ struct EstimatorFrame {
   std::vector<float> depth_m;
   Intrinsics intrinsics;
   // The reported joint positions (every actuated joint of the model).
-  renderer::JointPositions reported_joints;
+  robot_model::JointPositions reported_joints;
   // The reported camera pose: p_world = world_from_optical * p_optical.
   Eigen::Isometry3d world_from_optical = Eigen::Isometry3d::Identity();
 };
@@ -205,7 +205,7 @@ class MotionEstimator {
  public:
   // `renderer` must render `scene` (the same model) and outlive this.
   // Throws std::invalid_argument for options out of range.
-  MotionEstimator(const renderer::SceneModel& scene, renderer::DepthRenderer* renderer,
+  MotionEstimator(const robot_model::SceneModel& scene, renderer::DepthRenderer* renderer,
                   const EstimatorOptions& options);
 
   // Estimates what `frame` shows, with the options' free parameters (at
@@ -232,7 +232,7 @@ class MotionEstimator {
   EstimateResult estimate_camera(const std::vector<EstimatorFrame>& frames);
 
   const EstimatorOptions& options() const { return options_; }
-  const renderer::SceneModel& scene() const { return scene_; }
+  const robot_model::SceneModel& scene() const { return scene_; }
 
  private:
   struct ChainJoint {
@@ -282,7 +282,7 @@ class MotionEstimator {
   EstimateResult finish(const EstimatorFrame& frame, const State& state, const Linearization& lin,
                         bool camera_free, bool joints_free) const;
 
-  const renderer::SceneModel& scene_;
+  const robot_model::SceneModel& scene_;
   renderer::DepthRenderer* renderer_;
   EstimatorOptions options_;
   int num_params_ = 0;  // actuated joints

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "tofguard/risk/robot_tree.hpp"
+#include "tofguard/robot_model/kinematic_tree.hpp"
 #include "tofguard/common/config.hpp"
 #include "tofguard/common/risk_names.hpp"
 #include "tofguard/discrepancy_t.hpp"
@@ -50,12 +50,12 @@ struct LinkView {
 // and the context, with the per-link views every mismatch rule shares.
 class FrameEvidence {
  public:
-  FrameEvidence(const discrepancy_t& frame, const RobotTree& robot, const RiskConfig& config,
+  FrameEvidence(const discrepancy_t& frame, const robot_model::KinematicTree& robot, const RiskConfig& config,
                 const ClassifierContext& context)
       : frame(frame), robot(robot), config(config), context(context) {}
 
   const discrepancy_t& frame;
-  const RobotTree& robot;
+  const robot_model::KinematicTree& robot;
   const RiskConfig& config;
   const ClassifierContext& context;
 
@@ -88,7 +88,7 @@ struct FrameRule {
 const std::vector<FrameRule>& frame_rules();
 
 // The first finding of frame_rules(), or none.
-FrameFinding classify_frame(const discrepancy_t& frame, const RobotTree& robot, const RiskConfig& config,
+FrameFinding classify_frame(const discrepancy_t& frame, const robot_model::KinematicTree& robot, const RiskConfig& config,
                             const ClassifierContext& context);
 
 // `value` with `decimals` digits after the point, for detail lines.

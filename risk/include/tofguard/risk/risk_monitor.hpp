@@ -35,15 +35,15 @@
 #include "tofguard/risk/input_deadlines.hpp"
 #include "tofguard/risk/joint_states_by_utime.hpp"
 #include "tofguard/risk/plan_monitor.hpp"
-#include "tofguard/risk/robot_tree.hpp"
 #include "tofguard/risk_t.hpp"
+#include "tofguard/robot_model/kinematic_tree.hpp"
 
 namespace tofguard::risk {
 
 class RiskMonitor {
  public:
   // The deadlines run from `start_us` (monotonic).
-  RiskMonitor(const Config& config, RobotTree robot, int64_t start_us);
+  RiskMonitor(const Config& config, robot_model::KinematicTree robot, int64_t start_us);
 
   // Arrivals of valid messages.
   void on_depth(int64_t now_us) { deadlines_.on_depth(now_us); }
@@ -85,7 +85,7 @@ class RiskMonitor {
 
   const RiskConfig risk_config_;
   ClassifierContext classifier_context_;  // channel names; arm_moving set per frame
-  RobotTree robot_;
+  robot_model::KinematicTree robot_;
   InputDeadlines deadlines_;
   JointStatesByUtime joint_states_;
   PlanMonitor plan_;
