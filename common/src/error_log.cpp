@@ -6,6 +6,14 @@
 
 namespace tofguard {
 
+std::string one_line(std::string text) {
+  for (char& c : text) {
+    if (c == '\n' || c == '\r') c = ' ';
+  }
+  while (!text.empty() && text.back() == ' ') text.pop_back();
+  return text;
+}
+
 void ErrorLog::report(const std::string& key, const std::string& line) {
   last_ = line;
   KeyState& state = keys_[key];

@@ -10,6 +10,8 @@
 #include <console_bridge/console.h>
 #include <urdf_parser/urdf_parser.h>
 
+#include "tofguard/common/error_log.hpp"
+
 namespace tofguard::robot_model {
 namespace {
 
@@ -24,14 +26,6 @@ class CapturingOutputHandler : public console_bridge::OutputHandler {
   }
   std::string errors;
 };
-
-std::string one_line(std::string text) {
-  for (char& c : text) {
-    if (c == '\n' || c == '\r') c = ' ';
-  }
-  while (!text.empty() && text.back() == ' ') text.pop_back();
-  return text;
-}
 
 urdf::ModelInterfaceSharedPtr parse_urdf_file(const std::string& path) {
   std::ifstream in(path);

@@ -11,20 +11,13 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include "tofguard/common/error_log.hpp"
 #include "tofguard/robot_model/primitive_meshes.hpp"
 
 namespace tofguard::robot_model {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string one_line(std::string text) {
-  for (char& c : text) {
-    if (c == '\n' || c == '\r') c = ' ';
-  }
-  while (!text.empty() && text.back() == ' ') text.pop_back();
-  return text;
-}
 
 bool positive_finite(double v) { return std::isfinite(v) && v > 0; }
 

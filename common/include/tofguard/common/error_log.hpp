@@ -9,6 +9,11 @@
 
 namespace tofguard {
 
+// `text` with its line breaks turned into spaces and trailing spaces removed:
+// a library's multi-line error text (urdfdom, assimp) fit for the one-line
+// report every error gets.
+std::string one_line(std::string text);
+
 class ErrorLog {
  public:
   explicit ErrorLog(std::string process_name) : process_name_(std::move(process_name)) {}
