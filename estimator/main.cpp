@@ -1,127 +1,13 @@
 // tofguard-estimator: TOF_DEPTH, JOINT_STATE, CAMERA_POSE, SAFETY_DISCREPANCY
-// -> MOTION_ESTIMATE (src/estimator_process.hpp, docs/estimator.md).
-#include <cmath>
-#include <cstdlib>
-#include <iostream>
-
-#include <unistd.h>
-#include <cerrno>
-#include <cstring>
+// -> MOTION_ESTIMATE (estimator_process.hpp, docs/estimator.md).
+#include "tofguard/deployment/process_runner.hpp"
+#include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/estimator/estimator_process.hpp"
-#include "tofguard/common/clock.hpp"
-#include "tofguard/common/config_error.hpp"
-#include "tofguard/common/lcm_node.hpp"
-#include "tofguard/common/wire_checks.hpp"
-
-namespace tofguard::estimator {
-namespace {
-
-int run(const Config& config, const std::vector<std::string>& rest) {
-  const std::string name = process_info().name;
-  if (!rest.empty()) {
-    std::cerr << name << ": unknown argument '" << rest[0] << "'\n";
-    return kConfigErrorExitCode;
-  }
-  renderer::SceneModel scene;
-  try {
-    scene = load_estimator_scene(config);
-  } catch (const std::exception& e) {
-    std::cerr << name << ": " << e.what() << "\n";
-    return kConfigErrorExitCode;
-  }
-  EstimatorWorker worker(scene, config);
-  const std::string worker_error = worker.wait_ready();
-  if (!worker_error.empty()) {
-    std::cerr << name << ": cannot start the estimator: " << worker_error << "\n";
-    return 1;
-  }
-  EstimatorScheduler scheduler(config, scene);
-  LcmNode node(config, name);
-  node.heartbeat().set_status("waiting for frames");
-  int64_t published = 0;
-  int64_t unusable = 0;
-
-  auto dispatch = [&] {
-    for (ScheduledWork& work : scheduler.take_ready()) {
-      if (work.unusable) {
-        node.safety().publish(config.channels.motion_estimate, &*work.unusable);
-        node.counters().frames_out++;
-        ++unusable;
-        node.errors().report("unusable", "frame " + std::to_string(work.unusable->seq) +
-                                              " not estimated: " + work.unusable->unusable_reason);
-      } else if (work.job && worker.post(std::move(*work.job))) {
-        // Behind: the waiting job was replaced by this newer one.
-        node.counters().frames_dropped++;
-      }
-    }
-  };
-
-  node.subscribe<joint_state_t>(
-      node.safety(), config.channels.joint_state,
-      [&](const joint_state_t& state) {
-        if (!scheduler.on_joint_state(state)) {
-          node.counters().validation_errors++;
-          node.errors().report(config.channels.joint_state,
-                               config.channels.joint_state + ": ignored a message for robot_id '" + state.robot_id +
-                                   "' (expected '" + config.robot.id + "') or not newer than the last");
-        }
-      },
-      check_joint_state);
-  node.subscribe<camera_pose_t>(
-      node.safety(), config.channels.camera_pose, [&](const camera_pose_t& pose) { scheduler.on_camera_pose(pose); },
-      check_camera_pose);
-  node.subscribe<depth_image_t>(
-      node.images(), config.channels.depth,
-      [&](const depth_image_t& frame) {
-        if (scheduler.on_depth(frame)) {
-          node.heartbeat().set_last_frame_utime(frame.utime);
-          dispatch();
-        }
-      },
-      check_depth_image);
-  node.subscribe<discrepancy_t>(
-      node.safety(), config.channels.discrepancy,
-      [&](const discrepancy_t& d) {
-        scheduler.on_discrepancy(d);
-        dispatch();
-      },
-      check_discrepancy);
-  node.add_timer(static_cast<int64_t>(std::llround(config.estimator.periodic_period_ms * 1000)), [&] {
-    scheduler.request_newest();
-    dispatch();
-  });
-  node.add_timer(5000, [&] {
-    for (const motion_estimate_t& m : worker.take_results()) {
-      node.safety().publish(config.channels.motion_estimate, &m);
-      node.counters().frames_out++;
-      ++published;
-      if (!m.usable) ++unusable;
-    }
-    node.heartbeat().set_status("estimates " + std::to_string(published) + ", unusable " +
-                                std::to_string(unusable) + ", missed " + std::to_string(scheduler.missed()) +
-                                (worker.busy() ? ", estimating" : ", idle"));
-  });
-  node.run();
-  return 0;
-}
-
-}  // namespace
-}  // namespace tofguard::estimator
 
 int main(int argc, char** argv) {
-  // The estimator renders 176x144-sized images a dozen times per frame on
-  // its worker thread: llvmpipe's own render threads cost more in hand-over
-  // than they save at that size (docs/benchmarks.md, motion estimator: 36 ms
-  // per frame without them, 44 ms with). Set before the EGL display is
-  // opened; a value in the environment wins.
-  setenv("LP_NUM_THREADS", "0", /*overwrite=*/0);
-  // The estimate is a diagnosis, not part of the stop path: on a small CPU
-  // it must never take time from the renderer, discrepancy and risk, whose
-  // deadlines stop the arm. Niceness +10 for the process and every thread
-  // it starts (set before any thread exists).
-  errno = 0;
-  if (nice(10) == -1 && errno != 0) {
-    std::cerr << "tofguard-estimator: cannot lower its priority (nice 10): " << std::strerror(errno) << "\n";
-  }
-  return tofguard::run_process(argc, argv, tofguard::estimator::process_info(), tofguard::estimator::run);
+  using namespace tofguard;
+  return deployment::run_process(argc, argv, estimator::process_info(),
+                                 [](const deployment::Config& config, const std::vector<std::string>&) {
+                                   return estimator::run_estimator(deployment::estimator_process_settings(config));
+                                 });
 }

@@ -7,7 +7,7 @@
 
 namespace tofguard::camera {
 
-depth_image_t make_depth_image(const CameraConfig& camera, int64_t utime, int64_t seq,
+depth_image_t make_depth_image(const CameraSettings& camera, int64_t utime, int64_t seq,
                                bool calibrated, const std::vector<float>& depth_m,
                                const std::vector<float>& amplitude) {
   const Intrinsics& in = camera.intrinsics;

@@ -94,7 +94,7 @@ cv::Mat1b opened(const cv::Mat1b& mask, int radius_px) {
 
 }  // namespace
 
-Parameters parameters_from(const DiscrepancyConfig& config) {
+Parameters parameters_from(const DiscrepancySettings& config) {
   Parameters p;
   p.tolerance.sigma_at_0m_mm = config.noise_sigma_at_0m_mm;
   p.tolerance.sigma_per_m2_mm = config.noise_sigma_per_m2_mm;

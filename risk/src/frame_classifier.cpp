@@ -21,7 +21,7 @@ FrameFinding finding(int8_t cause, std::string suspect, double score, double thr
   return FrameFinding{cause, std::move(suspect), score, threshold, std::move(detail)};
 }
 
-FrameFinding sensor_finding(const discrepancy_t& f, const RiskConfig& config, const ClassifierContext& context) {
+FrameFinding sensor_finding(const discrepancy_t& f, const RiskSettings& config, const ClassifierContext& context) {
   if (!f.usable) {
     if (f.unusable_kind == discrepancy_t::UNUSABLE_NO_RENDERING) {
       return finding(risk_t::CAUSE_COMPONENT_FAULT, "tofguard-renderer", 1, 0,
@@ -67,7 +67,7 @@ bool is_fault_cause(int8_t cause) {
   return cause == risk_t::CAUSE_SENSOR_FAULT || cause == risk_t::CAUSE_COMPONENT_FAULT;
 }
 
-FrameFinding classify_frame(const discrepancy_t& f, const RobotTree& robot, const RiskConfig& config,
+FrameFinding classify_frame(const discrepancy_t& f, const RobotTree& robot, const RiskSettings& config,
                             const ClassifierContext& context) {
   if (FrameFinding sensor = sensor_finding(f, config, context); sensor.cause != risk_t::CAUSE_NONE) {
     return sensor;

@@ -8,8 +8,6 @@
 namespace tofguard::risk {
 namespace {
 
-int64_t ms_to_us(double ms) { return static_cast<int64_t>(std::llround(ms * 1000.0)); }
-
 constexpr double kRadToDeg = 180.0 / M_PI;
 // Estimates kept for frames still to come or waiting, and judged frames
 // remembered for counting late estimates.
@@ -18,19 +16,21 @@ constexpr size_t kKeptJudgedSeqs = 64;
 
 }  // namespace
 
-RiskMonitor::RiskMonitor(const Config& config, RobotTree robot, int64_t start_us)
-    : config_(config),
+RiskMonitor::RiskMonitor(const RiskSettings& settings, const ChannelNames& channels, RobotTree robot,
+                         int64_t start_us)
+    : settings_(settings),
+      channels_(channels),
       robot_(std::move(robot)),
-      depth_{config.channels.depth, risk_t::CAUSE_SENSOR_FAULT, ms_to_us(config.risk.depth_deadline_ms), start_us},
-      discrepancy_{config.channels.discrepancy, risk_t::CAUSE_COMPONENT_FAULT,
-                   ms_to_us(config.risk.discrepancy_deadline_ms), start_us},
-      joint_state_{config.channels.joint_state, risk_t::CAUSE_SENSOR_FAULT,
-                   ms_to_us(config.risk.joint_state_deadline_ms), start_us},
-      camera_pose_{config.channels.camera_pose, risk_t::CAUSE_SENSOR_FAULT,
-                   ms_to_us(config.risk.camera_pose_deadline_ms), start_us} {
-  for (const std::string& process : config.risk.required_heartbeats) {
+      depth_{channels.depth, risk_t::CAUSE_SENSOR_FAULT, settings.depth_deadline_us, start_us},
+      discrepancy_{channels.discrepancy, risk_t::CAUSE_COMPONENT_FAULT,
+                   settings.discrepancy_deadline_us, start_us},
+      joint_state_{channels.joint_state, risk_t::CAUSE_SENSOR_FAULT,
+                   settings.joint_state_deadline_us, start_us},
+      camera_pose_{channels.camera_pose, risk_t::CAUSE_SENSOR_FAULT,
+                   settings.camera_pose_deadline_us, start_us} {
+  for (const std::string& process : settings.required_heartbeats) {
     heartbeats_[process] =
-        Deadline{process, risk_t::CAUSE_COMPONENT_FAULT, ms_to_us(config.risk.heartbeat_deadline_ms), start_us};
+        Deadline{process, risk_t::CAUSE_COMPONENT_FAULT, settings.heartbeat_deadline_us, start_us};
   }
 }
 
@@ -62,13 +62,13 @@ const joint_state_t* RiskMonitor::joint_state_at(int64_t utime) const {
 }
 
 std::optional<FrameFinding> RiskMonitor::plan_deviation_at(int64_t utime) const {
-  if (!config_.risk.plan_enabled) return std::nullopt;
+  if (!settings_.plan_enabled) return std::nullopt;
   const joint_state_t* found = joint_state_at(utime);
   if (found == nullptr) return std::nullopt;
   const joint_state_t& state = *found;
   const auto planned = plan_.at(state.utime);
   if (!planned) return std::nullopt;  // outside the plan's time span: nothing to compare
-  const RiskConfig& r = config_.risk;
+  const RiskSettings& r = settings_;
   std::optional<FrameFinding> deviation_finding;
   double worst_ratio = 0;
   for (int i = 0; i < state.num_joints; ++i) {
@@ -98,7 +98,7 @@ bool RiskMonitor::arm_moving_at(int64_t utime) const {
   if (state == nullptr) return false;
   double fastest = 0;
   for (double v : state->velocity) fastest = std::max(fastest, std::abs(v));
-  return fastest >= config_.risk.moving_joint_speed_rad_s;
+  return fastest >= settings_.moving_joint_speed_rad_s;
 }
 
 void RiskMonitor::on_camera_pose(int64_t now_us) { touch(&camera_pose_, now_us); }
@@ -120,7 +120,7 @@ std::string RiskMonitor::check_joint_names(const std::vector<std::string>& names
 
 std::optional<FrameFinding> RiskMonitor::expired(int64_t now_us) const {
   std::vector<const Deadline*> order = {&depth_, &joint_state_};
-  if (config_.risk.camera_pose_required) order.push_back(&camera_pose_);
+  if (settings_.camera_pose_required) order.push_back(&camera_pose_);
   for (const auto& [name, d] : heartbeats_) order.push_back(&d);
   // Last: a silent discrepancy stream while the camera is fresh means the
   // comparison itself has stopped.
@@ -168,14 +168,14 @@ std::optional<risk_t> RiskMonitor::check_deadlines(int64_t now_us) const {
 
 FrameFinding RiskMonitor::discrepancy_finding(const discrepancy_t& frame) const {
   ClassifierContext context;
-  context.depth_channel = config_.channels.depth;
-  context.labels_channel = config_.channels.labels;
+  context.depth_channel = channels_.depth;
+  context.labels_channel = channels_.labels;
   context.arm_moving = arm_moving_at(frame.utime);
-  return classify_frame(frame, robot_, config_.risk, context);
+  return classify_frame(frame, robot_, settings_, context);
 }
 
 bool RiskMonitor::wants_estimate(const discrepancy_t& frame) const {
-  return config_.risk.estimate_enabled && is_model_mismatch(discrepancy_finding(frame).cause);
+  return settings_.estimate_enabled && is_model_mismatch(discrepancy_finding(frame).cause);
 }
 
 const motion_estimate_t* RiskMonitor::estimate_for(const discrepancy_t& frame, bool or_older) const {
@@ -185,7 +185,7 @@ const motion_estimate_t* RiskMonitor::estimate_for(const discrepancy_t& frame, b
   if (!or_older) return nullptr;
   // Else the newest of an earlier frame within max_age (camera utimes).
   const motion_estimate_t* newest = nullptr;
-  const int64_t max_age_us = ms_to_us(config_.risk.estimate_max_age_ms);
+  const int64_t max_age_us = settings_.estimate_max_age_us;
   for (const motion_estimate_t& e : estimates_) {
     if (e.camera_id != frame.camera_id || e.utime > frame.utime || frame.utime - e.utime > max_age_us) continue;
     if (!newest || e.utime > newest->utime) newest = &e;
@@ -203,7 +203,7 @@ std::vector<risk_t> RiskMonitor::on_frame(const discrepancy_t& frame, int64_t no
   WaitingFrame w;
   w.frame = frame;
   w.wants_estimate = wants_estimate(frame);
-  w.wait_until_us = now_us + ms_to_us(config_.risk.estimate_wait_ms);
+  w.wait_until_us = now_us + settings_.estimate_wait_us;
   waiting_.push_back(std::move(w));
   return release(now_us);
 }
@@ -243,12 +243,12 @@ risk_t RiskMonitor::judge(const discrepancy_t& frame, int64_t now_us, bool waite
   // The estimate refines a model mismatch (fail safe: it replaces one
   // finding by another, never by "safe"; without one the discrepancy rules
   // stand).
-  if (config_.risk.estimate_enabled && is_model_mismatch(finding.cause)) {
+  if (settings_.estimate_enabled && is_model_mismatch(finding.cause)) {
     if (const motion_estimate_t* estimate = estimate_for(frame, /*or_older=*/true)) {
       EstimateContext context;
       context.prismatic_joints = robot_.prismatic_joints();
-      context.near_arm_evidence = frame.near_arm_area_m2 >= config_.risk.unknown_object_min_area_m2;
-      FrameFinding refined = classify_estimate(*estimate, config_.risk, context);
+      context.near_arm_evidence = frame.near_arm_area_m2 >= settings_.unknown_object_min_area_m2;
+      FrameFinding refined = classify_estimate(*estimate, settings_, context);
       // An earlier frame's estimate is evidence only of what it names (a
       // joint or the camera): that it explained nothing says nothing about
       // this frame, which may show a fault that began after it.
@@ -271,7 +271,7 @@ risk_t RiskMonitor::judge(const discrepancy_t& frame, int64_t now_us, bool waite
                           ")";
       }
     } else if (waited) {
-      finding.detail += " (no motion estimate within " + fixed(config_.risk.estimate_wait_ms, 0) + " ms)";
+      finding.detail += " (no motion estimate within " + fixed(settings_.estimate_wait_us / 1000.0, 0) + " ms)";
     }
   }
   // The arm left its plan: only when nothing else is wrong with the frame.
@@ -291,7 +291,7 @@ risk_t RiskMonitor::judge(const discrepancy_t& frame, int64_t now_us, bool waite
                    "model and camera agree (mismatch fraction): " + std::to_string(frame.num_compared - frame.num_match) +
                        " of " + std::to_string(frame.num_compared) + " compared pixels differ");
   }
-  const int needed = is_fault_cause(finding.cause) ? config_.risk.sensor_debounce_frames : config_.risk.debounce_frames;
+  const int needed = is_fault_cause(finding.cause) ? settings_.sensor_debounce_frames : settings_.debounce_frames;
   return verdict(frame.utime, frame.seq, consecutive_ >= needed ? risk_t::DANGEROUS : risk_t::WARNING, finding,
                  finding.detail + " [" + std::to_string(std::min(consecutive_, needed)) + "/" +
                      std::to_string(needed) + " frames]");

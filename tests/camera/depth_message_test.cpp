@@ -6,7 +6,7 @@ namespace tofguard::camera {
 namespace {
 
 TEST(DepthMessage, RoundsToMillimetresAndNeverInventsDistances) {
-  CameraConfig c;
+  CameraSettings c;
   c.id = "cam";
   c.intrinsics.width = 2;
   c.intrinsics.height = 2;

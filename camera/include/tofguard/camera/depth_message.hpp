@@ -3,7 +3,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "tofguard/common/config.hpp"
+#include "tofguard/common/camera_settings.hpp"
 #include "tofguard/depth_image_t.hpp"
 
 namespace tofguard::camera {
@@ -13,7 +13,7 @@ namespace tofguard::camera {
 // rather than clipped: a clipped value would be a made-up distance.
 // `amplitude` is empty (no amplitude) or one value per pixel, clamped to
 // [0, 32767].
-depth_image_t make_depth_image(const CameraConfig& camera, int64_t utime, int64_t seq,
+depth_image_t make_depth_image(const CameraSettings& camera, int64_t utime, int64_t seq,
                                bool calibrated, const std::vector<float>& depth_m,
                                const std::vector<float>& amplitude);
 

@@ -1,12 +1,12 @@
 #pragma once
-// CameraPose (config.hpp) to and from the wire's camera_pose_t: the same
+// CameraPose (camera_settings.hpp) to and from the wire's camera_pose_t: the same
 // convention (the optical frame's pose in frame_id, p_frame = R * p_optical
 // + t, quaternion w, x, y, z).
 #include <cstdint>
 #include <string>
 
 #include "tofguard/camera_pose_t.hpp"
-#include "tofguard/common/config.hpp"
+#include "tofguard/common/camera_settings.hpp"
 
 namespace tofguard {
 

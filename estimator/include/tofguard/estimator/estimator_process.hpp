@@ -40,7 +40,7 @@
 #include "tofguard/estimator/motion_estimator.hpp"
 #include "tofguard/renderer/scene_model.hpp"
 #include "tofguard/camera_pose_t.hpp"
-#include "tofguard/common/config.hpp"
+#include "tofguard/estimator/estimator_settings.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/joint_state_t.hpp"
@@ -51,13 +51,19 @@ namespace tofguard::estimator {
 
 ProcessInfo process_info();
 
+// The process: TOF_DEPTH, JOINT_STATE, CAMERA_POSE, SAFETY_DISCREPANCY in,
+// MOTION_ESTIMATE out, until SIGINT/SIGTERM. Runs at niceness +10 (a
+// diagnosis must not take time from the stop path). A scene that cannot be
+// loaded is a configuration error (exit code 2).
+int run_estimator(const EstimatorProcessSettings& settings);
+
 // The estimator's options from the config (noise model from
 // `discrepancy`, iterations and stride from `estimator`).
-EstimatorOptions options_from_config(const Config& config);
+EstimatorOptions options_from_settings(const EstimatorProcessSettings& settings);
 
 // The scene the estimator compares with the camera: the robot and the
 // environment as the camera sees them (visual geometry, no padding).
-renderer::SceneModel load_estimator_scene(const Config& config);
+renderer::SceneModel load_estimator_scene(const EstimatorProcessSettings& settings);
 
 // The name of a joint that moves `link` (the nearest one up the chain), ""
 // for a static link.
@@ -85,7 +91,7 @@ struct ScheduledWork {
 
 class EstimatorScheduler {
  public:
-  EstimatorScheduler(const Config& config, const renderer::SceneModel& scene);
+  EstimatorScheduler(const EstimatorProcessSettings& settings, const renderer::SceneModel& scene);
 
   // False (ignored) for another robot's state or one not newer than the
   // last.
@@ -113,7 +119,7 @@ class EstimatorScheduler {
   std::optional<EstimatorFrame> estimator_frame(const depth_image_t& frame, const std::string& frame_id,
                                                 std::string* why) const;
 
-  Config config_;
+  EstimatorProcessSettings settings_;
   const renderer::SceneModel& scene_;
   risk::RobotTree robot_;
   renderer::JointHistory history_;
@@ -131,7 +137,7 @@ class EstimatorScheduler {
 // job waits at most: a newer one replaces it and counts as dropped.
 class EstimatorWorker {
  public:
-  EstimatorWorker(const renderer::SceneModel& scene, const Config& config);
+  EstimatorWorker(const renderer::SceneModel& scene, const EstimatorProcessSettings& settings);
   ~EstimatorWorker();
   EstimatorWorker(const EstimatorWorker&) = delete;
   EstimatorWorker& operator=(const EstimatorWorker&) = delete;
@@ -147,7 +153,7 @@ class EstimatorWorker {
   void run();
 
   const renderer::SceneModel& scene_;
-  Config config_;
+  EstimatorProcessSettings settings_;
   std::mutex mutex_;
   std::condition_variable wake_;
   bool started_ = false;

@@ -28,7 +28,7 @@
 #include "tofguard/renderer/egl_context.hpp"
 #include "tofguard/renderer/kinematics.hpp"
 #include "tofguard/renderer/scene_model.hpp"
-#include "tofguard/common/config.hpp"
+#include "tofguard/common/camera_settings.hpp"
 
 namespace tofguard::renderer {
 

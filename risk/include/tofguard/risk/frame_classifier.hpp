@@ -8,7 +8,7 @@
 #include <string>
 
 #include "tofguard/risk/robot_tree.hpp"
-#include "tofguard/common/config.hpp"
+#include "tofguard/risk/risk_settings.hpp"
 #include "tofguard/discrepancy_t.hpp"
 
 namespace tofguard::risk {
@@ -34,7 +34,7 @@ struct ClassifierContext {
   bool arm_moving = false;
 };
 
-FrameFinding classify_frame(const discrepancy_t& frame, const RobotTree& robot, const RiskConfig& config,
+FrameFinding classify_frame(const discrepancy_t& frame, const RobotTree& robot, const RiskSettings& config,
                             const ClassifierContext& context);
 
 // `value` with `decimals` digits after the point, for detail lines.

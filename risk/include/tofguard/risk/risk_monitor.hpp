@@ -30,7 +30,8 @@
 
 #include "tofguard/risk/frame_classifier.hpp"
 #include "tofguard/risk/robot_tree.hpp"
-#include "tofguard/common/config.hpp"
+#include "tofguard/common/lcm_settings.hpp"
+#include "tofguard/risk/risk_settings.hpp"
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/heartbeat_t.hpp"
 #include "tofguard/joint_state_t.hpp"
@@ -43,7 +44,8 @@ namespace tofguard::risk {
 
 class RiskMonitor {
  public:
-  RiskMonitor(const Config& config, RobotTree robot, int64_t start_us);
+  // `channels` name the inputs in the verdicts' details.
+  RiskMonitor(const RiskSettings& settings, const ChannelNames& channels, RobotTree robot, int64_t start_us);
 
   // Arrivals of valid messages.
   void on_depth(int64_t now_us);
@@ -118,7 +120,8 @@ class RiskMonitor {
   std::optional<FrameFinding> plan_deviation_at(int64_t utime) const;
   static void touch(Deadline* d, int64_t now_us);
 
-  const Config config_;
+  const RiskSettings settings_;
+  const ChannelNames channels_;
   RobotTree robot_;
   Deadline depth_;
   Deadline discrepancy_;
