@@ -1,5 +1,5 @@
-// tofguard-estimator: TOF_DEPTH, JOINT_STATE, CAMERA_POSE, SAFETY_DISCREPANCY
-// -> MOTION_ESTIMATE (estimator_process.hpp, docs/estimator.md).
+// tofguard-estimator: TOF_DEPTH, JOINT_STATE, CAMERA_POSE, SAFETY_DISCREPANCY,
+// SAFETY_RISK -> MOTION_ESTIMATE (estimator_process.hpp, docs/estimator.md).
 #include "tofguard/deployment/process_runner.hpp"
 #include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/estimator/estimator_process.hpp"

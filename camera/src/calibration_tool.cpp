@@ -16,6 +16,7 @@
 
 #include "tofguard/camera/depth_calibration.hpp"
 #include "tofguard/depth_image_t.hpp"
+#include "tofguard/common/camera_geometry.hpp"
 #include "tofguard/common/wire_checks.hpp"
 
 namespace fs = std::filesystem;
@@ -207,8 +208,10 @@ PixelRays parse_pixel_rays(const std::string& text) {
   char c1 = 0, c2 = 0, c3 = 0;
   std::istringstream in(text);
   in >> rays.fx >> c1 >> rays.fy >> c2 >> rays.cx >> c3 >> rays.cy;
-  if (in.fail() || !in.eof() || c1 != ',' || c2 != ',' || c3 != ',' || !(rays.fx > 0) ||
-      !(rays.fy > 0) || !std::isfinite(rays.cx) || !std::isfinite(rays.cy)) {
+  // The image size is not known before the PNGs are read: Intrinsics' rule
+  // on the rays alone (one pixel stands in for the size).
+  if (in.fail() || !in.eof() || c1 != ',' || c2 != ',' || c3 != ',' ||
+      Intrinsics::check(1, 1, rays.fx, rays.fy, rays.cx, rays.cy)) {
     throw CalibrationInputError(
         "--intrinsics: expected FX,FY,CX,CY in pixels (fx, fy > 0), got \"" + text + "\"");
   }

@@ -4,7 +4,7 @@
 
 #include "tofguard/camera/camera_sources.hpp"
 #include "tofguard/camera/depth_calibration.hpp"
-#include "tofguard/camera/depth_message.hpp"
+#include "tofguard/common/depth_frame.hpp"
 #include "tofguard/common/clock.hpp"
 #include "tofguard/common/lcm_node.hpp"
 #include "tofguard/camera/uvc_camera.hpp"
@@ -76,8 +76,8 @@ int run_uvc_camera(const UvcCameraProcessSettings& settings) {
       node.counters().frames_in++;
       last_frame_us = now_us;
       if (calibrated) calibration.apply_z(&frame->depth_m, rays);
-      const depth_image_t image = make_depth_image(camera_config, frame->utime,
-                                                   frame->frame_number, calibrated, frame->depth_m, {});
+      const depth_image_t image = make_depth_image(camera_config.id, camera_config.intrinsics, frame->utime,
+                                                   frame->frame_number, calibrated, frame->depth_m);
       node.images().publish(settings.channels.depth, &image);
       node.counters().frames_out++;
       node.heartbeat().set_last_frame_utime(frame->utime);

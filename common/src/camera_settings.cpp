@@ -1,39 +1,38 @@
 #include "tofguard/common/camera_settings.hpp"
 
-#include <cmath>
+#include <cstdint>
+#include <limits>
 
 namespace tofguard {
-namespace {
 
-constexpr double kBig = 1e9;
-
-}  // namespace
-
+// The rule is Intrinsics::check (camera_geometry.hpp); the YAML keys are its
+// field names, so a violation names the key.
 Intrinsics read_intrinsics(YamlMap& map) {
-  Intrinsics in;
-  in.width = static_cast<int>(map.integer("width", 1, 8192));
-  in.height = static_cast<int>(map.integer("height", 1, 8192));
-  in.fx = map.number("fx", 1e-6, kBig);
-  in.fy = map.number("fy", 1e-6, kBig);
-  in.cx = map.number("cx", -kBig, kBig);
-  in.cy = map.number("cy", -kBig, kBig);
-  return in;
+  constexpr double kAny = std::numeric_limits<double>::max();
+  constexpr int64_t kAnyInt = std::numeric_limits<int>::max();
+  const int width = static_cast<int>(map.integer("width", -kAnyInt, kAnyInt));
+  const int height = static_cast<int>(map.integer("height", -kAnyInt, kAnyInt));
+  const double fx = map.number("fx", -kAny, kAny);
+  const double fy = map.number("fy", -kAny, kAny);
+  const double cx = map.number("cx", -kAny, kAny);
+  const double cy = map.number("cy", -kAny, kAny);
+  if (auto v = Intrinsics::check(width, height, fx, fy, cx, cy)) map.fail(v->field, v->expected, v->got);
+  return Intrinsics(width, height, fx, fy, cx, cy);
 }
 
+// The rule is CameraPose::check; `frame` is a non-empty string and the
+// numbers are finite by YamlMap's reading, so only the quaternion's norm is
+// left to refuse here, under its own key.
 CameraPose read_camera_pose(YamlMap map) {
-  CameraPose pose;
-  pose.frame_id = map.string("frame");
+  const std::string frame = map.string("frame");
   const auto t = map.numbers("translation_m", 3);
-  pose.translation_m = Eigen::Vector3d(t[0], t[1], t[2]);
   const auto q = map.numbers("rotation_wxyz", 4);
-  const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-  if (std::abs(norm - 1.0) > 1e-6) {
-    map.fail("rotation_wxyz", "a unit quaternion w, x, y, z (norm 1 within 1e-6)",
-             "norm " + std::to_string(norm));
+  const Eigen::Quaterniond rotation(q[0], q[1], q[2], q[3]);
+  if (auto v = UnitQuaternion::check(rotation, kConfigQuaternionTolerance, "rotation_wxyz")) {
+    map.fail(v->field, v->expected, v->got);
   }
-  pose.rotation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]);
   map.finish();
-  return pose;
+  return CameraPose(frame, Eigen::Vector3d(t[0], t[1], t[2]), UnitQuaternion(rotation, kConfigQuaternionTolerance));
 }
 
 }  // namespace tofguard

@@ -5,6 +5,15 @@
 
 namespace tofguard {
 
+bool is_model_mismatch(int8_t cause) {
+  return cause == risk_t::CAUSE_JOINT_ERROR || cause == risk_t::CAUSE_CALIBRATION_ERROR ||
+         cause == risk_t::CAUSE_UNKNOWN_OBJECT || cause == risk_t::CAUSE_UNCLASSIFIED;
+}
+
+bool is_fault_cause(int8_t cause) {
+  return cause == risk_t::CAUSE_SENSOR_FAULT || cause == risk_t::CAUSE_COMPONENT_FAULT;
+}
+
 std::string risk_level_name(int8_t level) {
   switch (level) {
     case risk_t::SAFE: return "SAFE";

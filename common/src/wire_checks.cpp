@@ -35,16 +35,10 @@ std::string check_names(const std::vector<std::string>& names, const std::string
   return "";
 }
 
+// The rule is UnitQuaternion::check (camera_geometry.hpp).
 std::string check_unit_quaternion(const double q[4], const std::string& field) {
-  double norm2 = 0;
-  for (int i = 0; i < 4; ++i) {
-    if (!std::isfinite(q[i])) return expected(field + "[" + std::to_string(i) + "]", "a finite number", q[i]);
-    norm2 += q[i] * q[i];
-  }
-  if (std::abs(std::sqrt(norm2) - 1.0) > 1e-3) {
-    return expected(field, "a unit quaternion w,x,y,z (norm 1 within 1e-3), norm", std::sqrt(norm2));
-  }
-  return "";
+  const auto v = UnitQuaternion::check(Eigen::Quaterniond(q[0], q[1], q[2], q[3]), kWireQuaternionTolerance, field);
+  return v ? v->line() : "";
 }
 
 }  // namespace
@@ -62,10 +56,7 @@ std::string check_depth_image(const depth_image_t& image) {
     return expected("num_amplitude", "0 or width*height = " + std::to_string(pixels),
                     image.num_amplitude);
   }
-  if (!std::isfinite(image.fx) || image.fx <= 0) return expected("fx", "a focal length > 0 px", image.fx);
-  if (!std::isfinite(image.fy) || image.fy <= 0) return expected("fy", "a focal length > 0 px", image.fy);
-  if (!std::isfinite(image.cx)) return expected("cx", "a finite principal point", image.cx);
-  if (!std::isfinite(image.cy)) return expected("cy", "a finite principal point", image.cy);
+  if (auto v = Intrinsics::check(image.width, image.height, image.fx, image.fy, image.cx, image.cy)) return v->line();
   return "";
 }
 
@@ -93,14 +84,11 @@ std::string check_joint_state(const joint_state_t& state) {
 }
 
 std::string check_camera_pose(const camera_pose_t& pose) {
-  if (pose.frame_id.empty()) return "frame_id: expected a URDF link name, got an empty string";
-  for (int i = 0; i < 3; ++i) {
-    if (!std::isfinite(pose.translation[i])) {
-      return expected("translation[" + std::to_string(i) + "]", "a finite number of metres",
-                      pose.translation[i]);
-    }
-  }
-  return check_unit_quaternion(pose.rotation, "rotation");
+  const auto v = CameraPose::check(
+      pose.frame_id, Eigen::Vector3d(pose.translation[0], pose.translation[1], pose.translation[2]),
+      Eigen::Quaterniond(pose.rotation[0], pose.rotation[1], pose.rotation[2], pose.rotation[3]),
+      kWireQuaternionTolerance);
+  return v ? v->line() : "";
 }
 
 std::string check_link_labels(const link_labels_t& labels) {
@@ -229,6 +217,63 @@ std::string check_planned_trajectory(const planned_trajectory_t& plan) {
       }
     }
   }
+  return "";
+}
+
+std::string check_discrepancy(const discrepancy_t& d) {
+  if (d.utime <= 0) return expected("utime", "a capture time > 0", static_cast<double>(d.utime));
+  if (d.seq < 0) return expected("seq", "a frame number >= 0", static_cast<double>(d.seq));
+  if (d.num_robot_links < 0 || d.num_robot_links > d.num_links) {
+    return expected("num_robot_links", "0..num_links = " + std::to_string(d.num_links), d.num_robot_links);
+  }
+  if (!(d.invalid_fraction >= 0 && d.invalid_fraction <= 1)) {
+    return expected("invalid_fraction", "a fraction in [0, 1]", d.invalid_fraction);
+  }
+  if (!(d.mismatch_fraction >= 0 && d.mismatch_fraction <= 1)) {
+    return expected("mismatch_fraction", "a fraction in [0, 1]", d.mismatch_fraction);
+  }
+  if (!std::isfinite(d.p95_abs_dis_mm) || d.p95_abs_dis_mm < 0) {
+    return expected("p95_abs_dis_mm", "a finite value >= 0 mm", d.p95_abs_dis_mm);
+  }
+  for (int i = 0; i < d.num_links; ++i) {
+    if (d.link_compared[i] < 0 || d.link_match[i] < 0 || d.link_farther[i] < 0 ||
+        d.link_match[i] > d.link_compared[i] || d.link_farther[i] > d.link_compared[i]) {
+      return "link_compared[" + std::to_string(i) + "]: expected counts with 0 <= match, farther <= compared";
+    }
+  }
+  if (!std::isfinite(d.near_arm_area_m2) || !std::isfinite(d.largest_blob_area_m2)) {
+    return "near_arm_area_m2 / largest_blob_area_m2: expected finite areas";
+  }
+  return "";
+}
+
+std::string check_heartbeat(const heartbeat_t& hb) {
+  if (hb.process.empty()) return "process: expected a process name, got an empty string";
+  return "";
+}
+
+std::string check_sim_camera_fault(const sim_camera_fault_t& f) {
+  auto finite3 = [](const double v[3]) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); };
+  if (f.kind < sim_camera_fault_t::CLEAR || f.kind > sim_camera_fault_t::INTRUDING_OBJECT) {
+    return "kind: expected 0..4, got " + std::to_string(f.kind);
+  }
+  if (f.kind != sim_camera_fault_t::CLEAR && !(f.duration_s > 0 && f.duration_s < 1e6)) {
+    return "duration_s: expected a duration in (0, 1e6) s, got " + std::to_string(f.duration_s);
+  }
+  if (!finite3(f.drift_translation_m_per_s) || !finite3(f.drift_rotation_rad_per_s) || !finite3(f.object_size_m) ||
+      !finite3(f.object_position_m) || !finite3(f.object_velocity_m_per_s)) {
+    return "vectors: expected finite numbers";
+  }
+  if (f.kind == sim_camera_fault_t::INTRUDING_OBJECT &&
+      !(f.object_size_m[0] > 0 && f.object_size_m[1] > 0 && f.object_size_m[2] > 0)) {
+    return "object_size_m: expected 3 sizes > 0";
+  }
+  return "";
+}
+
+std::string check_sim_joint_fault(const sim_joint_fault_t& f) {
+  if (f.joint.empty()) return "joint: expected a joint name, got an empty string";
+  if (!std::isfinite(f.offset)) return expected("offset", "a finite offset (rad, or m for a prismatic joint)", f.offset);
   return "";
 }
 

@@ -61,7 +61,7 @@ Frames make_frames(int width, int height) {
   f.labels.num_links = 4;
   f.labels.link_name = {"base_link", "link1", "link2", "floor"};
   f.labels.num_pixels = width * height;
-  f.labels.label.assign(width * height, 1000);
+  f.labels.label.assign(width * height, tofguard::kLabelEnvironmentFirst);
   box(&f.rendered.depth_mm, &f.labels.label, 40, 100, 60, 140, 1500, 1);
   box(&f.rendered.depth_mm, &f.labels.label, 40, 60, 60, 100, 1500, 2);
   box(&f.rendered.depth_mm, &f.labels.label, 60, 60, 100, 80, 1500, 3);
@@ -72,7 +72,7 @@ Frames make_frames(int width, int height) {
   std::mt19937 rng(1);
   std::normal_distribution<double> unit(0, 1);
   for (int16_t& d : f.camera.depth_mm) {
-    const double m = d * 1e-3;
+    const double m = tofguard::metres_from_mm(d);
     d = static_cast<int16_t>(std::lround(d + unit(rng) * (4 + 1.2 * m * m)));
   }
   return f;

@@ -7,6 +7,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "tofguard/common/demand.hpp"
+
 namespace tofguard::discrepancy {
 namespace {
 
@@ -141,6 +143,15 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
   const int width = camera.width;
   const int height = camera.height;
   const int num_pixels = width * height;
+  // Every loop below reads the three images through raw pointers up to
+  // num_pixels. The wire checks (num_pixels == width * height, decoded
+  // arrays of num_pixels) and mismatch_reason (same sizes) guarantee it; a
+  // caller that skipped them would read past the end.
+  TOFGUARD_DEMAND(camera.depth_mm.size() == static_cast<size_t>(num_pixels) &&
+                      rendered.depth_mm.size() == static_cast<size_t>(num_pixels) &&
+                      labels.label.size() == static_cast<size_t>(num_pixels),
+                  "frame seq " + std::to_string(camera.seq) + ": image arrays do not hold width*height = " +
+                      std::to_string(num_pixels) + " pixels");
   const int num_links = labels.num_links;
   const int num_robot_links = labels.num_robot_links;
   const int num_environment_links = num_links - num_robot_links;
@@ -207,16 +218,12 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
 
   for (int i = 0; i < num_pixels; ++i) {
     const int l = label[i];
-    int link = -1;
-    if (l >= link_labels_t::ROBOT_FIRST && l < link_labels_t::ROBOT_FIRST + num_robot_links) {
-      link = l - link_labels_t::ROBOT_FIRST;
-    } else if (l >= link_labels_t::ENVIRONMENT_FIRST &&
-               l < link_labels_t::ENVIRONMENT_FIRST + num_environment_links) {
-      link = num_robot_links + l - link_labels_t::ENVIRONMENT_FIRST;
-    } else if (l != link_labels_t::NOTHING) {
+    const int link = link_of_label(l, num_robot_links, num_links);
+    if (link < 0 && l != kLabelNothing) {
       std::ostringstream why;
-      why << "label[" << i << "]: expected 0, 1.." << num_robot_links << " or 1000.."
-          << 999 + num_environment_links << ", got " << l;
+      why << "label[" << i << "]: expected " << kLabelNothing << ", " << kLabelRobotFirst << ".."
+          << kLabelRobotFirst + num_robot_links - 1 << " or " << kLabelEnvironmentFirst << ".."
+          << kLabelEnvironmentFirst + num_environment_links - 1 << ", got " << l;
       frame = DiscrepancyFrame{};
       frame.summary = unusable_summary(camera, discrepancy_t::UNUSABLE_MISMATCHED, why.str());
       return frame;
@@ -302,7 +309,7 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
   // square metres.
   const double inv_fx_fy = 1.0 / (camera.fx * camera.fy);
   auto footprint_m2 = [&](int i) {
-    const double z_m = (tof[i] > 0 ? tof[i] : gen[i]) * 1e-3;
+    const double z_m = metres_from_mm(tof[i] > 0 ? tof[i] : gen[i]);
     return z_m * z_m * inv_fx_fy;
   };
 
@@ -355,7 +362,7 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
         }
       }
       auto point_m = [&](int i, int depth_mm) {
-        const double z = depth_mm * 1e-3;
+        const double z = metres_from_mm(depth_mm);
         return cv::Point3d((i % width - camera.cx) * z / camera.fx, (i / width - camera.cy) * z / camera.fy, z);
       };
       const uint8_t* candidate = candidates.ptr<uint8_t>();
@@ -365,7 +372,7 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
         if (candidate[i] == 0) continue;
         double distance_m;
         if (pixel_class[i] == discrepancy_t::PIXEL_OCCLUDED) {
-          distance_m = (gen[i] - tof[i]) * 1e-3;
+          distance_m = metres_from_mm(gen[i] - tof[i]);
         } else {
           const int k = nearest_label[i];
           const int arm = k < static_cast<int>(pixel_of_label.size()) ? pixel_of_label[k] : -1;
@@ -413,6 +420,11 @@ discrepancy_image_t colour_image(const DiscrepancyFrame& frame, double full_scal
   image.num_bytes = 3 * num_pixels;
   image.rgb.assign(image.num_bytes, 0);
   if (frame.pixel_class.empty()) return image;
+  // The class and I_dis images were made with the summary's size.
+  TOFGUARD_DEMAND(frame.pixel_class.total() == static_cast<size_t>(num_pixels) &&
+                      frame.dis_mm.total() == static_cast<size_t>(num_pixels),
+                  "discrepancy images do not match the summary's " + std::to_string(image.width) + "x" +
+                      std::to_string(image.height));
   const uint8_t* pixel_class = frame.pixel_class.ptr<uint8_t>();
   const int32_t* dis = frame.dis_mm.ptr<int32_t>();
   for (int i = 0; i < num_pixels; ++i) {

@@ -13,7 +13,9 @@
 #include "tofguard/renderer/kinematics.hpp"
 #include "tofguard/common/camera_pose_message.hpp"
 #include "tofguard/common/config_error.hpp"
+#include "tofguard/common/depth_frame.hpp"
 #include "tofguard/common/lcm_node.hpp"
+#include "tofguard/common/risk_names.hpp"
 #include "tofguard/common/wire_checks.hpp"
 
 namespace tofguard::estimator {
@@ -21,8 +23,9 @@ namespace tofguard::estimator {
 ProcessInfo process_info() {
   return {"tofguard-estimator",
           "Estimates which joint offsets and which camera-pose correction best explain the camera's depth image "
-          "(docs/estimator.md): TOF_DEPTH, JOINT_STATE, CAMERA_POSE, SAFETY_DISCREPANCY -> MOTION_ESTIMATE, for "
-          "every frame whose discrepancy passes the warning level and periodically."};
+          "(docs/estimator.md): TOF_DEPTH, JOINT_STATE, CAMERA_POSE, SAFETY_DISCREPANCY, SAFETY_RISK -> "
+          "MOTION_ESTIMATE, for every frame whose discrepancy passes the warning level or that tofguard-risk "
+          "judged a model mismatch, and periodically."};
 }
 
 EstimatorOptions options_from_settings(const EstimatorProcessSettings& settings) {
@@ -51,28 +54,9 @@ std::string moving_joint_of(const renderer::SceneModel& scene, int link) {
   return "";
 }
 
-std::vector<float> depth_in_metres(const depth_image_t& frame) {
-  std::vector<float> depth_m(frame.depth_mm.size());
-  for (size_t i = 0; i < frame.depth_mm.size(); ++i) {
-    depth_m[i] = frame.depth_mm[i] > 0 ? frame.depth_mm[i] / 1000.0f : 0.0f;
-  }
-  return depth_m;
-}
-
-std::string check_discrepancy(const discrepancy_t& d) {
-  if (!std::isfinite(d.mismatch_fraction) || d.mismatch_fraction < 0 || d.mismatch_fraction > 1) {
-    return "mismatch_fraction: expected 0..1, got " + std::to_string(d.mismatch_fraction);
-  }
-  if (!std::isfinite(d.p95_abs_dis_mm) || d.p95_abs_dis_mm < 0) {
-    return "p95_abs_dis_mm: expected a finite value >= 0, got " + std::to_string(d.p95_abs_dis_mm);
-  }
-  return "";
-}
-
 EstimatorScheduler::EstimatorScheduler(const EstimatorProcessSettings& settings, const renderer::SceneModel& scene)
     : settings_(settings),
       scene_(scene),
-      robot_(risk::RobotTree::from_urdf_file(settings.robot.urdf_path)),
       history_(settings.renderer.max_extrapolation_us),
       camera_poses_(settings.renderer.camera_pose_history_us,
                     settings.renderer.camera_pose_max_extrapolation_us,
@@ -123,30 +107,42 @@ bool EstimatorScheduler::on_depth(const depth_image_t& frame) {
 }
 
 bool EstimatorScheduler::passes_warning(const discrepancy_t& d) const {
-  // The risk classifier's own rules decide "passes the warning level" (one
-  // rule set, tofguard-risk waits for this estimate exactly then), plus the
-  // estimator's coarser thresholds.
+  // The estimator's own thresholds on the published summary (estimator.
+  // warning); tofguard-risk's verdicts add the frames its rules judge a
+  // model mismatch (on_risk).
   return d.mismatch_fraction >= settings_.estimator.warning_mismatch_fraction ||
-         d.p95_abs_dis_mm >= settings_.estimator.warning_p95_abs_dis_mm ||
-         risk::is_model_mismatch(risk::classify_frame(d, robot_, settings_.risk, {}).cause);
+         d.p95_abs_dis_mm >= settings_.estimator.warning_p95_abs_dis_mm;
 }
 
 void EstimatorScheduler::on_discrepancy(const discrepancy_t& d) {
   if (d.camera_id != settings_.camera.id || !d.usable) return;
-  const bool warning = passes_warning(d);
-  if (warning && (frames_.empty() || d.seq >= frames_.begin()->first)) warning_seqs_.insert(d.seq);
-  if (!warning || estimated_.count(d.seq) > 0) return;
+  if (passes_warning(d)) on_warning(d.seq, d.utime);
+}
+
+void EstimatorScheduler::on_risk(const risk_t& r) {
+  // Timeouts (seq -1) are about no frame; faults are not the model's.
+  if (r.seq < 0 || r.level < risk_t::WARNING || !is_model_mismatch(r.cause)) return;
+  // A verdict on a frame kept with another utime is not about that frame
+  // (a camera restarted its seqs).
+  const auto f = frames_.find(r.seq);
+  if (f != frames_.end() && f->second.utime != r.utime) return;
+  on_warning(r.seq, r.utime);
+}
+
+void EstimatorScheduler::on_warning(int64_t seq, int64_t utime) {
+  if (frames_.empty() || seq >= frames_.begin()->first) warning_seqs_.insert(seq);
+  if (estimated_.count(seq) > 0) return;
   const int64_t min_interval_us = settings_.estimator.warning_min_interval_us;
-  if (last_warning_utime_ > 0 && d.utime >= last_warning_utime_ && d.utime - last_warning_utime_ < min_interval_us) {
+  if (last_warning_utime_ > 0 && utime >= last_warning_utime_ && utime - last_warning_utime_ < min_interval_us) {
     return;  // rate limit (camera time)
   }
-  last_warning_utime_ = d.utime;
-  const auto f = frames_.find(d.seq);
+  last_warning_utime_ = utime;
+  const auto f = frames_.find(seq);
   if (f != frames_.end()) {
     ready_.push_back(build(f->second, motion_estimate_t::TRIGGER_WARNING));
-    estimated_.insert(d.seq);
-  } else if (frames_.empty() || d.seq > frames_.begin()->first) {
-    wanted_[d.seq] = motion_estimate_t::TRIGGER_WARNING;
+    estimated_.insert(seq);
+  } else if (frames_.empty() || seq > frames_.begin()->first) {
+    wanted_[seq] = motion_estimate_t::TRIGGER_WARNING;
   } else {
     ++missed_;
   }
@@ -202,10 +198,10 @@ std::optional<EstimatorFrame> EstimatorScheduler::estimator_frame(const depth_im
     return std::nullopt;
   }
   EstimatorFrame out;
-  out.intrinsics = Intrinsics{frame.width, frame.height, frame.fx, frame.fy, frame.cx, frame.cy};
+  out.intrinsics = intrinsics_of(frame);
   out.reported_joints = joints.joints;
   out.world_from_optical = poses.world_from_link[frame_link] * pose.pose.frame_from_optical();
-  out.depth_m = depth_in_metres(frame);
+  out.depth_m = depth_m_of(frame);
   return out;
 }
 
@@ -413,6 +409,13 @@ int run_estimator(const EstimatorProcessSettings& settings) {
         dispatch();
       },
       check_discrepancy);
+  node.subscribe<risk_t>(
+      node.safety(), settings.channels.risk,
+      [&](const risk_t& r) {
+        scheduler.on_risk(r);
+        dispatch();
+      },
+      check_risk);
   node.add_timer(settings.estimator.periodic_period_us, [&] {
     scheduler.request_newest();
     dispatch();

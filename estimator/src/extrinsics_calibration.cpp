@@ -12,6 +12,7 @@
 #include "tofguard/estimator/estimator_process.hpp"
 #include "tofguard/renderer/joint_history.hpp"
 #include "tofguard/common/decode.hpp"
+#include "tofguard/common/depth_frame.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/common/wire_checks.hpp"
@@ -138,10 +139,10 @@ CalibrationResult calibrate_extrinsics(const EstimatorProcessSettings& settings,
   for (const Candidate* c : chosen) {
     EstimatorFrame f;
     const depth_image_t& d = *c->frame;
-    f.intrinsics = Intrinsics{d.width, d.height, d.fx, d.fy, d.cx, d.cy};
+    f.intrinsics = intrinsics_of(d);
     f.reported_joints = c->joints;
     f.world_from_optical = world_from_optical;
-    f.depth_m = depth_in_metres(d);
+    f.depth_m = depth_m_of(d);
     estimator_frames.push_back(std::move(f));
   }
   EstimatorOptions estimator_options = options_from_settings(settings);

@@ -9,6 +9,8 @@
 #include <Eigen/Cholesky>
 #include <opencv2/imgproc.hpp>
 
+#include "tofguard/common/depth_frame.hpp"
+
 namespace tofguard::estimator {
 
 using renderer::JointType;
@@ -151,22 +153,6 @@ Eigen::Isometry3d twist_exp(const Eigen::Vector3d& v, const Eigen::Vector3d& w) 
 
 }  // namespace
 
-bool significant_offset(const JointEstimate& joint, double min_offset, double sigmas) {
-  const double offset = std::abs(joint.offset());
-  return joint.observable && offset >= min_offset && offset >= sigmas * joint.sigma;
-}
-
-int suspect_joint(const EstimateResult& result, double min_offset, double sigmas) {
-  int best = -1;
-  for (size_t k = 0; k < result.joints.size(); ++k) {
-    if (!significant_offset(result.joints[k], min_offset, sigmas)) continue;
-    if (best < 0 || std::abs(result.joints[k].offset()) > std::abs(result.joints[best].offset())) {
-      best = static_cast<int>(k);
-    }
-  }
-  return best;
-}
-
 double correction_angle_rad(const EstimateResult& result) {
   return Eigen::AngleAxisd(result.correction.linear()).angle();
 }
@@ -211,8 +197,7 @@ MotionEstimator::MotionEstimator(const renderer::SceneModel& scene, renderer::De
 }
 
 std::string MotionEstimator::check_frame(const EstimatorFrame& frame) const {
-  const std::string intrinsics = renderer::check_intrinsics(frame.intrinsics);
-  if (!intrinsics.empty()) return "intrinsics: " + intrinsics;
+  if (const auto v = frame.intrinsics.check()) return "intrinsics: " + v->line();
   const size_t pixels = static_cast<size_t>(frame.intrinsics.width) * frame.intrinsics.height;
   if (frame.depth_m.size() != pixels) {
     return "depth image: expected " + std::to_string(pixels) + " pixels, got " + std::to_string(frame.depth_m.size());
@@ -249,16 +234,6 @@ std::vector<JointAxis> joint_axes(const renderer::SceneModel& scene, const rende
     axes[j].origin_world = world_from_joint.translation();
   }
   return axes;
-}
-
-int link_of_label(int16_t label, int num_robot_links) {
-  if (label >= renderer::kLabelRobotFirst && label < renderer::kLabelEnvironmentFirst) {
-    return label - renderer::kLabelRobotFirst;
-  }
-  if (label >= renderer::kLabelEnvironmentFirst && label < renderer::kLabelExtraObjectFirst) {
-    return num_robot_links + label - renderer::kLabelEnvironmentFirst;
-  }
-  return -1;
 }
 
 }  // namespace
@@ -372,7 +347,7 @@ std::string MotionEstimator::linearize(const EstimatorFrame& frame, const State&
   for (int v = 1; v + 1 < height; ++v) {
     for (int u = 1; u + 1 < width; ++u) {
       const size_t i = static_cast<size_t>(v) * width + u;
-      const int link = link_of_label(labels[i], scene_.num_robot_links);
+      const int link = link_of_label(labels[i], scene_.num_robot_links, static_cast<int>(scene_.links.size()));
       if (link < 0) continue;
       const std::vector<ChainJoint>& chain = chains_[link];
       if (points == PointSet::kStatic && !chain.empty()) continue;
@@ -435,7 +410,7 @@ std::string MotionEstimator::linearize(const EstimatorFrame& frame, const State&
       // ToF camera's systematic error (calibration residual, multipath)
       // shifts a small object's surface along the rays by about the same
       // amount, which would otherwise turn the distal joints.
-      const bool robot = labels[i] < renderer::kLabelEnvironmentFirst;
+      const bool robot = is_robot_label(labels[i]);
       const Eigen::Vector3d ray((u - in.cx) / in.fx, (v - in.cy) / in.fy, 1.0);
       const Eigen::Vector3d d = back_project(u, v, z_measured) + (robot ? state.robot_depth_offset_m : 0.0) * ray;
       const double residual = normal.dot(m - d);

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "tofguard/common/demand.hpp"
 #include "tofguard/common/risk_names.hpp"
 #include "tofguard/safety_status_t.hpp"
 
@@ -20,6 +21,18 @@ std::string describe(const risk_t& risk) {
   if (!risk.suspect.empty()) text += ", suspect " + risk.suspect;
   if (!risk.detail.empty()) text += " (" + risk.detail + ")";
   return text;
+}
+
+// The published status must never contradict itself: motion is allowed
+// exactly when there is no stop and no latch, and the power is off only
+// under a power cut. A robot controller reading motion_allowed alone must
+// see the same decision as one reading stop or latched.
+void demand_consistent(const Status& s) {
+  TOFGUARD_DEMAND(s.motion_allowed == (s.stop == safety_status_t::STOP_NONE) && s.motion_allowed == !s.latched &&
+                      (s.power_enabled || s.stop == safety_status_t::STOP_POWER_CUT),
+                  "inconsistent status: motion_allowed " + std::to_string(s.motion_allowed) + ", stop " +
+                      std::to_string(s.stop) + ", latched " + std::to_string(s.latched) + ", power_enabled " +
+                      std::to_string(s.power_enabled));
 }
 
 }  // namespace
@@ -69,6 +82,7 @@ void InterventionLogic::stop(int8_t kind, int8_t cause, const std::string& reaso
     status_.power_enabled = kind != safety_status_t::STOP_POWER_CUT;
     stop_started_us_ = now_us;
     changed_ = true;
+    demand_consistent(status_);
     return;
   }
   // Already stopped: a stop only escalates (software -> power cut); the
@@ -80,6 +94,7 @@ void InterventionLogic::stop(int8_t kind, int8_t cause, const std::string& reaso
     status_.reason = reason + "; stopped before: " + status_.reason;
     changed_ = true;
   }
+  demand_consistent(status_);
 }
 
 void InterventionLogic::on_risk(const risk_t& risk, int64_t now_us, int64_t now_utime) {
@@ -165,6 +180,7 @@ ResetDecision InterventionLogic::on_reset(const reset_request_t& request, int64_
   status_.since_utime = now_utime;
   status_.power_enabled = true;
   changed_ = true;
+  demand_consistent(status_);
   return {true, "accepted"};
 }
 

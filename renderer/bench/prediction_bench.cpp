@@ -10,8 +10,8 @@
 //       --benchmark_report_aggregates_only=true   (one command line)
 #include <benchmark/benchmark.h>
 
-#include "tofguard/camera/depth_message.hpp"
 #include "tofguard/renderer/renderer_process.hpp"
+#include "tofguard/common/depth_frame.hpp"
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/deployment/process_settings.hpp"
 
@@ -46,8 +46,8 @@ joint_state_t joints_at(int64_t utime) {
 // A flat wall 1.5 m away filling the frame (what it shows does not matter).
 depth_image_t frame_at(int64_t utime, int64_t seq) {
   const CameraSettings& camera = sim_config().camera;
-  return camera::make_depth_image(camera, utime, seq, /*calibrated=*/true,
-                                  std::vector<float>(camera.intrinsics.width * camera.intrinsics.height, 1.5f), {});
+  return make_depth_image(camera.id, camera.intrinsics, utime, seq, /*calibrated=*/true,
+                          std::vector<float>(camera.intrinsics.width * camera.intrinsics.height, 1.5f));
 }
 
 planned_trajectory_t hold_plan() {

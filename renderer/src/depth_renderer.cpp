@@ -6,10 +6,11 @@
 
 #include <GLES3/gl3.h>
 
+#include "tofguard/common/demand.hpp"
+
 namespace tofguard::renderer {
 namespace {
 
-constexpr int kMaxImageSide = 8192;
 constexpr size_t kMaxExtraObjects = 1000;
 
 // Linear Z is computed from the optical-frame position in the vertex shader
@@ -99,19 +100,6 @@ Eigen::Matrix4d clip_from_optical(const Intrinsics& k, double near_m, double far
   m(2, 3) = -2 * f * n / (f - n);
   m(3, 2) = 1;
   return m;
-}
-
-std::string check_intrinsics(const Intrinsics& k) {
-  const auto side = [](int v) { return v >= 1 && v <= kMaxImageSide; };
-  if (!side(k.width) || !side(k.height)) {
-    return "intrinsics: width and height must be 1.." + std::to_string(kMaxImageSide) + " pixels, got " +
-           std::to_string(k.width) + "x" + std::to_string(k.height);
-  }
-  if (!(std::isfinite(k.fx) && k.fx > 0 && std::isfinite(k.fy) && k.fy > 0)) {
-    return "intrinsics: fx and fy must be positive, got " + std::to_string(k.fx) + ", " + std::to_string(k.fy);
-  }
-  if (!std::isfinite(k.cx) || !std::isfinite(k.cy)) return "intrinsics: cx and cy must be finite";
-  return "";
 }
 
 struct DepthRenderer::Impl {
@@ -251,7 +239,9 @@ struct DepthRenderer::Impl {
     };
     if (!poses.usable) return unusable(poses.unusable_reason);
     if (poses.world_from_link.size() != scene.links.size()) return unusable("link poses do not match the scene");
-    if (const std::string why = check_intrinsics(intrinsics); !why.empty()) return unusable(why);
+    // A caller of this public API may hand in intrinsics it assembled field
+    // by field: refused as unusable, not DEMANDed.
+    if (const auto v = intrinsics.check()) return unusable("intrinsics: " + v->line());
     if (!world_from_optical.matrix().allFinite()) return unusable("camera pose is not finite");
     if (extra_objects.size() > kMaxExtraObjects) {
       return unusable("more than " + std::to_string(kMaxExtraObjects) + " extra objects");
@@ -281,9 +271,8 @@ struct DepthRenderer::Impl {
 
     const Eigen::Isometry3d optical_from_world = world_from_optical.inverse();
     for (const Shape& shape : scene.shapes) {
-      const Link& link = scene.links[shape.link_index];
-      const int label = link.is_environment ? kLabelEnvironmentFirst + (shape.link_index - scene.num_robot_links)
-                                            : kLabelRobotFirst + shape.link_index;
+      // SceneModel::links: the robot's first, then the environment's.
+      const int label = label_of_link(shape.link_index, scene.num_robot_links);
       const Eigen::Matrix4d optical_from_mesh = (optical_from_world * poses.world_from_link[shape.link_index] *
                                                  shape.link_from_shape)
                                                     .matrix() *
@@ -300,12 +289,19 @@ struct DepthRenderer::Impl {
       draw(mesh, optical_from_mesh, kLabelExtraObjectFirst + static_cast<int>(i));
     }
 
+    // glReadPixels writes width * height texels of read_channels uint32 each
+    // into readback: a buffer sized for another framebuffer would be a heap
+    // overrun, not a bad image.
+    const size_t pixels = static_cast<size_t>(intrinsics.width) * intrinsics.height;
+    TOFGUARD_DEMAND(fb_width == intrinsics.width && fb_height == intrinsics.height &&
+                        readback.size() == pixels * static_cast<size_t>(read_channels),
+                    "readback buffer does not match the " + std::to_string(intrinsics.width) + "x" +
+                        std::to_string(intrinsics.height) + " framebuffer");
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
     glReadPixels(0, 0, intrinsics.width, intrinsics.height, read_channels == 2 ? GL_RG_INTEGER : GL_RGBA_INTEGER,
                  GL_UNSIGNED_INT, readback.data());
     if (const GLenum error = glGetError(); error != GL_NO_ERROR) return unusable("GL: " + gl_error_text(error));
 
-    const size_t pixels = static_cast<size_t>(intrinsics.width) * intrinsics.height;
     result.depth_m.resize(pixels);
     result.labels.resize(pixels);
     for (size_t i = 0; i < pixels; ++i) {
@@ -347,8 +343,8 @@ DepthRenderer::DepthRenderer(const SceneModel& scene, double near_m, double far_
     throw std::invalid_argument("DepthRenderer: need 0 < near_m < far_m, got near_m " + std::to_string(near_m) +
                                 ", far_m " + std::to_string(far_m));
   }
-  if (scene.num_robot_links >= kLabelEnvironmentFirst - kLabelRobotFirst ||
-      static_cast<int>(scene.links.size()) - scene.num_robot_links >= kLabelExtraObjectFirst - kLabelEnvironmentFirst) {
+  if (scene.num_robot_links >= kMaxLabelledRobotLinks ||
+      static_cast<int>(scene.links.size()) - scene.num_robot_links >= kMaxLabelledEnvironmentLinks) {
     throw std::invalid_argument("DepthRenderer: at most 999 robot links and 1000 environment links can be labelled");
   }
   impl_ = std::make_unique<Impl>(scene, near_m, far_m, platform);
@@ -362,12 +358,11 @@ RenderResult DepthRenderer::render(const JointPositions& joints, const CameraPos
   Eigen::Isometry3d world_from_optical = Eigen::Isometry3d::Identity();
   if (poses.usable) {
     const int frame = impl_->scene.find_link(camera_pose.frame_id);
-    const double norm = camera_pose.rotation.norm();
     if (frame < 0) {
       poses = {false, "camera pose frame '" + camera_pose.frame_id + "' is not a link of the model", {}};
-    } else if (!(std::abs(norm - 1) < 1e-3) || !camera_pose.translation_m.allFinite()) {
+    } else if (const auto v = camera_pose.check(kWireQuaternionTolerance)) {
       // Normalising a rotation far from unit would hide a fault upstream.
-      poses = {false, "camera pose must be finite with a unit quaternion (norm " + std::to_string(norm) + ")", {}};
+      poses = {false, "camera pose: " + v->line(), {}};
     } else {
       world_from_optical = poses.world_from_link[frame] * camera_pose.frame_from_optical();
     }

@@ -118,7 +118,7 @@ int run_render_cli(const std::vector<std::string>& args, std::ostream& out, std:
     if (!have_pose) throw UsageError("--camera-pose is required");
     if (!have_intrinsics) throw UsageError("--intrinsics is required");
     if (out_path.empty()) throw UsageError("--out is required");
-    if (const std::string why = check_intrinsics(intrinsics); !why.empty()) throw UsageError(why);
+    if (const auto v = intrinsics.check()) throw UsageError("--intrinsics: " + v->line());
     if (!(near_m > 0 && far_m > near_m)) throw UsageError("need 0 < --near < --far");
   } catch (const UsageError& e) {
     err << "tofguard-renderer render: " << e.what() << "\n" << render_cli_usage();
@@ -146,8 +146,8 @@ int run_render_cli(const std::vector<std::string>& args, std::ostream& out, std:
         const double mm = std::round(result.depth_m[i] * 1000.0);
         depth_mm.at<uint16_t>(v, u) = static_cast<uint16_t>(mm > 0 && mm <= 65535 ? mm : 0);
         labels.at<uint16_t>(v, u) = static_cast<uint16_t>(result.labels[i]);
-        robot_pixels += result.labels[i] >= kLabelRobotFirst && result.labels[i] < kLabelEnvironmentFirst;
-        environment_pixels += result.labels[i] >= kLabelEnvironmentFirst;
+        robot_pixels += is_robot_label(result.labels[i]);
+        environment_pixels += is_environment_label(result.labels[i]);
       }
     }
     if (!cv::imwrite(out_path, depth_mm)) {

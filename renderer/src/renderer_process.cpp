@@ -8,6 +8,7 @@
 
 #include "tofguard/common/camera_pose_message.hpp"
 #include "tofguard/common/config_error.hpp"
+#include "tofguard/common/depth_frame.hpp"
 #include "tofguard/common/lcm_node.hpp"
 #include "tofguard/common/wire_checks.hpp"
 
@@ -119,7 +120,7 @@ void RendererService::plan_prediction(const depth_image_t& frame) {
   Prediction p;
   p.camera_id = frame.camera_id;
   p.utime = utime;
-  p.intrinsics = Intrinsics{frame.width, frame.height, frame.fx, frame.fy, frame.cx, frame.cy};
+  p.intrinsics = intrinsics_of(frame);
   for (const std::string& joint : scene_.actuated_joint_names) {
     const auto value = planned->find(joint);
     if (value == planned->end()) return;  // the plan does not cover the model
@@ -180,8 +181,7 @@ RenderedFrame RendererService::render(const depth_image_t& frame) {
     const bool missed = prediction_ && prediction_->rendered;
     (missed ? prediction_stats_.misses : prediction_stats_.without)++;
     if (missed) ++consecutive_misses_;
-    const Intrinsics intrinsics{frame.width, frame.height, frame.fx, frame.fy, frame.cx, frame.cy};
-    result = renderer_->render(joints.joints, pose.pose, intrinsics);
+    result = renderer_->render(joints.joints, pose.pose, intrinsics_of(frame));
   }
   RenderedFrame out = make_output(frame, std::move(result));
   plan_prediction(frame);
@@ -190,44 +190,15 @@ RenderedFrame RendererService::render(const depth_image_t& frame) {
 
 RenderedFrame RendererService::make_output(const depth_image_t& frame, RenderResult result) const {
   RenderedFrame out;
-  link_labels_t& labels = out.labels;
-  labels.utime = frame.utime;
-  labels.seq = frame.seq;
-  labels.camera_id = frame.camera_id;
-  labels.width = frame.width;
-  labels.height = frame.height;
-  labels.num_robot_links = scene_.num_robot_links;
-  labels.link_name = scene_.link_names();
-  labels.num_links = static_cast<int32_t>(labels.link_name.size());
-  labels.num_pixels = 0;
-  labels.usable = false;
   if (!result.usable) {
-    labels.unusable_reason = result.unusable_reason;
+    out.labels = make_unusable_link_labels(frame, scene_.num_robot_links, scene_.link_names(), result.unusable_reason);
     return out;
   }
-  labels.usable = true;
-  labels.num_pixels = static_cast<int32_t>(result.labels.size());
-  labels.label = std::move(result.labels);
-
-  depth_image_t depth;
-  depth.utime = frame.utime;
-  depth.seq = frame.seq;
-  depth.camera_id = frame.camera_id;
-  depth.width = frame.width;
-  depth.height = frame.height;
-  depth.fx = frame.fx;
-  depth.fy = frame.fy;
-  depth.cx = frame.cx;
-  depth.cy = frame.cy;
-  depth.calibrated = true;
-  depth.num_pixels = static_cast<int32_t>(result.depth_m.size());
-  depth.depth_mm.resize(result.depth_m.size());
-  for (size_t i = 0; i < result.depth_m.size(); ++i) {
-    const double mm = std::round(static_cast<double>(result.depth_m[i]) * 1000.0);
-    depth.depth_mm[i] = static_cast<int16_t>(mm > 0 && mm <= 32767 ? mm : 0);
-  }
-  depth.num_amplitude = 0;
-  out.depth = std::move(depth);
+  out.labels = make_link_labels(frame, scene_.num_robot_links, scene_.link_names(), std::move(result.labels));
+  // The model's depth is exact: calibrated (no distance calibration to
+  // apply), no amplitude.
+  out.depth = make_depth_image(frame.camera_id, intrinsics_of(frame), frame.utime, frame.seq, /*calibrated=*/true,
+                               result.depth_m);
   return out;
 }
 

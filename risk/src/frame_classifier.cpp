@@ -6,6 +6,7 @@
 #include <sstream>
 #include <vector>
 
+#include "tofguard/common/demand.hpp"
 #include "tofguard/risk_t.hpp"
 
 namespace tofguard::risk {
@@ -58,20 +59,22 @@ struct LinkView {
 
 }  // namespace
 
-bool is_model_mismatch(int8_t cause) {
-  return cause == risk_t::CAUSE_JOINT_ERROR || cause == risk_t::CAUSE_CALIBRATION_ERROR ||
-         cause == risk_t::CAUSE_UNKNOWN_OBJECT || cause == risk_t::CAUSE_UNCLASSIFIED;
-}
-
-bool is_fault_cause(int8_t cause) {
-  return cause == risk_t::CAUSE_SENSOR_FAULT || cause == risk_t::CAUSE_COMPONENT_FAULT;
-}
-
 FrameFinding classify_frame(const discrepancy_t& f, const RobotTree& robot, const RiskSettings& config,
                             const ClassifierContext& context) {
   if (FrameFinding sensor = sensor_finding(f, config, context); sensor.cause != risk_t::CAUSE_NONE) {
     return sensor;
   }
+
+  // The loop below indexes six per-link arrays by i < num_links and splits
+  // robot from environment links at num_robot_links; a discrepancy that
+  // passed its wire check has them consistent.
+  TOFGUARD_DEMAND(f.num_robot_links >= 0 && f.num_robot_links <= f.num_links && f.num_links >= 0 &&
+                      f.link_name.size() == static_cast<size_t>(f.num_links) &&
+                      f.link_compared.size() == static_cast<size_t>(f.num_links) &&
+                      f.link_match.size() == static_cast<size_t>(f.num_links) &&
+                      f.link_farther.size() == static_cast<size_t>(f.num_links),
+                  "discrepancy seq " + std::to_string(f.seq) + ": per-link arrays do not match num_links " +
+                      std::to_string(f.num_links));
 
   // Robot links seen well enough to judge, and the environment as a whole.
   std::vector<LinkView> visible;

@@ -10,37 +10,6 @@
 #include "tofguard/common/wire_checks.hpp"
 
 namespace tofguard::risk {
-namespace {
-
-// The summary's own consistency (the decoder already sized the arrays).
-std::string check_discrepancy(const discrepancy_t& d) {
-  if (d.utime <= 0) return "utime: expected a capture time > 0, got " + std::to_string(d.utime);
-  if (d.seq < 0) return "seq: expected a frame number >= 0, got " + std::to_string(d.seq);
-  if (d.num_robot_links < 0 || d.num_robot_links > d.num_links) {
-    return "num_robot_links: expected 0..num_links = " + std::to_string(d.num_links) + ", got " +
-           std::to_string(d.num_robot_links);
-  }
-  if (!(d.invalid_fraction >= 0 && d.invalid_fraction <= 1)) {
-    return "invalid_fraction: expected a fraction in [0, 1], got " + std::to_string(d.invalid_fraction);
-  }
-  for (int i = 0; i < d.num_links; ++i) {
-    if (d.link_compared[i] < 0 || d.link_match[i] < 0 || d.link_farther[i] < 0 || d.link_match[i] > d.link_compared[i] ||
-        d.link_farther[i] > d.link_compared[i]) {
-      return "link_compared[" + std::to_string(i) + "]: expected counts with 0 <= match, farther <= compared";
-    }
-  }
-  if (!std::isfinite(d.near_arm_area_m2) || !std::isfinite(d.largest_blob_area_m2)) {
-    return "near_arm_area_m2 / largest_blob_area_m2: expected finite areas";
-  }
-  return "";
-}
-
-std::string check_heartbeat(const heartbeat_t& hb) {
-  if (hb.process.empty()) return "process: expected a process name, got an empty string";
-  return "";
-}
-
-}  // namespace
 
 ProcessInfo process_info() {
   return {"tofguard-risk",

@@ -61,7 +61,7 @@ int run_joints_sim(const JointsSimProcessSettings& settings) {
     }
     std::cerr << "tofguard-joints-sim: encoder fault on " << fault.joint << ": offset " << fault.offset
               << std::endl;
-  });
+  }, check_sim_joint_fault);
 
   const int64_t period_us = static_cast<int64_t>(1e6 / settings.joints_sim.rate_hz);
   int64_t last_step_us = monotonic_us();

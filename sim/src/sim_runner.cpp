@@ -4,7 +4,7 @@
 
 #include "tofguard/sim/sim_camera_runner.hpp"
 #include "tofguard/camera/depth_calibration.hpp"
-#include "tofguard/camera/depth_message.hpp"
+#include "tofguard/common/depth_frame.hpp"
 #include "tofguard/renderer/depth_renderer.hpp"
 #include "tofguard/renderer/scene_model.hpp"
 #include "tofguard/sim/sim_camera.hpp"
@@ -53,29 +53,6 @@ class UrdfSceneRenderer : public SceneRenderer {
   renderer::SceneModel scene_;
   std::unique_ptr<renderer::DepthRenderer> renderer_;
 };
-
-// "" for a usable fault request, else "field: expected ..., got ...".
-std::string check_fault(const sim_camera_fault_t& f) {
-  auto finite3 = [](const double v[3]) {
-    return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
-  };
-  if (f.kind < sim_camera_fault_t::CLEAR || f.kind > sim_camera_fault_t::INTRUDING_OBJECT) {
-    return "kind: expected 0..4, got " + std::to_string(f.kind);
-  }
-  if (f.kind != sim_camera_fault_t::CLEAR && !(f.duration_s > 0 && f.duration_s < 1e6)) {
-    return "duration_s: expected a duration in (0, 1e6) s, got " + std::to_string(f.duration_s);
-  }
-  if (!finite3(f.drift_translation_m_per_s) || !finite3(f.drift_rotation_rad_per_s) ||
-      !finite3(f.object_size_m) || !finite3(f.object_position_m) ||
-      !finite3(f.object_velocity_m_per_s)) {
-    return "vectors: expected finite numbers";
-  }
-  if (f.kind == sim_camera_fault_t::INTRUDING_OBJECT &&
-      !(f.object_size_m[0] > 0 && f.object_size_m[1] > 0 && f.object_size_m[2] > 0)) {
-    return "object_size_m: expected 3 sizes > 0";
-  }
-  return "";
-}
 
 ActiveSimFault to_fault(const sim_camera_fault_t& m, int64_t now_utime) {
   static const char* kinds[] = {"", "frozen_image", "stall", "pose_drift", "intruding_object"};
@@ -137,7 +114,7 @@ int run_sim_camera(const SimCameraProcessSettings& settings) {
         std::cerr << "tofguard-camera: fault " << fault.fault.kind << " for " << m.duration_s
                   << " s" << std::endl;
       },
-      check_fault);
+      check_sim_camera_fault);
 
   // Frame slots on the monotonic clock; the capture time is one period
   // before publication (exposure and read-out of a real camera), so that
@@ -171,8 +148,8 @@ int run_sim_camera(const SimCameraProcessSettings& settings) {
     }
     std::vector<float> depth_m = frame.image.depth_m;
     if (calibrated) calibration.apply_z(&depth_m, rays);
-    const depth_image_t image = camera::make_depth_image(camera_config, capture_utime, slot, calibrated,
-                                                 depth_m, frame.image.amplitude);
+    const depth_image_t image = make_depth_image(camera_config.id, camera_config.intrinsics, capture_utime, slot,
+                                                 calibrated, depth_m, frame.image.amplitude);
     node.images().publish(settings.channels.depth, &image);
     node.counters().frames_out++;
     node.heartbeat().set_last_frame_utime(capture_utime);

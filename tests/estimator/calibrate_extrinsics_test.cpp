@@ -12,7 +12,7 @@
 #include <iostream>
 #include <sstream>
 
-#include "tofguard/camera/depth_message.hpp"
+#include "tofguard/common/depth_frame.hpp"
 #include "estimator_test_support.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/joint_state_t.hpp"
@@ -64,7 +64,7 @@ std::string write_log(const std::string& name, const deployment::Config& config,
     if (with_depth) {
       const std::vector<float> depth_m = frames.capture(poses[k], camera, in, k + 1);
       const depth_image_t frame =
-          camera::make_depth_image(config.camera, utime, static_cast<int64_t>(k), true, depth_m, {});
+          make_depth_image(config.camera.id, config.camera.intrinsics, utime, static_cast<int64_t>(k), true, depth_m);
       write_event(&log, utime, config.channels.depth, frame);
     }
     state.utime = utime + 5000;

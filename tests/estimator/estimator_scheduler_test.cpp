@@ -2,7 +2,7 @@
 // estimate is made of (estimator.frames_per_estimate, docs/estimator.md).
 #include <gtest/gtest.h>
 
-#include "tofguard/camera/depth_message.hpp"
+#include "tofguard/common/depth_frame.hpp"
 #include "tofguard/estimator/estimator_process.hpp"
 #include "tofguard/deployment/process_settings.hpp"
 #include "estimator_test_support.hpp"
@@ -42,7 +42,7 @@ class SchedulerTest : public ::testing::Test {
     const Intrinsics& in = config_.camera.intrinsics;
     // Every pixel at 1000 + seq mm: tells the frames apart.
     const std::vector<float> depth_m(static_cast<size_t>(in.width) * in.height, (1000.0f + seq) / 1000.0f);
-    return camera::make_depth_image(config_.camera, kStartUtime + seq * kFramePeriodUs, seq, true, depth_m, {});
+    return make_depth_image(config_.camera.id, in, kStartUtime + seq * kFramePeriodUs, seq, true, depth_m);
   }
 
   discrepancy_t discrepancy(int64_t seq, bool warning) const {
@@ -107,6 +107,53 @@ TEST_F(SchedulerTest, AWarningEstimateDoesNotTakeFramesFromBeforeTheFault) {
   scheduler_.on_discrepancy(discrepancy(13, false));
   scheduler_.request_newest();
   EXPECT_EQ(job_seqs(), (std::vector<int>{13, 12}));
+}
+
+// tofguard-risk's published verdict triggers like a discrepancy past the
+// warning level: a model mismatch on SAFETY_RISK gets its frame estimated
+// (the discrepancy alone was below estimator.warning); a fault, a SAFE
+// verdict or a timeout does not; a verdict about another utime is ignored.
+risk_t verdict(int64_t seq, int8_t level, int8_t cause) {
+  risk_t r{};
+  r.utime = kStartUtime + seq * kFramePeriodUs;
+  r.seq = seq;
+  r.level = level;
+  r.cause = cause;
+  return r;
+}
+
+TEST_F(SchedulerTest, ARiskVerdictOfAModelMismatchTriggersAnEstimate) {
+  for (int seq = 1; seq <= 3; ++seq) {
+    ASSERT_TRUE(scheduler_.on_depth(frame(seq)));
+    scheduler_.on_discrepancy(discrepancy(seq, false));
+  }
+  scheduler_.on_risk(verdict(1, risk_t::SAFE, risk_t::CAUSE_NONE));
+  scheduler_.on_risk(verdict(2, risk_t::DANGEROUS, risk_t::CAUSE_SENSOR_FAULT));
+  scheduler_.on_risk(verdict(-1, risk_t::DANGEROUS, risk_t::CAUSE_COMPONENT_FAULT));
+  risk_t other_frame = verdict(3, risk_t::WARNING, risk_t::CAUSE_JOINT_ERROR);
+  other_frame.utime += 1;
+  scheduler_.on_risk(other_frame);
+  EXPECT_TRUE(scheduler_.take_ready().empty());
+
+  scheduler_.on_risk(verdict(3, risk_t::WARNING, risk_t::CAUSE_JOINT_ERROR));
+  std::vector<ScheduledWork> ready = scheduler_.take_ready();
+  ASSERT_EQ(ready.size(), 1u);
+  ASSERT_TRUE(ready[0].job.has_value());
+  EXPECT_EQ(ready[0].job->context.seq, 3);
+  EXPECT_EQ(ready[0].job->context.trigger, motion_estimate_t::TRIGGER_WARNING);
+  // A warning frame: estimated alone (frames 1, 2 are from before it).
+  EXPECT_EQ(ready[0].job->frames.size(), 1u);
+  // Once only.
+  scheduler_.on_risk(verdict(3, risk_t::DANGEROUS, risk_t::CAUSE_JOINT_ERROR));
+  EXPECT_TRUE(scheduler_.take_ready().empty());
+
+  // A verdict before its frame (past the warning rate limit, 200 ms of
+  // camera time): estimated when the frame comes, with the earlier warning
+  // frame 3.
+  scheduler_.on_risk(verdict(10, risk_t::WARNING, risk_t::CAUSE_UNKNOWN_OBJECT));
+  EXPECT_TRUE(scheduler_.take_ready().empty());
+  ASSERT_TRUE(scheduler_.on_depth(frame(10)));
+  EXPECT_EQ(job_seqs(), (std::vector<int>{10, 3}));
 }
 
 // Each frame carries the joints interpolated at its own utime.

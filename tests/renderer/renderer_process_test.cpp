@@ -10,12 +10,12 @@
 #include <optional>
 #include <regex>
 
-#include "tofguard/camera/depth_message.hpp"
 #include "tofguard/renderer/depth_renderer.hpp"
 #include "tofguard/renderer/renderer_process.hpp"
 #include "test_support.hpp"
 #include "tofguard/common/camera_pose_message.hpp"
 #include "tofguard/common/clock.hpp"
+#include "tofguard/common/depth_frame.hpp"
 #include "tofguard/heartbeat_t.hpp"
 #include "tofguard/deployment/process_settings.hpp"
 
@@ -83,8 +83,8 @@ struct Bench {
   }
   int64_t publish_frame(int64_t utime) {
     const Intrinsics& k = config.camera.intrinsics;
-    const depth_image_t f = camera::make_depth_image(config.camera, utime, ++seq, /*calibrated=*/true,
-                                                     std::vector<float>(k.width * k.height, 1.5f), {});
+    const depth_image_t f = make_depth_image(config.camera.id, k, utime, ++seq, /*calibrated=*/true,
+                                             std::vector<float>(k.width * k.height, 1.5f));
     images.publish(config.channels.depth, &f);
     return f.seq;
   }

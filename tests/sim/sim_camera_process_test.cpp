@@ -13,6 +13,7 @@
 #include "test_support.hpp"
 #include "tofguard/common/camera_pose_message.hpp"
 #include "tofguard/common/clock.hpp"
+#include "tofguard/common/depth_frame.hpp"
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/depth_image_t.hpp"
@@ -150,12 +151,12 @@ TEST(SimCameraProcess, PublishesFaultsAndRendersIntruders) {
 double robot_match_fraction(renderer::DepthRenderer* renderer, const depth_image_t& frame, const CameraPose& pose) {
   renderer::JointPositions joints;
   for (int i = 0; i < 7; ++i) joints["a" + std::to_string(i + 1)] = kArm[i];
-  const Intrinsics k{frame.width, frame.height, frame.fx, frame.fy, frame.cx, frame.cy};
+  const Intrinsics k = intrinsics_of(frame);
   const renderer::RenderResult model = renderer->render(joints, pose, k);
   if (!model.usable) return -1;
   int robot = 0, match = 0;
   for (size_t i = 0; i < model.labels.size(); ++i) {
-    if (model.labels[i] <= 0 || model.labels[i] >= renderer::kLabelEnvironmentFirst || frame.depth_mm[i] <= 0) continue;
+    if (!is_robot_label(model.labels[i]) || frame.depth_mm[i] <= 0) continue;
     ++robot;
     match += std::abs(frame.depth_mm[i] - model.depth_m[i] * 1000.0) < 30.0;
   }

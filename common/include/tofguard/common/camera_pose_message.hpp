@@ -6,12 +6,13 @@
 #include <string>
 
 #include "tofguard/camera_pose_t.hpp"
-#include "tofguard/common/camera_settings.hpp"
+#include "tofguard/common/camera_geometry.hpp"
 
 namespace tofguard {
 
 camera_pose_t to_camera_pose_message(const std::string& camera_id, int64_t utime, const CameraPose& pose);
-// The rotation is normalised (check_camera_pose allows a norm within 1e-3 of 1).
+// `message` must have passed check_camera_pose (TOFGUARD_DEMANDed); the
+// rotation is normalised (the check allows a norm within 1e-3 of 1).
 CameraPose from_camera_pose_message(const camera_pose_t& message);
 
 }  // namespace tofguard

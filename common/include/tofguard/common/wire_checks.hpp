@@ -6,24 +6,28 @@
 #include <string>
 
 #include "tofguard/camera_pose_t.hpp"
+#include "tofguard/common/camera_geometry.hpp"
 #include "tofguard/depth_image_t.hpp"
+#include "tofguard/discrepancy_t.hpp"
+#include "tofguard/heartbeat_t.hpp"
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/link_labels_t.hpp"
 #include "tofguard/motion_estimate_t.hpp"
 #include "tofguard/planned_trajectory_t.hpp"
 #include "tofguard/risk_t.hpp"
 #include "tofguard/safety_status_t.hpp"
+#include "tofguard/sim_camera_fault_t.hpp"
+#include "tofguard/sim_joint_fault_t.hpp"
 
 namespace tofguard {
 
-// Largest image side accepted, pixels.
-constexpr int kMaxImageSide = 8192;
-
+// The intrinsics by Intrinsics::check (camera_geometry.hpp).
 std::string check_depth_image(const depth_image_t& image);
 // check_depth_image, and the frame must come from camera `camera_id`.
 std::string check_depth_image_from(const depth_image_t& image, const std::string& camera_id);
 std::string check_joint_state(const joint_state_t& state);
-// The rotation must be a unit quaternion within 1e-3.
+// CameraPose::check with kWireQuaternionTolerance (a unit quaternion within
+// 1e-3, normalised by from_camera_pose_message).
 std::string check_camera_pose(const camera_pose_t& pose);
 std::string check_link_labels(const link_labels_t& labels);
 // level and cause must be one of risk_t's constants.
@@ -39,5 +43,17 @@ std::string check_motion_estimate(const motion_estimate_t& estimate);
 // At least one joint (unique non-empty names) and one point; point utimes
 // > 0 and strictly increasing; finite positions.
 std::string check_planned_trajectory(const planned_trajectory_t& plan);
+// The summary's own consistency (the decoder already sized the arrays):
+// utime > 0, seq >= 0, 0 <= num_robot_links <= num_links, invalid_fraction
+// and mismatch_fraction in [0, 1], p95_abs_dis_mm finite and >= 0, per link
+// 0 <= match, farther <= compared, finite near-arm and blob areas.
+std::string check_discrepancy(const discrepancy_t& discrepancy);
+// A process name.
+std::string check_heartbeat(const heartbeat_t& heartbeat);
+// kind one of the constants; for a fault (not CLEAR) a duration in
+// (0, 1e6) s; finite vectors; an intruding object's sizes > 0.
+std::string check_sim_camera_fault(const sim_camera_fault_t& fault);
+// A joint name and a finite offset (rad, or m for a prismatic joint).
+std::string check_sim_joint_fault(const sim_joint_fault_t& fault);
 
 }  // namespace tofguard

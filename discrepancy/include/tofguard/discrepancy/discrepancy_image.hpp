@@ -13,6 +13,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "tofguard/common/depth_frame.hpp"
 #include "tofguard/discrepancy/discrepancy_settings.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/discrepancy_image_t.hpp"
@@ -32,7 +33,7 @@ struct Tolerance {
 
   // Largest |I_dis| still a match at camera depth `depth_mm`, millimetres.
   double at(double depth_mm) const {
-    const double d_m = depth_mm * 1e-3;
+    const double d_m = metres_from_mm(depth_mm);
     return sigmas * (sigma_at_0m_mm + sigma_per_m2_mm * d_m * d_m) + model_mm;
   }
 };

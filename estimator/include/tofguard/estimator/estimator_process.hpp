@@ -4,12 +4,15 @@
 // worker thread that estimates them without ever blocking the LCM loop
 // (EstimatorWorker).
 //
-// Triggers (config `estimator`, docs/estimator.md):
-//   TRIGGER_WARNING  a frame whose discrepancy_t is usable and reaches
-//                    warning.mismatch_fraction or warning.p95_abs_dis_mm,
-//                    or in which the risk classifier's rules
-//                    (risk::classify_frame) find a model mismatch,
-//                    as soon as both the frame and its discrepancy are in;
+// Triggers (config `estimator`, docs/estimator.md), on the messages as
+// published (the estimator runs none of tofguard-risk's rules):
+//   TRIGGER_WARNING  a frame whose discrepancy_t (SAFETY_DISCREPANCY) is
+//                    usable and reaches warning.mismatch_fraction or
+//                    warning.p95_abs_dis_mm, or whose risk_t verdict
+//                    (SAFETY_RISK) is WARNING or DANGEROUS with a model-
+//                    mismatch cause (is_model_mismatch), as soon as both the
+//                    frame and the trigger are in; at most one frame per
+//                    warning.min_interval_ms of camera time;
 //   TRIGGER_PERIODIC the newest frame every periodic_period_ms.
 // A frame is estimated once, jointly with up to frames_per_estimate - 1
 // kept frames just before it (MotionEstimator::estimate(frames)) that are
@@ -35,8 +38,6 @@
 #include "tofguard/renderer/camera_pose_history.hpp"
 #include "tofguard/estimator/estimate_message.hpp"
 #include "tofguard/renderer/joint_history.hpp"
-#include "tofguard/risk/frame_classifier.hpp"
-#include "tofguard/risk/robot_tree.hpp"
 #include "tofguard/estimator/motion_estimator.hpp"
 #include "tofguard/renderer/scene_model.hpp"
 #include "tofguard/camera_pose_t.hpp"
@@ -46,12 +47,13 @@
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/motion_estimate_t.hpp"
 #include "tofguard/common/process.hpp"
+#include "tofguard/risk_t.hpp"
 
 namespace tofguard::estimator {
 
 ProcessInfo process_info();
 
-// The process: TOF_DEPTH, JOINT_STATE, CAMERA_POSE, SAFETY_DISCREPANCY in,
+// The process: TOF_DEPTH, JOINT_STATE, CAMERA_POSE, SAFETY_DISCREPANCY, SAFETY_RISK in,
 // MOTION_ESTIMATE out, until SIGINT/SIGTERM. Runs at niceness +10 (a
 // diagnosis must not take time from the stop path). A scene that cannot be
 // loaded is a configuration error (exit code 2).
@@ -68,13 +70,6 @@ renderer::SceneModel load_estimator_scene(const EstimatorProcessSettings& settin
 // The name of a joint that moves `link` (the nearest one up the chain), ""
 // for a static link.
 std::string moving_joint_of(const renderer::SceneModel& scene, int link);
-
-// A depth_image_t's depth in metres (0 = no return), row-major.
-std::vector<float> depth_in_metres(const depth_image_t& frame);
-
-// "" for a discrepancy_t the trigger may use, else one line naming the
-// field.
-std::string check_discrepancy(const discrepancy_t& d);
 
 struct EstimateJob {
   // frames[0] is the frame the estimate is about, the others the frames
@@ -100,6 +95,10 @@ class EstimatorScheduler {
   // Frames of other cameras are ignored (false).
   bool on_depth(const depth_image_t& frame);
   void on_discrepancy(const discrepancy_t& discrepancy);
+  // tofguard-risk's verdict (check_risk passed): a model mismatch on a
+  // frame makes it a warning frame like a discrepancy past the warning
+  // level. Timeouts (seq -1), SAFE and fault verdicts change nothing.
+  void on_risk(const risk_t& risk);
   // Asks for the newest frame (periodic trigger).
   void request_newest();
   // The work that became ready (frame and trigger both in), oldest first.
@@ -111,9 +110,11 @@ class EstimatorScheduler {
 
  private:
   ScheduledWork build(const depth_image_t& frame, int8_t trigger) const;
-  // The discrepancy passed the warning level (estimator.warning, or the
-  // risk rules' model mismatch).
+  // The discrepancy passed the warning level (estimator.warning).
   bool passes_warning(const discrepancy_t& d) const;
+  // Frame `seq` (captured at `utime`) is a warning frame: estimate it
+  // (rate limited), now or once it is in.
+  void on_warning(int64_t seq, int64_t utime);
   // The frame with its reported joints and camera pose (for `context`'s
   // camera frame_id), or "" and the reason it cannot be estimated.
   std::optional<EstimatorFrame> estimator_frame(const depth_image_t& frame, const std::string& frame_id,
@@ -121,13 +122,12 @@ class EstimatorScheduler {
 
   EstimatorProcessSettings settings_;
   const renderer::SceneModel& scene_;
-  risk::RobotTree robot_;
   renderer::JointHistory history_;
   renderer::CameraPoseHistory camera_poses_;
   std::map<int64_t, depth_image_t> frames_;  // by seq
   std::map<int64_t, int8_t> wanted_;          // seq -> trigger
   std::set<int64_t> estimated_;
-  std::set<int64_t> warning_seqs_;  // kept frames whose discrepancy passed the warning level
+  std::set<int64_t> warning_seqs_;  // kept frames that passed the warning level (discrepancy or risk)
   int64_t last_warning_utime_ = 0;  // utime of the last warning-triggered frame
   std::vector<ScheduledWork> ready_;
   int64_t missed_ = 0;

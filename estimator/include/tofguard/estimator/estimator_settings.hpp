@@ -11,7 +11,6 @@
 #include "tofguard/common/robot_settings.hpp"
 #include "tofguard/common/yaml_reader.hpp"
 #include "tofguard/renderer/renderer_settings.hpp"
-#include "tofguard/risk/risk_settings.hpp"
 
 namespace tofguard::estimator {
 
@@ -64,8 +63,6 @@ struct EstimatorProcessSettings {
   // model the estimator weighs residuals with, millimetres.
   double noise_sigma_at_0m_mm = 0;
   double noise_sigma_per_m2_mm = 0;
-  // The risk rules (a model mismatch also triggers an estimate).
-  risk::RiskSettings risk;
   EstimatorSettings estimator;
 };
 

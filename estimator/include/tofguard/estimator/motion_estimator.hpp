@@ -198,11 +198,6 @@ struct EstimateResult {
   int64_t compute_us = 0;
 };
 
-// The joint with the largest significant offset: observable, |offset| at
-// least min_offset and at least sigmas * sigma. -1 when none.
-int suspect_joint(const EstimateResult& result, double min_offset, double sigmas);
-bool significant_offset(const JointEstimate& joint, double min_offset, double sigmas);
-
 // Rotation angle of the correction, radians.
 double correction_angle_rad(const EstimateResult& result);
 

@@ -28,15 +28,10 @@
 #include "tofguard/renderer/egl_context.hpp"
 #include "tofguard/renderer/kinematics.hpp"
 #include "tofguard/renderer/scene_model.hpp"
-#include "tofguard/common/camera_settings.hpp"
+#include "tofguard/common/camera_geometry.hpp"
+#include "tofguard/common/depth_frame.hpp"
 
 namespace tofguard::renderer {
-
-// Label values (the same as link_labels_t's constants).
-constexpr int16_t kLabelNothing = 0;
-constexpr int16_t kLabelRobotFirst = 1;           // + robot link index
-constexpr int16_t kLabelEnvironmentFirst = 1000;  // + (link index - num_robot_links)
-constexpr int16_t kLabelExtraObjectFirst = 2000;  // + index in render()'s extra_objects
 
 // A primitive that is not part of the model, given per render() call (e.g.
 // the simulated camera's person's arm). Drawn with the unit primitives that
@@ -66,8 +61,9 @@ struct RenderResult {
   // Z along the optical axis of the nearest surface, metres, row-major;
   // 0 where nothing is seen within [near_m, far_m].
   std::vector<float> depth_m;
-  // Which link (or extra object) is seen at each pixel; see the kLabel*
-  // constants. Row-major like depth_m.
+  // Which link (or extra object) is seen at each pixel: the label values
+  // of common/depth_frame.hpp (label_of_link, kLabelExtraObjectFirst +
+  // index in render()'s extra_objects). Row-major like depth_m.
   std::vector<int16_t> labels;
   // SceneModel::links' names: robot links first, then the environment's.
   std::vector<std::string> link_names;
@@ -112,9 +108,5 @@ class DepthRenderer {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
-
-// Checks intrinsics for rendering: "" when usable, else one line naming the
-// field (sizes 1..8192, fx, fy > 0 and finite, cx, cy finite).
-std::string check_intrinsics(const Intrinsics& intrinsics);
 
 }  // namespace tofguard::renderer

@@ -2,7 +2,7 @@
 // `tofguard-renderer render ...`: renders one image from the command line,
 // for checks and docs. Writes a 16-bit PNG of depth in millimetres (0 =
 // nothing; OpenCV imwrite, CV_16UC1) and optionally a 16-bit PNG of labels
-// (the values of depth_renderer.hpp's kLabel* constants).
+// (the label values of common/depth_frame.hpp).
 #include <ostream>
 #include <string>
 #include <vector>

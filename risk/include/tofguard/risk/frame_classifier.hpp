@@ -8,6 +8,7 @@
 #include <string>
 
 #include "tofguard/risk/robot_tree.hpp"
+#include "tofguard/common/risk_names.hpp"
 #include "tofguard/risk/risk_settings.hpp"
 #include "tofguard/discrepancy_t.hpp"
 
@@ -40,12 +41,8 @@ FrameFinding classify_frame(const discrepancy_t& frame, const RobotTree& robot, 
 // `value` with `decimals` digits after the point, for detail lines.
 std::string fixed(double value, int decimals);
 
-// True for the causes that count as sensor/component faults (debounced
-// with risk.sensor_debounce_frames).
-bool is_fault_cause(int8_t cause);
-
-// True for the causes of a model mismatch (JOINT_ERROR, CALIBRATION_ERROR,
-// UNKNOWN_OBJECT, UNCLASSIFIED): the findings a motion estimate can name.
-bool is_model_mismatch(int8_t cause);
+// is_fault_cause and is_model_mismatch (which causes are faults, which are
+// model mismatches) are the wire's, in common/risk_names.hpp: the estimator
+// triggers on the same model-mismatch causes.
 
 }  // namespace tofguard::risk
