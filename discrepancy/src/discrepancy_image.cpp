@@ -45,12 +45,11 @@ class Histogram {
     if (count_ == 0) return 0.0f;
     return static_cast<float>(value_at_rank(static_cast<int64_t>(std::floor(q * static_cast<double>(count_ - 1)))));
   }
-  // The histogram of |value|.
-  Histogram folded() const {
-    Histogram abs;
-    for (int v = -kHistogramMm; v <= kHistogramMm; ++v) abs.bins_[std::abs(v) + kHistogramMm] += bins_[v + kHistogramMm];
-    abs.count_ = count_;
-    return abs;
+  // Adds the counts of |value| to `abs` (in place: no histogram is
+  // allocated or freed while a frame is scored, see DisHistograms).
+  void add_folded_to(Histogram* abs) const {
+    for (int v = -kHistogramMm; v <= kHistogramMm; ++v) abs->bins_[std::abs(v) + kHistogramMm] += bins_[v + kHistogramMm];
+    abs->count_ += count_;
   }
 
  private:
@@ -92,6 +91,310 @@ cv::Mat1b opened(const cv::Mat1b& mask, int radius_px) {
       cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * radius_px + 1, 2 * radius_px + 1));
   cv::morphologyEx(mask, out, cv::MORPH_OPEN, kernel);
   return out;
+}
+
+// ---- The stages of compute_discrepancy, in order ----
+
+// Stage 1, label decoding: "" when every label value names a link or
+// nothing (link_of_label, common/depth_frame.hpp), else why not (the first
+// bad pixel). The later stages decode each pixel's label again: one lookup
+// costs less than a per-pixel link buffer (see per_link_statistics on heap
+// churn).
+std::string check_labels(const link_labels_t& labels) {
+  const int num_robot_links = labels.num_robot_links;
+  const int num_links = labels.num_links;
+  const int num_pixels = labels.width * labels.height;
+  for (int i = 0; i < num_pixels; ++i) {
+    const int l = labels.label[i];
+    if (l == kLabelNothing || link_of_label(l, num_robot_links, num_links) >= 0) continue;
+    std::ostringstream why;
+    why << "label[" << i << "]: expected " << kLabelNothing << ", " << kLabelRobotFirst << ".."
+        << kLabelRobotFirst + num_robot_links - 1 << " or " << kLabelEnvironmentFirst << ".."
+        << kLabelEnvironmentFirst + (num_links - num_robot_links) - 1 << ", got " << l;
+    return why.str();
+  }
+  return "";
+}
+
+// Stage 2, silhouette mask: 1 for the pixels beside a rendered depth step
+// larger than silhouette_jump_mm (or the model's outline), 4-neighbours. A
+// ToF pixel there mixes both surfaces, so its I_dis says nothing about a
+// link's pose; on a thin link (a finger three pixels wide) it would
+// otherwise be most of the link.
+std::vector<uint8_t> silhouette_mask(const depth_image_t& rendered, double silhouette_jump_mm) {
+  const int width = rendered.width;
+  const int height = rendered.height;
+  const int16_t* gen = rendered.depth_mm.data();
+  std::vector<uint8_t> silhouette(static_cast<size_t>(width) * height, 0);
+  for (int v = 0; v < height && silhouette_jump_mm > 0; ++v) {
+    for (int u = 0; u < width; ++u) {
+      const int i = v * width + u;
+      const int neighbours[2] = {u + 1 < width ? i + 1 : -1, v + 1 < height ? i + width : -1};
+      for (int n : neighbours) {
+        if (n < 0) continue;
+        const int a = gen[i] > 0 ? gen[i] : 0;
+        const int b = gen[n] > 0 ? gen[n] : 0;
+        if ((a > 0) != (b > 0) || std::abs(a - b) > silhouette_jump_mm) {
+          silhouette[i] = 1;
+          silhouette[n] = 1;
+        }
+      }
+    }
+  }
+  return silhouette;
+}
+
+// What the pixel classes leave for the later stages.
+struct PixelClasses {
+  PixelClasses(int height, int width)
+      : mismatch_mask(height, width, uint8_t{0}),
+        nearer_mask(height, width, uint8_t{0}),
+        not_robot(height, width, uint8_t{255}) {}
+  int count[6] = {0, 0, 0, 0, 0, 0};  // per discrepancy_t::PIXEL_*
+  int num_compared = 0;               // camera and model both have a surface
+  double sum_abs_dis_mm = 0;          // over the compared pixels
+  // 255 where a modelled surface mismatches (for blobs), and where the
+  // camera sees a nearer surface (occluded or unexpected, for near-arm
+  // objects); silhouette pixels left out of both except unmodelled ones.
+  cv::Mat1b mismatch_mask;
+  cv::Mat1b nearer_mask;
+  // 0 where the model has a robot link, 255 elsewhere (distance transform).
+  cv::Mat1b not_robot;
+  bool any_robot = false;
+};
+
+// Stage 3, pixel classes: I_dis = I_gen - I_ToF (mm) and the class of every
+// pixel (docs/safety-chain.md, "Pixel classes") into frame->pixel_class and
+// frame->dis_mm (allocated by the caller), with the masks and totals the
+// later stages need into `p` (fresh).
+void classify_pixels(const depth_image_t& camera, const depth_image_t& rendered, const link_labels_t& labels,
+                     const std::vector<uint8_t>& silhouette, const Tolerance& tolerance, DiscrepancyFrame* frame,
+                     PixelClasses* classes) {
+  PixelClasses& p = *classes;
+  const int num_links = labels.num_links;
+  const int num_robot_links = labels.num_robot_links;
+  const int16_t* label = labels.label.data();
+  const int width = camera.width;
+  const int height = camera.height;
+  const int num_pixels = width * height;
+
+  const int16_t* tof = camera.depth_mm.data();
+  const int16_t* gen = rendered.depth_mm.data();
+  uint8_t* pixel_class = frame->pixel_class.ptr<uint8_t>();
+  int32_t* dis = frame->dis_mm.ptr<int32_t>();
+  uint8_t* mismatch = p.mismatch_mask.ptr<uint8_t>();
+  uint8_t* nearer = p.nearer_mask.ptr<uint8_t>();
+  uint8_t* robot_free = p.not_robot.ptr<uint8_t>();
+  for (int i = 0; i < num_pixels; ++i) {
+    const int link = link_of_label(label[i], labels.num_robot_links, num_links);
+    const int t = tof[i];
+    const int g = gen[i];
+    const bool modelled = g > 0;
+    const bool robot = modelled && link >= 0 && link < num_robot_links;
+    if (robot) {
+      robot_free[i] = 0;
+      p.any_robot = true;
+    }
+    dis[i] = 0;
+    int8_t c;
+    if (t <= 0) {
+      c = discrepancy_t::PIXEL_INVALID;
+    } else if (!modelled) {
+      // The camera sees a surface where the model has none.
+      c = discrepancy_t::PIXEL_UNEXPECTED_SURFACE;
+      nearer[i] = 255;
+    } else {
+      const int d = g - t;
+      dis[i] = d;
+      const int magnitude = std::abs(d);
+      p.sum_abs_dis_mm += magnitude;
+      ++p.num_compared;
+      if (magnitude <= tolerance.at(t)) {
+        c = discrepancy_t::PIXEL_MATCH;
+      } else if (d > 0) {
+        c = robot ? discrepancy_t::PIXEL_OCCLUDED : discrepancy_t::PIXEL_UNEXPECTED_SURFACE;
+        nearer[i] = silhouette[i] ? 0 : 255;
+        mismatch[i] = silhouette[i] ? 0 : 255;
+      } else {
+        c = robot ? discrepancy_t::PIXEL_ROBOT_MISSING : discrepancy_t::PIXEL_ENVIRONMENT_MISSING;
+        mismatch[i] = silhouette[i] ? 0 : 255;
+      }
+    }
+    pixel_class[i] = static_cast<uint8_t>(c);
+    p.count[c]++;
+  }
+}
+
+// Stage 4, per-link statistics: per link the compared, matched, farther,
+// nearer and invalid pixel counts (silhouettes left out of the compared
+// ones) and the signed median of I_dis; the robust scores over the frame
+// (median and 95th percentile of |I_dis|, signed medians of the robot's and
+// the environment's pixels). Medians from 1 mm histograms.
+//
+// The histograms (64 kB each) come back to the caller, which keeps them
+// until the frame is done, and none is freed or replaced on the way: a
+// histogram freed between stages lets malloc hand the heap's top back to
+// the kernel, and the blob and near-arm stages then fault it in again
+// (3x the frame time in tofguard-discrepancy-bench).
+struct DisHistograms {
+  std::vector<Histogram> per_link;  // per link, plus one for modelled pixels without a label
+  Histogram robot;
+  Histogram environment;
+  Histogram all;
+  Histogram abs;
+};
+
+DisHistograms per_link_statistics(const DiscrepancyFrame& frame, const depth_image_t& camera,
+                                  const depth_image_t& rendered, const link_labels_t& labels,
+                                  const std::vector<uint8_t>& silhouette, discrepancy_t* s) {
+  const int16_t* label = labels.label.data();
+  const int num_links = s->num_links;
+  const int num_robot_links = s->num_robot_links;
+  const int num_pixels = camera.width * camera.height;
+  const int16_t* tof = camera.depth_mm.data();
+  const int16_t* gen = rendered.depth_mm.data();
+  const uint8_t* pixel_class = frame.pixel_class.ptr<uint8_t>();
+  const int32_t* dis = frame.dis_mm.ptr<int32_t>();
+  DisHistograms h;
+  std::vector<Histogram>& link_dis = h.per_link;
+  link_dis.resize(num_links + 1);
+  for (int i = 0; i < num_pixels; ++i) {
+    const int link = link_of_label(label[i], labels.num_robot_links, num_links);
+    const bool modelled = gen[i] > 0;
+    if (tof[i] <= 0) {
+      if (link >= 0 && modelled) s->link_invalid[link]++;
+      continue;
+    }
+    if (!modelled) continue;
+    // Compared: both the camera and the model have a surface.
+    const int d = dis[i];
+    link_dis[link >= 0 ? link : num_links].add(d);
+    if (link < 0 || silhouette[i]) continue;
+    s->link_compared[link]++;
+    if (pixel_class[i] == discrepancy_t::PIXEL_MATCH) {
+      s->link_match[link]++;
+    } else if (d > 0) {
+      s->link_nearer[link]++;
+    } else {
+      s->link_farther[link]++;
+    }
+  }
+  for (int link = 0; link < num_links; ++link) {
+    s->link_median_dis_mm[link] = link_dis[link].median();
+    (link < num_robot_links ? h.robot : h.environment).add(link_dis[link]);
+  }
+  h.all = h.robot;
+  h.all.add(h.environment);
+  h.all.add(link_dis[num_links]);
+  h.all.add_folded_to(&h.abs);
+  s->median_abs_dis_mm = h.abs.median();
+  s->p95_abs_dis_mm = h.abs.quantile(0.95);
+  s->robot_median_dis_mm = h.robot.median();
+  s->environment_median_dis_mm = h.environment.median();
+  return h;
+}
+
+// Metric footprint of a pixel at the camera's depth (else the model's), m^2:
+// (Z/fx)*(Z/fy).
+class PixelFootprint {
+ public:
+  PixelFootprint(const depth_image_t& camera, const depth_image_t& rendered)
+      : tof_(camera.depth_mm.data()), gen_(rendered.depth_mm.data()), inv_fx_fy_(1.0 / (camera.fx * camera.fy)) {}
+  double m2(int i) const {
+    const double z_m = metres_from_mm(tof_[i] > 0 ? tof_[i] : gen_[i]);
+    return z_m * z_m * inv_fx_fy_;
+  }
+
+ private:
+  const int16_t* tof_;
+  const int16_t* gen_;
+  double inv_fx_fy_;
+};
+
+// Stage 5, blobs: the largest 8-connected component of the opened mismatch
+// mask, its pixel count and metric area.
+void largest_blob(const cv::Mat1b& mismatch_mask, int opening_radius_px, const PixelFootprint& footprint,
+                  discrepancy_t* s) {
+  const cv::Mat1b blobs = opened(mismatch_mask, opening_radius_px);
+  cv::Mat1i component;
+  cv::Mat stats;
+  cv::Mat centroids;
+  const int n = cv::connectedComponentsWithStats(blobs, component, stats, centroids, 8, CV_32S);
+  int largest = 0;
+  for (int k = 1; k < n; ++k) {
+    if (largest == 0 || stats.at<int>(k, cv::CC_STAT_AREA) > stats.at<int>(largest, cv::CC_STAT_AREA)) {
+      largest = k;
+    }
+  }
+  if (largest == 0) return;
+  s->largest_blob_pixels = stats.at<int>(largest, cv::CC_STAT_AREA);
+  double area = 0;
+  const int* comp = component.ptr<int>();
+  const int num_pixels = static_cast<int>(component.total());
+  for (int i = 0; i < num_pixels; ++i) {
+    if (comp[i] == largest) area += footprint.m2(i);
+  }
+  s->largest_blob_area_m2 = static_cast<float>(area);
+}
+
+// Stage 6, near-arm surfaces: nearer surfaces (after the same opening)
+// within near_arm_m of the modelled arm. For an occluded pixel the distance
+// is how far in front of the arm the surface is; for an unexpected surface
+// it is the 3-D distance to the modelled arm point at the nearest robot
+// pixel in the image (an approximation of the distance to the arm's visible
+// surface). Pixel count, area (m^2) and smallest distance (m; -1: none).
+void near_arm_surfaces(const depth_image_t& camera, const depth_image_t& rendered, const DiscrepancyFrame& frame,
+                       const PixelClasses& classes, const Parameters& parameters, const PixelFootprint& footprint,
+                       discrepancy_t* s) {
+  const cv::Mat1b candidates = opened(classes.nearer_mask, parameters.opening_radius_px);
+  s->near_arm_min_distance_m = -1;
+  if (!classes.any_robot || cv::countNonZero(candidates) == 0) return;
+  const int width = camera.width;
+  const int num_pixels = width * camera.height;
+  const int16_t* tof = camera.depth_mm.data();
+  const int16_t* gen = rendered.depth_mm.data();
+  const uint8_t* pixel_class = frame.pixel_class.ptr<uint8_t>();
+  cv::Mat1f distance_px;
+  cv::Mat1i nearest;
+  cv::distanceTransform(classes.not_robot, distance_px, nearest, cv::DIST_L2, cv::DIST_MASK_5, cv::DIST_LABEL_PIXEL);
+  // Each robot pixel carries its own label: label -> pixel index.
+  std::vector<int> pixel_of_label;
+  const int* nearest_label = nearest.ptr<int>();
+  const uint8_t* robot_free = classes.not_robot.ptr<uint8_t>();
+  for (int i = 0; i < num_pixels; ++i) {
+    if (robot_free[i] == 0) {
+      const int k = nearest_label[i];
+      if (k >= static_cast<int>(pixel_of_label.size())) pixel_of_label.resize(k + 1, -1);
+      pixel_of_label[k] = i;
+    }
+  }
+  // The camera-frame point (optical frame, m) of pixel i at depth_mm.
+  auto point_m = [&](int i, int depth_mm) {
+    const double z = metres_from_mm(depth_mm);
+    return cv::Point3d((i % width - camera.cx) * z / camera.fx, (i / width - camera.cy) * z / camera.fy, z);
+  };
+  const uint8_t* candidate = candidates.ptr<uint8_t>();
+  double min_distance = std::numeric_limits<double>::infinity();
+  double area = 0;
+  for (int i = 0; i < num_pixels; ++i) {
+    if (candidate[i] == 0) continue;
+    double distance_m;
+    if (pixel_class[i] == discrepancy_t::PIXEL_OCCLUDED) {
+      distance_m = metres_from_mm(gen[i] - tof[i]);
+    } else {
+      const int k = nearest_label[i];
+      const int arm = k < static_cast<int>(pixel_of_label.size()) ? pixel_of_label[k] : -1;
+      if (arm < 0) continue;
+      distance_m = cv::norm(point_m(i, tof[i]) - point_m(arm, gen[arm]));
+    }
+    if (distance_m <= parameters.near_arm_m) {
+      s->near_arm_pixels++;
+      area += footprint.m2(i);
+      min_distance = std::min(min_distance, distance_m);
+    }
+  }
+  s->near_arm_area_m2 = static_cast<float>(area);
+  if (s->near_arm_pixels > 0) s->near_arm_min_distance_m = static_cast<float>(min_distance);
 }
 
 }  // namespace
@@ -139,28 +442,26 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
     frame.summary = unusable_summary(camera, discrepancy_t::UNUSABLE_MISMATCHED, why);
     return frame;
   }
-
-  const int width = camera.width;
-  const int height = camera.height;
-  const int num_pixels = width * height;
-  // Every loop below reads the three images through raw pointers up to
-  // num_pixels. The wire checks (num_pixels == width * height, decoded
-  // arrays of num_pixels) and mismatch_reason (same sizes) guarantee it; a
-  // caller that skipped them would read past the end.
+  // Every stage below reads the three images through raw pointers up to
+  // width * height pixels. The wire checks (num_pixels == width * height,
+  // decoded arrays of num_pixels) and mismatch_reason (same sizes) guarantee
+  // it; a caller that skipped them would read past the end.
+  const int num_pixels = camera.width * camera.height;
   TOFGUARD_DEMAND(camera.depth_mm.size() == static_cast<size_t>(num_pixels) &&
                       rendered.depth_mm.size() == static_cast<size_t>(num_pixels) &&
                       labels.label.size() == static_cast<size_t>(num_pixels),
                   "frame seq " + std::to_string(camera.seq) + ": image arrays do not hold width*height = " +
                       std::to_string(num_pixels) + " pixels");
-  const int num_links = labels.num_links;
-  const int num_robot_links = labels.num_robot_links;
-  const int num_environment_links = num_links - num_robot_links;
+  if (const std::string why = check_labels(labels); !why.empty()) {
+    frame.summary = unusable_summary(camera, discrepancy_t::UNUSABLE_MISMATCHED, why);
+    return frame;
+  }
 
+  const int num_links = labels.num_links;
   discrepancy_t& s = frame.summary;
   s = unusable_summary(camera, discrepancy_t::UNUSABLE_NONE, "");
   s.usable = true;
-  s.num_invalid = 0;
-  s.num_robot_links = num_robot_links;
+  s.num_robot_links = labels.num_robot_links;
   s.num_links = num_links;
   s.link_name = labels.link_name;
   s.link_compared.assign(num_links, 0);
@@ -170,225 +471,34 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
   s.link_invalid.assign(num_links, 0);
   s.link_median_dis_mm.assign(num_links, 0.0f);
 
-  frame.pixel_class.create(height, width);
-  frame.dis_mm.create(height, width);
-  // Mismatches between modelled surfaces (for blobs), and nearer surfaces
-  // (occluded or unexpected, for near-arm objects).
-  cv::Mat1b mismatch_mask(height, width, uint8_t{0});
-  cv::Mat1b nearer_mask(height, width, uint8_t{0});
-  // 0 where the model has a robot link, 255 elsewhere (distance transform).
-  cv::Mat1b not_robot(height, width, uint8_t{255});
+  // The images first, then the per-frame scratch, in this order: it keeps
+  // the heap's layout (and its page faults) as they were when this was one
+  // function.
+  frame.pixel_class.create(camera.height, camera.width);
+  frame.dis_mm.create(camera.height, camera.width);
+  PixelClasses classes(camera.height, camera.width);
+  const std::vector<uint8_t> silhouette = silhouette_mask(rendered, parameters.silhouette_jump_mm);
+  classify_pixels(camera, rendered, labels, silhouette, parameters.tolerance, &frame, &classes);
 
-  // Per link, plus one for modelled pixels without a link label.
-  std::vector<Histogram> link_dis(num_links + 1);
-  double sum_abs = 0;
-  int num_compared = 0;
-  int counts[6] = {0, 0, 0, 0, 0, 0};
-  bool any_robot = false;
-
-  const int16_t* tof = camera.depth_mm.data();
-  const int16_t* gen = rendered.depth_mm.data();
-  const int16_t* label = labels.label.data();
-  uint8_t* pixel_class = frame.pixel_class.ptr<uint8_t>();
-  int32_t* dis = frame.dis_mm.ptr<int32_t>();
-  uint8_t* mismatch = mismatch_mask.ptr<uint8_t>();
-  uint8_t* nearer = nearer_mask.ptr<uint8_t>();
-  uint8_t* robot_free = not_robot.ptr<uint8_t>();
-
-  // Silhouette pixels: beside a rendered depth step (or the model's
-  // outline). A ToF pixel there mixes both surfaces, so its I_dis says
-  // nothing about a link's pose; on a thin link (a finger three pixels
-  // wide) it would otherwise be most of the link.
-  std::vector<uint8_t> silhouette(num_pixels, 0);
-  for (int v = 0; v < height && parameters.silhouette_jump_mm > 0; ++v) {
-    for (int u = 0; u < width; ++u) {
-      const int i = v * width + u;
-      const int neighbours[2] = {u + 1 < width ? i + 1 : -1, v + 1 < height ? i + width : -1};
-      for (int n : neighbours) {
-        if (n < 0) continue;
-        const int a = gen[i] > 0 ? gen[i] : 0;
-        const int b = gen[n] > 0 ? gen[n] : 0;
-        if ((a > 0) != (b > 0) || std::abs(a - b) > parameters.silhouette_jump_mm) {
-          silhouette[i] = 1;
-          silhouette[n] = 1;
-        }
-      }
-    }
-  }
-
-  for (int i = 0; i < num_pixels; ++i) {
-    const int l = label[i];
-    const int link = link_of_label(l, num_robot_links, num_links);
-    if (link < 0 && l != kLabelNothing) {
-      std::ostringstream why;
-      why << "label[" << i << "]: expected " << kLabelNothing << ", " << kLabelRobotFirst << ".."
-          << kLabelRobotFirst + num_robot_links - 1 << " or " << kLabelEnvironmentFirst << ".."
-          << kLabelEnvironmentFirst + num_environment_links - 1 << ", got " << l;
-      frame = DiscrepancyFrame{};
-      frame.summary = unusable_summary(camera, discrepancy_t::UNUSABLE_MISMATCHED, why.str());
-      return frame;
-    }
-    const int t = tof[i];
-    const int g = gen[i];
-    const bool modelled = g > 0;
-    const bool robot = modelled && link >= 0 && link < num_robot_links;
-    if (robot) {
-      robot_free[i] = 0;
-      any_robot = true;
-    }
-    dis[i] = 0;
-    int8_t c;
-    if (t <= 0) {
-      c = discrepancy_t::PIXEL_INVALID;
-      if (link >= 0 && modelled) s.link_invalid[link]++;
-    } else if (!modelled) {
-      // The camera sees a surface where the model has none.
-      c = discrepancy_t::PIXEL_UNEXPECTED_SURFACE;
-      nearer[i] = 255;
-    } else {
-      const int d = g - t;
-      dis[i] = d;
-      const int magnitude = std::abs(d);
-      sum_abs += magnitude;
-      ++num_compared;
-      link_dis[link >= 0 ? link : num_links].add(d);
-      if (magnitude <= parameters.tolerance.at(t)) {
-        c = discrepancy_t::PIXEL_MATCH;
-      } else if (d > 0) {
-        c = robot ? discrepancy_t::PIXEL_OCCLUDED : discrepancy_t::PIXEL_UNEXPECTED_SURFACE;
-        nearer[i] = silhouette[i] ? 0 : 255;
-        mismatch[i] = silhouette[i] ? 0 : 255;
-      } else {
-        c = robot ? discrepancy_t::PIXEL_ROBOT_MISSING : discrepancy_t::PIXEL_ENVIRONMENT_MISSING;
-        mismatch[i] = silhouette[i] ? 0 : 255;
-      }
-      if (link >= 0 && !silhouette[i]) {
-        s.link_compared[link]++;
-        if (c == discrepancy_t::PIXEL_MATCH) {
-          s.link_match[link]++;
-        } else if (d > 0) {
-          s.link_nearer[link]++;
-        } else {
-          s.link_farther[link]++;
-        }
-      }
-    }
-    pixel_class[i] = static_cast<uint8_t>(c);
-    counts[c]++;
-  }
-
-  s.num_match = counts[discrepancy_t::PIXEL_MATCH];
-  s.num_robot_missing = counts[discrepancy_t::PIXEL_ROBOT_MISSING];
-  s.num_occluded = counts[discrepancy_t::PIXEL_OCCLUDED];
-  s.num_unexpected_surface = counts[discrepancy_t::PIXEL_UNEXPECTED_SURFACE];
-  s.num_environment_missing = counts[discrepancy_t::PIXEL_ENVIRONMENT_MISSING];
-  s.num_invalid = counts[discrepancy_t::PIXEL_INVALID];
+  // The seed's score and the class counts.
+  s.num_match = classes.count[discrepancy_t::PIXEL_MATCH];
+  s.num_robot_missing = classes.count[discrepancy_t::PIXEL_ROBOT_MISSING];
+  s.num_occluded = classes.count[discrepancy_t::PIXEL_OCCLUDED];
+  s.num_unexpected_surface = classes.count[discrepancy_t::PIXEL_UNEXPECTED_SURFACE];
+  s.num_environment_missing = classes.count[discrepancy_t::PIXEL_ENVIRONMENT_MISSING];
+  s.num_invalid = classes.count[discrepancy_t::PIXEL_INVALID];
   s.invalid_fraction = static_cast<float>(s.num_invalid) / static_cast<float>(num_pixels);
-  s.num_compared = num_compared;
-  s.sum_abs_dis_mm = sum_abs;
+  s.num_compared = classes.num_compared;
+  s.sum_abs_dis_mm = classes.sum_abs_dis_mm;
   s.normalized_sum_abs_dis =
-      s.num_compared > 0 ? sum_abs / (s.num_compared * parameters.max_depth_mm) : 0.0;
+      s.num_compared > 0 ? classes.sum_abs_dis_mm / (s.num_compared * parameters.max_depth_mm) : 0.0;
   s.mismatch_fraction =
       s.num_compared > 0 ? static_cast<float>(s.num_compared - s.num_match) / s.num_compared : 0.0f;
-  Histogram robot_dis;
-  Histogram environment_dis;
-  for (int link = 0; link < num_links; ++link) {
-    s.link_median_dis_mm[link] = link_dis[link].median();
-    (link < num_robot_links ? robot_dis : environment_dis).add(link_dis[link]);
-  }
-  Histogram all_dis = robot_dis;
-  all_dis.add(environment_dis);
-  all_dis.add(link_dis[num_links]);
-  const Histogram abs_dis = all_dis.folded();
-  s.median_abs_dis_mm = abs_dis.median();
-  s.p95_abs_dis_mm = abs_dis.quantile(0.95);
-  s.robot_median_dis_mm = robot_dis.median();
-  s.environment_median_dis_mm = environment_dis.median();
 
-  // Metric footprint of pixel i at the camera's depth (else the model's),
-  // square metres.
-  const double inv_fx_fy = 1.0 / (camera.fx * camera.fy);
-  auto footprint_m2 = [&](int i) {
-    const double z_m = metres_from_mm(tof[i] > 0 ? tof[i] : gen[i]);
-    return z_m * z_m * inv_fx_fy;
-  };
-
-  // Largest blob of mismatching modelled pixels.
-  {
-    const cv::Mat1b blobs = opened(mismatch_mask, parameters.opening_radius_px);
-    cv::Mat1i component;
-    cv::Mat stats;
-    cv::Mat centroids;
-    const int n = cv::connectedComponentsWithStats(blobs, component, stats, centroids, 8, CV_32S);
-    int largest = 0;
-    for (int k = 1; k < n; ++k) {
-      if (largest == 0 ||
-          stats.at<int>(k, cv::CC_STAT_AREA) > stats.at<int>(largest, cv::CC_STAT_AREA)) {
-        largest = k;
-      }
-    }
-    if (largest > 0) {
-      s.largest_blob_pixels = stats.at<int>(largest, cv::CC_STAT_AREA);
-      double area = 0;
-      const int* comp = component.ptr<int>();
-      for (int i = 0; i < num_pixels; ++i) {
-        if (comp[i] == largest) area += footprint_m2(i);
-      }
-      s.largest_blob_area_m2 = static_cast<float>(area);
-    }
-  }
-
-  // Nearer surfaces close to the modelled arm. For an occluded pixel the
-  // distance is how far in front of the arm the surface is; for an
-  // unexpected surface it is the 3-D distance to the modelled arm point at
-  // the nearest robot pixel in the image (an approximation of the distance
-  // to the arm's visible surface).
-  {
-    const cv::Mat1b candidates = opened(nearer_mask, parameters.opening_radius_px);
-    s.near_arm_min_distance_m = -1;
-    if (any_robot && cv::countNonZero(candidates) > 0) {
-      cv::Mat1f distance_px;
-      cv::Mat1i nearest;
-      cv::distanceTransform(not_robot, distance_px, nearest, cv::DIST_L2, cv::DIST_MASK_5,
-                            cv::DIST_LABEL_PIXEL);
-      // Each robot pixel carries its own label: label -> pixel index.
-      std::vector<int> pixel_of_label;
-      const int* nearest_label = nearest.ptr<int>();
-      for (int i = 0; i < num_pixels; ++i) {
-        if (robot_free[i] == 0) {
-          const int k = nearest_label[i];
-          if (k >= static_cast<int>(pixel_of_label.size())) pixel_of_label.resize(k + 1, -1);
-          pixel_of_label[k] = i;
-        }
-      }
-      auto point_m = [&](int i, int depth_mm) {
-        const double z = metres_from_mm(depth_mm);
-        return cv::Point3d((i % width - camera.cx) * z / camera.fx, (i / width - camera.cy) * z / camera.fy, z);
-      };
-      const uint8_t* candidate = candidates.ptr<uint8_t>();
-      double min_distance = std::numeric_limits<double>::infinity();
-      double area = 0;
-      for (int i = 0; i < num_pixels; ++i) {
-        if (candidate[i] == 0) continue;
-        double distance_m;
-        if (pixel_class[i] == discrepancy_t::PIXEL_OCCLUDED) {
-          distance_m = metres_from_mm(gen[i] - tof[i]);
-        } else {
-          const int k = nearest_label[i];
-          const int arm = k < static_cast<int>(pixel_of_label.size()) ? pixel_of_label[k] : -1;
-          if (arm < 0) continue;
-          distance_m = cv::norm(point_m(i, tof[i]) - point_m(arm, gen[arm]));
-        }
-        if (distance_m <= parameters.near_arm_m) {
-          s.near_arm_pixels++;
-          area += footprint_m2(i);
-          min_distance = std::min(min_distance, distance_m);
-        }
-      }
-      s.near_arm_area_m2 = static_cast<float>(area);
-      if (s.near_arm_pixels > 0) s.near_arm_min_distance_m = static_cast<float>(min_distance);
-    }
-  }
+  const DisHistograms histograms = per_link_statistics(frame, camera, rendered, labels, silhouette, &s);
+  const PixelFootprint footprint(camera, rendered);
+  largest_blob(classes.mismatch_mask, parameters.opening_radius_px, footprint, &s);
+  near_arm_surfaces(camera, rendered, frame, classes, parameters, footprint, &s);
   return frame;
 }
 

@@ -43,7 +43,7 @@ void BM_Estimate(benchmark::State& state) {
   options.noise_sigma_at_0m_m = config.discrepancy.noise_sigma_at_0m_mm / 1000;
   options.noise_sigma_per_m2_m = config.discrepancy.noise_sigma_per_m2_mm / 1000;
   MotionEstimator estimator(frames.scene(), &frames.renderer(), options);
-  const renderer::JointPositions truth = {{"a1", -0.6}, {"a2", 1.3}, {"a3", -0.4}, {"a4", 1.2},
+  const robot_model::JointPositions truth = {{"a1", -0.6}, {"a2", 1.3}, {"a3", -0.4}, {"a4", 1.2},
                                           {"a5", 0.6},  {"a6", 1.0}, {"a7", -0.4}};
   const Eigen::Isometry3d camera = config.camera.pose.frame_from_optical();
   const Intrinsics intrinsics =

@@ -10,8 +10,7 @@
 #include <iostream>
 
 #include "tofguard/renderer/depth_renderer.hpp"
-#include "tofguard/renderer/kinematics.hpp"
-#include "tofguard/common/camera_pose_message.hpp"
+#include "tofguard/robot_model/kinematics.hpp"
 #include "tofguard/common/config_error.hpp"
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/common/lcm_node.hpp"
@@ -39,43 +38,25 @@ EstimatorOptions options_from_settings(const EstimatorProcessSettings& settings)
   return o;
 }
 
-renderer::SceneModel load_estimator_scene(const EstimatorProcessSettings& settings) {
-  renderer::SceneOptions options;
-  options.geometry = renderer::GeometrySource::kVisual;
+robot_model::SceneModel load_estimator_scene(const EstimatorProcessSettings& settings) {
+  robot_model::SceneOptions options;
+  options.geometry = robot_model::GeometrySource::kVisual;
   options.padding_m = 0;
   options.package_paths = settings.robot.package_paths;
-  return renderer::load_scene(settings.robot.urdf_path, settings.environment.urdf_paths, options);
+  return robot_model::load_scene(settings.robot.urdf_path, settings.environment.urdf_paths, options);
 }
 
-std::string moving_joint_of(const renderer::SceneModel& scene, int link) {
-  for (int j = scene.links[link].parent_joint; j >= 0; j = scene.links[scene.joints[j].parent_link].parent_joint) {
-    if (scene.joints[j].type != renderer::JointType::kFixed) return scene.joints[j].name;
-  }
-  return "";
-}
-
-EstimatorScheduler::EstimatorScheduler(const EstimatorProcessSettings& settings, const renderer::SceneModel& scene)
+EstimatorScheduler::EstimatorScheduler(const EstimatorProcessSettings& settings, const robot_model::SceneModel& scene)
     : settings_(settings),
       scene_(scene),
-      history_(settings.renderer.max_extrapolation_us),
-      camera_poses_(settings.renderer.camera_pose_history_us,
-                    settings.renderer.camera_pose_max_extrapolation_us,
-                    settings.renderer.camera_pose_max_gap_us) {
-  camera_poses_.set_static(settings.camera.id, settings.camera.pose);
-}
+      state_(renderer::state_history_settings(settings.renderer, settings.robot.id, settings.camera)) {}
 
 bool EstimatorScheduler::on_joint_state(const joint_state_t& state) {
-  if (state.robot_id != settings_.robot.id) return false;
-  renderer::JointPositions positions;
-  for (int i = 0; i < state.num_joints; ++i) positions[state.name[i]] = state.position[i];
-  const bool added = history_.add(state.utime, positions);
   // A frame waiting for its joints may now be ready.
-  return added;
+  return state_.add_joint_state(state);
 }
 
-void EstimatorScheduler::on_camera_pose(const camera_pose_t& message) {
-  camera_poses_.add(message.camera_id, message.utime, from_camera_pose_message(message));
-}
+void EstimatorScheduler::on_camera_pose(const camera_pose_t& message) { state_.add_camera_pose(message); }
 
 bool EstimatorScheduler::on_depth(const depth_image_t& frame) {
   if (frame.camera_id != settings_.camera.id) return false;
@@ -165,12 +146,12 @@ std::vector<ScheduledWork> EstimatorScheduler::take_ready() {
 std::optional<EstimatorFrame> EstimatorScheduler::estimator_frame(const depth_image_t& frame,
                                                                   const std::string& frame_id,
                                                                   std::string* why) const {
-  const renderer::JointsAtTime joints = history_.at(frame.utime);
-  if (!joints.usable) {
-    *why = "joint state: " + joints.unusable_reason;
+  const robot_state::StateAtFrame state = state_.at(frame.camera_id, frame.utime);
+  if (!state.joints.usable) {
+    *why = "joint state: " + state.joints.unusable_reason;
     return std::nullopt;
   }
-  const renderer::PoseAtTime pose = camera_poses_.at(frame.camera_id, frame.utime);
+  const robot_state::PoseAtTime& pose = state.camera_pose;
   if (!pose.usable) {
     *why = "camera pose: " + pose.unusable_reason;
     return std::nullopt;
@@ -186,20 +167,20 @@ std::optional<EstimatorFrame> EstimatorScheduler::estimator_frame(const depth_im
   }
   // A camera on a moving link would move with the joints being estimated:
   // not modelled.
-  const std::string moving = moving_joint_of(scene_, frame_link);
+  const std::string moving = scene_.nearest_movable_joint_above(frame_id);
   if (!moving.empty()) {
     *why = "camera pose frame '" + frame_id + "' moves with joint '" + moving +
            "': a camera on the arm is not supported by the estimator";
     return std::nullopt;
   }
-  const renderer::LinkPoses poses = renderer::forward_kinematics(scene_, joints.joints);
+  const robot_model::LinkPoses poses = robot_model::forward_kinematics(scene_, state.joints.joints);
   if (!poses.usable) {
     *why = poses.unusable_reason;
     return std::nullopt;
   }
   EstimatorFrame out;
   out.intrinsics = intrinsics_of(frame);
-  out.reported_joints = joints.joints;
+  out.reported_joints = state.joints.joints;
   out.world_from_optical = poses.world_from_link[frame_link] * pose.pose.frame_from_optical();
   out.depth_m = depth_m_of(frame);
   return out;
@@ -213,15 +194,15 @@ ScheduledWork EstimatorScheduler::build(const depth_image_t& frame, int8_t trigg
   context.camera_id = frame.camera_id;
   context.trigger = trigger;
   context.joint_names = scene_.actuated_joint_names;
-  const renderer::PoseAtTime pose = camera_poses_.at(frame.camera_id, frame.utime);
-  if (pose.usable) {
-    context.frame_id = pose.pose.frame_id;
-    context.frame_from_optical = pose.pose.frame_from_optical();
+  const robot_state::StateAtFrame state = state_.at(frame.camera_id, frame.utime);
+  if (state.camera_pose.usable) {
+    context.frame_id = state.camera_pose.pose.frame_id;
+    context.frame_from_optical = state.camera_pose.pose.frame_from_optical();
   }
-  const renderer::JointsAtTime joints = history_.at(frame.utime);
+  const robot_model::JointPositions& joints = state.joints.joints;
   for (const std::string& name : context.joint_names) {
-    const auto found = joints.joints.find(name);
-    context.reported_positions.push_back(found != joints.joints.end() ? found->second : 0.0);
+    const auto found = joints.find(name);
+    context.reported_positions.push_back(found != joints.end() ? found->second : 0.0);
   }
   std::string why;
   std::optional<EstimatorFrame> first = estimator_frame(frame, context.frame_id, &why);
@@ -249,7 +230,7 @@ ScheduledWork EstimatorScheduler::build(const depth_image_t& frame, int8_t trigg
   return work;
 }
 
-EstimatorWorker::EstimatorWorker(const renderer::SceneModel& scene, const EstimatorProcessSettings& settings)
+EstimatorWorker::EstimatorWorker(const robot_model::SceneModel& scene, const EstimatorProcessSettings& settings)
     : scene_(scene), settings_(settings), thread_([this] { run(); }) {}
 
 EstimatorWorker::~EstimatorWorker() {
@@ -345,7 +326,7 @@ int run_estimator(const EstimatorProcessSettings& settings) {
   if (nice(10) == -1 && errno != 0) {
     std::cerr << name << ": cannot lower its priority (nice 10): " << std::strerror(errno) << "\n";
   }
-  renderer::SceneModel scene;
+  robot_model::SceneModel scene;
   try {
     scene = load_estimator_scene(settings);
   } catch (const std::exception& e) {

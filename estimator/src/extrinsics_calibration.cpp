@@ -8,9 +8,9 @@
 #include <memory>
 #include <sstream>
 
-#include "tofguard/renderer/depth_renderer.hpp"
 #include "tofguard/estimator/estimator_process.hpp"
-#include "tofguard/renderer/joint_history.hpp"
+#include "tofguard/renderer/depth_renderer.hpp"
+#include "tofguard/robot_state/state_history.hpp"
 #include "tofguard/common/decode.hpp"
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/depth_image_t.hpp"
@@ -21,7 +21,7 @@ namespace tofguard::estimator {
 
 namespace {
 
-double pose_distance(const renderer::JointPositions& a, const renderer::JointPositions& b) {
+double pose_distance(const robot_model::JointPositions& a, const robot_model::JointPositions& b) {
   double d = 0;
   for (const auto& [name, value] : a) {
     const auto other = b.find(name);
@@ -52,18 +52,21 @@ CalibrationResult calibrate_extrinsics(const EstimatorProcessSettings& settings,
     result.error = log_path + ": cannot open as an LCM log";
     return result;
   }
-  // Every joint state first (the frames need the states around them).
-  renderer::JointHistory history(settings.renderer.max_extrapolation_us,
-                                 std::numeric_limits<int64_t>::max() / 4, std::numeric_limits<size_t>::max());
+  // Every joint state first (the frames need the states around them): the
+  // whole log is kept. The camera pose is the settings' (CAMERA_POSE is not
+  // read: the pose is what is being calibrated).
+  robot_state::StateHistorySettings state_settings =
+      renderer::state_history_settings(settings.renderer, settings.robot.id, settings.camera);
+  state_settings.joint_span_us = std::numeric_limits<int64_t>::max() / 4;
+  state_settings.joint_max_messages = std::numeric_limits<size_t>::max();
+  robot_state::StateHistory history(state_settings);
   std::vector<depth_image_t> frames;
   int joint_states = 0;
   for (const lcm::LogEvent* event = log.readNextEvent(); event != nullptr; event = log.readNextEvent()) {
     if (event->channel == settings.channels.joint_state) {
       const auto state = decode_message<joint_state_t>(event->data, event->datalen);
-      if (!state || !check_joint_state(*state).empty() || state->robot_id != settings.robot.id) continue;
-      renderer::JointPositions positions;
-      for (int i = 0; i < state->num_joints; ++i) positions[state->name[i]] = state->position[i];
-      if (history.add(state->utime, positions)) ++joint_states;
+      if (!state || !check_joint_state(*state).empty()) continue;
+      if (history.add_joint_state(*state)) ++joint_states;
     } else if (event->channel == settings.channels.depth) {
       const auto frame = decode_message<depth_image_t>(event->data, event->datalen);
       if (!frame || !check_depth_image_from(*frame, settings.camera.id).empty()) continue;
@@ -80,13 +83,13 @@ CalibrationResult calibrate_extrinsics(const EstimatorProcessSettings& settings,
     return result;
   }
 
-  const renderer::SceneModel scene = load_estimator_scene(settings);
+  const robot_model::SceneModel scene = load_estimator_scene(settings);
   const int frame_link = scene.find_link(settings.camera.pose.frame_id);
   if (frame_link < 0) {
     result.error = "camera.pose.frame '" + settings.camera.pose.frame_id + "' is not a model link";
     return result;
   }
-  const std::string moving = moving_joint_of(scene, frame_link);
+  const std::string moving = scene.nearest_movable_joint_above(settings.camera.pose.frame_id);
   if (!moving.empty()) {
     result.error = "camera.pose.frame '" + settings.camera.pose.frame_id + "' moves with joint '" + moving +
                    "': only a static camera can be calibrated";
@@ -96,12 +99,12 @@ CalibrationResult calibrate_extrinsics(const EstimatorProcessSettings& settings,
   // Frames with joint states around them, then the most diverse poses.
   struct Candidate {
     const depth_image_t* frame;
-    renderer::JointPositions joints;
+    robot_model::JointPositions joints;
   };
   std::vector<Candidate> candidates;
   for (const depth_image_t& frame : frames) {
-    const renderer::JointsAtTime joints = history.at(frame.utime);
-    if (joints.usable) candidates.push_back({&frame, joints.joints});
+    const robot_state::StateAtFrame state = history.at(frame.camera_id, frame.utime);
+    if (state.joints.usable) candidates.push_back({&frame, state.joints.joints});
   }
   std::vector<const Candidate*> chosen;
   if (!candidates.empty()) chosen.push_back(&candidates.front());
@@ -127,7 +130,7 @@ CalibrationResult calibrate_extrinsics(const EstimatorProcessSettings& settings,
     return result;
   }
 
-  const renderer::LinkPoses static_poses = renderer::forward_kinematics(scene, chosen.front()->joints);
+  const robot_model::LinkPoses static_poses = robot_model::forward_kinematics(scene, chosen.front()->joints);
   if (!static_poses.usable) {
     result.error = static_poses.unusable_reason;
     return result;

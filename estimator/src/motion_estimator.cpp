@@ -13,7 +13,7 @@
 
 namespace tofguard::estimator {
 
-using renderer::JointType;
+using robot_model::JointType;
 
 // The current estimate: joint offsets (added to each frame's reported
 // positions, actuated order) and the camera correction.
@@ -157,7 +157,7 @@ double correction_angle_rad(const EstimateResult& result) {
   return Eigen::AngleAxisd(result.correction.linear()).angle();
 }
 
-MotionEstimator::MotionEstimator(const renderer::SceneModel& scene, renderer::DepthRenderer* renderer,
+MotionEstimator::MotionEstimator(const robot_model::SceneModel& scene, renderer::DepthRenderer* renderer,
                                  const EstimatorOptions& options)
     : scene_(scene), renderer_(renderer), options_(options) {
   if (renderer_ == nullptr) throw std::invalid_argument("MotionEstimator: renderer is null");
@@ -178,7 +178,7 @@ MotionEstimator::MotionEstimator(const renderer::SceneModel& scene, renderer::De
   for (size_t l = 0; l < scene_.links.size(); ++l) {
     int joint_index = scene_.links[l].parent_joint;
     while (joint_index >= 0) {
-      const renderer::Joint& joint = scene_.joints[joint_index];
+      const robot_model::Joint& joint = scene_.joints[joint_index];
       if (joint.type != JointType::kFixed) {
         // A mimic joint moves with its leader: d(value)/d(leader) is the
         // product of the multipliers down the mimic chain.
@@ -213,9 +213,9 @@ std::string MotionEstimator::check_frame(const EstimatorFrame& frame) const {
 
 namespace {
 
-renderer::JointPositions joints_at(const renderer::SceneModel& scene, const EstimatorFrame& frame,
+robot_model::JointPositions joints_at(const robot_model::SceneModel& scene, const EstimatorFrame& frame,
                                    const std::vector<double>& offsets) {
-  renderer::JointPositions joints = frame.reported_joints;
+  robot_model::JointPositions joints = frame.reported_joints;
   for (size_t k = 0; k < offsets.size(); ++k) joints[scene.actuated_joint_names[k]] += offsets[k];
   return joints;
 }
@@ -225,10 +225,10 @@ struct JointAxis {
   Eigen::Vector3d origin_world;
 };
 
-std::vector<JointAxis> joint_axes(const renderer::SceneModel& scene, const renderer::LinkPoses& poses) {
+std::vector<JointAxis> joint_axes(const robot_model::SceneModel& scene, const robot_model::LinkPoses& poses) {
   std::vector<JointAxis> axes(scene.joints.size());
   for (size_t j = 0; j < scene.joints.size(); ++j) {
-    const renderer::Joint& joint = scene.joints[j];
+    const robot_model::Joint& joint = scene.joints[j];
     const Eigen::Isometry3d world_from_joint = poses.world_from_link[joint.parent_link] * joint.parent_from_joint;
     axes[j].axis_world = world_from_joint.linear() * joint.axis;
     axes[j].origin_world = world_from_joint.translation();
@@ -286,151 +286,197 @@ const MotionEstimator::MeasuredEdges& MotionEstimator::edges_of(const EstimatorF
   return edges;
 }
 
+// What the contour and depth terms of one frame rendered at one state
+// share: the rendered images, the joint axes and the camera pose at that
+// state, the measured contours, and the robust scales of this stage.
+struct MotionEstimator::RenderedView {
+  const EstimatorFrame& frame;
+  const State& state;
+  const renderer::RenderResult& rendered;
+  const MeasuredEdges& edges;
+  std::vector<JointAxis> axes;  // per scene joint, world frame
+  Eigen::Isometry3d world_from_optical;
+  Eigen::Matrix3d optical_from_world_rotation;
+  double scale;  // robust (Tukey) scale of the depth term, m
+  int stride;    // depth term on every stride-th pixel
+  bool joints_free;
+  double gate;              // |z_model - z_measured| beyond this is an outlier, m
+  double clip;              // residuals clipped here in clipped_sq, m
+  double sigma_1m;          // noise sigma at 1 m, m
+  double contour_scale_px;  // robust scale of the contour term, px
+  double contour_weight;    // contour px^2 in units of depth m^2
+
+  // The optical-frame point (m) of pixel (u, v) at depth z (m).
+  Eigen::Vector3d back_project(int u, int v, double z) const {
+    const Intrinsics& in = frame.intrinsics;
+    return Eigen::Vector3d((u - in.cx) * z / in.fx, (v - in.cy) * z / in.fy, z);
+  }
+};
+
+void MotionEstimator::add_residual(const RenderedView& view, const std::vector<ChainJoint>& chain,
+                                   const Eigen::Vector3d& m, const Eigen::Vector3d& world, const Eigen::Vector3d& g,
+                                   double residual, double weight, bool count_joint_points, double d_depth_offset,
+                                   Linearization* lin) const {
+  const int n = num_params_;
+  const Eigen::Vector3d g_cross_m = g.cross(m);
+  if (chain.empty() || !view.joints_free) {
+    Linearization::StaticRow row;
+    row << -g, g_cross_m, d_depth_offset;
+    lin->add_static(row, weight, residual);
+    return;
+  }
+  double* row = lin->add_row(weight, residual);
+  row[n + 6] = d_depth_offset;
+  for (const ChainJoint& c : chain) {
+    const JointAxis& axis = view.axes[c.scene_joint];
+    const Eigen::Vector3d d_world = scene_.joints[c.scene_joint].type == JointType::kPrismatic
+                                        ? axis.axis_world
+                                        : Eigen::Vector3d(axis.axis_world.cross(world - axis.origin_world));
+    row[c.param] += c.multiplier * g.dot(view.optical_from_world_rotation * d_world);
+    if (count_joint_points) ++lin->joint_points[c.param];
+  }
+  // The seen frame moved by the twist (v, w): m' = m - v - w x m.
+  for (int k = 0; k < 3; ++k) {
+    row[n + k] = -g[k];
+    row[n + 3 + k] = g_cross_m[k];
+  }
+}
+
+void MotionEstimator::add_contour_term(const RenderedView& view, const std::vector<ChainJoint>& chain, int u, int v,
+                                       Linearization* lin) const {
+  const Intrinsics& in = view.frame.intrinsics;
+  const int width = in.width;
+  const std::vector<float>& model = view.rendered.depth_m;
+  const size_t i = static_cast<size_t>(v) * width + u;
+  const double z_model = model[i];
+  // The direction (image, px) in which the rendered surface steps away:
+  // this pixel is on the model's occluding contour when there is one.
+  Eigen::Vector2d outward = Eigen::Vector2d::Zero();
+  const double contour_jump = options_.contour_jump_fraction * z_model;
+  auto farther = [&](size_t j) { return model[j] > 0 && model[j] - z_model > contour_jump; };
+  if (farther(i - 1)) outward.x() -= 1;
+  if (farther(i + 1)) outward.x() += 1;
+  if (farther(i - width)) outward.y() -= 1;
+  if (farther(i + width)) outward.y() += 1;
+  if (!(outward.squaredNorm() > 0) || view.edges.nearest[i] < 0) return;
+  outward.normalize();
+  const int edge_u = view.edges.nearest[i] % width;
+  const int edge_v = view.edges.nearest[i] / width;
+  const double e = outward.dot(Eigen::Vector2d(u - edge_u, v - edge_v));
+  ++lin->num_contour_points;
+  if (!(std::abs(e) < view.contour_scale_px)) return;
+  const double t = e / view.contour_scale_px;
+  const double tukey = (1 - t * t) * (1 - t * t);
+  const Eigen::Vector3d m = view.back_project(u, v, z_model);
+  const double inv_z = 1.0 / m.z();
+  // d(e)/d(m) = outward^T * d(pixel)/d(m).
+  const Eigen::Vector3d g(outward.x() * in.fx * inv_z, outward.y() * in.fy * inv_z,
+                          -(outward.x() * in.fx * m.x() + outward.y() * in.fy * m.y()) * inv_z * inv_z);
+  add_residual(view, chain, m, view.world_from_optical * m, g, e, tukey * view.contour_weight, false, 0.0, lin);
+  ++lin->num_contour_inliers;
+}
+
+void MotionEstimator::add_depth_term(const RenderedView& view, const std::vector<ChainJoint>& chain, int link, int u,
+                                     int v, Linearization* lin, std::vector<Sample>* samples) const {
+  const Intrinsics& in = view.frame.intrinsics;
+  const int width = in.width;
+  const std::vector<float>& model = view.rendered.depth_m;
+  const std::vector<int16_t>& labels = view.rendered.labels;
+  const size_t i = static_cast<size_t>(v) * width + u;
+  const size_t left = i - 1, right = i + 1, up = i - width, down = i + width;
+  const double z_model = model[i];
+  const int point_stride = chain.empty() ? view.stride : std::min(view.stride, options_.pixel_stride);
+  if (u % point_stride != 0 || v % point_stride != 0) return;
+  const double z_measured = view.frame.depth_m[i];
+  if (!(z_measured > 0) || !std::isfinite(z_measured)) return;
+  bool smooth = true;
+  for (size_t nb : {left, right, up, down}) {
+    smooth = smooth && labels[nb] == labels[i] && std::abs(model[nb] - z_model) < options_.normal_jump_m;
+  }
+  if (!smooth) return;
+  const Eigen::Vector3d m = view.back_project(u, v, z_model);
+  Eigen::Vector3d normal = (view.back_project(u + 1, v, model[right]) - view.back_project(u - 1, v, model[left]))
+                               .cross(view.back_project(u, v + 1, model[down]) - view.back_project(u, v - 1, model[up]));
+  const double normal_norm = normal.norm();
+  if (!(normal_norm > 0)) return;
+  normal /= normal_norm;
+  if (normal.dot(m) > 0) normal = -normal;
+  const Eigen::Vector3d world = view.world_from_optical * m;
+  if (samples != nullptr && !chain.empty()) samples->push_back({link, world});
+
+  // The robot's measured surfaces corrected by the depth offset: the
+  // ToF camera's systematic error (calibration residual, multipath)
+  // shifts a small object's surface along the rays by about the same
+  // amount, which would otherwise turn the distal joints.
+  const bool robot = is_robot_label(labels[i]);
+  const Eigen::Vector3d ray((u - in.cx) / in.fx, (v - in.cy) / in.fy, 1.0);
+  const Eigen::Vector3d d =
+      view.back_project(u, v, z_measured) + (robot ? view.state.robot_depth_offset_m : 0.0) * ray;
+  const double residual = normal.dot(m - d);
+  const double depth_difference = z_model - z_measured;
+  ++lin->num_points;
+  const bool gated = std::abs(depth_difference) > view.gate;
+  const double clipped = gated ? view.clip : std::min(std::abs(residual), view.clip);
+  lin->clipped_sq += clipped * clipped;
+  if (gated || std::abs(residual) >= view.scale) return;
+  const double t = residual / view.scale;
+  const double tukey = (1 - t * t) * (1 - t * t);
+  const double sigma = options_.noise_sigma_at_0m_m + options_.noise_sigma_per_m2_m * z_measured * z_measured;
+  ++lin->num_inliers;
+  add_residual(view, chain, m, world, normal, residual,
+               // (A strided pixel stands for point_stride^2 pixels, so that
+               // the depth and contour terms keep their balance.)
+               point_stride * point_stride * tukey * view.sigma_1m * view.sigma_1m /
+                   (sigma * sigma + options_.model_sigma_m * options_.model_sigma_m),
+               true, robot ? -normal.dot(ray) : 0.0, lin);
+}
+
 std::string MotionEstimator::linearize(const EstimatorFrame& frame, const State& state, double scale, int stride,
                                        PointSet points, bool joints_free, Linearization* lin,
                                        std::vector<Sample>* samples) {
-  const renderer::LinkPoses poses = renderer::forward_kinematics(scene_, joints_at(scene_, frame, state.joint_offsets));
+  const robot_model::LinkPoses poses = robot_model::forward_kinematics(scene_, joints_at(scene_, frame, state.joint_offsets));
   if (!poses.usable) return poses.unusable_reason;
   const Eigen::Isometry3d world_from_optical = frame.world_from_optical * state.correction;
   const renderer::RenderResult rendered = renderer_->render_at(poses, world_from_optical, frame.intrinsics);
   if (!rendered.usable) return "render: " + rendered.unusable_reason;
-  const std::vector<JointAxis> axes = joint_axes(scene_, poses);
-  const Eigen::Matrix3d optical_from_world_rotation = world_from_optical.linear().transpose();
-  const MeasuredEdges& edges = edges_of(frame);
-
-  const Intrinsics& in = frame.intrinsics;
-  const int width = in.width;
-  const int height = in.height;
-  const int n = num_params_;
-  const double gate = options_.gate_scales * scale;
-  const double clip = options_.residual_clip_m;
   const double sigma_1m = options_.noise_sigma_at_0m_m + options_.noise_sigma_per_m2_m;
-  // The contour scale shrinks with the depth scale.
-  const double contour_scale_px = options_.final_contour_scale_px * scale / options_.final_robust_scale_m;
-  const double contour_weight = sigma_1m * sigma_1m / (options_.contour_sigma_px * options_.contour_sigma_px);
-  const std::vector<float>& model = rendered.depth_m;
-  const std::vector<int16_t>& labels = rendered.labels;
-  auto back_project = [&](int u, int v, double z) {
-    return Eigen::Vector3d((u - in.cx) * z / in.fx, (v - in.cy) * z / in.fy, z);
-  };
-  // Adds one residual whose derivative with respect to the model point
-  // (seen optical frame) is `g`.
-  auto add = [&](const std::vector<ChainJoint>& chain, const Eigen::Vector3d& m, const Eigen::Vector3d& world,
-                 const Eigen::Vector3d& g, double residual, double weight, bool count_joint_points,
-                 double d_depth_offset) {
-    const Eigen::Vector3d g_cross_m = g.cross(m);
-    if (chain.empty() || !joints_free) {
-      Linearization::StaticRow row;
-      row << -g, g_cross_m, d_depth_offset;
-      lin->add_static(row, weight, residual);
-      return;
-    }
-    double* row = lin->add_row(weight, residual);
-    row[n + 6] = d_depth_offset;
-    if (joints_free) {
-      for (const ChainJoint& c : chain) {
-        const JointAxis& axis = axes[c.scene_joint];
-        const Eigen::Vector3d d_world = scene_.joints[c.scene_joint].type == JointType::kPrismatic
-                                            ? axis.axis_world
-                                            : Eigen::Vector3d(axis.axis_world.cross(world - axis.origin_world));
-        row[c.param] += c.multiplier * g.dot(optical_from_world_rotation * d_world);
-        if (count_joint_points) ++lin->joint_points[c.param];
-      }
-    }
-    // The seen frame moved by the twist (v, w): m' = m - v - w x m.
-    for (int k = 0; k < 3; ++k) {
-      row[n + k] = -g[k];
-      row[n + 3 + k] = g_cross_m[k];
-    }
+  const RenderedView view{
+      frame,
+      state,
+      rendered,
+      edges_of(frame),
+      joint_axes(scene_, poses),
+      world_from_optical,
+      world_from_optical.linear().transpose(),
+      scale,
+      stride,
+      joints_free,
+      options_.gate_scales * scale,
+      options_.residual_clip_m,
+      sigma_1m,
+      // The contour scale shrinks with the depth scale.
+      options_.final_contour_scale_px * scale / options_.final_robust_scale_m,
+      sigma_1m * sigma_1m / (options_.contour_sigma_px * options_.contour_sigma_px),
   };
 
+  const int width = frame.intrinsics.width;
+  const int height = frame.intrinsics.height;
   for (int v = 1; v + 1 < height; ++v) {
     for (int u = 1; u + 1 < width; ++u) {
       const size_t i = static_cast<size_t>(v) * width + u;
-      const int link = link_of_label(labels[i], scene_.num_robot_links, static_cast<int>(scene_.links.size()));
+      const int link = link_of_label(rendered.labels[i], scene_.num_robot_links, static_cast<int>(scene_.links.size()));
       if (link < 0) continue;
       const std::vector<ChainJoint>& chain = chains_[link];
       if (points == PointSet::kStatic && !chain.empty()) continue;
-      const double z_model = model[i];
-      if (!(z_model > 0)) continue;
-      const size_t left = i - 1, right = i + 1, up = i - width, down = i + width;
-
+      if (!(rendered.depth_m[i] > 0)) continue;
       // Contour term: a rendered occluding contour pixel against the
       // nearest measured one, distance along the contour's normal, pixels.
-      Eigen::Vector2d outward = Eigen::Vector2d::Zero();
-      const double contour_jump = options_.contour_jump_fraction * z_model;
-      auto farther = [&](size_t j) { return model[j] > 0 && model[j] - z_model > contour_jump; };
-      if (farther(left)) outward.x() -= 1;
-      if (farther(right)) outward.x() += 1;
-      if (farther(up)) outward.y() -= 1;
-      if (farther(down)) outward.y() += 1;
-      if (outward.squaredNorm() > 0 && edges.nearest[i] >= 0) {
-        outward.normalize();
-        const int edge_u = edges.nearest[i] % width;
-        const int edge_v = edges.nearest[i] / width;
-        const double e = outward.dot(Eigen::Vector2d(u - edge_u, v - edge_v));
-        ++lin->num_contour_points;
-        if (std::abs(e) < contour_scale_px) {
-          const double t = e / contour_scale_px;
-          const double tukey = (1 - t * t) * (1 - t * t);
-          const Eigen::Vector3d m = back_project(u, v, z_model);
-          const double inv_z = 1.0 / m.z();
-          // d(e)/d(m) = outward^T * d(pixel)/d(m).
-          const Eigen::Vector3d g(outward.x() * in.fx * inv_z, outward.y() * in.fy * inv_z,
-                                  -(outward.x() * in.fx * m.x() + outward.y() * in.fy * m.y()) * inv_z * inv_z);
-          add(chain, m, world_from_optical * m, g, e, tukey * contour_weight, false, 0.0);
-          ++lin->num_contour_inliers;
-        }
-      }
-
+      add_contour_term(view, chain, u, v, lin);
       // Depth term (every stride-th pixel): point-to-plane against the
       // measured point on the same pixel, with the rendered surface's
       // normal from the neighbouring pixels of the same link; none on a
       // silhouette.
-      const int point_stride = chain.empty() ? stride : std::min(stride, options_.pixel_stride);
-      if (u % point_stride != 0 || v % point_stride != 0) continue;
-      const double z_measured = frame.depth_m[i];
-      if (!(z_measured > 0) || !std::isfinite(z_measured)) continue;
-      bool smooth = true;
-      for (size_t nb : {left, right, up, down}) {
-        smooth = smooth && labels[nb] == labels[i] && std::abs(model[nb] - z_model) < options_.normal_jump_m;
-      }
-      if (!smooth) continue;
-      const Eigen::Vector3d m = back_project(u, v, z_model);
-      Eigen::Vector3d normal = (back_project(u + 1, v, model[right]) - back_project(u - 1, v, model[left]))
-                                   .cross(back_project(u, v + 1, model[down]) - back_project(u, v - 1, model[up]));
-      const double normal_norm = normal.norm();
-      if (!(normal_norm > 0)) continue;
-      normal /= normal_norm;
-      if (normal.dot(m) > 0) normal = -normal;
-      const Eigen::Vector3d world = world_from_optical * m;
-      if (samples != nullptr && !chain.empty()) samples->push_back({link, world});
-
-      // The robot's measured surfaces corrected by the depth offset: the
-      // ToF camera's systematic error (calibration residual, multipath)
-      // shifts a small object's surface along the rays by about the same
-      // amount, which would otherwise turn the distal joints.
-      const bool robot = is_robot_label(labels[i]);
-      const Eigen::Vector3d ray((u - in.cx) / in.fx, (v - in.cy) / in.fy, 1.0);
-      const Eigen::Vector3d d = back_project(u, v, z_measured) + (robot ? state.robot_depth_offset_m : 0.0) * ray;
-      const double residual = normal.dot(m - d);
-      const double depth_difference = z_model - z_measured;
-      ++lin->num_points;
-      const bool gated = std::abs(depth_difference) > gate;
-      const double clipped = gated ? clip : std::min(std::abs(residual), clip);
-      lin->clipped_sq += clipped * clipped;
-      if (gated || std::abs(residual) >= scale) continue;
-      const double t = residual / scale;
-      const double tukey = (1 - t * t) * (1 - t * t);
-      const double sigma = options_.noise_sigma_at_0m_m + options_.noise_sigma_per_m2_m * z_measured * z_measured;
-      ++lin->num_inliers;
-      add(chain, m, world, normal, residual,
-          // (A strided pixel stands for point_stride^2 pixels, so that
-          // the depth and contour terms keep their balance.)
-          point_stride * point_stride * tukey * sigma_1m * sigma_1m /
-              (sigma * sigma + options_.model_sigma_m * options_.model_sigma_m),
-          true,
-          robot ? -normal.dot(ray) : 0.0);
+      add_depth_term(view, chain, link, u, v, lin, samples);
     }
   }
   lin->flush();
@@ -555,7 +601,7 @@ int MotionEstimator::search_joints(const EstimatorFrame& frame, State* state, st
     *error = linearize(frame, *state, options_.final_robust_scale_m, options_.pixel_stride, PointSet::kAll, false,
                        &scratch, &samples);
     if (!error->empty()) return moves;
-    const renderer::LinkPoses base = renderer::forward_kinematics(scene_, joints_at(scene_, frame, state->joint_offsets));
+    const robot_model::LinkPoses base = robot_model::forward_kinematics(scene_, joints_at(scene_, frame, state->joint_offsets));
     const Eigen::Isometry3d optical_from_world = (frame.world_from_optical * state->correction).inverse();
 
     // +1 for a point the camera sees where the model puts it, -1 for one
@@ -616,7 +662,7 @@ int MotionEstimator::search_joints(const EstimatorFrame& frame, State* state, st
       for (double offset : grid) {
         std::vector<double> offsets = state->joint_offsets;
         offsets[k] += offset;
-        const renderer::LinkPoses poses = renderer::forward_kinematics(scene_, joints_at(scene_, frame, offsets));
+        const robot_model::LinkPoses poses = robot_model::forward_kinematics(scene_, joints_at(scene_, frame, offsets));
         if (!poses.usable) continue;
         for (size_t l = 0; l < moved.size(); ++l) {
           moved[l] = poses.world_from_link[l] * base.world_from_link[l].inverse();

@@ -33,7 +33,7 @@ BenchScene* friend_arm() {
   static std::unique_ptr<BenchScene> scene = [] {
     auto s = std::make_unique<BenchScene>();
     const std::string models = std::string(TOFGUARD_SOURCE_DIR) + "/config/models/";
-    const SceneModel model = load_scene(models + "friend_arm.urdf", {models + "wheelchair_environment.urdf"}, {});
+    const robot_model::SceneModel model = robot_model::load_scene(models + "friend_arm.urdf", {models + "wheelchair_environment.urdf"}, {});
     s->renderer = std::make_unique<DepthRenderer>(model, 0.1, 8.0);
     s->joints = model.actuated_joint_names;
     s->pose.frame_id = "world";
@@ -52,7 +52,7 @@ BenchScene* iiwa14() {
                       "iiwa14_no_collision_relative.urdf";
     if (!std::filesystem::exists(urdf)) return nullptr;
     auto s = std::make_unique<BenchScene>();
-    const SceneModel model = load_scene(urdf.string(), {}, {});
+    const robot_model::SceneModel model = robot_model::load_scene(urdf.string(), {}, {});
     s->renderer = std::make_unique<DepthRenderer>(model, 0.1, 8.0);
     s->joints = model.actuated_joint_names;
     // 2 m in front of the arm, looking back at it (see the scene tests).
@@ -60,9 +60,9 @@ BenchScene* iiwa14() {
     s->pose.translation_m = Eigen::Vector3d(2.0, 0, 0.65);
     s->pose.rotation = Eigen::Quaterniond(0.5, -0.5, -0.5, 0.5);
     int closed = 0;
-    for (const TriangleMesh& mesh : model.meshes) closed += mesh.closed_outward;
+    for (const robot_model::TriangleMesh& mesh : model.meshes) closed += mesh.closed_outward;
     std::cerr << "iiwa14 visual: " << model.num_triangles() << " triangles, " << model.shapes.size() << " shapes, "
-              << closed - kNumUnitMeshes << " of " << model.meshes.size() - kNumUnitMeshes
+              << closed - robot_model::kNumUnitMeshes << " of " << model.meshes.size() - robot_model::kNumUnitMeshes
               << " meshes closed (back faces culled); " << s->renderer->description() << "\n";
     return s;
   }();
@@ -75,7 +75,7 @@ BenchScene* empty_scene() {
     auto s = std::make_unique<BenchScene>();
     const std::string path = (std::filesystem::temp_directory_path() / "tofguard_bench_empty.urdf").string();
     std::ofstream(path) << "<robot name=\"empty\"><link name=\"world\"/></robot>";
-    const SceneModel model = load_scene(path, {}, {});
+    const robot_model::SceneModel model = robot_model::load_scene(path, {}, {});
     s->renderer = std::make_unique<DepthRenderer>(model, 0.1, 8.0);
     s->pose.frame_id = "world";
     return s;
@@ -89,7 +89,7 @@ void render_loop(benchmark::State& state, BenchScene* scene) {
     return;
   }
   const Intrinsics k = intrinsics_at(static_cast<int>(state.range(0)));
-  JointPositions joints;
+  robot_model::JointPositions joints;
   int i = 0;
   size_t seen = 0;
   for (auto _ : state) {

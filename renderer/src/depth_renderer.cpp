@@ -109,7 +109,7 @@ struct DepthRenderer::Impl {
     bool cull_back_faces = false;
   };
 
-  Impl(const SceneModel& scene_in, double near, double far, EglPlatform platform)
+  Impl(const robot_model::SceneModel& scene_in, double near, double far, EglPlatform platform)
       : scene(scene_in), context(platform), near_m(near), far_m(far) {
     upload();
   }
@@ -148,7 +148,7 @@ struct DepthRenderer::Impl {
     // base-vertex draws, so the indices are made absolute here).
     std::vector<float> vertices;
     std::vector<uint32_t> indices;
-    for (const TriangleMesh& mesh : scene.meshes) {
+    for (const robot_model::TriangleMesh& mesh : scene.meshes) {
       const uint32_t base = static_cast<uint32_t>(vertices.size() / 3);
       ranges.push_back(
           {static_cast<GLsizei>(mesh.indices.size()), indices.size() * sizeof(uint32_t), mesh.closed_outward});
@@ -226,7 +226,7 @@ struct DepthRenderer::Impl {
                    reinterpret_cast<const void*>(range.first_index_byte));
   }
 
-  RenderResult render_at(const LinkPoses& poses, const Eigen::Isometry3d& world_from_optical,
+  RenderResult render_at(const robot_model::LinkPoses& poses, const Eigen::Isometry3d& world_from_optical,
                          const Intrinsics& intrinsics, const std::vector<ExtraObject>& extra_objects) {
     RenderResult result;
     result.width = intrinsics.width;
@@ -270,7 +270,7 @@ struct DepthRenderer::Impl {
     glUniformMatrix4fv(clip_from_optical_location, 1, GL_FALSE, projection.data());
 
     const Eigen::Isometry3d optical_from_world = world_from_optical.inverse();
-    for (const Shape& shape : scene.shapes) {
+    for (const robot_model::Shape& shape : scene.shapes) {
       // SceneModel::links: the robot's first, then the environment's.
       const int label = label_of_link(shape.link_index, scene.num_robot_links);
       const Eigen::Matrix4d optical_from_mesh = (optical_from_world * poses.world_from_link[shape.link_index] *
@@ -281,9 +281,9 @@ struct DepthRenderer::Impl {
     }
     for (size_t i = 0; i < extra_objects.size(); ++i) {
       const ExtraObject& o = extra_objects[i];
-      const int mesh = o.kind == ExtraObject::Kind::kBox      ? kUnitBox
-                       : o.kind == ExtraObject::Kind::kSphere ? kUnitSphere
-                                                              : kUnitCylinder;
+      const int mesh = o.kind == ExtraObject::Kind::kBox      ? robot_model::kUnitBox
+                       : o.kind == ExtraObject::Kind::kSphere ? robot_model::kUnitSphere
+                                                              : robot_model::kUnitCylinder;
       const Eigen::Matrix4d optical_from_mesh =
           (optical_from_world * o.world_from_object).matrix() * o.size_m.homogeneous().asDiagonal();
       draw(mesh, optical_from_mesh, kLabelExtraObjectFirst + static_cast<int>(i));
@@ -315,7 +315,7 @@ struct DepthRenderer::Impl {
     return result;
   }
 
-  SceneModel scene;
+  robot_model::SceneModel scene;
   EglContext context;
   double near_m;
   double far_m;
@@ -335,10 +335,10 @@ struct DepthRenderer::Impl {
   bool culling = false;
 };
 
-DepthRenderer::DepthRenderer(const SceneModel& scene, double near_m, double far_m)
+DepthRenderer::DepthRenderer(const robot_model::SceneModel& scene, double near_m, double far_m)
     : DepthRenderer(scene, near_m, far_m, egl_platform_from_environment()) {}
 
-DepthRenderer::DepthRenderer(const SceneModel& scene, double near_m, double far_m, EglPlatform platform) {
+DepthRenderer::DepthRenderer(const robot_model::SceneModel& scene, double near_m, double far_m, EglPlatform platform) {
   if (!(std::isfinite(near_m) && std::isfinite(far_m) && near_m > 0 && far_m > near_m)) {
     throw std::invalid_argument("DepthRenderer: need 0 < near_m < far_m, got near_m " + std::to_string(near_m) +
                                 ", far_m " + std::to_string(far_m));
@@ -352,9 +352,9 @@ DepthRenderer::DepthRenderer(const SceneModel& scene, double near_m, double far_
 
 DepthRenderer::~DepthRenderer() = default;
 
-RenderResult DepthRenderer::render(const JointPositions& joints, const CameraPose& camera_pose,
+RenderResult DepthRenderer::render(const robot_model::JointPositions& joints, const CameraPose& camera_pose,
                                    const Intrinsics& intrinsics, const std::vector<ExtraObject>& extra_objects) {
-  LinkPoses poses = forward_kinematics(impl_->scene, joints);
+  robot_model::LinkPoses poses = robot_model::forward_kinematics(impl_->scene, joints);
   Eigen::Isometry3d world_from_optical = Eigen::Isometry3d::Identity();
   if (poses.usable) {
     const int frame = impl_->scene.find_link(camera_pose.frame_id);
@@ -370,7 +370,7 @@ RenderResult DepthRenderer::render(const JointPositions& joints, const CameraPos
   return impl_->render_at(poses, world_from_optical, intrinsics, extra_objects);
 }
 
-RenderResult DepthRenderer::render_at(const LinkPoses& link_poses, const Eigen::Isometry3d& world_from_optical,
+RenderResult DepthRenderer::render_at(const robot_model::LinkPoses& link_poses, const Eigen::Isometry3d& world_from_optical,
                                       const Intrinsics& intrinsics, const std::vector<ExtraObject>& extra_objects) {
   return impl_->render_at(link_poses, world_from_optical, intrinsics, extra_objects);
 }

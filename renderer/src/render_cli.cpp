@@ -62,8 +62,8 @@ std::string render_cli_usage() {
 int run_render_cli(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
   std::string robot_urdf, out_path, labels_path, frame;
   std::vector<std::string> environment_urdfs;
-  SceneOptions options;
-  JointPositions joints;
+  robot_model::SceneOptions options;
+  robot_model::JointPositions joints;
   CameraPose pose;
   Intrinsics intrinsics;
   bool have_pose = false, have_intrinsics = false;
@@ -82,7 +82,7 @@ int run_render_cli(const std::vector<std::string>& args, std::ostream& out, std:
       } else if (option == "--env") {
         environment_urdfs.push_back(value);
       } else if (option == "--geometry") {
-        options.geometry = parse_geometry_source(value);
+        options.geometry = robot_model::parse_geometry_source(value);
       } else if (option == "--padding") {
         options.padding_m = parse_numbers(option, value, 1)[0];
       } else if (option == "--package-path") {
@@ -123,13 +123,13 @@ int run_render_cli(const std::vector<std::string>& args, std::ostream& out, std:
   } catch (const UsageError& e) {
     err << "tofguard-renderer render: " << e.what() << "\n" << render_cli_usage();
     return 2;
-  } catch (const ModelError& e) {  // --geometry
+  } catch (const robot_model::ModelError& e) {  // --geometry
     err << "tofguard-renderer render: " << e.what() << "\n";
     return 2;
   }
 
   try {
-    const SceneModel scene = load_scene(robot_urdf, environment_urdfs, options);
+    const robot_model::SceneModel scene = robot_model::load_scene(robot_urdf, environment_urdfs, options);
     pose.frame_id = frame.empty() ? scene.links.front().name : frame;
     DepthRenderer renderer(scene, near_m, far_m);
     const RenderResult result = renderer.render(joints, pose, intrinsics);

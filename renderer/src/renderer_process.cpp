@@ -6,7 +6,6 @@
 #include <stdexcept>
 #include <vector>
 
-#include "tofguard/common/camera_pose_message.hpp"
 #include "tofguard/common/config_error.hpp"
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/common/lcm_node.hpp"
@@ -21,9 +20,9 @@ ProcessInfo process_info() {
           "Also: tofguard-renderer render --help (one image to PNG files)."};
 }
 
-SceneOptions scene_options(const RendererSettings& renderer, const RobotSettings& robot) {
-  SceneOptions options;
-  options.geometry = parse_geometry_source(renderer.geometry);
+robot_model::SceneOptions scene_options(const RendererSettings& renderer, const RobotSettings& robot) {
+  robot_model::SceneOptions options;
+  options.geometry = robot_model::parse_geometry_source(renderer.geometry);
   options.padding_m = renderer.padding_m;
   options.package_paths = robot.package_paths;
   return options;
@@ -31,7 +30,7 @@ SceneOptions scene_options(const RendererSettings& renderer, const RobotSettings
 
 namespace {
 
-std::unique_ptr<DepthRenderer> make_renderer(const SceneModel& scene, const RendererSettings& config) {
+std::unique_ptr<DepthRenderer> make_renderer(const robot_model::SceneModel& scene, const RendererSettings& config) {
   if (config.far_m > kMaxFarM) {
     throw std::invalid_argument("renderer.far_m must be at most " + std::to_string(kMaxFarM) +
                                 " m (depth_mm is int16 millimetres), got " + std::to_string(config.far_m));
@@ -43,28 +42,14 @@ std::unique_ptr<DepthRenderer> make_renderer(const SceneModel& scene, const Rend
 
 RendererService::RendererService(const RendererProcessSettings& settings)
     : settings_(settings),
-      scene_(load_scene(settings.robot.urdf_path, settings.environment.urdf_paths,
-                        scene_options(settings.renderer, settings.robot))),
+      scene_(robot_model::load_scene(settings.robot.urdf_path, settings.environment.urdf_paths,
+                                     scene_options(settings.renderer, settings.robot))),
       renderer_(make_renderer(scene_, settings.renderer)),
-      history_(settings.renderer.max_extrapolation_us),
-      camera_poses_(settings.renderer.camera_pose_history_us, settings.renderer.camera_pose_max_extrapolation_us,
-                    settings.renderer.camera_pose_max_gap_us) {
-  camera_poses_.set_static(settings.camera.id, settings.camera.pose);
-  for (const Joint& joint : scene_.joints) {
-    if (joint.type == JointType::kPrismatic) prismatic_joints_.insert(joint.name);
-  }
-}
+      state_(state_history_settings(settings.renderer, settings.robot.id, settings.camera)) {}
 
-bool RendererService::on_joint_state(const joint_state_t& state) {
-  if (state.robot_id != settings_.robot.id) return false;
-  JointPositions positions;
-  for (int i = 0; i < state.num_joints; ++i) positions[state.name[i]] = state.position[i];
-  return history_.add(state.utime, positions);
-}
+bool RendererService::on_joint_state(const joint_state_t& state) { return state_.add_joint_state(state); }
 
-bool RendererService::on_camera_pose(const camera_pose_t& message) {
-  return camera_poses_.add(message.camera_id, message.utime, from_camera_pose_message(message));
-}
+bool RendererService::on_camera_pose(const camera_pose_t& message) { return state_.add_camera_pose(message); }
 
 bool RendererService::on_depth(const depth_image_t& frame) {
   const bool dropped = pending_.has_value();
@@ -128,7 +113,7 @@ void RendererService::plan_prediction(const depth_image_t& frame) {
   }
   // The pose for that time now; a moving camera's later reading may differ
   // (then the frame is a miss).
-  const PoseAtTime pose = camera_poses_.at(frame.camera_id, utime);
+  const robot_state::PoseAtTime pose = state_.camera_poses().at(frame.camera_id, utime);
   if (!pose.usable) return;
   p.pose = pose.pose;
   prediction_ = std::move(p);
@@ -143,7 +128,7 @@ void RendererService::render_prediction() {
   prediction_stats_.rendered++;
 }
 
-bool RendererService::prediction_matches(const depth_image_t& frame, const JointPositions& joints,
+bool RendererService::prediction_matches(const depth_image_t& frame, const robot_model::JointPositions& joints,
                                          const CameraPose& pose) const {
   const Prediction& p = *prediction_;
   if (!p.rendered || !p.result.usable || p.camera_id != frame.camera_id || p.intrinsics.width != frame.width ||
@@ -155,7 +140,7 @@ bool RendererService::prediction_matches(const depth_image_t& frame, const Joint
   for (const auto& [joint, predicted] : p.joints) {
     const auto actual = joints.find(joint);
     if (actual == joints.end()) return false;
-    const double tolerance = prismatic_joints_.count(joint) ? r.prediction_joint_tolerance_m
+    const double tolerance = scene_.is_prismatic_joint(joint) ? r.prediction_joint_tolerance_m
                                                             : r.prediction_joint_tolerance_deg * kDegToRad;
     if (!(std::abs(actual->second - predicted) <= tolerance)) return false;
   }
@@ -166,14 +151,11 @@ bool RendererService::prediction_matches(const depth_image_t& frame, const Joint
 
 RenderedFrame RendererService::render(const depth_image_t& frame) {
   learn_period(frame);
-  const JointsAtTime joints = history_.at(frame.utime);
-  const PoseAtTime pose = camera_poses_.at(frame.camera_id, frame.utime);
+  const robot_state::StateAtFrame state = state_.at(frame.camera_id, frame.utime);
   RenderResult result;
-  if (!joints.usable) {
-    result.unusable_reason = joints.unusable_reason;
-  } else if (!pose.usable) {
-    result.unusable_reason = pose.unusable_reason;
-  } else if (prediction_ && prediction_matches(frame, joints.joints, pose.pose)) {
+  if (!state.usable()) {
+    result.unusable_reason = state.unusable_reason();
+  } else if (prediction_ && prediction_matches(frame, state.joints.joints, state.camera_pose.pose)) {
     prediction_stats_.hits++;
     consecutive_misses_ = 0;
     result = std::move(prediction_->result);
@@ -181,7 +163,7 @@ RenderedFrame RendererService::render(const depth_image_t& frame) {
     const bool missed = prediction_ && prediction_->rendered;
     (missed ? prediction_stats_.misses : prediction_stats_.without)++;
     if (missed) ++consecutive_misses_;
-    result = renderer_->render(joints.joints, pose.pose, intrinsics_of(frame));
+    result = renderer_->render(state.joints.joints, state.camera_pose.pose, intrinsics_of(frame));
   }
   RenderedFrame out = make_output(frame, std::move(result));
   plan_prediction(frame);

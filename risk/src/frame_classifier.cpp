@@ -1,6 +1,6 @@
-#include <algorithm>
 #include "tofguard/risk/frame_classifier.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
@@ -16,222 +16,279 @@ std::string fixed(double value, int decimals) {
   return s.str();
 }
 
+void FrameEvidence::build_link_views() const {
+  if (built_) return;
+  built_ = true;
+  // The loop below indexes six per-link arrays by i < num_links and splits
+  // robot from environment links at num_robot_links; a discrepancy that
+  // passed its wire check has them consistent. (Checked here, after the
+  // sensor rules: an unusable frame carries no per-link arrays.)
+  TOFGUARD_DEMAND(frame.num_robot_links >= 0 && frame.num_robot_links <= frame.num_links && frame.num_links >= 0 &&
+                      frame.link_name.size() == static_cast<size_t>(frame.num_links) &&
+                      frame.link_compared.size() == static_cast<size_t>(frame.num_links) &&
+                      frame.link_match.size() == static_cast<size_t>(frame.num_links) &&
+                      frame.link_farther.size() == static_cast<size_t>(frame.num_links),
+                  "discrepancy seq " + std::to_string(frame.seq) + ": per-link arrays do not match num_links " +
+                      std::to_string(frame.num_links));
+  for (int i = 0; i < frame.num_links; ++i) {
+    if (i >= frame.num_robot_links) {
+      environment_compared_ += frame.link_compared[i];
+      environment_match_ += frame.link_match[i];
+      continue;
+    }
+    if (frame.link_compared[i] < config.min_link_pixels) continue;
+    LinkView view;
+    view.name = frame.link_name[i];
+    view.compared = frame.link_compared[i];
+    view.mismatch = static_cast<double>(frame.link_compared[i] - frame.link_match[i]) / frame.link_compared[i];
+    view.missing = static_cast<double>(frame.link_farther[i]) / frame.link_compared[i];
+    visible_.push_back(view);
+  }
+}
+
+const std::vector<LinkView>& FrameEvidence::visible_links() const {
+  build_link_views();
+  return visible_;
+}
+
+int64_t FrameEvidence::environment_compared() const {
+  build_link_views();
+  return environment_compared_;
+}
+
+int64_t FrameEvidence::environment_match() const {
+  build_link_views();
+  return environment_match_;
+}
+
 namespace {
 
 FrameFinding finding(int8_t cause, std::string suspect, double score, double threshold, std::string detail) {
   return FrameFinding{cause, std::move(suspect), score, threshold, std::move(detail)};
 }
 
-FrameFinding sensor_finding(const discrepancy_t& f, const RiskSettings& config, const ClassifierContext& context) {
-  if (!f.usable) {
-    if (f.unusable_kind == discrepancy_t::UNUSABLE_NO_RENDERING) {
-      return finding(risk_t::CAUSE_COMPONENT_FAULT, "tofguard-renderer", 1, 0,
-                     "frame not rendered in time: " + f.unusable_reason);
+// ---- Sensor and component faults (debounced with sensor_debounce_frames) ----
+
+// The discrepancy process could not compare the frame: no rendering in time
+// (the renderer is dead or slow), or labels unusable / not fitting it.
+FrameFinding unusable_frame(const FrameEvidence& e) {
+  const discrepancy_t& f = e.frame;
+  if (f.usable) return {};
+  if (f.unusable_kind == discrepancy_t::UNUSABLE_NO_RENDERING) {
+    return finding(risk_t::CAUSE_COMPONENT_FAULT, "tofguard-renderer", 1, 0,
+                   "frame not rendered in time: " + f.unusable_reason);
+  }
+  return finding(risk_t::CAUSE_SENSOR_FAULT, e.context.labels_channel, 1, 0, "frame unusable: " + f.unusable_reason);
+}
+
+// Too many pixels without a return (fraction of the image).
+FrameFinding invalid_pixels(const FrameEvidence& e) {
+  const discrepancy_t& f = e.frame;
+  const RiskSettings& config = e.config;
+  if (!(f.invalid_fraction > config.max_invalid_fraction)) return {};
+  return finding(risk_t::CAUSE_SENSOR_FAULT, e.context.depth_channel, f.invalid_fraction, config.max_invalid_fraction,
+                 "invalid pixels (fraction): " + fixed(100.0 * f.invalid_fraction, 1) + " % have no return, limit " +
+                     fixed(100.0 * config.max_invalid_fraction, 1) + " %");
+}
+
+FrameFinding uncalibrated_camera(const FrameEvidence& e) {
+  if (!e.config.calibrated_required || e.frame.calibrated) return {};
+  return finding(risk_t::CAUSE_SENSOR_FAULT, e.context.depth_channel, 0, 1,
+                 "camera frame not calibrated (calibrated = false) but risk.sensor.calibrated_required");
+}
+
+// The same depth image again while the arm moves (at the frame's capture
+// time): a real ToF camera's noise never repeats.
+FrameFinding frozen_image(const FrameEvidence& e) {
+  const discrepancy_t& f = e.frame;
+  const RiskSettings& config = e.config;
+  if (!e.context.arm_moving || f.repeat_count < config.frozen_repeat_frames) return {};
+  return finding(risk_t::CAUSE_SENSOR_FAULT, e.context.depth_channel, f.repeat_count, config.frozen_repeat_frames,
+                 "frozen image (repeated frames): the same depth image " + std::to_string(f.repeat_count + 1) +
+                     " times in a row while the arm moves");
+}
+
+// ---- What the mismatch looks like ----
+
+// CALIBRATION_ERROR: the static environment and the arm disagree broadly.
+FrameFinding calibration_error(const FrameEvidence& e) {
+  const discrepancy_t& f = e.frame;
+  const RiskSettings& config = e.config;
+  const std::vector<LinkView>& visible = e.visible_links();
+  const int64_t environment_compared = e.environment_compared();
+  if (environment_compared < config.min_environment_pixels) return {};
+  const double environment_mismatch = static_cast<double>(environment_compared - e.environment_match()) /
+                                      static_cast<double>(environment_compared);
+  int mismatching_links = 0;
+  for (const LinkView& link : visible) mismatching_links += link.mismatch >= config.link_mismatch_fraction ? 1 : 0;
+  const double robot_fraction =
+      visible.empty() ? 1.0 : static_cast<double>(mismatching_links) / static_cast<double>(visible.size());
+  // A link fixed to the robot's root (its base) cannot be moved by any
+  // joint: when it mismatches together with most of the arm, the camera
+  // pose is off. (A camera moved by a few centimetres shifts the near arm
+  // far more than a distant floor, which may stay within tolerance.)
+  std::string fixed_link_mismatching;
+  for (const LinkView& link : visible) {
+    if (link.mismatch >= config.link_mismatch_fraction && e.robot.is_robot_link(link.name) &&
+        e.robot.nearest_movable_joint_above(link.name).empty()) {
+      fixed_link_mismatching = link.name;
     }
-    return finding(risk_t::CAUSE_SENSOR_FAULT, context.labels_channel, 1, 0,
-                   "frame unusable: " + f.unusable_reason);
   }
-  if (f.invalid_fraction > config.max_invalid_fraction) {
-    return finding(risk_t::CAUSE_SENSOR_FAULT, context.depth_channel, f.invalid_fraction,
-                   config.max_invalid_fraction,
-                   "invalid pixels (fraction): " + fixed(100.0 * f.invalid_fraction, 1) + " % have no return, limit " +
-                       fixed(100.0 * config.max_invalid_fraction, 1) + " %");
+  const bool broad_mismatch =
+      robot_fraction >= config.calibration_robot_link_fraction &&
+      (environment_mismatch >= config.calibration_environment_mismatch_fraction || !fixed_link_mismatching.empty());
+  if (!broad_mismatch) return {};
+  return finding(risk_t::CAUSE_CALIBRATION_ERROR, "", environment_mismatch,
+                 config.calibration_environment_mismatch_fraction,
+                 "camera pose or calibration off (environment mismatch fraction): " +
+                     fixed(100.0 * environment_mismatch, 1) + " % of the environment and " +
+                     std::to_string(mismatching_links) + "/" + std::to_string(visible.size()) +
+                     " visible links mismatch" +
+                     (fixed_link_mismatching.empty() ? std::string()
+                                                     : ", the fixed " + fixed_link_mismatching + " among them") +
+                     "; median I_dis environment " + fixed(f.environment_median_dis_mm, 0) + " mm, arm " +
+                     fixed(f.robot_median_dis_mm, 0) + " mm");
+}
+
+// JOINT_ERROR: the arm is missing where the model has it, on links that all
+// hang below one moving joint; the proximal links match. A missing link the
+// URDF does not know is UNCLASSIFIED (never judged safe).
+FrameFinding joint_error_missing_links(const FrameEvidence& e) {
+  const RiskSettings& config = e.config;
+  const robot_model::KinematicTree& robot = e.robot;
+  const std::vector<LinkView>& visible = e.visible_links();
+  std::vector<std::string> missing_links;
+  int64_t missing_pixels = 0;
+  int64_t compared_pixels = 0;
+  std::string unknown;
+  for (const LinkView& link : visible) {
+    // Only a displaced arm is missing where the model has it: an object
+    // can hide a link (nearer) but never make the camera see farther.
+    if (link.missing < config.joint_link_missing_fraction) continue;
+    if (!robot.is_robot_link(link.name)) {
+      unknown = link.name;
+      continue;
+    }
+    missing_links.push_back(link.name);
+    missing_pixels += static_cast<int64_t>(std::lround(link.mismatch * link.compared));
+    compared_pixels += link.compared;
   }
-  if (config.calibrated_required && !f.calibrated) {
-    return finding(risk_t::CAUSE_SENSOR_FAULT, context.depth_channel, 0, 1,
-                   "camera frame not calibrated (calibrated = false) but risk.sensor.calibrated_required");
+  if (!missing_links.empty()) {
+    std::string common = robot.lowest_common_ancestor(missing_links);
+    // The joint's own link moves least (it turns about the joint), so it
+    // may mismatch only slightly while its distal links are missing: blame
+    // the most proximal link on the way down to `common` that is visibly
+    // affected, when all above it match.
+    for (const std::string& link : robot.chain_from_root(common)) {
+      const auto view =
+          std::find_if(visible.begin(), visible.end(), [&](const LinkView& v) { return v.name == link; });
+      if (view != visible.end() && view->mismatch >= config.joint_link_affected_fraction &&
+          view->mismatch * view->compared >= config.joint_link_affected_min_pixels) {
+        common = link;
+        break;
+      }
+    }
+    const std::string joint = robot.nearest_movable_joint_above(common);
+    if (!joint.empty()) {
+      const double score = static_cast<double>(missing_pixels) / static_cast<double>(compared_pixels);
+      std::string links;
+      for (const std::string& l : missing_links) links += (links.empty() ? "" : ", ") + l;
+      return finding(risk_t::CAUSE_JOINT_ERROR, joint, score, config.joint_link_missing_fraction,
+                     "joint " + joint + " reads other than seen (mismatch fraction): the arm mismatches at " +
+                         fixed(100.0 * score, 1) + " % of the modelled pixels of " + links + ", all distal to " +
+                         joint);
+    }
   }
-  if (context.arm_moving && f.repeat_count >= config.frozen_repeat_frames) {
-    return finding(risk_t::CAUSE_SENSOR_FAULT, context.depth_channel, f.repeat_count,
-                   config.frozen_repeat_frames,
-                   "frozen image (repeated frames): the same depth image " + std::to_string(f.repeat_count + 1) +
-                       " times in a row while the arm moves");
+  if (!unknown.empty()) {
+    return finding(risk_t::CAUSE_UNCLASSIFIED, unknown, 1, 0,
+                   "link '" + unknown + "' of the discrepancy is not in the robot's URDF");
   }
   return {};
 }
 
-struct LinkView {
-  std::string name;
-  int compared = 0;
-  double mismatch = 0;  // (compared - match) / compared
-  double missing = 0;   // farther / compared
-};
+// JOINT_ERROR, second chance: no link is missing enough, yet the arm's own
+// links mismatch (a link moved towards the camera is seen nearer, and the
+// surfaces beside it look like an object near the arm). When every visibly
+// affected link hangs below one moving joint and the links above it match,
+// that joint is the suspect. (An object that hides part of a link lands
+// here too: either way the arm stops.)
+FrameFinding joint_error_beside_unexplained_surfaces(const FrameEvidence& e) {
+  const RiskSettings& config = e.config;
+  const robot_model::KinematicTree& robot = e.robot;
+  if (!(e.frame.near_arm_area_m2 >= config.unknown_object_min_area_m2)) return {};
+  std::vector<std::string> affected;
+  int64_t mismatching = 0;
+  int64_t compared = 0;
+  for (const LinkView& link : e.visible_links()) {
+    if (!robot.is_robot_link(link.name)) continue;
+    if (link.mismatch < config.joint_link_affected_fraction ||
+        link.mismatch * link.compared < config.joint_link_affected_min_pixels) {
+      continue;
+    }
+    affected.push_back(link.name);
+    mismatching += static_cast<int64_t>(std::lround(link.mismatch * link.compared));
+    compared += link.compared;
+  }
+  if (affected.empty()) return {};
+  const std::string common = robot.lowest_common_ancestor(affected);
+  const std::string joint = robot.nearest_movable_joint_above(common);
+  // The affected links must be the common link and links below it.
+  if (joint.empty() || std::find(affected.begin(), affected.end(), common) == affected.end()) return {};
+  const double score = static_cast<double>(mismatching) / static_cast<double>(compared);
+  std::string links;
+  for (const std::string& l : affected) links += (links.empty() ? "" : ", ") + l;
+  return finding(risk_t::CAUSE_JOINT_ERROR, joint, score, config.joint_link_affected_fraction,
+                 "joint " + joint + " reads other than seen (mismatch fraction): " + links + " mismatch at " +
+                     fixed(100.0 * score, 1) + " % and surfaces beside them are " +
+                     "unexplained; the links above " + joint + " match");
+}
+
+// UNKNOWN_OBJECT: nearer surfaces the model does not explain close to the
+// arm (area in m^2).
+FrameFinding unknown_object(const FrameEvidence& e) {
+  const discrepancy_t& f = e.frame;
+  const double min_area_m2 = e.config.unknown_object_min_area_m2;
+  if (!(f.near_arm_area_m2 >= min_area_m2)) return {};
+  return finding(risk_t::CAUSE_UNKNOWN_OBJECT, "", f.near_arm_area_m2, min_area_m2,
+                 "unknown object near the arm (area m^2): " + fixed(f.near_arm_area_m2 * 1e4, 1) + " cm^2 (" +
+                     std::to_string(f.near_arm_pixels) + " px) within reach, nearest " +
+                     fixed(f.near_arm_min_distance_m * 100, 1) + " cm from the arm");
+}
+
+// UNCLASSIFIED: a large mismatch none of the rules above explains (area of
+// the largest blob in m^2).
+FrameFinding unexplained_blob(const FrameEvidence& e) {
+  const discrepancy_t& f = e.frame;
+  const double min_area_m2 = e.config.unclassified_blob_area_m2;
+  if (!(f.largest_blob_area_m2 >= min_area_m2)) return {};
+  return finding(risk_t::CAUSE_UNCLASSIFIED, "", f.largest_blob_area_m2, min_area_m2,
+                 "unexplained mismatch (largest blob area m^2): " + fixed(f.largest_blob_area_m2 * 1e4, 0) +
+                     " cm^2 (" + std::to_string(f.largest_blob_pixels) + " px)");
+}
 
 }  // namespace
 
-FrameFinding classify_frame(const discrepancy_t& f, const RobotTree& robot, const RiskSettings& config,
+const std::vector<FrameRule>& frame_rules() {
+  static const std::vector<FrameRule> rules = {
+      {"unusable frame", unusable_frame},
+      {"invalid pixels", invalid_pixels},
+      {"uncalibrated camera", uncalibrated_camera},
+      {"frozen image", frozen_image},
+      {"calibration error", calibration_error},
+      {"joint error: links missing", joint_error_missing_links},
+      {"joint error: links beside unexplained surfaces", joint_error_beside_unexplained_surfaces},
+      {"unknown object", unknown_object},
+      {"unexplained blob", unexplained_blob},
+  };
+  return rules;
+}
+
+FrameFinding classify_frame(const discrepancy_t& frame, const robot_model::KinematicTree& robot, const RiskSettings& config,
                             const ClassifierContext& context) {
-  if (FrameFinding sensor = sensor_finding(f, config, context); sensor.cause != risk_t::CAUSE_NONE) {
-    return sensor;
-  }
-
-  // The loop below indexes six per-link arrays by i < num_links and splits
-  // robot from environment links at num_robot_links; a discrepancy that
-  // passed its wire check has them consistent.
-  TOFGUARD_DEMAND(f.num_robot_links >= 0 && f.num_robot_links <= f.num_links && f.num_links >= 0 &&
-                      f.link_name.size() == static_cast<size_t>(f.num_links) &&
-                      f.link_compared.size() == static_cast<size_t>(f.num_links) &&
-                      f.link_match.size() == static_cast<size_t>(f.num_links) &&
-                      f.link_farther.size() == static_cast<size_t>(f.num_links),
-                  "discrepancy seq " + std::to_string(f.seq) + ": per-link arrays do not match num_links " +
-                      std::to_string(f.num_links));
-
-  // Robot links seen well enough to judge, and the environment as a whole.
-  std::vector<LinkView> visible;
-  int64_t environment_compared = 0;
-  int64_t environment_match = 0;
-  for (int i = 0; i < f.num_links; ++i) {
-    if (i >= f.num_robot_links) {
-      environment_compared += f.link_compared[i];
-      environment_match += f.link_match[i];
-      continue;
-    }
-    if (f.link_compared[i] < config.min_link_pixels) continue;
-    LinkView view;
-    view.name = f.link_name[i];
-    view.compared = f.link_compared[i];
-    view.mismatch = static_cast<double>(f.link_compared[i] - f.link_match[i]) / f.link_compared[i];
-    view.missing = static_cast<double>(f.link_farther[i]) / f.link_compared[i];
-    visible.push_back(view);
-  }
-
-  // CALIBRATION_ERROR: the static environment and the arm disagree broadly.
-  if (environment_compared >= config.min_environment_pixels) {
-    const double environment_mismatch =
-        static_cast<double>(environment_compared - environment_match) / static_cast<double>(environment_compared);
-    int mismatching_links = 0;
-    for (const LinkView& link : visible) mismatching_links += link.mismatch >= config.link_mismatch_fraction ? 1 : 0;
-    const double robot_fraction =
-        visible.empty() ? 1.0 : static_cast<double>(mismatching_links) / static_cast<double>(visible.size());
-    // A link fixed to the robot's root (its base) cannot be moved by any
-    // joint: when it mismatches together with most of the arm, the camera
-    // pose is off. (A camera moved by a few centimetres shifts the near arm
-    // far more than a distant floor, which may stay within tolerance.)
-    std::string fixed_link_mismatching;
-    for (const LinkView& link : visible) {
-      if (link.mismatch >= config.link_mismatch_fraction && robot.has_link(link.name) &&
-          robot.nearest_movable_joint_above(link.name).empty()) {
-        fixed_link_mismatching = link.name;
-      }
-    }
-    if (robot_fraction >= config.calibration_robot_link_fraction &&
-        (environment_mismatch >= config.calibration_environment_mismatch_fraction ||
-         !fixed_link_mismatching.empty())) {
-      return finding(risk_t::CAUSE_CALIBRATION_ERROR, "", environment_mismatch,
-                     config.calibration_environment_mismatch_fraction,
-                     "camera pose or calibration off (environment mismatch fraction): " +
-                         fixed(100.0 * environment_mismatch, 1) + " % of the environment and " +
-                         std::to_string(mismatching_links) + "/" + std::to_string(visible.size()) +
-                         " visible links mismatch" +
-                         (fixed_link_mismatching.empty() ? std::string()
-                                                         : ", the fixed " + fixed_link_mismatching + " among them") +
-                         "; median I_dis environment " +
-                         fixed(f.environment_median_dis_mm, 0) + " mm, arm " + fixed(f.robot_median_dis_mm, 0) +
-                         " mm");
-    }
-  }
-
-  // JOINT_ERROR: the arm is missing where the model has it, on links that
-  // all hang below one moving joint; the proximal links match.
-  {
-    std::vector<std::string> missing_links;
-    int64_t missing_pixels = 0;
-    int64_t compared_pixels = 0;
-    std::string unknown;
-    for (const LinkView& link : visible) {
-      // Only a displaced arm is missing where the model has it: an object
-      // can hide a link (nearer) but never make the camera see farther.
-      if (link.missing < config.joint_link_missing_fraction) continue;
-      if (!robot.has_link(link.name)) {
-        unknown = link.name;
-        continue;
-      }
-      missing_links.push_back(link.name);
-      missing_pixels += static_cast<int64_t>(std::lround(link.mismatch * link.compared));
-      compared_pixels += link.compared;
-    }
-    if (!missing_links.empty()) {
-      std::string common = robot.lowest_common_ancestor(missing_links);
-      // The joint's own link moves least (it turns about the joint), so it
-      // may mismatch only slightly while its distal links are missing: blame
-      // the most proximal link on the way down to `common` that is visibly
-      // affected, when all above it match.
-      for (const std::string& link : robot.chain_from_root(common)) {
-        const auto view = std::find_if(visible.begin(), visible.end(),
-                                       [&](const LinkView& v) { return v.name == link; });
-        if (view != visible.end() && view->mismatch >= config.joint_link_affected_fraction &&
-            view->mismatch * view->compared >= config.joint_link_affected_min_pixels) {
-          common = link;
-          break;
-        }
-      }
-      const std::string joint = robot.nearest_movable_joint_above(common);
-      if (!joint.empty()) {
-        const double score = static_cast<double>(missing_pixels) / static_cast<double>(compared_pixels);
-        std::string links;
-        for (const std::string& l : missing_links) links += (links.empty() ? "" : ", ") + l;
-        return finding(risk_t::CAUSE_JOINT_ERROR, joint, score, config.joint_link_missing_fraction,
-                       "joint " + joint + " reads other than seen (mismatch fraction): the arm mismatches at " +
-                           fixed(100.0 * score, 1) + " % of the modelled pixels of " + links +
-                           ", all distal to " + joint);
-      }
-    }
-    if (!unknown.empty()) {
-      return finding(risk_t::CAUSE_UNCLASSIFIED, unknown, 1, 0,
-                     "link '" + unknown + "' of the discrepancy is not in the robot's URDF");
-    }
-  }
-
-  // JOINT_ERROR, second chance: no link is missing enough, yet the arm's
-  // own links mismatch (a link moved towards the camera is seen nearer, and
-  // the surfaces beside it look like an object near the arm). When every
-  // visibly affected link hangs below one moving joint and the links above
-  // it match, that joint is the suspect. (An object that hides part of a
-  // link lands here too: either way the arm stops.)
-  if (f.near_arm_area_m2 >= config.unknown_object_min_area_m2) {
-    std::vector<std::string> affected;
-    int64_t mismatching = 0;
-    int64_t compared = 0;
-    for (const LinkView& link : visible) {
-      if (!robot.has_link(link.name)) continue;
-      if (link.mismatch < config.joint_link_affected_fraction ||
-          link.mismatch * link.compared < config.joint_link_affected_min_pixels) {
-        continue;
-      }
-      affected.push_back(link.name);
-      mismatching += static_cast<int64_t>(std::lround(link.mismatch * link.compared));
-      compared += link.compared;
-    }
-    if (!affected.empty()) {
-      const std::string common = robot.lowest_common_ancestor(affected);
-      const std::string joint = robot.nearest_movable_joint_above(common);
-      // The affected links must be the common link and links below it.
-      if (!joint.empty() && std::find(affected.begin(), affected.end(), common) != affected.end()) {
-        const double score = static_cast<double>(mismatching) / static_cast<double>(compared);
-        std::string links;
-        for (const std::string& l : affected) links += (links.empty() ? "" : ", ") + l;
-        return finding(risk_t::CAUSE_JOINT_ERROR, joint, score, config.joint_link_affected_fraction,
-                       "joint " + joint + " reads other than seen (mismatch fraction): " + links +
-                           " mismatch at " + fixed(100.0 * score, 1) + " % and surfaces beside them are " +
-                           "unexplained; the links above " + joint + " match");
-      }
-    }
-  }
-
-  // UNKNOWN_OBJECT: nearer surfaces the model does not explain close to the
-  // arm.
-  if (f.near_arm_area_m2 >= config.unknown_object_min_area_m2) {
-    return finding(risk_t::CAUSE_UNKNOWN_OBJECT, "", f.near_arm_area_m2, config.unknown_object_min_area_m2,
-                   "unknown object near the arm (area m^2): " + fixed(f.near_arm_area_m2 * 1e4, 1) + " cm^2 (" +
-                       std::to_string(f.near_arm_pixels) + " px) within reach, nearest " +
-                       fixed(f.near_arm_min_distance_m * 100, 1) + " cm from the arm");
-  }
-
-  // UNCLASSIFIED: a large mismatch none of the rules explains.
-  if (f.largest_blob_area_m2 >= config.unclassified_blob_area_m2) {
-    return finding(risk_t::CAUSE_UNCLASSIFIED, "", f.largest_blob_area_m2, config.unclassified_blob_area_m2,
-                   "unexplained mismatch (largest blob area m^2): " + fixed(f.largest_blob_area_m2 * 1e4, 0) +
-                       " cm^2 (" + std::to_string(f.largest_blob_pixels) + " px)");
+  const FrameEvidence evidence(frame, robot, config, context);
+  for (const FrameRule& rule : frame_rules()) {
+    FrameFinding f = rule.apply(evidence);
+    if (f.cause != risk_t::CAUSE_NONE) return f;
   }
   return {};
 }

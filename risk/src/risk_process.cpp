@@ -18,7 +18,7 @@ ProcessInfo process_info() {
 }
 
 int run_risk(const RiskProcessSettings& settings) {
-  RiskMonitor monitor(settings.risk, settings.channels, RobotTree::from_urdf_file(settings.robot_urdf_path),
+  RiskMonitor monitor(settings.risk, settings.channels, robot_model::load_kinematic_tree(settings.robot_urdf_path),
                       monotonic_us());
   const std::string camera_id = settings.camera_id;
   LcmNode node(settings.lcm, settings.channels, process_info().name);

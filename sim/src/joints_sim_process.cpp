@@ -2,12 +2,16 @@
 
 #include <iostream>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "tofguard/common/clock.hpp"
+#include "tofguard/common/config_error.hpp"
 #include "tofguard/common/lcm_node.hpp"
 #include "tofguard/common/wire_checks.hpp"
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/planned_trajectory_t.hpp"
+#include "tofguard/robot_model/kinematic_tree.hpp"
 #include "tofguard/safety_status_t.hpp"
 #include "tofguard/sim/simulated_arm.hpp"
 #include "tofguard/sim_joint_fault_t.hpp"
@@ -38,10 +42,16 @@ ProcessInfo joints_sim_info() {
 }
 
 int run_joints_sim(const JointsSimProcessSettings& settings) {
-  // A motion that does not fit the URDF throws ConfigError: the process
-  // runner reports it as a config error (exit code 2).
-  const auto arm = std::make_unique<SimulatedArm>(settings.joints_sim, movable_joints(settings.robot.urdf_path),
-                                                  settings.config_file);
+  // A URDF that cannot be loaded, or a motion that does not fit it, throws
+  // ConfigError: the process runner reports it as a config error (exit
+  // code 2). The robot's URDF is part of the configuration.
+  std::vector<std::string> urdf_joints;
+  try {
+    urdf_joints = robot_model::load_kinematic_tree(settings.robot.urdf_path).actuated_joint_names;
+  } catch (const robot_model::ModelError& e) {
+    throw ConfigError(e.what());
+  }
+  const auto arm = std::make_unique<SimulatedArm>(settings.joints_sim, urdf_joints, settings.config_file);
   LcmNode node(settings.lcm, settings.channels, "tofguard-joints-sim");
 
   bool status_allows = false;

@@ -11,7 +11,7 @@ constexpr int64_t kMaxExtrapolationUs = 50000;
 
 bool SimulatedCamera::add_true_joint_state(int64_t utime, const std::vector<std::string>& names,
                                            const std::vector<double>& positions) {
-  renderer::JointPositions joints;
+  robot_model::JointPositions joints;
   for (size_t i = 0; i < names.size() && i < positions.size(); ++i) joints[names[i]] = positions[i];
   return joints_.add(utime, joints);
 }
@@ -113,7 +113,7 @@ SimulatedCamera::Frame SimulatedCamera::capture(int64_t utime, uint64_t frame_in
       return frame;
     }
   }
-  const renderer::JointsAtTime joints = joints_.at(utime);
+  const robot_state::JointsAtTime joints = joints_.at(utime);
   if (!joints.usable) {
     frame.outcome = Frame::Outcome::kNoJointState;
     frame.why = "true joint state: " + joints.unusable_reason;

@@ -6,7 +6,7 @@
 #include "tofguard/camera/depth_calibration.hpp"
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/renderer/depth_renderer.hpp"
-#include "tofguard/renderer/scene_model.hpp"
+#include "tofguard/robot_model/scene_model.hpp"
 #include "tofguard/sim/sim_camera.hpp"
 #include "tofguard/common/clock.hpp"
 #include "tofguard/common/camera_pose_message.hpp"
@@ -23,12 +23,12 @@ namespace {
 class UrdfSceneRenderer : public SceneRenderer {
  public:
   explicit UrdfSceneRenderer(const SimCameraProcessSettings& settings) {
-    renderer::SceneOptions options;
+    robot_model::SceneOptions options;
     // The camera sees the real surfaces: visual geometry, no safety padding.
-    options.geometry = renderer::GeometrySource::kVisual;
+    options.geometry = robot_model::GeometrySource::kVisual;
     options.padding_m = 0;
     options.package_paths = settings.robot.package_paths;
-    scene_ = renderer::load_scene(settings.robot.urdf_path, settings.environment.urdf_paths, options);
+    scene_ = robot_model::load_scene(settings.robot.urdf_path, settings.environment.urdf_paths, options);
     renderer_ = std::make_unique<renderer::DepthRenderer>(scene_, settings.near_m, settings.far_m);
   }
 
@@ -50,7 +50,7 @@ class UrdfSceneRenderer : public SceneRenderer {
   const std::string& description() const { return renderer_->description(); }
 
  private:
-  renderer::SceneModel scene_;
+  robot_model::SceneModel scene_;
   std::unique_ptr<renderer::DepthRenderer> renderer_;
 };
 

@@ -1,33 +1,10 @@
 #include "tofguard/sim/simulated_arm.hpp"
 
-#include <urdf_parser/urdf_parser.h>
-
 #include <algorithm>
 #include <cmath>
 #include <set>
 
 namespace tofguard::sim {
-
-std::vector<std::string> movable_joints(const std::string& urdf_path) {
-  urdf::ModelInterfaceSharedPtr model = urdf::parseURDFFile(urdf_path);
-  if (!model) throw ConfigError(urdf_path + ": not a valid URDF (urdfdom could not parse it)");
-  // urdfdom keeps joints in a map; recover the file's order by walking the
-  // tree from the root, children in file order.
-  std::vector<std::string> joints;
-  std::vector<urdf::LinkConstSharedPtr> stack{model->getRoot()};
-  while (!stack.empty()) {
-    auto link = stack.back();
-    stack.pop_back();
-    for (auto it = link->child_joints.rbegin(); it != link->child_joints.rend(); ++it) {
-      stack.push_back(model->getLink((*it)->child_link_name));
-    }
-    if (link->parent_joint && link->parent_joint->type != urdf::Joint::FIXED &&
-        !link->parent_joint->mimic) {
-      joints.push_back(link->parent_joint->name);
-    }
-  }
-  return joints;
-}
 
 SimulatedArm::SimulatedArm(const JointsSimSettings& config, const std::vector<std::string>& urdf_joints,
                            const std::string& config_file) {

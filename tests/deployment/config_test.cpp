@@ -62,6 +62,20 @@ TEST(Config, EmbeddedDefaultLoads) {
   EXPECT_EQ(config.renderer.camera_pose_max_extrapolation_us, 40000);
 }
 
+// Durations are read once, rounded to the nearest microsecond: what the
+// renderer's state history and risk's deadlines compare.
+TEST(Config, MillisecondsAreRoundedToWholeMicrosecondsOnce) {
+  const std::string path = sim_config_variant(
+      "config-fractional-ms",
+      {{"  max_extrapolation_ms: 20\n", "  max_extrapolation_ms: 12.3456\n"},
+       {"camera_pose: {history_ms: 2000, max_extrapolation_ms: 40,", "camera_pose: {history_ms: 2000, max_extrapolation_ms: 40.0004,"},
+       {"deadlines_ms: {depth: 150,", "deadlines_ms: {depth: 33.3334,"}});
+  const deployment::Config config = deployment::load_config(path, nullptr);
+  EXPECT_EQ(config.renderer.max_extrapolation_us, 12'346);
+  EXPECT_EQ(config.renderer.camera_pose_max_extrapolation_us, 40'000);
+  EXPECT_EQ(config.risk.depth_deadline_us, 33'333);
+}
+
 TEST(Config, LcmUrlComesFromConfigThenEnvironmentThenHostLocalDefault) {
   EXPECT_EQ(resolve_lcm_url("udpm://239.1.1.1:7000", "udpm://239.2.2.2:7000"), "udpm://239.1.1.1:7000");
   EXPECT_EQ(resolve_lcm_url("", "udpm://239.2.2.2:7000"), "udpm://239.2.2.2:7000");

@@ -39,7 +39,7 @@ void write_event(lcm::LogFile* log, int64_t utime, const std::string& channel, c
 
 // A log of `poses` (one camera frame each, joint states 5 ms before and
 // after it), frames from the simulated camera at the config's true pose.
-std::string write_log(const std::string& name, const deployment::Config& config, const std::vector<renderer::JointPositions>& poses,
+std::string write_log(const std::string& name, const deployment::Config& config, const std::vector<robot_model::JointPositions>& poses,
                       bool with_depth) {
   const std::string dir = tofguard::test::output_dir() + "/estimator";
   std::filesystem::create_directories(dir);
@@ -74,12 +74,12 @@ std::string write_log(const std::string& name, const deployment::Config& config,
   return path;
 }
 
-std::vector<renderer::JointPositions> arm_poses() {
-  std::vector<renderer::JointPositions> poses;
-  const renderer::JointPositions a = test::reach_pose();
-  const renderer::JointPositions b = test::side_reach_pose();
+std::vector<robot_model::JointPositions> arm_poses() {
+  std::vector<robot_model::JointPositions> poses;
+  const robot_model::JointPositions a = test::reach_pose();
+  const robot_model::JointPositions b = test::side_reach_pose();
   for (int k = 0; k < 8; ++k) {
-    renderer::JointPositions p;
+    robot_model::JointPositions p;
     const double t = k / 7.0;
     for (const auto& [name, value] : a) p[name] = (1 - t) * value + t * b.at(name);
     p["a7"] += 0.3 * std::sin(k);
@@ -153,7 +153,7 @@ TEST(CalibrateExtrinsics, OneLineErrors) {
   EXPECT_EQ(tofguard::test::run_command("calibrate-no-depth", {bin, "--config", config_path, joints_only}, nullptr, &err), 1);
   EXPECT_NE(err.find("no TOF_DEPTH frames of camera 'tof-mast'"), std::string::npos) << err;
   // All frames at one pose.
-  const std::vector<renderer::JointPositions> still(4, test::side_reach_pose());
+  const std::vector<robot_model::JointPositions> still(4, test::side_reach_pose());
   const std::string one_pose = write_log("one-pose.lcm", config, still, true);
   EXPECT_EQ(tofguard::test::run_command("calibrate-one-pose", {bin, "--config", config_path, one_pose}, nullptr, &err), 1);
   EXPECT_NE(err.find("too few frames with distinct arm poses (1"), std::string::npos) << err;

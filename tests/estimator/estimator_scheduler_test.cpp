@@ -67,7 +67,7 @@ class SchedulerTest : public ::testing::Test {
   }
 
   estimator::EstimatorProcessSettings config_;
-  renderer::SceneModel scene_;
+  robot_model::SceneModel scene_;
   EstimatorScheduler scheduler_;
 };
 

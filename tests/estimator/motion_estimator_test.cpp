@@ -57,7 +57,7 @@ tofguard::test::SimulatedFrames* MotionEstimatorTest::frames_ = nullptr;
 // The frames of an estimate with an encoder offset on `joint`
 // (SimulatedFrames::frames_with_offset): the sim camera where configured.
 std::vector<EstimatorFrame> frames_with_offset(tofguard::test::SimulatedFrames* frames, const deployment::Config& config,
-                                               const renderer::JointPositions& truth, const std::string& joint,
+                                               const robot_model::JointPositions& truth, const std::string& joint,
                                                double offset_rad, int num_frames, uint64_t* index) {
   return frames->frames_with_offset(truth, test::pose_of(config.camera.pose), config.camera.intrinsics, joint,
                                     offset_rad, num_frames, index);
@@ -158,7 +158,7 @@ TEST_F(MotionEstimatorTest, CameraPoseErrors) {
   };
   uint64_t index = 100;
   for (const Case& c : cases) {
-    for (const renderer::JointPositions& joints : {test::reach_pose(), test::side_reach_pose()}) {
+    for (const robot_model::JointPositions& joints : {test::reach_pose(), test::side_reach_pose()}) {
       EstimatorFrame frame;
       frame.intrinsics = in;
       frame.depth_m = frames_->capture(joints, truth_camera, in, ++index);
@@ -201,8 +201,8 @@ TEST_F(MotionEstimatorTest, ObjectBesideTheArm) {
   MotionEstimator estimator(frames_->scene(), &frames_->renderer(), options());
   const Eigen::Isometry3d camera = test::pose_of(config_->camera.pose);
   const Intrinsics& in = config_->camera.intrinsics;
-  const renderer::JointPositions joints = test::side_reach_pose();
-  const renderer::LinkPoses poses = renderer::forward_kinematics(frames_->scene(), joints);
+  const robot_model::JointPositions joints = test::side_reach_pose();
+  const robot_model::LinkPoses poses = robot_model::forward_kinematics(frames_->scene(), joints);
   uint64_t index = 200;
   for (const char* link : {"link4", "link6", "gripper"}) {
     // A 12 cm box whose side is 10 cm from the link's frame origin, seen

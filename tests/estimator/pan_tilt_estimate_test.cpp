@@ -57,7 +57,7 @@ PanTiltCase estimate_at(const deployment::Config& config, tofguard::test::Simula
   PanTiltCase out;
   out.reading_error_deg =
       test::to_deg(Eigen::AngleAxisd(true_pose.rotation.inverse() * reading->rotation).angle());
-  const renderer::JointPositions joints = test::side_reach_pose();
+  const robot_model::JointPositions joints = test::side_reach_pose();
   EstimatorFrame frame;
   frame.intrinsics = config.camera.intrinsics;
   frame.depth_m = frames->capture(joints, test::pose_of(true_pose), frame.intrinsics, index);

@@ -24,7 +24,7 @@ Usage: check_includes.py [REPO_ROOT]   (default: two folders up from here)
        check_includes.py --self-test   (the rules on a small made-up tree)
 Exit status 0 when every include keeps the rules (known violations in
 KNOWN_VIOLATIONS are listed but allowed), 1 otherwise. Folders that do not
-exist yet (robot_model/, robot_state/, deployment/) are simply not scanned.
+exist yet (deployment/) are simply not scanned.
 """
 import fnmatch
 import os
@@ -75,13 +75,11 @@ ALLOWED_SAME_LAYER = {
 # reported as stale (not an error, so that the removal can land in any order).
 KNOWN_VIOLATIONS = [
     # The estimator runs the risk classifier's rules (risk::classify_frame on
-    # a RobotTree) to decide when to estimate. Removed by issue 13 item 6:
-    # the estimator triggers on SAFETY_DISCREPANCY / SAFETY_RISK as published;
-    # RobotTree's job moves into robot_model (item 1).
+    # robot_model's tree) to decide when to estimate. Removed by issue 13
+    # item 6: the estimator triggers on SAFETY_DISCREPANCY / SAFETY_RISK as
+    # published.
     ("estimator/include/tofguard/estimator/estimator_process.hpp", "tofguard/risk/frame_classifier.hpp",
      "issue 13 item 6"),
-    ("estimator/include/tofguard/estimator/estimator_process.hpp", "tofguard/risk/robot_tree.hpp",
-     "issue 13 items 1 and 6"),
 ]
 
 SKIP_DIRS = {".git", "node_modules", "__pycache__"}

@@ -222,8 +222,8 @@ class AnalyticRender : public ::testing::Test {
     return p;
   }
 
-  static SceneModel scene() {
-    return load_scene(write_test_file("analytic.urdf", urdf_for(primitives())), {}, SceneOptions{});
+  static robot_model::SceneModel scene() {
+    return robot_model::load_scene(write_test_file("analytic.urdf", urdf_for(primitives())), {}, robot_model::SceneOptions{});
   }
 };
 
@@ -285,7 +285,7 @@ TEST(AnalyticRenderOrientation, AsymmetricSceneIsNeitherMirroredNorTransposed) {
          << "\"><visual><geometry><box size=\"0.1 0.1 0.1\"/></geometry></visual></link>";
   }
   urdf << "</robot>";
-  const SceneModel scene = load_scene(write_test_file("corners.urdf", urdf.str()), {}, SceneOptions{});
+  const robot_model::SceneModel scene = robot_model::load_scene(write_test_file("corners.urdf", urdf.str()), {}, robot_model::SceneOptions{});
   DepthRenderer renderer(scene, 0.1, 5.0);
   const Intrinsics k{160, 100, 120.0, 110.0, 70.4, 45.6};
   // The camera's optical frame is the world frame here.

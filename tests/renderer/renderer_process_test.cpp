@@ -26,8 +26,8 @@ using tofguard::test::wait_until;
 
 // Joint values that change linearly in time, so that interpolation between
 // any two messages is exact: a_i(t) = 0.1*i + 0.5*i*(t - t0) [s].
-JointPositions arm_at(int64_t utime, int64_t t0) {
-  JointPositions q;
+robot_model::JointPositions arm_at(int64_t utime, int64_t t0) {
+  robot_model::JointPositions q;
   for (int i = 1; i <= 7; ++i) q["a" + std::to_string(i)] = 0.1 * i + 0.5 * i * (utime - t0) * 1e-6;
   return q;
 }
@@ -57,7 +57,7 @@ struct Bench {
     images.handleTimeout(2);
     safety.handleTimeout(2);
   }
-  void publish_joints(int64_t utime, const JointPositions& q) {
+  void publish_joints(int64_t utime, const robot_model::JointPositions& q) {
     joint_state_t m;
     m.utime = utime;
     m.robot_id = config.robot.id;
@@ -76,7 +76,7 @@ struct Bench {
       publish_joints(next_joint_utime, fixed_joints ? *fixed_joints : arm_at(next_joint_utime, t0));
     }
   }
-  std::optional<JointPositions> fixed_joints;
+  std::optional<robot_model::JointPositions> fixed_joints;
   void publish_pose(int64_t utime, const CameraPose& pose) {
     const camera_pose_t m = to_camera_pose_message(config.camera.id, utime, pose);
     safety.publish(config.channels.camera_pose, &m);
@@ -124,7 +124,7 @@ TEST(RendererProcess, RendersFramesAtInterpolatedJointsAndMarksUnusableOnes) {
 
   // The numbers: the library at the joints interpolated at the frame's utime.
   const deployment::Config& config = bench.config;
-  const SceneModel scene = load_scene(config.robot.urdf_path, config.environment.urdf_paths, scene_options(config.renderer, config.robot));
+  const robot_model::SceneModel scene = robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths, scene_options(config.renderer, config.robot));
   DepthRenderer renderer(scene, config.renderer.near_m, config.renderer.far_m);
   const RenderResult expected = renderer.render(arm_at(out.utime, bench.t0), config.camera.pose, config.camera.intrinsics);
   ASSERT_TRUE(expected.usable);
@@ -142,7 +142,7 @@ TEST(RendererProcess, RendersFramesAtInterpolatedJointsAndMarksUnusableOnes) {
   // arrives first.)
   const int64_t late_seq = bench.publish_frame(bench.next_joint_utime - 10'000 + 200'000);
   // A frame whose joint state lacks a4.
-  JointPositions without_a4 = arm_at(bench.next_joint_utime, bench.t0);
+  robot_model::JointPositions without_a4 = arm_at(bench.next_joint_utime, bench.t0);
   without_a4.erase("a4");
   bench.publish_joints(bench.next_joint_utime, without_a4);
   const int64_t missing_seq = bench.publish_frame(bench.next_joint_utime);
@@ -281,7 +281,7 @@ TEST(RendererProcess, FollowsAMovingCameraAtEachFramesUtime) {
            return why;
          }();
 
-  const SceneModel scene = load_scene(config.robot.urdf_path, config.environment.urdf_paths, scene_options(config.renderer, config.robot));
+  const robot_model::SceneModel scene = robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths, scene_options(config.renderer, config.robot));
   DepthRenderer renderer(scene, config.renderer.near_m, config.renderer.far_m);
   const RenderResult at_mid = renderer.render(arm_at(mid_utime, t0), panned(2), config.camera.intrinsics);
   const RenderResult unpanned = renderer.render(arm_at(mid_utime, t0), panned(0), config.camera.intrinsics);
@@ -316,7 +316,7 @@ TEST(RendererProcess, APlannedFrameIsRenderedAheadAndIdenticalToTheNormalRenderi
   ASSERT_TRUE(wait_until([&] { return bench.heartbeat.utime > 0; }, std::chrono::seconds(20), [&] { bench.pump(); }))
       << process.stderr_text();
   // The arm holds still where its plan says, for 10 s.
-  const JointPositions planned = arm_at(bench.t0 + 300'000, bench.t0);
+  const robot_model::JointPositions planned = arm_at(bench.t0 + 300'000, bench.t0);
   bench.fixed_joints = planned;
   planned_trajectory_t plan;
   plan.utime = bench.t0;
@@ -370,7 +370,7 @@ TEST(RendererProcess, APlannedFrameIsRenderedAheadAndIdenticalToTheNormalRenderi
 
   // Every rendered frame is the library's rendering at the planned joints:
   // those published from a prediction are identical to the others.
-  const SceneModel scene = load_scene(config.robot.urdf_path, config.environment.urdf_paths, scene_options(config.renderer, config.robot));
+  const robot_model::SceneModel scene = robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths, scene_options(config.renderer, config.robot));
   DepthRenderer renderer(scene, config.renderer.near_m, config.renderer.far_m);
   const RenderResult expected = renderer.render(planned, config.camera.pose, config.camera.intrinsics);
   ASSERT_TRUE(expected.usable);
@@ -388,7 +388,7 @@ TEST(RendererProcess, APlannedFrameIsRenderedAheadAndIdenticalToTheNormalRenderi
 
   // The arm leaves the plan by 0.2 deg at a2: a miss, rendered at the
   // reported joints.
-  JointPositions off = planned;
+  robot_model::JointPositions off = planned;
   off["a2"] += 0.2 * M_PI / 180;
   bench.fixed_joints = off;
   // Its joint states first, taken in before the frame comes (else the frame

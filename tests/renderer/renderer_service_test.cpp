@@ -13,7 +13,7 @@ namespace {
 
 deployment::Config sim_config() { return deployment::load_config(tofguard::test::source_dir() + "/config/sim.yaml", nullptr); }
 
-joint_state_t joint_state(int64_t utime, const JointPositions& positions, const std::string& robot = "friend-sim") {
+joint_state_t joint_state(int64_t utime, const robot_model::JointPositions& positions, const std::string& robot = "friend-sim") {
   joint_state_t m;
   m.utime = utime;
   m.robot_id = robot;
@@ -44,8 +44,8 @@ depth_image_t frame(int64_t utime, int64_t seq, const Intrinsics& k) {
   return f;
 }
 
-JointPositions arm(double s) {
-  JointPositions q;
+robot_model::JointPositions arm(double s) {
+  robot_model::JointPositions q;
   for (int i = 1; i <= 7; ++i) q["a" + std::to_string(i)] = 0.1 * i * s;
   return q;
 }
@@ -70,7 +70,7 @@ TEST(RendererService, PublishesTheModelAtTheInterpolatedJointsInMillimetres) {
   EXPECT_EQ(out.labels.num_links, static_cast<int>(out.labels.link_name.size()));
 
   // The same as the library at arm(1.25), rounded to millimetres.
-  const SceneModel scene = load_scene(config.robot.urdf_path, config.environment.urdf_paths, scene_options(config.renderer, config.robot));
+  const robot_model::SceneModel scene = robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths, scene_options(config.renderer, config.robot));
   DepthRenderer renderer(scene, config.renderer.near_m, config.renderer.far_m);
   const RenderResult expected = renderer.render(arm(1.25), config.camera.pose, k);
   ASSERT_TRUE(expected.usable);
@@ -98,7 +98,7 @@ TEST(RendererService, UnusableFramesPublishOnlyLabelsWithTheReason) {
   EXPECT_FALSE(out.depth.has_value());
   EXPECT_EQ(out.labels.num_pixels, 0);
 
-  JointPositions without_a4 = arm(1.0);
+  robot_model::JointPositions without_a4 = arm(1.0);
   without_a4.erase("a4");
   service.on_joint_state(joint_state(1'000'000, without_a4));
   out = service.render(frame(1'000'000, 2, k));

@@ -10,7 +10,7 @@
 #include "tofguard/discrepancy/discrepancy_image.hpp"
 #include "tofguard/risk/estimate_finding.hpp"
 #include "tofguard/risk/risk_monitor.hpp"
-#include "tofguard/risk/robot_tree.hpp"
+#include "tofguard/robot_model/kinematic_tree.hpp"
 #include "synthetic_estimates.hpp"
 #include "test_support.hpp"
 #include "tofguard/deployment/config.hpp"
@@ -25,7 +25,6 @@ using risk::classify_estimate;
 using risk::EstimateContext;
 using risk::FrameFinding;
 using risk::RiskMonitor;
-using risk::RobotTree;
 
 constexpr int64_t kStart = 5'000'000'000;  // monotonic
 constexpr int64_t kMs = 1000;
@@ -41,8 +40,8 @@ const deployment::Config& sim_config() {
   return config;
 }
 
-const RobotTree& friend_arm() {
-  static const RobotTree tree = RobotTree::from_urdf_file(sim_config().robot.urdf_path);
+const robot_model::KinematicTree& friend_arm() {
+  static const robot_model::KinematicTree tree = robot_model::load_kinematic_tree(sim_config().robot.urdf_path);
   return tree;
 }
 
@@ -391,6 +390,14 @@ planned_trajectory_t plan_a1(int64_t from_utime, double from_rad, int64_t to_uti
   return p;
 }
 
+// The verdict on one frame through the production path (on_frame): a frame
+// without a model mismatch is judged on arrival, it never waits.
+risk_t judged_at_once(RiskMonitor* m, const discrepancy_t& frame, int64_t now) {
+  const std::vector<risk_t> verdicts = m->on_frame(frame, now);
+  EXPECT_EQ(verdicts.size(), 1u) << "frame " << frame.seq << " should be judged on arrival";
+  return verdicts.empty() ? risk_t{} : verdicts.front();
+}
+
 // Each frame is judged with the joint state of its capture time (the
 // newest at or before its utime), whenever it is processed.
 TEST(PlanDeviation, TheJointStateAtTheFramesUtimeAwayFromThePlanIsAFindingDebouncedLikeTheOthers) {
@@ -408,13 +415,13 @@ TEST(PlanDeviation, TheJointStateAtTheFramesUtimeAwayFromThePlanIsAFindingDeboun
 
   // On the plan at t0 + 200 ms (0.2 rad), within 5 deg.
   m.on_joint_state(joints_at(t0 + 200'000, 0.2 + 4.9 * kDeg), kStart);
-  EXPECT_EQ(m.on_discrepancy(frame_at(t0 + 205'000), kStart).level, risk_t::SAFE);
+  EXPECT_EQ(judged_at_once(&m, frame_at(t0 + 205'000), kStart).level, risk_t::SAFE);
 
   // 7.2 deg off from t0 + 210 ms on.
   std::vector<int8_t> levels;
   for (int i = 0; i < 3; ++i) {
     m.on_joint_state(joints_at(t0 + 210'000 + i * 10'000, 0.21 + i * 0.01 - 7.2 * kDeg), kStart);
-    const risk_t r = m.on_discrepancy(frame_at(t0 + 215'000 + i * 10'000), kStart);
+    const risk_t r = judged_at_once(&m, frame_at(t0 + 215'000 + i * 10'000), kStart);
     EXPECT_EQ(r.cause, risk_t::CAUSE_UNCLASSIFIED);
     EXPECT_EQ(r.suspect, "a1");
     EXPECT_NEAR(r.score, 7.2, 1e-6);
@@ -431,17 +438,17 @@ TEST(PlanDeviation, TheJointStateAtTheFramesUtimeAwayFromThePlanIsAFindingDeboun
   late.on_plan(plan_a1(t0, 0.0, t0 + 500'000, 0.5));
   late.on_joint_state(joints_at(t0 + 200'000, 0.2), kStart);
   late.on_joint_state(joints_at(t0 + 300'000, 0.3 - 7.2 * kDeg), kStart);
-  EXPECT_EQ(late.on_discrepancy(frame_at(t0 + 250'000), kStart).level, risk_t::SAFE);
-  EXPECT_EQ(late.on_discrepancy(frame_at(t0 + 310'000), kStart).cause, risk_t::CAUSE_UNCLASSIFIED);
+  EXPECT_EQ(judged_at_once(&late, frame_at(t0 + 250'000), kStart).level, risk_t::SAFE);
+  EXPECT_EQ(judged_at_once(&late, frame_at(t0 + 310'000), kStart).cause, risk_t::CAUSE_UNCLASSIFIED);
 
   // Beyond the plan's end there is nothing to compare with.
   m.on_joint_state(joints_at(t0 + 600'000, 3.0), kStart);
-  EXPECT_EQ(m.on_discrepancy(frame_at(t0 + 605'000), kStart).level, risk_t::SAFE);
+  EXPECT_EQ(judged_at_once(&m, frame_at(t0 + 605'000), kStart).level, risk_t::SAFE);
 
   // A new plan replaces the old one from its first point on.
   m.on_plan(plan_a1(t0 + 550'000, 2.9, t0 + 900'000, 3.2));
   m.on_joint_state(joints_at(t0 + 610'000, 2.95), kStart);
-  EXPECT_EQ(m.on_discrepancy(frame_at(t0 + 615'000), kStart).level, risk_t::SAFE);
+  EXPECT_EQ(judged_at_once(&m, frame_at(t0 + 615'000), kStart).level, risk_t::SAFE);
 
   deployment::Config off = sim_config();
   off.risk.plan_enabled = false;
@@ -449,7 +456,36 @@ TEST(PlanDeviation, TheJointStateAtTheFramesUtimeAwayFromThePlanIsAFindingDeboun
   feed_all(&without, kStart);
   without.on_plan(plan_a1(t0, 0.0, t0 + 500'000, 0.5));
   without.on_joint_state(joints_at(t0 + 200'000, 1.0), kStart);
-  EXPECT_EQ(without.on_discrepancy(frame_at(t0 + 205'000), kStart).level, risk_t::SAFE);
+  EXPECT_EQ(judged_at_once(&without, frame_at(t0 + 205'000), kStart).level, risk_t::SAFE);
+}
+
+// Each frame is classified once, on arrival, with the joint state of its
+// capture time: a frame queued behind one that waits for its estimate keeps
+// the finding it was classified with, whatever joint states arrive while it
+// queues.
+TEST(PlanDeviation, AQueuedFrameKeepsTheFindingItWasClassifiedWithOnArrival) {
+  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kStart);
+  const int64_t t0 = 1'700'000'000'000'000;
+  feed_all(&m, kStart);
+  m.on_plan(plan_a1(t0, 0.0, t0 + 500'000, 0.5));
+  m.on_joint_state(joints_at(t0 + 200'000, 0.2 - 7.2 * kDeg), kStart);  // 7.2 deg off the plan
+  const discrepancy_t waiting = mismatch_frame(100, 0);                  // waits up to 60 ms
+  discrepancy_t queued = summary_of(default_arm(), 101);                 // nothing the camera sees
+  queued.utime = t0 + 243'000;
+  EXPECT_TRUE(m.on_frame(waiting, kStart).empty());
+  EXPECT_TRUE(m.on_frame(queued, kStart + 33 * kMs).empty());
+  // Back on the plan before the queued frame's capture time, arriving while
+  // it queues.
+  m.on_joint_state(joints_at(t0 + 240'000, 0.24), kStart + 40 * kMs);
+  const std::vector<risk_t> out = m.release_due(kStart + 60 * kMs);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_EQ(out[0].seq, 100);
+  EXPECT_EQ(out[0].cause, risk_t::CAUSE_JOINT_ERROR);
+  EXPECT_EQ(out[1].seq, 101);
+  EXPECT_EQ(out[1].cause, risk_t::CAUSE_UNCLASSIFIED);
+  EXPECT_EQ(out[1].suspect, "a1");
+  EXPECT_NEAR(out[1].score, 7.2, 1e-6);
+  EXPECT_EQ(out[1].detail, "arm left its plan (deg): a1 is 7.2° from the plan (limit 5.0°) [2/3 frames]");
 }
 
 TEST(PlannedTrajectory, InterpolatesInsideItsSpanAndKeepsTheOldPlanBeforeANewOne) {

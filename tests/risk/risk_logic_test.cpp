@@ -1,13 +1,13 @@
-// The risk classifier's logic: the robot tree from the URDF, the frame
-// rules (on summaries computed from synthetic images), debouncing and
-// deadlines on an explicit monotonic clock.
+// The risk classifier's logic: the frame rules (on summaries computed from
+// synthetic images; the robot's tree is robot_model's, tested there),
+// debouncing and deadlines on an explicit monotonic clock.
 #include <gtest/gtest.h>
 
 #include "synthetic_frames.hpp"
 #include "tofguard/discrepancy/discrepancy_image.hpp"
 #include "tofguard/risk/frame_classifier.hpp"
 #include "tofguard/risk/risk_monitor.hpp"
-#include "tofguard/risk/robot_tree.hpp"
+#include "tofguard/robot_model/kinematic_tree.hpp"
 #include "test_support.hpp"
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/deployment/process_settings.hpp"
@@ -19,7 +19,6 @@ using risk::ClassifierContext;
 using risk::classify_frame;
 using risk::FrameFinding;
 using risk::RiskMonitor;
-using risk::RobotTree;
 
 const deployment::Config& sim_config() {
   static const deployment::Config config = deployment::load_config(source_dir() + "/config/sim.yaml", nullptr);
@@ -37,8 +36,8 @@ const deployment::Config& config_depth_100ms() {
   return config;
 }
 
-const RobotTree& friend_arm() {
-  static const RobotTree tree = RobotTree::from_urdf_file(sim_config().robot.urdf_path);
+const robot_model::KinematicTree& friend_arm() {
+  static const robot_model::KinematicTree tree = robot_model::load_kinematic_tree(sim_config().robot.urdf_path);
   return tree;
 }
 
@@ -59,19 +58,24 @@ FrameFinding classify(const discrepancy_t& d, bool arm_moving = false) {
   return classify_frame(d, friend_arm(), sim_config().risk, context);
 }
 
-TEST(RobotTree, FriendArmJointsAndDistalLinks) {
-  const RobotTree& tree = friend_arm();
-  EXPECT_EQ(tree.movable_joints(), (std::vector<std::string>{"a1", "a2", "a3", "a4", "a5", "a6", "a7"}));
-  EXPECT_EQ(tree.nearest_movable_joint_above("link4"), "a4");
-  // The gripper hangs on a fixed joint below link7.
-  EXPECT_EQ(tree.nearest_movable_joint_above("gripper"), "a7");
-  EXPECT_EQ(tree.nearest_movable_joint_above("base_link"), "");
-  EXPECT_EQ(tree.lowest_common_ancestor({"gripper", "link5", "link6"}), "link5");
-  EXPECT_EQ(tree.lowest_common_ancestor({"link7"}), "link7");
-  EXPECT_TRUE(tree.is_descendant_or_self("gripper", "link2"));
-  EXPECT_FALSE(tree.is_descendant_or_self("link1", "link2"));
-  EXPECT_EQ(tree.child_link("a3"), "link3");
-  EXPECT_THROW(RobotTree::from_urdf_string("<robot name='x'><link name='a'/><oops/>"), std::runtime_error);
+// The frame rules are one ordered table (docs/safety-chain.md, "Frame
+// rules"): the first that applies is the finding.
+TEST(FrameClassifier, RulesAreEvaluatedInTheDocumentedOrder) {
+  std::vector<std::string> names;
+  for (const risk::FrameRule& rule : risk::frame_rules()) names.push_back(rule.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"unusable frame", "invalid pixels", "uncalibrated camera", "frozen image",
+                                             "calibration error", "joint error: links missing",
+                                             "joint error: links beside unexplained surfaces", "unknown object",
+                                             "unexplained blob"}));
+  // An object near the arm that also makes a large blob is an unknown
+  // object, not unclassified: the earlier rule wins.
+  discrepancy_t d = summary_of(default_arm());
+  d.near_arm_area_m2 = 0.002f;
+  d.near_arm_pixels = 40;
+  d.largest_blob_area_m2 = 0.5f;
+  EXPECT_EQ(classify(d).cause, risk_t::CAUSE_UNKNOWN_OBJECT);
+  d.near_arm_area_m2 = 0.001f;  // below risk.unknown_object_min_area_m2 = 0.0015
+  EXPECT_EQ(classify(d).cause, risk_t::CAUSE_UNCLASSIFIED);
 }
 
 TEST(FrameClassifier, NoiseOnlyFramesAreSafe) {
@@ -251,6 +255,15 @@ void feed_all(RiskMonitor* m, int64_t now) {
   }
 }
 
+// The verdict on one frame through the production path (on_frame, which
+// releases it at once: sim.yaml does not wait for estimates, and a frame
+// without a model mismatch never waits).
+risk_t judged_at_once(RiskMonitor* m, const discrepancy_t& frame, int64_t now) {
+  const std::vector<risk_t> verdicts = m->on_frame(frame, now);
+  EXPECT_EQ(verdicts.size(), 1u) << "frame " << frame.seq << " should be judged on arrival";
+  return verdicts.empty() ? risk_t{} : verdicts.front();
+}
+
 TEST(RiskMonitor, NothingArrivedIsStaleAfterTheFirstDeadline) {
   RiskMonitor m(config_depth_100ms().risk, config_depth_100ms().channels, friend_arm(), kStart);
   EXPECT_FALSE(m.check_deadlines(kStart + 100 * kMs).has_value());
@@ -271,13 +284,13 @@ TEST(RiskMonitor, EachInputHasItsOwnDeadlineAndCause) {
   int64_t now = kStart;
   feed_all(&m, now);
   discrepancy_t d = summary_of(default_arm(), 40);
-  EXPECT_EQ(m.on_discrepancy(d, now).level, risk_t::SAFE);
+  EXPECT_EQ(judged_at_once(&m, d, now).level, risk_t::SAFE);
   EXPECT_FALSE(m.check_deadlines(now + 100 * kMs).has_value());
 
   // Camera stalls: TOF_DEPTH 100 ms.
   now += 90 * kMs;
   feed_all(&m, now);
-  m.on_discrepancy(d, now);
+  judged_at_once(&m, d, now);
   now += 101 * kMs;
   m.on_joint_state(joints(0.5), now);
   for (const char* p : {"tofguard-camera", "tofguard-renderer", "tofguard-discrepancy"}) m.on_heartbeat(heartbeat(p), now);
@@ -288,17 +301,17 @@ TEST(RiskMonitor, EachInputHasItsOwnDeadlineAndCause) {
 
   // Joint state stalls: 100 ms.
   feed_all(&m, now);
-  m.on_discrepancy(d, now);
+  judged_at_once(&m, d, now);
   now += 101 * kMs;
   m.on_depth(now);
   for (const char* p : {"tofguard-camera", "tofguard-renderer", "tofguard-discrepancy"}) m.on_heartbeat(heartbeat(p), now);
-  m.on_discrepancy(d, now);
+  judged_at_once(&m, d, now);
   r = m.check_deadlines(now);
   ASSERT_TRUE(r);
   EXPECT_EQ(r->cause, risk_t::CAUSE_SENSOR_FAULT);
   EXPECT_EQ(r->suspect, "JOINT_STATE");
   // A frame judged meanwhile is dangerous too, with its own seq.
-  const risk_t frame = m.on_discrepancy(d, now);
+  const risk_t frame = judged_at_once(&m, d, now);
   EXPECT_EQ(frame.level, risk_t::DANGEROUS);
   EXPECT_EQ(frame.seq, 40);
   EXPECT_EQ(frame.suspect, "JOINT_STATE");
@@ -309,7 +322,7 @@ TEST(RiskMonitor, EachInputHasItsOwnDeadlineAndCause) {
     now += 50 * kMs;
     m.on_depth(now);
     m.on_joint_state(joints(0.5), now);
-    m.on_discrepancy(d, now);
+    judged_at_once(&m, d, now);
     m.on_heartbeat(heartbeat("tofguard-camera"), now);
     m.on_heartbeat(heartbeat("tofguard-discrepancy"), now);
   }
@@ -321,7 +334,7 @@ TEST(RiskMonitor, EachInputHasItsOwnDeadlineAndCause) {
 
   // The discrepancy stream stops while the camera is fresh: 200 ms.
   feed_all(&m, now);
-  m.on_discrepancy(d, now);
+  judged_at_once(&m, d, now);
   for (int i = 0; i < 5; ++i) {
     now += 50 * kMs;
     feed_all(&m, now);
@@ -336,13 +349,13 @@ TEST(RiskMonitor, CameraPoseIsWatchedOnlyWhenRequired) {
   deployment::Config config = sim_config();
   RiskMonitor optional(config.risk, config.channels, friend_arm(), kStart);
   feed_all(&optional, kStart + 2000 * kMs);
-  optional.on_discrepancy(summary_of(default_arm()), kStart + 2000 * kMs);
+  judged_at_once(&optional, summary_of(default_arm()), kStart + 2000 * kMs);
   EXPECT_FALSE(optional.check_deadlines(kStart + 2000 * kMs).has_value());
 
   config.risk.camera_pose_required = true;
   RiskMonitor required(config.risk, config.channels, friend_arm(), kStart);
   feed_all(&required, kStart + 2000 * kMs);
-  required.on_discrepancy(summary_of(default_arm()), kStart + 2000 * kMs);
+  judged_at_once(&required, summary_of(default_arm()), kStart + 2000 * kMs);
   const auto r = required.check_deadlines(kStart + 2000 * kMs);
   ASSERT_TRUE(r);
   EXPECT_EQ(r->suspect, "CAMERA_POSE");
@@ -359,7 +372,7 @@ TEST(RiskMonitor, MismatchIsWarningUntilDebouncedThenDangerousAndClearsOnAGoodFr
   for (int i = 0; i < 4; ++i) {
     now += 33 * kMs;
     feed_all(&m, now);
-    const risk_t r = m.on_discrepancy(bad, now);
+    const risk_t r = judged_at_once(&m, bad, now);
     EXPECT_EQ(r.cause, risk_t::CAUSE_JOINT_ERROR);
     EXPECT_EQ(r.suspect, "a2");
     EXPECT_EQ(r.seq, 100);
@@ -370,12 +383,12 @@ TEST(RiskMonitor, MismatchIsWarningUntilDebouncedThenDangerousAndClearsOnAGoodFr
   EXPECT_EQ(levels, (std::vector<int8_t>{risk_t::WARNING, risk_t::WARNING, risk_t::DANGEROUS, risk_t::DANGEROUS}));
   now += 33 * kMs;
   feed_all(&m, now);
-  const risk_t r = m.on_discrepancy(good, now);
+  const risk_t r = judged_at_once(&m, good, now);
   EXPECT_EQ(r.level, risk_t::SAFE);
   EXPECT_EQ(r.cause, risk_t::CAUSE_NONE);
   now += 33 * kMs;
   feed_all(&m, now);
-  EXPECT_EQ(m.on_discrepancy(bad, now).level, risk_t::WARNING);
+  EXPECT_EQ(judged_at_once(&m, bad, now).level, risk_t::WARNING);
 }
 
 TEST(RiskMonitor, SensorFaultsUseTheirOwnDebounce) {
@@ -385,8 +398,8 @@ TEST(RiskMonitor, SensorFaultsUseTheirOwnDebounce) {
   unusable.unusable_kind = discrepancy_t::UNUSABLE_RENDERER;
   unusable.unusable_reason = "renderer: joint a3 missing";
   feed_all(&m, kStart);
-  EXPECT_EQ(m.on_discrepancy(unusable, kStart).level, risk_t::WARNING);
-  EXPECT_EQ(m.on_discrepancy(unusable, kStart).level, risk_t::DANGEROUS);  // sensor_debounce_frames = 2
+  EXPECT_EQ(judged_at_once(&m, unusable, kStart).level, risk_t::WARNING);
+  EXPECT_EQ(judged_at_once(&m, unusable, kStart).level, risk_t::DANGEROUS);  // sensor_debounce_frames = 2
 }
 
 TEST(RiskMonitor, FrozenImageNeedsAMovingArm) {
@@ -395,9 +408,9 @@ TEST(RiskMonitor, FrozenImageNeedsAMovingArm) {
   frozen.repeat_count = 3;
   m.on_depth(kStart);
   m.on_joint_state(joints(0.0), kStart);
-  EXPECT_EQ(m.on_discrepancy(frozen, kStart).level, risk_t::SAFE);
+  EXPECT_EQ(judged_at_once(&m, frozen, kStart).level, risk_t::SAFE);
   m.on_joint_state(joints(-0.3), kStart);
-  const risk_t r = m.on_discrepancy(frozen, kStart);
+  const risk_t r = judged_at_once(&m, frozen, kStart);
   EXPECT_EQ(r.cause, risk_t::CAUSE_SENSOR_FAULT);
   EXPECT_NE(r.detail.find("frozen"), std::string::npos);
 }
@@ -420,14 +433,14 @@ TEST(RiskMonitor, FrozenImageIsJudgedByTheJointStateAtTheFramesCaptureTime) {
     m.on_depth(kStart);
     m.on_joint_state(joints_at(0.3, kCapture - 10 * kMs), kStart);
     m.on_joint_state(joints_at(0.0, kCapture + 50 * kMs), kStart);  // the arm halted after the capture
-    EXPECT_EQ(m.on_discrepancy(frozen, kStart).cause, risk_t::CAUSE_SENSOR_FAULT);
+    EXPECT_EQ(judged_at_once(&m, frozen, kStart).cause, risk_t::CAUSE_SENSOR_FAULT);
   }
   {
     RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kStart);
     m.on_depth(kStart);
     m.on_joint_state(joints_at(0.0, kCapture - 10 * kMs), kStart);
     m.on_joint_state(joints_at(0.3, kCapture + 50 * kMs), kStart);  // it started after the capture
-    EXPECT_EQ(m.on_discrepancy(frozen, kStart).level, risk_t::SAFE);
+    EXPECT_EQ(judged_at_once(&m, frozen, kStart).level, risk_t::SAFE);
   }
 }
 

@@ -149,7 +149,7 @@ TEST(SimCameraProcess, PublishesFaultsAndRendersIntruders) {
 // camera depth is within 30 mm of the model: about 1 when the camera was
 // where `pose` says.
 double robot_match_fraction(renderer::DepthRenderer* renderer, const depth_image_t& frame, const CameraPose& pose) {
-  renderer::JointPositions joints;
+  robot_model::JointPositions joints;
   for (int i = 0; i < 7; ++i) joints["a" + std::to_string(i + 1)] = kArm[i];
   const Intrinsics k = intrinsics_of(frame);
   const renderer::RenderResult model = renderer->render(joints, pose, k);
@@ -188,9 +188,9 @@ TEST(SimCameraProcess, PanTiltHeadPublishesThePoseOfEachFrameAndAnOffsetReadingD
   EXPECT_EQ(camera.wait(std::chrono::seconds(5)), 0) << camera.stderr_text();
 
   const deployment::Config& config = rig.config;
-  renderer::SceneOptions options = renderer::scene_options(config.renderer, config.robot);
+  robot_model::SceneOptions options = renderer::scene_options(config.renderer, config.robot);
   options.padding_m = 0;
-  const renderer::SceneModel scene = renderer::load_scene(config.robot.urdf_path, config.environment.urdf_paths, options);
+  const robot_model::SceneModel scene = robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths, options);
   renderer::DepthRenderer renderer(scene, config.renderer.near_m, config.renderer.far_m);
   int consistent = 0, disagreeing = 0;
   double smallest_pan_deg = 1e9, largest_pan_deg = -1e9;

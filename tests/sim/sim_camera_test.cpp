@@ -1,6 +1,6 @@
 // The simulated camera's logic with a fake renderer: true joint states
 // interpolated at the capture time, determinism, and the injected faults.
-// (The interpolation itself is renderer::JointHistory's, tested there.)
+// (The interpolation itself is robot_state::JointHistory's, tested there.)
 #include "tofguard/sim/sim_camera.hpp"
 
 #include <gtest/gtest.h>

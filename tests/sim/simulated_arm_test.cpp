@@ -19,11 +19,6 @@ JointsSimSettings two_joints() {
   return c;
 }
 
-TEST(SimulatedArm, MovableJointsOfTheDefaultArmInOrder) {
-  const auto joints = movable_joints(test::source_dir() + "/config/models/friend_arm.urdf");
-  EXPECT_EQ(joints, (std::vector<std::string>{"a1", "a2", "a3", "a4", "a5", "a6", "a7"}));
-}
-
 TEST(SimulatedArm, FollowsItsMotionOnlyWhileAllowed) {
   SimulatedArm arm(two_joints(), {"j1", "j2"}, "test.yaml");
   // URDF order, not config order.

@@ -26,7 +26,7 @@ inline Eigen::Isometry3d pose_of(const CameraPose& pose) { return pose.frame_fro
 // distal links in view and bent away from the joint's axis (a3, a5 and a7
 // turn cylinders about their own axes: only the bent links after them show
 // their angle).
-inline renderer::JointPositions reach_pose() {
+inline robot_model::JointPositions reach_pose() {
   // The simulated arm's centre pose (config/sim.yaml joints_sim): reaching
   // forward over the table, elbow bent, wrist bent.
   return {{"a1", -0.30}, {"a2", 0.70}, {"a3", 0.0}, {"a4", 1.10}, {"a5", 0.0}, {"a6", 0.60}, {"a7", 0.0}};
@@ -35,7 +35,7 @@ inline renderer::JointPositions reach_pose() {
 // Reaching down and to the right over the table's near edge, upper arm
 // nearly level, forearm and wrist bent down, the gripper turned: every link
 // in view, seen from the side rather than end-on.
-inline renderer::JointPositions side_reach_pose() {
+inline robot_model::JointPositions side_reach_pose() {
   return {{"a1", -0.6}, {"a2", 1.3}, {"a3", -0.4}, {"a4", 1.2}, {"a5", 0.6}, {"a6", 1.0}, {"a7", -0.4}};
 }
 

@@ -4,7 +4,7 @@
 
 #include "tofguard/estimator/estimator_process.hpp"
 #include "tofguard/deployment/process_settings.hpp"
-#include "tofguard/renderer/kinematics.hpp"
+#include "tofguard/robot_model/kinematics.hpp"
 
 namespace tofguard::test {
 
@@ -15,11 +15,11 @@ SimulatedFrames::SimulatedFrames(const deployment::Config& config)
       calibration_(config.camera.depth_calibration.enabled ? config.camera.depth_calibration.coefficients_m
                                                            : std::vector<double>{}) {}
 
-std::vector<float> SimulatedFrames::capture(const renderer::JointPositions& true_joints,
+std::vector<float> SimulatedFrames::capture(const robot_model::JointPositions& true_joints,
                                             const Eigen::Isometry3d& true_world_from_optical,
                                             const Intrinsics& intrinsics, uint64_t frame_index,
                                             const std::vector<renderer::ExtraObject>& objects) {
-  const renderer::LinkPoses poses = renderer::forward_kinematics(scene_, true_joints);
+  const robot_model::LinkPoses poses = robot_model::forward_kinematics(scene_, true_joints);
   if (!poses.usable) throw std::runtime_error(poses.unusable_reason);
   const renderer::RenderResult rendered = renderer_->render_at(poses, true_world_from_optical, intrinsics, objects);
   if (!rendered.usable) throw std::runtime_error(rendered.unusable_reason);
@@ -29,7 +29,7 @@ std::vector<float> SimulatedFrames::capture(const renderer::JointPositions& true
   return image.depth_m;
 }
 
-std::vector<estimator::EstimatorFrame> SimulatedFrames::frames_with_offset(const renderer::JointPositions& true_joints,
+std::vector<estimator::EstimatorFrame> SimulatedFrames::frames_with_offset(const robot_model::JointPositions& true_joints,
                                                                 const Eigen::Isometry3d& world_from_optical,
                                                                 const Intrinsics& intrinsics, const std::string& joint,
                                                                 double offset_rad, int num_frames,
@@ -37,7 +37,7 @@ std::vector<estimator::EstimatorFrame> SimulatedFrames::frames_with_offset(const
   constexpr double kJointStepRad = 0.5 * 3.141592653589793 / 180;  // per frame
   std::vector<estimator::EstimatorFrame> frames;
   for (int k = 0; k < num_frames; ++k) {
-    renderer::JointPositions at = true_joints;
+    robot_model::JointPositions at = true_joints;
     for (auto& [name, position] : at) position -= k * kJointStepRad;
     estimator::EstimatorFrame frame;
     frame.intrinsics = intrinsics;

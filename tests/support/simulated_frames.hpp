@@ -13,7 +13,7 @@
 #include "tofguard/camera/depth_calibration.hpp"
 #include "tofguard/estimator/motion_estimator.hpp"
 #include "tofguard/renderer/depth_renderer.hpp"
-#include "tofguard/renderer/scene_model.hpp"
+#include "tofguard/robot_model/scene_model.hpp"
 #include "tofguard/sim/tof_error_model.hpp"
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/deployment/process_settings.hpp"
@@ -29,7 +29,7 @@ class SimulatedFrames {
   // Calibrated Z in metres (0 = no return), row-major, for `intrinsics`.
   // `frame_index` selects the noise. Throws std::runtime_error when the
   // scene cannot be rendered.
-  std::vector<float> capture(const renderer::JointPositions& true_joints,
+  std::vector<float> capture(const robot_model::JointPositions& true_joints,
                              const Eigen::Isometry3d& true_world_from_optical, const Intrinsics& intrinsics,
                              uint64_t frame_index, const std::vector<renderer::ExtraObject>& objects = {});
 
@@ -39,18 +39,18 @@ class SimulatedFrames {
   // (every joint 0.5 degrees a frame), each reporting its joints with
   // `offset_rad` added to `joint` (an encoder offset; 0: none) and the
   // camera where it is. Advances *frame_index by num_frames.
-  std::vector<estimator::EstimatorFrame> frames_with_offset(const renderer::JointPositions& true_joints,
+  std::vector<estimator::EstimatorFrame> frames_with_offset(const robot_model::JointPositions& true_joints,
                                                  const Eigen::Isometry3d& world_from_optical,
                                                  const Intrinsics& intrinsics, const std::string& joint,
                                                  double offset_rad, int num_frames, uint64_t* frame_index);
 
-  const renderer::SceneModel& scene() const { return scene_; }
+  const robot_model::SceneModel& scene() const { return scene_; }
   // The renderer, to share with an estimator on the same thread.
   renderer::DepthRenderer& renderer() { return *renderer_; }
 
  private:
   deployment::Config config_;
-  renderer::SceneModel scene_;
+  robot_model::SceneModel scene_;
   std::unique_ptr<renderer::DepthRenderer> renderer_;
   camera::DepthCalibration calibration_;
 };

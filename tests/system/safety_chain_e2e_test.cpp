@@ -19,8 +19,7 @@
 #include <memory>
 #include <thread>
 
-#include "tofguard/renderer/kinematics.hpp"
-#include "tofguard/renderer/scene_model.hpp"
+#include "tofguard/robot_model/kinematics.hpp"
 #include "test_support.hpp"
 #include "tofguard/heartbeat_t.hpp"
 #include "tofguard/joint_state_t.hpp"
@@ -243,10 +242,10 @@ class Chain {
   // A point `distance_m` from link5's origin along the camera's x axis
   // (image right), at the latest joint state (world frame, metres).
   Eigen::Vector3d object_beside_forearm_m(double distance_m) {
-    const renderer::SceneModel scene = renderer::load_scene(config_.robot.urdf_path, {}, renderer::SceneOptions{});
-    const renderer::LinkPoses poses = renderer::forward_kinematics(scene, latest_joints_);
+    const robot_model::KinematicTree tree = robot_model::load_kinematic_tree(config_.robot.urdf_path);
+    const robot_model::LinkPoses poses = robot_model::forward_kinematics(tree, latest_joints_);
     EXPECT_TRUE(poses.usable) << poses.unusable_reason;
-    const auto names = scene.link_names();
+    const auto names = tree.link_names();
     const size_t link5 = std::find(names.begin(), names.end(), "link5") - names.begin();
     EXPECT_LT(link5, names.size());
     const Eigen::Vector3d forearm = poses.world_from_link.at(link5).translation();
@@ -325,7 +324,7 @@ class Chain {
 
  private:
   int64_t last_pose_us_ = 0;
-  renderer::JointPositions latest_joints_;
+  robot_model::JointPositions latest_joints_;
   std::string risk_log_;
   std::vector<std::string> risk_details_;  // of frame verdicts since the last fault
   std::vector<std::string> estimate_log_;  // one line per MOTION_ESTIMATE

@@ -21,11 +21,9 @@
 // any other frame, earlier frames whose discrepancy did not (or has not
 // come). An offset that began between two frames is not averaged with the
 // frames before it. The
-// joints are the JOINT_STATE history interpolated at each frame's utime
-// (renderer's JointHistory, the renderer's extrapolation limit); the
-// camera pose is CAMERA_POSE at the frame's utime (renderer's
-// CameraPoseHistory, with the renderer's limits), else the config's static
-// pose.
+// joints and the camera pose are the robot's state at each frame's utime
+// (robot_state::StateHistory, with the renderer's limits: JOINT_STATE
+// interpolated, CAMERA_POSE else the config's static pose).
 #include <condition_variable>
 #include <deque>
 #include <map>
@@ -35,11 +33,10 @@
 #include <string>
 #include <thread>
 
-#include "tofguard/renderer/camera_pose_history.hpp"
 #include "tofguard/estimator/estimate_message.hpp"
-#include "tofguard/renderer/joint_history.hpp"
 #include "tofguard/estimator/motion_estimator.hpp"
-#include "tofguard/renderer/scene_model.hpp"
+#include "tofguard/robot_model/scene_model.hpp"
+#include "tofguard/robot_state/state_history.hpp"
 #include "tofguard/camera_pose_t.hpp"
 #include "tofguard/estimator/estimator_settings.hpp"
 #include "tofguard/depth_image_t.hpp"
@@ -65,11 +62,7 @@ EstimatorOptions options_from_settings(const EstimatorProcessSettings& settings)
 
 // The scene the estimator compares with the camera: the robot and the
 // environment as the camera sees them (visual geometry, no padding).
-renderer::SceneModel load_estimator_scene(const EstimatorProcessSettings& settings);
-
-// The name of a joint that moves `link` (the nearest one up the chain), ""
-// for a static link.
-std::string moving_joint_of(const renderer::SceneModel& scene, int link);
+robot_model::SceneModel load_estimator_scene(const EstimatorProcessSettings& settings);
 
 struct EstimateJob {
   // frames[0] is the frame the estimate is about, the others the frames
@@ -86,7 +79,7 @@ struct ScheduledWork {
 
 class EstimatorScheduler {
  public:
-  EstimatorScheduler(const EstimatorProcessSettings& settings, const renderer::SceneModel& scene);
+  EstimatorScheduler(const EstimatorProcessSettings& settings, const robot_model::SceneModel& scene);
 
   // False (ignored) for another robot's state or one not newer than the
   // last.
@@ -121,9 +114,8 @@ class EstimatorScheduler {
                                                 std::string* why) const;
 
   EstimatorProcessSettings settings_;
-  const renderer::SceneModel& scene_;
-  renderer::JointHistory history_;
-  renderer::CameraPoseHistory camera_poses_;
+  const robot_model::SceneModel& scene_;
+  robot_state::StateHistory state_;
   std::map<int64_t, depth_image_t> frames_;  // by seq
   std::map<int64_t, int8_t> wanted_;          // seq -> trigger
   std::set<int64_t> estimated_;
@@ -137,7 +129,7 @@ class EstimatorScheduler {
 // job waits at most: a newer one replaces it and counts as dropped.
 class EstimatorWorker {
  public:
-  EstimatorWorker(const renderer::SceneModel& scene, const EstimatorProcessSettings& settings);
+  EstimatorWorker(const robot_model::SceneModel& scene, const EstimatorProcessSettings& settings);
   ~EstimatorWorker();
   EstimatorWorker(const EstimatorWorker&) = delete;
   EstimatorWorker& operator=(const EstimatorWorker&) = delete;
@@ -152,7 +144,7 @@ class EstimatorWorker {
  private:
   void run();
 
-  const renderer::SceneModel& scene_;
+  const robot_model::SceneModel& scene_;
   EstimatorProcessSettings settings_;
   std::mutex mutex_;
   std::condition_variable wake_;

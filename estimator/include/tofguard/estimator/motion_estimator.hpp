@@ -35,8 +35,8 @@
 #include <Eigen/Geometry>
 
 #include "tofguard/renderer/depth_renderer.hpp"
-#include "tofguard/renderer/kinematics.hpp"
-#include "tofguard/renderer/scene_model.hpp"
+#include "tofguard/robot_model/kinematics.hpp"
+#include "tofguard/robot_model/scene_model.hpp"
 #include "tofguard/common/camera_settings.hpp"
 
 namespace tofguard::estimator {
@@ -141,7 +141,7 @@ struct EstimatorFrame {
   std::vector<float> depth_m;
   Intrinsics intrinsics;
   // The reported joint positions (every actuated joint of the model).
-  renderer::JointPositions reported_joints;
+  robot_model::JointPositions reported_joints;
   // The reported camera pose: p_world = world_from_optical * p_optical.
   Eigen::Isometry3d world_from_optical = Eigen::Isometry3d::Identity();
 };
@@ -205,7 +205,7 @@ class MotionEstimator {
  public:
   // `renderer` must render `scene` (the same model) and outlive this.
   // Throws std::invalid_argument for options out of range.
-  MotionEstimator(const renderer::SceneModel& scene, renderer::DepthRenderer* renderer,
+  MotionEstimator(const robot_model::SceneModel& scene, renderer::DepthRenderer* renderer,
                   const EstimatorOptions& options);
 
   // Estimates what `frame` shows, with the options' free parameters (at
@@ -232,7 +232,7 @@ class MotionEstimator {
   EstimateResult estimate_camera(const std::vector<EstimatorFrame>& frames);
 
   const EstimatorOptions& options() const { return options_; }
-  const renderer::SceneModel& scene() const { return scene_; }
+  const robot_model::SceneModel& scene() const { return scene_; }
 
  private:
   struct ChainJoint {
@@ -258,6 +258,21 @@ class MotionEstimator {
   // or why the frame cannot be rendered.
   std::string linearize(const EstimatorFrame& frame, const State& state, double scale, int stride, PointSet points,
                         bool joints_free, Linearization* lin, std::vector<Sample>* samples);
+  // linearize's stages, per rendered pixel of a link (`chain`: its movable
+  // joints up to the root): the contour term (distance in pixels from a
+  // rendered occluding contour to the nearest measured one) and the depth
+  // term (point-to-plane distance in metres to the measured point), each
+  // adding its residual through add_residual.
+  struct RenderedView;
+  void add_contour_term(const RenderedView& view, const std::vector<ChainJoint>& chain, int u, int v,
+                        Linearization* lin) const;
+  void add_depth_term(const RenderedView& view, const std::vector<ChainJoint>& chain, int link, int u, int v,
+                      Linearization* lin, std::vector<Sample>* samples) const;
+  // One residual whose derivative with respect to the model point (seen
+  // optical frame) is `g`.
+  void add_residual(const RenderedView& view, const std::vector<ChainJoint>& chain, const Eigen::Vector3d& m,
+                    const Eigen::Vector3d& world, const Eigen::Vector3d& g, double residual, double weight,
+                    bool count_joint_points, double d_depth_offset, Linearization* lin) const;
   // Gauss-Newton stage over `frames`; returns "" or an unusable reason.
   std::string solve(const std::vector<const EstimatorFrame*>& frames, bool joints_free, bool camera_free,
                     PointSet points, int max_iterations, State* state, Linearization* final_lin,
@@ -267,7 +282,7 @@ class MotionEstimator {
   EstimateResult finish(const EstimatorFrame& frame, const State& state, const Linearization& lin,
                         bool camera_free, bool joints_free) const;
 
-  const renderer::SceneModel& scene_;
+  const robot_model::SceneModel& scene_;
   renderer::DepthRenderer* renderer_;
   EstimatorOptions options_;
   int num_params_ = 0;  // actuated joints

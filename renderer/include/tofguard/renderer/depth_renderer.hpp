@@ -26,8 +26,8 @@
 #include <Eigen/Geometry>
 
 #include "tofguard/renderer/egl_context.hpp"
-#include "tofguard/renderer/kinematics.hpp"
-#include "tofguard/renderer/scene_model.hpp"
+#include "tofguard/robot_model/kinematics.hpp"
+#include "tofguard/robot_model/scene_model.hpp"
 #include "tofguard/common/camera_geometry.hpp"
 #include "tofguard/common/depth_frame.hpp"
 
@@ -82,8 +82,8 @@ class DepthRenderer {
   // Creates the context (TOFGUARD_EGL_PLATFORM picks the platform, default
   // device then surfaceless) and uploads the scene. 0 < near_m < far_m.
   // Throws RenderError (no context, GL failure) or std::invalid_argument.
-  DepthRenderer(const SceneModel& scene, double near_m, double far_m);
-  DepthRenderer(const SceneModel& scene, double near_m, double far_m, EglPlatform platform);
+  DepthRenderer(const robot_model::SceneModel& scene, double near_m, double far_m);
+  DepthRenderer(const robot_model::SceneModel& scene, double near_m, double far_m, EglPlatform platform);
   ~DepthRenderer();
   DepthRenderer(const DepthRenderer&) = delete;
   DepthRenderer& operator=(const DepthRenderer&) = delete;
@@ -91,12 +91,12 @@ class DepthRenderer {
   // `camera_pose` is the optical frame's pose in link camera_pose.frame_id
   // (resolved through forward kinematics, so a camera on the arm moves with
   // it). Never throws for bad input: the result is then unusable.
-  RenderResult render(const JointPositions& joints, const CameraPose& camera_pose, const Intrinsics& intrinsics,
+  RenderResult render(const robot_model::JointPositions& joints, const CameraPose& camera_pose, const Intrinsics& intrinsics,
                       const std::vector<ExtraObject>& extra_objects = {});
 
   // Same, with the camera pose already in the world frame and the links'
   // poses already known (e.g. a motion estimator trying many candidates).
-  RenderResult render_at(const LinkPoses& link_poses, const Eigen::Isometry3d& world_from_optical,
+  RenderResult render_at(const robot_model::LinkPoses& link_poses, const Eigen::Isometry3d& world_from_optical,
                          const Intrinsics& intrinsics, const std::vector<ExtraObject>& extra_objects = {});
 
   // Which EGL platform and GL renderer is in use, for logs.

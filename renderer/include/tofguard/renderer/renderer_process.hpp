@@ -1,8 +1,8 @@
 #pragma once
 // tofguard-renderer's logic without LCM: for each TOF_DEPTH frame, the
 // model rendered at the joints interpolated at the frame's utime, from the
-// camera pose at the frame's utime (CameraPoseHistory: CAMERA_POSE per
-// camera_id, or the config's static pose), at the frame's own size and
+// camera pose at the frame's utime (robot_state::StateHistory: CAMERA_POSE
+// per camera_id, or the config's static pose), at the frame's own size and
 // intrinsics.
 //
 // Outputs per frame (both carry the camera frame's utime, seq, camera_id):
@@ -38,10 +38,9 @@
 #include <set>
 #include <string>
 
-#include "tofguard/renderer/camera_pose_history.hpp"
 #include "tofguard/renderer/depth_renderer.hpp"
-#include "tofguard/renderer/joint_history.hpp"
 #include "tofguard/renderer/renderer_settings.hpp"
+#include "tofguard/robot_state/state_history.hpp"
 #include "tofguard/camera_pose_t.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/joint_state_t.hpp"
@@ -65,7 +64,7 @@ constexpr double kMaxFarM = 32.767;
 
 // The scene options of the renderer's settings (geometry, padding) and the
 // robot's package paths. Throws ModelError for a bad geometry word.
-SceneOptions scene_options(const RendererSettings& renderer, const RobotSettings& robot);
+robot_model::SceneOptions scene_options(const RendererSettings& renderer, const RobotSettings& robot);
 
 struct RenderedFrame {
   link_labels_t labels;
@@ -120,7 +119,7 @@ class RendererService {
     std::string camera_id;
     int64_t utime = 0;
     Intrinsics intrinsics;
-    JointPositions joints;
+    robot_model::JointPositions joints;
     CameraPose pose;
     bool rendered = false;
     RenderResult result;  // usable when rendered and worth using
@@ -129,16 +128,14 @@ class RendererService {
   void learn_period(const depth_image_t& frame);
   void plan_prediction(const depth_image_t& frame);
   // True when `prediction_` may stand for `frame` rendered at `joints` and `pose`.
-  bool prediction_matches(const depth_image_t& frame, const JointPositions& joints, const CameraPose& pose) const;
+  bool prediction_matches(const depth_image_t& frame, const robot_model::JointPositions& joints, const CameraPose& pose) const;
 
   RendererProcessSettings settings_;
-  SceneModel scene_;
+  robot_model::SceneModel scene_;
   std::unique_ptr<DepthRenderer> renderer_;
-  JointHistory history_;
-  CameraPoseHistory camera_poses_;
+  robot_state::StateHistory state_;
   std::optional<depth_image_t> pending_;
   PlannedTrajectory plan_;
-  std::set<std::string> prismatic_joints_;
   std::optional<int64_t> last_frame_utime_;
   std::deque<int64_t> frame_intervals_us_;
   std::optional<Prediction> prediction_;

@@ -3,11 +3,13 @@
 // first (unusable frame, invalid pixels, uncalibrated, frozen while the arm
 // moves), then what the mismatch looks like: CALIBRATION_ERROR, JOINT_ERROR,
 // UNKNOWN_OBJECT or UNCLASSIFIED. docs/safety-chain.md gives the rules.
-// Pure logic; the debouncing into WARNING / DANGEROUS is RiskMonitor's.
+// Pure logic; the debouncing into WARNING / DANGEROUS is DecisionRule's
+// (decision_rule.hpp).
 #include <cstdint>
 #include <string>
+#include <vector>
 
-#include "tofguard/risk/robot_tree.hpp"
+#include "tofguard/robot_model/kinematic_tree.hpp"
 #include "tofguard/common/risk_names.hpp"
 #include "tofguard/risk/risk_settings.hpp"
 #include "tofguard/discrepancy_t.hpp"
@@ -35,7 +37,58 @@ struct ClassifierContext {
   bool arm_moving = false;
 };
 
-FrameFinding classify_frame(const discrepancy_t& frame, const RobotTree& robot, const RiskSettings& config,
+// A robot link seen well enough to judge (>= risk.joint_error.min_link_pixels
+// compared pixels, silhouettes left out).
+struct LinkView {
+  std::string name;
+  int compared = 0;
+  double mismatch = 0;  // (compared - match) / compared
+  double missing = 0;   // farther / compared
+};
+
+// What the frame rules look at: the frame, the robot's tree, the thresholds
+// and the context, with the per-link views every mismatch rule shares.
+class FrameEvidence {
+ public:
+  FrameEvidence(const discrepancy_t& frame, const robot_model::KinematicTree& robot, const RiskSettings& config,
+                const ClassifierContext& context)
+      : frame(frame), robot(robot), config(config), context(context) {}
+
+  const discrepancy_t& frame;
+  const robot_model::KinematicTree& robot;
+  const RiskSettings& config;
+  const ClassifierContext& context;
+
+  // The visible robot links, in discrepancy_t order.
+  const std::vector<LinkView>& visible_links() const;
+  // Compared and matching pixels over all environment links.
+  int64_t environment_compared() const;
+  int64_t environment_match() const;
+
+ private:
+  // Built on first use: the sensor rules judge frames (unusable ones
+  // among them) without per-link counts.
+  void build_link_views() const;
+  mutable bool built_ = false;
+  mutable std::vector<LinkView> visible_;
+  mutable int64_t environment_compared_ = 0;
+  mutable int64_t environment_match_ = 0;
+};
+
+// One frame rule: its finding, or a finding with cause CAUSE_NONE when it
+// does not apply.
+struct FrameRule {
+  const char* name;
+  FrameFinding (*apply)(const FrameEvidence& evidence);
+};
+
+// The frame rules in order of precedence (docs/safety-chain.md, "Frame
+// rules"); the first that applies is the frame's finding. A new rule is a
+// new entry at its place in this list.
+const std::vector<FrameRule>& frame_rules();
+
+// The first finding of frame_rules(), or none.
+FrameFinding classify_frame(const discrepancy_t& frame, const robot_model::KinematicTree& robot, const RiskSettings& config,
                             const ClassifierContext& context);
 
 // `value` with `decimals` digits after the point, for detail lines.

@@ -15,7 +15,7 @@
 
 #include <Eigen/Geometry>
 
-#include "tofguard/renderer/joint_history.hpp"
+#include "tofguard/robot_state/joint_history.hpp"
 #include "tofguard/sim/tof_error_model.hpp"
 #include "tofguard/common/camera_settings.hpp"
 #include "tofguard/sim/sim_settings.hpp"
@@ -114,7 +114,7 @@ class SimulatedCamera {
   SceneRenderer* renderer_;
   int64_t start_utime_;
   TofErrorModel model_;
-  renderer::JointHistory joints_;
+  robot_state::JointHistory joints_;
   std::vector<ActiveSimFault> faults_;
   std::optional<TofImage> last_image_;
 };

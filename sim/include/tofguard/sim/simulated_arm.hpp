@@ -20,15 +20,12 @@ struct ArmState {
   std::vector<double> velocity;
 };
 
-// The movable (non-fixed) joints of a URDF, in file order; throws
-// ConfigError naming the file when it cannot be parsed.
-std::vector<std::string> movable_joints(const std::string& urdf_path);
-
 class SimulatedArm {
  public:
-  // Throws ConfigError (naming `config_file` and the joints_sim key) when
-  // the motion does not cover exactly the URDF's movable joints or a fault
-  // names an unknown joint.
+  // `urdf_joints`: the URDF's actuated joints
+  // (robot_model::KinematicTree::actuated_joint_names). Throws ConfigError
+  // (naming `config_file` and the joints_sim key) when the motion does not
+  // cover exactly those joints or a fault names an unknown joint.
   SimulatedArm(const JointsSimSettings& config, const std::vector<std::string>& urdf_joints,
                const std::string& config_file);
 

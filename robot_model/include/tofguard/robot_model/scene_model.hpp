@@ -1,34 +1,28 @@
 #pragma once
 // The scene tofguard renders: the robot's URDF (moving links) plus any number
 // of static-environment URDFs (fixed links only: floor, table, wheelchair),
-// reduced to what a depth renderer needs: a kinematic tree and, per link, a
-// list of triangle meshes at fixed poses in that link's frame.
+// reduced to what a depth renderer needs: the kinematic tree
+// (kinematic_tree.hpp) and, per link, a list of triangle meshes at fixed
+// poses in that link's frame.
 //
-// Frames: every URDF link frame as the URDF defines it. "World" is the robot's
-// root link; every environment URDF's root link is placed at that same frame
-// (config: "placed in the same world frame as the robot's root link").
-// Units: metres and radians throughout.
+// Frames and units as in kinematic_tree.hpp: URDF link frames, the world
+// is the robot's root link; metres and radians.
 //
 // Loading happens once, at start; everything that can be wrong with a model
 // (malformed XML, a mesh that cannot be found or read, a geometry type the
 // renderer does not know, a moving joint in an environment) is a ModelError
-// there, never a surprise later.
-#include <map>
-#include <stdexcept>
+// there, never a surprise later. Meshes are read with assimp: this part of
+// robot_model is its own library (tofguard_scene_model), so that users of
+// the tree alone (the risk classifier) do not link assimp.
+#include <cstdint>
 #include <string>
 #include <vector>
 
 #include <Eigen/Geometry>
 
-namespace tofguard::renderer {
+#include "tofguard/robot_model/kinematic_tree.hpp"
 
-// A model that cannot be used. what() is one line naming the file and, where
-// it applies, the link and the mesh, e.g.
-//   "friend_arm.urdf: link 'link3': mesh 'package://arm/l3.stl' not found (searched: ...)".
-class ModelError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+namespace tofguard::robot_model {
 
 enum class GeometrySource { kVisual, kCollision };
 
@@ -79,55 +73,14 @@ struct Shape {
   Eigen::Isometry3d link_from_shape = Eigen::Isometry3d::Identity();
 };
 
-enum class JointType { kFixed, kRevolute, kContinuous, kPrismatic };
-
-struct Joint {
-  std::string name;
-  JointType type = JointType::kFixed;
-  int parent_link = -1;
-  int child_link = -1;
-  // Joint frame in the parent link's frame (URDF <origin>: xyz, then rpy as
-  // fixed-axis roll about x, pitch about y, yaw about z: R = Rz*Ry*Rx).
-  Eigen::Isometry3d parent_from_joint = Eigen::Isometry3d::Identity();
-  // Unit axis in the joint frame: rotation axis (revolute, continuous, right
-  // hand rule, radians) or translation direction (prismatic, metres).
-  Eigen::Vector3d axis = Eigen::Vector3d::UnitX();
-  // Mimic: value = multiplier * value(mimicked joint) + offset.
-  int mimic_joint = -1;
-  double mimic_multiplier = 1;
-  double mimic_offset = 0;
-};
-
-struct Link {
-  std::string name;
-  // The joint whose child this link is; -1 for a root (the robot's root and
-  // every environment root, all at the world frame).
-  int parent_joint = -1;
-  bool is_environment = false;
-  // The URDF file it came from, for messages.
-  std::string file;
-};
-
-struct SceneModel {
-  // Robot links first (index 0 is the robot's root), then each
-  // environment's links, each URDF depth-first from its root with siblings
-  // in the order of their names; so every link comes after its parent.
-  std::vector<Link> links;
-  int num_robot_links = 0;
-  // Ordered so that a joint's parent link's pose is known before it.
-  std::vector<Joint> joints;
-  // The robot joints a joint state must provide (revolute, continuous,
-  // prismatic, not mimic), in URDF order.
-  std::vector<std::string> actuated_joint_names;
+// The kinematic tree with the geometry of the source chosen
+// (SceneOptions::geometry) as meshes and shapes.
+struct SceneModel : KinematicTree {
   // Unit primitives first (UnitMesh), then one mesh per distinct
   // (file, scale, padding).
   std::vector<TriangleMesh> meshes;
   std::vector<Shape> shapes;
 
-  // Index of the link called `name` (robot links win over environment links
-  // of the same name), -1 when there is none.
-  int find_link(const std::string& name) const;
-  std::vector<std::string> link_names() const;
   // Triangles drawn per render (every shape, scaled meshes counted once per
   // shape that uses them).
   size_t num_triangles() const;
@@ -142,4 +95,4 @@ struct SceneModel {
 SceneModel load_scene(const std::string& robot_urdf, const std::vector<std::string>& environment_urdfs,
                       const SceneOptions& options);
 
-}  // namespace tofguard::renderer
+}  // namespace tofguard::robot_model

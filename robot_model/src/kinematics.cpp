@@ -1,8 +1,8 @@
-#include "tofguard/renderer/kinematics.hpp"
+#include "tofguard/robot_model/kinematics.hpp"
 
 #include <cmath>
 
-namespace tofguard::renderer {
+namespace tofguard::robot_model {
 
 Eigen::Isometry3d joint_motion(const Joint& joint, double value) {
   Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
@@ -20,13 +20,13 @@ Eigen::Isometry3d joint_motion(const Joint& joint, double value) {
   return motion;
 }
 
-LinkPoses forward_kinematics(const SceneModel& scene, const JointPositions& joints) {
+LinkPoses forward_kinematics(const KinematicTree& tree, const JointPositions& joints) {
   LinkPoses result;
   // Joint values first, so that a missing joint is reported by name before
   // anything is computed.
-  std::vector<double> value(scene.joints.size(), 0.0);
-  for (size_t j = 0; j < scene.joints.size(); ++j) {
-    const Joint& joint = scene.joints[j];
+  std::vector<double> value(tree.joints.size(), 0.0);
+  for (size_t j = 0; j < tree.joints.size(); ++j) {
+    const Joint& joint = tree.joints[j];
     if (joint.type == JointType::kFixed || joint.mimic_joint >= 0) continue;
     const auto found = joints.find(joint.name);
     if (found == joints.end()) {
@@ -40,20 +40,20 @@ LinkPoses forward_kinematics(const SceneModel& scene, const JointPositions& join
     value[j] = found->second;
   }
   // Mimic chains end at an actuated joint (checked at load).
-  for (size_t j = 0; j < scene.joints.size(); ++j) {
-    if (scene.joints[j].mimic_joint < 0) continue;
+  for (size_t j = 0; j < tree.joints.size(); ++j) {
+    if (tree.joints[j].mimic_joint < 0) continue;
     double multiplier = 1, offset = 0;
     int at = static_cast<int>(j);
-    while (scene.joints[at].mimic_joint >= 0) {
-      offset = multiplier * scene.joints[at].mimic_offset + offset;
-      multiplier *= scene.joints[at].mimic_multiplier;
-      at = scene.joints[at].mimic_joint;
+    while (tree.joints[at].mimic_joint >= 0) {
+      offset = multiplier * tree.joints[at].mimic_offset + offset;
+      multiplier *= tree.joints[at].mimic_multiplier;
+      at = tree.joints[at].mimic_joint;
     }
     value[j] = multiplier * value[at] + offset;
   }
-  result.world_from_link.assign(scene.links.size(), Eigen::Isometry3d::Identity());
-  for (size_t j = 0; j < scene.joints.size(); ++j) {
-    const Joint& joint = scene.joints[j];
+  result.world_from_link.assign(tree.links.size(), Eigen::Isometry3d::Identity());
+  for (size_t j = 0; j < tree.joints.size(); ++j) {
+    const Joint& joint = tree.joints[j];
     result.world_from_link[joint.child_link] =
         result.world_from_link[joint.parent_link] * joint.parent_from_joint * joint_motion(joint, value[j]);
   }
@@ -61,4 +61,4 @@ LinkPoses forward_kinematics(const SceneModel& scene, const JointPositions& join
   return result;
 }
 
-}  // namespace tofguard::renderer
+}  // namespace tofguard::robot_model

@@ -1,13 +1,13 @@
 // CameraPoseHistory: the camera pose at a frame's utime (interpolated,
 // bounded extrapolation, unusable beyond), static poses and calibration
 // steps held, frame changes.
-#include "tofguard/renderer/camera_pose_history.hpp"
+#include "tofguard/robot_state/camera_pose_history.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-namespace tofguard::renderer {
+namespace tofguard::robot_state {
 namespace {
 
 constexpr int64_t kT0 = 1'700'000'000'000'000;
@@ -114,4 +114,4 @@ TEST(CameraPoseHistory, KeepsOnlyTheHistorySpanAndStartsAnewInAnotherFrame) {
 }
 
 }  // namespace
-}  // namespace tofguard::renderer
+}  // namespace tofguard::robot_state

@@ -1,5 +1,5 @@
 #pragma once
-// Forward kinematics of a SceneModel with Eigen: where every link is in the
+// Forward kinematics of a KinematicTree with Eigen: where every link is in the
 // world frame (the robot's root link) for given joint values.
 #include <map>
 #include <string>
@@ -7,9 +7,9 @@
 
 #include <Eigen/Geometry>
 
-#include "tofguard/renderer/scene_model.hpp"
+#include "tofguard/robot_model/kinematic_tree.hpp"
 
-namespace tofguard::renderer {
+namespace tofguard::robot_model {
 
 // Joint values matched by URDF joint name: radians for revolute and
 // continuous joints, metres for prismatic joints. Names that the model does
@@ -22,7 +22,7 @@ struct LinkPoses {
   // world_from_link is empty.
   bool usable = false;
   std::string unusable_reason;
-  // Pose of each link (SceneModel::links order) in the world frame:
+  // Pose of each link (KinematicTree::links order) in the world frame:
   // p_world = world_from_link[i] * p_link.
   std::vector<Eigen::Isometry3d> world_from_link;
 };
@@ -31,9 +31,9 @@ struct LinkPoses {
 // leader (value = multiplier * leader + offset) and need not be present.
 // Joint limits are not applied: the renderer shows what the joint state
 // reports. Never throws for a bad joint state.
-LinkPoses forward_kinematics(const SceneModel& scene, const JointPositions& joints);
+LinkPoses forward_kinematics(const KinematicTree& tree, const JointPositions& joints);
 
 // Motion of one joint at `value`: joint frame -> child link frame.
 Eigen::Isometry3d joint_motion(const Joint& joint, double value);
 
-}  // namespace tofguard::renderer
+}  // namespace tofguard::robot_model

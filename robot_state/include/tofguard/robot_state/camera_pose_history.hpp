@@ -30,7 +30,7 @@
 
 #include "tofguard/common/camera_settings.hpp"
 
-namespace tofguard::renderer {
+namespace tofguard::robot_state {
 
 struct PoseAtTime {
   bool usable = false;
@@ -77,4 +77,4 @@ class CameraPoseHistory {
   std::map<std::string, Camera> cameras_;
 };
 
-}  // namespace tofguard::renderer
+}  // namespace tofguard::robot_state

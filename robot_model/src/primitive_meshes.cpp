@@ -1,8 +1,8 @@
-#include "tofguard/renderer/primitive_meshes.hpp"
+#include "tofguard/robot_model/primitive_meshes.hpp"
 
 #include <cmath>
 
-namespace tofguard::renderer {
+namespace tofguard::robot_model {
 namespace {
 
 uint32_t add_vertex(TriangleMesh& mesh, double x, double y, double z) {
@@ -87,4 +87,4 @@ TriangleMesh unit_cylinder() {
   return mesh;
 }
 
-}  // namespace tofguard::renderer
+}  // namespace tofguard::robot_model

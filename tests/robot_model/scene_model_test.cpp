@@ -78,7 +78,7 @@ std::string one_link_urdf(const std::string& geometry, const std::string& origin
 
 const Intrinsics kIntrinsics{160, 120, 150.0, 145.0, 78.6, 61.2};
 
-RenderResult render_world_view(const SceneModel& scene, const JointPositions& joints = {}) {
+RenderResult render_world_view(const robot_model::SceneModel& scene, const robot_model::JointPositions& joints = {}) {
   DepthRenderer renderer(scene, 0.1, 5.0);
   return renderer.render(joints, camera_pose_in("world", Eigen::Isometry3d::Identity()), kIntrinsics);
 }
@@ -104,13 +104,13 @@ TEST(SceneModel, TessellatedBoxAsStlAndObjRendersLikeThePrimitiveBox) {
   write_test_file("meshes/unit_box.obj", obj(tessellated_box(Eigen::Vector3d::Constant(0.5), 3)));
   const fs::path packages = fs::path(stl_path).parent_path().parent_path().parent_path();
 
-  const SceneModel primitive = load_scene(write_test_file("box_primitive.urdf", one_link_urdf("<box size=\"0.3 0.2 0.25\"/>")), {}, {});
-  SceneOptions with_packages;
+  const robot_model::SceneModel primitive = robot_model::load_scene(write_test_file("box_primitive.urdf", one_link_urdf("<box size=\"0.3 0.2 0.25\"/>")), {}, {});
+  robot_model::SceneOptions with_packages;
   with_packages.package_paths = {"/nonexistent", packages.string()};
-  const SceneModel stl = load_scene(
+  const robot_model::SceneModel stl = robot_model::load_scene(
       write_test_file("box_stl.urdf", one_link_urdf("<mesh filename=\"package://testpkg/meshes/box.stl\"/>")), {},
       with_packages);
-  const SceneModel obj_scaled = load_scene(
+  const robot_model::SceneModel obj_scaled = robot_model::load_scene(
       write_test_file("box_obj.urdf", one_link_urdf("<mesh filename=\"meshes/unit_box.obj\" scale=\"0.3 0.2 0.25\"/>")),
       {}, {});
   EXPECT_EQ(stl.meshes.back().num_triangles(), 6u * 4 * 4 * 2);
@@ -137,12 +137,12 @@ TEST(SceneModel, PaddingInflatesPrimitivesAndMeshes) {
   const std::string mesh = write_test_file(
       "pad_mesh.urdf", one_link_urdf("<mesh filename=\"meshes/unit_box.obj\" scale=\"0.3 0.2 0.25\"/>", origin));
   const std::string bigger = write_test_file("pad_bigger.urdf", one_link_urdf("<box size=\"0.34 0.24 0.29\"/>", origin));
-  SceneOptions padded;
+  robot_model::SceneOptions padded;
   padded.padding_m = 0.02;
-  const RenderResult plain = render_world_view(load_scene(box, {}, {}));
-  const RenderResult padded_box = render_world_view(load_scene(box, {}, padded));
-  const RenderResult padded_mesh = render_world_view(load_scene(mesh, {}, padded));
-  const RenderResult reference = render_world_view(load_scene(bigger, {}, {}));
+  const RenderResult plain = render_world_view(robot_model::load_scene(box, {}, {}));
+  const RenderResult padded_box = render_world_view(robot_model::load_scene(box, {}, padded));
+  const RenderResult padded_mesh = render_world_view(robot_model::load_scene(mesh, {}, padded));
+  const RenderResult reference = render_world_view(robot_model::load_scene(bigger, {}, {}));
   const size_t centre = static_cast<size_t>(std::lround(kIntrinsics.cy)) * kIntrinsics.width +
                         static_cast<size_t>(std::lround(kIntrinsics.cx));
   EXPECT_NEAR(plain.depth_m[centre], 1.2 - 0.125, 1e-5);
@@ -155,8 +155,8 @@ TEST(SceneModel, PaddingInflatesPrimitivesAndMeshes) {
 }
 
 TEST(SceneModel, ExtraObjectsGetTheirOwnLabelsAndExactDepth) {
-  const SceneModel scene =
-      load_scene(write_test_file("extra_base.urdf", one_link_urdf("<box size=\"0.1 0.1 0.1\"/>", "xyz=\"0.3 0 2\"")), {}, {});
+  const robot_model::SceneModel scene =
+      robot_model::load_scene(write_test_file("extra_base.urdf", one_link_urdf("<box size=\"0.1 0.1 0.1\"/>", "xyz=\"0.3 0 2\"")), {}, {});
   DepthRenderer renderer(scene, 0.1, 5.0);
   Eigen::Isometry3d at = Eigen::Isometry3d::Identity();
   at.translation() = Eigen::Vector3d(-0.2, 0.1, 1.0);
@@ -183,7 +183,7 @@ TEST(SceneModel, ExtraObjectsGetTheirOwnLabelsAndExactDepth) {
 }
 
 TEST(SceneModel, DeviceAndSurfacelessPlatformsRenderTheSameImage) {
-  const SceneModel scene = load_scene(write_test_file("platform.urdf", one_link_urdf("<sphere radius=\"0.2\"/>")), {}, {});
+  const robot_model::SceneModel scene = robot_model::load_scene(write_test_file("platform.urdf", one_link_urdf("<sphere radius=\"0.2\"/>")), {}, {});
   std::vector<RenderResult> results;
   for (EglPlatform platform : {EglPlatform::kDevice, EglPlatform::kSurfaceless}) {
     try {
@@ -201,7 +201,7 @@ TEST(SceneModel, DeviceAndSurfacelessPlatformsRenderTheSameImage) {
 }
 
 TEST(SceneModel, OneRendererPerThreadRendersConcurrently) {
-  const SceneModel scene = load_scene(write_test_file("threads.urdf", one_link_urdf("<cylinder radius=\"0.1\" length=\"0.4\"/>")), {}, {});
+  const robot_model::SceneModel scene = robot_model::load_scene(write_test_file("threads.urdf", one_link_urdf("<cylinder radius=\"0.1\" length=\"0.4\"/>")), {}, {});
   const RenderResult expected = render_world_view(scene);
   std::vector<RenderResult> results(2);
   std::vector<std::thread> threads;
@@ -222,7 +222,7 @@ TEST(SceneModel, OneRendererPerThreadRendersConcurrently) {
 
 // --- the default arm and the real iiwa14 ---
 
-JointPositions friend_arm_joints() {
+robot_model::JointPositions friend_arm_joints() {
   return {{"a1", 0.3}, {"a2", 0.5}, {"a3", -0.2}, {"a4", 0.9}, {"a5", 0.1}, {"a6", 0.6}, {"a7", 0.0}};
 }
 
@@ -237,7 +237,7 @@ CameraPose sim_camera_pose() {
 
 TEST(SceneModel, DefaultArmAndEnvironmentLabelRanges) {
   const std::string models = tofguard::test::source_dir() + "/config/models/";
-  const SceneModel scene = load_scene(models + "friend_arm.urdf", {models + "wheelchair_environment.urdf"}, {});
+  const robot_model::SceneModel scene = robot_model::load_scene(models + "friend_arm.urdf", {models + "wheelchair_environment.urdf"}, {});
   EXPECT_EQ(scene.num_robot_links, 10);  // world, base_link, link1..7, gripper
   EXPECT_EQ(scene.actuated_joint_names.size(), 7u);
   DepthRenderer renderer(scene, 0.1, 8.0);
@@ -266,9 +266,9 @@ TEST(SceneModel, DefaultArmAndEnvironmentLabelRanges) {
 
 TEST(SceneModel, JointMissingFromTheJointStateMakesTheFrameUnusable) {
   const std::string models = tofguard::test::source_dir() + "/config/models/";
-  const SceneModel scene = load_scene(models + "friend_arm.urdf", {}, {});
+  const robot_model::SceneModel scene = robot_model::load_scene(models + "friend_arm.urdf", {}, {});
   DepthRenderer renderer(scene, 0.1, 8.0);
-  JointPositions joints = friend_arm_joints();
+  robot_model::JointPositions joints = friend_arm_joints();
   joints.erase("a4");
   const RenderResult r = renderer.render(joints, sim_camera_pose(), Intrinsics{176, 144, 221.0, 220.5, 87.3, 71.8});
   EXPECT_FALSE(r.usable);
@@ -278,7 +278,7 @@ TEST(SceneModel, JointMissingFromTheJointStateMakesTheFrameUnusable) {
 }
 
 TEST(SceneModel, UnknownCameraFrameAndBadIntrinsicsAreUnusable) {
-  const SceneModel scene = load_scene(write_test_file("frames.urdf", one_link_urdf("<sphere radius=\"0.2\"/>")), {}, {});
+  const robot_model::SceneModel scene = robot_model::load_scene(write_test_file("frames.urdf", one_link_urdf("<sphere radius=\"0.2\"/>")), {}, {});
   DepthRenderer renderer(scene, 0.1, 5.0);
   CameraPose pose = camera_pose_in("nowhere", Eigen::Isometry3d::Identity());
   RenderResult r = renderer.render({}, pose, kIntrinsics);
@@ -314,20 +314,20 @@ class Iiwa14 : public ::testing::Test {
     world_from_optical.linear().col(2) = Eigen::Vector3d(-1, 0, 0);  // forward
     return camera_pose_in("base", world_from_optical);
   }
-  static JointPositions joints() {
-    JointPositions q;
+  static robot_model::JointPositions joints() {
+    robot_model::JointPositions q;
     const double values[7] = {0.2, 0.3, -0.1, -0.4, 0.3, 0.5, 0.1};
     for (int i = 0; i < 7; ++i) q["iiwa_joint_" + std::to_string(i + 1)] = values[i];
     return q;
   }
-  void expect_every_link_with_geometry_labelled(const SceneModel& scene) {
+  void expect_every_link_with_geometry_labelled(const robot_model::SceneModel& scene) {
     DepthRenderer renderer(scene, 0.1, 5.0);
     const RenderResult r = renderer.render(joints(), side_view(), Intrinsics{320, 240, 300, 300, 160, 120});
     ASSERT_TRUE(r.usable) << r.unusable_reason;
     int checked = 0;
     for (size_t link = 0; link < scene.links.size(); ++link) {
       bool has_geometry = false;
-      for (const Shape& shape : scene.shapes) has_geometry = has_geometry || shape.link_index == static_cast<int>(link);
+      for (const robot_model::Shape& shape : scene.shapes) has_geometry = has_geometry || shape.link_index == static_cast<int>(link);
       if (!has_geometry) continue;
       EXPECT_GT(count_label(r, kLabelRobotFirst + static_cast<int>(link)), 20) << scene.links[link].name;
       ++checked;
@@ -345,7 +345,7 @@ class Iiwa14 : public ::testing::Test {
 };
 
 TEST_F(Iiwa14, VisualObjMeshesRenderWithEveryLinkLabelled) {
-  const SceneModel scene = load_scene((root / "urdf" / "iiwa14_no_collision_relative.urdf").string(), {}, {});
+  const robot_model::SceneModel scene = robot_model::load_scene((root / "urdf" / "iiwa14_no_collision_relative.urdf").string(), {}, {});
   std::cout << "iiwa14 visual: " << scene.num_triangles() << " triangles\n";
   EXPECT_GT(scene.num_triangles(), 50000u);
   expect_every_link_with_geometry_labelled(scene);
@@ -358,22 +358,22 @@ TEST_F(Iiwa14, SphereCollisionsThroughPackageUrisRenderWithEveryLinkLabelled) {
   if (!fs::exists(packages / "drake_models" / "iiwa_description")) {
     fs::create_directory_symlink(root, packages / "drake_models" / "iiwa_description");
   }
-  SceneOptions options;
-  options.geometry = GeometrySource::kCollision;
+  robot_model::SceneOptions options;
+  options.geometry = robot_model::GeometrySource::kCollision;
   options.package_paths = {packages.string()};
-  const SceneModel scene = load_scene((root / "urdf" / "iiwa14_spheres_collision.urdf").string(), {}, options);
+  const robot_model::SceneModel scene = robot_model::load_scene((root / "urdf" / "iiwa14_spheres_collision.urdf").string(), {}, options);
   expect_every_link_with_geometry_labelled(scene);
-  options.geometry = GeometrySource::kVisual;
-  EXPECT_GT(load_scene((root / "urdf" / "iiwa14_spheres_collision.urdf").string(), {}, options).num_triangles(), 50000u);
+  options.geometry = robot_model::GeometrySource::kVisual;
+  EXPECT_GT(robot_model::load_scene((root / "urdf" / "iiwa14_spheres_collision.urdf").string(), {}, options).num_triangles(), 50000u);
 }
 
 // --- bad models ---
 
 std::string model_error(const std::string& robot, const std::vector<std::string>& environments = {},
-                        const SceneOptions& options = {}) {
+                        const robot_model::SceneOptions& options = {}) {
   try {
-    load_scene(robot, environments, options);
-  } catch (const ModelError& e) {
+    robot_model::load_scene(robot, environments, options);
+  } catch (const robot_model::ModelError& e) {
     return e.what();
   }
   return "(no error)";
@@ -395,7 +395,7 @@ TEST(SceneModelErrors, MissingMeshNamesLinkAndFile) {
   const std::string package = write_test_file("bad/missing_package.urdf", one_link_urdf("<mesh filename=\"package://nopkg/m.stl\"/>"));
   EXPECT_EQ(model_error(package), package + ": link 'thing': mesh 'package://nopkg/m.stl' not found "
                                             "(searched: no package_paths configured)");
-  SceneOptions options;
+  robot_model::SceneOptions options;
   options.package_paths = {"/tmp/a"};
   EXPECT_EQ(model_error(package, {}, options),
             package + ": link 'thing': mesh 'package://nopkg/m.stl' not found (searched: /tmp/a/nopkg/m.stl)");
@@ -430,7 +430,7 @@ TEST(SceneModelErrors, MovingJointInTheEnvironment) {
 TEST(SceneModelErrors, BadSizesAndPadding) {
   const std::string path = write_test_file("bad/zero_box.urdf", one_link_urdf("<box size=\"0.1 0 0.1\"/>"));
   EXPECT_EQ(model_error(path), path + ": link 'thing': box size must be three positive lengths");
-  SceneOptions options;
+  robot_model::SceneOptions options;
   options.padding_m = -0.01;
   EXPECT_NE(model_error(write_test_file("bad/ok.urdf", one_link_urdf("<sphere radius=\"0.1\"/>")), {}, options)
                 .find("padding_m"),

@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "tofguard/renderer/kinematics.hpp"
+#include "tofguard/robot_model/kinematics.hpp"
 
-namespace tofguard::renderer {
+namespace tofguard::robot_state {
 
 struct JointsAtTime {
   // False when no joint values may be used; then `unusable_reason` says why.
@@ -23,7 +23,7 @@ struct JointsAtTime {
   std::string unusable_reason;
   // Joints reported in both bracketing messages (a joint missing from one
   // of them is left out, and forward kinematics then names it).
-  JointPositions joints;
+  robot_model::JointPositions joints;
 };
 
 class JointHistory {
@@ -36,7 +36,7 @@ class JointHistory {
   // Adds one message; a message not newer than the newest one so far is
   // ignored and false returned (LCM does not reorder one publisher's
   // messages, so this is a duplicate or a second publisher, worth counting).
-  bool add(int64_t utime, const JointPositions& positions);
+  bool add(int64_t utime, const robot_model::JointPositions& positions);
 
   JointsAtTime at(int64_t utime) const;
 
@@ -45,9 +45,9 @@ class JointHistory {
  private:
   struct Sample {
     int64_t utime;
-    JointPositions positions;
+    robot_model::JointPositions positions;
   };
-  static JointPositions blend(const Sample& a, const Sample& b, int64_t utime);
+  static robot_model::JointPositions blend(const Sample& a, const Sample& b, int64_t utime);
 
   int64_t max_extrapolation_us_;
   int64_t span_us_;
@@ -55,4 +55,4 @@ class JointHistory {
   std::deque<Sample> history_;
 };
 
-}  // namespace tofguard::renderer
+}  // namespace tofguard::robot_state

@@ -2,9 +2,9 @@
 // extrapolation, a bounded history.
 #include <gtest/gtest.h>
 
-#include "tofguard/renderer/joint_history.hpp"
+#include "tofguard/robot_state/joint_history.hpp"
 
-namespace tofguard::renderer {
+namespace tofguard::robot_state {
 namespace {
 
 TEST(JointHistory, InterpolatesLinearlyBetweenTheBracketingMessages) {
@@ -65,4 +65,4 @@ TEST(JointHistory, StaysBounded) {
 }
 
 }  // namespace
-}  // namespace tofguard::renderer
+}  // namespace tofguard::robot_state

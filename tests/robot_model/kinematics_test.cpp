@@ -2,11 +2,14 @@
 // mimic and continuous joints against transforms written out by hand.
 #include <gtest/gtest.h>
 
-#include "tofguard/renderer/kinematics.hpp"
-#include "renderer_test_util.hpp"
+#include "model_test_util.hpp"
+#include "tofguard/robot_model/kinematics.hpp"
 
-namespace tofguard::renderer::test {
+namespace tofguard::robot_model::test {
 namespace {
+
+using tofguard::test::pose;
+using tofguard::test::write_test_file;
 
 // base -j1 revolute z-> l1 -j2 prismatic x-> l2 -j3 fixed-> l3
 //   -j4 revolute y, mimics j1 (x2, +0.1)-> l4 -j5 continuous (0, 0.6, 0.8)-> l5
@@ -52,20 +55,20 @@ Eigen::Isometry3d translation(const Eigen::Vector3d& v) {
 
 class Kinematics : public ::testing::Test {
  protected:
-  void SetUp() override { scene = load_scene(write_test_file("chain.urdf", kChain), {}, SceneOptions{}); }
+  void SetUp() override { tree = load_kinematic_tree(write_test_file("chain.urdf", kChain)); }
   const Eigen::Isometry3d& pose_of(const LinkPoses& poses, const std::string& link) {
-    const int index = scene.find_link(link);
+    const int index = tree.find_link(link);
     EXPECT_GE(index, 0) << link;
     return poses.world_from_link.at(index);
   }
-  SceneModel scene;
+  KinematicTree tree;
 };
 
 TEST_F(Kinematics, ChainMatchesHandComputedTransforms) {
   const double q1 = 0.7, q2 = 0.25, q5 = -1.1;
-  const LinkPoses poses = forward_kinematics(scene, {{"j1", q1}, {"j2", q2}, {"j5", q5}, {"unrelated", 9.0}});
+  const LinkPoses poses = forward_kinematics(tree, {{"j1", q1}, {"j2", q2}, {"j5", q5}, {"unrelated", 9.0}});
   ASSERT_TRUE(poses.usable) << poses.unusable_reason;
-  ASSERT_EQ(scene.actuated_joint_names, (std::vector<std::string>{"j1", "j2", "j5"}));
+  ASSERT_EQ(tree.actuated_joint_names, (std::vector<std::string>{"j1", "j2", "j5"}));
 
   const Eigen::Isometry3d l1 = pose({0.1, 0.2, 0.3}, {0.3, -0.2, 0.5}) * rotation_about({0, 0, 1}, q1);
   const Eigen::Isometry3d l2 = l1 * pose({0, 0, 0.4}, {0, 0.5, 0}) * translation({q2, 0, 0});
@@ -86,7 +89,7 @@ TEST_F(Kinematics, ChainMatchesHandComputedTransforms) {
 TEST_F(Kinematics, WrongRpyOrderOrAxisWouldBeDetected) {
   // The hand-written transforms above differ measurably from the usual
   // mistakes, so the test above would catch them.
-  const LinkPoses poses = forward_kinematics(scene, {{"j1", 0.7}, {"j2", 0.25}, {"j5", -1.1}});
+  const LinkPoses poses = forward_kinematics(tree, {{"j1", 0.7}, {"j2", 0.25}, {"j5", -1.1}});
   ASSERT_TRUE(poses.usable);
   Eigen::Isometry3d xyz_order = Eigen::Isometry3d::Identity();
   xyz_order.translation() = Eigen::Vector3d(0.1, 0.2, 0.3);
@@ -102,25 +105,25 @@ TEST_F(Kinematics, WrongRpyOrderOrAxisWouldBeDetected) {
 }
 
 TEST_F(Kinematics, MissingJointMakesTheResultUnusableNamingTheJoint) {
-  const LinkPoses poses = forward_kinematics(scene, {{"j1", 0.7}, {"j5", 0.0}});
+  const LinkPoses poses = forward_kinematics(tree, {{"j1", 0.7}, {"j5", 0.0}});
   EXPECT_FALSE(poses.usable);
   EXPECT_EQ(poses.unusable_reason, "joint 'j2' missing from the joint state");
   EXPECT_TRUE(poses.world_from_link.empty());
 }
 
 TEST_F(Kinematics, NonFiniteJointValueIsUnusable) {
-  const LinkPoses poses = forward_kinematics(scene, {{"j1", 0.7}, {"j2", std::nan("")}, {"j5", 0.0}});
+  const LinkPoses poses = forward_kinematics(tree, {{"j1", 0.7}, {"j2", std::nan("")}, {"j5", 0.0}});
   EXPECT_FALSE(poses.usable);
   EXPECT_EQ(poses.unusable_reason, "joint 'j2' is not a finite number");
 }
 
 TEST_F(Kinematics, MimicJointIgnoresAValueOfItsOwn) {
   // The mimic follows j1 even if the joint state reports something else for it.
-  const LinkPoses a = forward_kinematics(scene, {{"j1", 0.7}, {"j2", 0.0}, {"j5", 0.0}});
-  const LinkPoses b = forward_kinematics(scene, {{"j1", 0.7}, {"j2", 0.0}, {"j5", 0.0}, {"j4", 2.0}});
+  const LinkPoses a = forward_kinematics(tree, {{"j1", 0.7}, {"j2", 0.0}, {"j5", 0.0}});
+  const LinkPoses b = forward_kinematics(tree, {{"j1", 0.7}, {"j2", 0.0}, {"j5", 0.0}, {"j4", 2.0}});
   ASSERT_TRUE(a.usable && b.usable);
   EXPECT_TRUE(pose_of(a, "l4").isApprox(pose_of(b, "l4"), 1e-15));
 }
 
 }  // namespace
-}  // namespace tofguard::renderer::test
+}  // namespace tofguard::robot_model::test

@@ -1,11 +1,11 @@
-#include "tofguard/renderer/camera_pose_history.hpp"
+#include "tofguard/robot_state/camera_pose_history.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
 
-namespace tofguard::renderer {
+namespace tofguard::robot_state {
 namespace {
 
 // Poses closer than this are the same (a repeated calibration), metres and
@@ -120,4 +120,4 @@ PoseAtTime CameraPoseHistory::at(const std::string& camera_id, int64_t utime) co
   return result;
 }
 
-}  // namespace tofguard::renderer
+}  // namespace tofguard::robot_state

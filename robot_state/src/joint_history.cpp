@@ -1,15 +1,15 @@
-#include "tofguard/renderer/joint_history.hpp"
+#include "tofguard/robot_state/joint_history.hpp"
 
 #include <algorithm>
 
-namespace tofguard::renderer {
+namespace tofguard::robot_state {
 
 JointHistory::JointHistory(int64_t max_extrapolation_us, int64_t span_us, size_t max_messages)
     : max_extrapolation_us_(std::max<int64_t>(0, max_extrapolation_us)),
       span_us_(span_us),
       max_messages_(std::max<size_t>(2, max_messages)) {}
 
-bool JointHistory::add(int64_t utime, const JointPositions& positions) {
+bool JointHistory::add(int64_t utime, const robot_model::JointPositions& positions) {
   if (!history_.empty() && utime <= history_.back().utime) return false;
   history_.push_back({utime, positions});
   while (history_.size() > max_messages_ || (history_.size() > 2 && history_.front().utime < utime - span_us_)) {
@@ -18,10 +18,10 @@ bool JointHistory::add(int64_t utime, const JointPositions& positions) {
   return true;
 }
 
-JointPositions JointHistory::blend(const Sample& a, const Sample& b, int64_t utime) {
+robot_model::JointPositions JointHistory::blend(const Sample& a, const Sample& b, int64_t utime) {
   // Linear in time through a and b; also beyond them (extrapolation).
   const double s = static_cast<double>(utime - a.utime) / static_cast<double>(b.utime - a.utime);
-  JointPositions result;
+  robot_model::JointPositions result;
   for (const auto& [name, value_a] : a.positions) {
     const auto value_b = b.positions.find(name);
     if (value_b != b.positions.end()) result[name] = value_a + s * (value_b->second - value_a);
@@ -64,4 +64,4 @@ JointsAtTime JointHistory::at(int64_t utime) const {
   return result;
 }
 
-}  // namespace tofguard::renderer
+}  // namespace tofguard::robot_state

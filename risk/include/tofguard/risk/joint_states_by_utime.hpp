@@ -1,0 +1,31 @@
+#pragma once
+// The joint states of the last 2 s of utime, in utime order: the frozen-image
+// and plan rules ask about a frame's capture time, not about whichever joint
+// state arrived last, so that a replayed log is judged the same on every run
+// however late a frame is processed.
+#include <cstdint>
+#include <deque>
+
+#include "tofguard/joint_state_t.hpp"
+
+namespace tofguard::risk {
+
+class JointStatesByUtime {
+ public:
+  // Keeps the states whose utime is within `keep_us` of the newest.
+  explicit JointStatesByUtime(int64_t keep_us = 2'000'000) : keep_us_(keep_us) {}
+
+  // A joint state older than the newest kept one (out of order) is not
+  // added: the record stays sorted by utime.
+  void add(const joint_state_t& state);
+
+  // The newest joint state taken at or before `utime`; for a frame older
+  // than all of them, the oldest; nullptr when there is none.
+  const joint_state_t* at(int64_t utime) const;
+
+ private:
+  int64_t keep_us_;
+  std::deque<joint_state_t> states_;
+};
+
+}  // namespace tofguard::risk
