@@ -1,18 +1,13 @@
-// tofguard-discrepancy: wires config + LCM + the library in src/.
-#include <exception>
-#include <iostream>
-
+// tofguard-discrepancy: TOF_DEPTH, TOF_RENDERED, TOF_LABELS -> SAFETY_DISCREPANCY
+// (discrepancy_process.hpp).
+#include "tofguard/deployment/process_runner.hpp"
+#include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/discrepancy/discrepancy_process.hpp"
 
 int main(int argc, char** argv) {
-  const tofguard::ProcessInfo info = tofguard::discrepancy::process_info();
-  return tofguard::run_process(argc, argv, info,
-                               [&](const tofguard::Config& config, const std::vector<std::string>&) {
-                                 try {
-                                   return tofguard::discrepancy::run_discrepancy(config);
-                                 } catch (const std::exception& e) {
-                                   std::cerr << info.name << ": " << e.what() << "\n";
-                                   return 1;
-                                 }
-                               });
+  using namespace tofguard;
+  return deployment::run_process(argc, argv, discrepancy::process_info(),
+                                 [](const deployment::Config& config, const std::vector<std::string>&) {
+                                   return discrepancy::run_discrepancy(deployment::discrepancy_process_settings(config));
+                                 });
 }

@@ -1,66 +1,14 @@
 // tofguard-calibrate-extrinsics: the camera's pose from an LCM log of the arm
-// moving with known joint angles (src/extrinsics_calibration.hpp).
-#include <fstream>
-#include <iostream>
-
-#include "tofguard/estimator/extrinsics_calibration.hpp"
-#include "tofguard/common/process.hpp"
+// moving with known joint angles (calibrate_extrinsics_tool.hpp).
+#include "tofguard/deployment/process_runner.hpp"
+#include "tofguard/deployment/process_settings.hpp"
+#include "tofguard/estimator/calibrate_extrinsics_tool.hpp"
 
 int main(int argc, char** argv) {
-  const tofguard::ProcessInfo info{
-      "tofguard-calibrate-extrinsics",
-      "Estimates the camera's pose (extrinsic calibration) from an LCM log with TOF_DEPTH and JOINT_STATE of the "
-      "arm moving with known joint angles, starting from the config's camera.pose; prints the YAML block for "
-      "camera.pose. Usage: tofguard-calibrate-extrinsics --config FILE LOG [--out FILE] [--frames N]"};
-  return tofguard::run_process(argc, argv, info, [&](const tofguard::Config& config,
-                                                     const std::vector<std::string>& rest) {
-    std::string log_path, out_path;
-    tofguard::estimator::CalibrationOptions options;
-    for (size_t i = 0; i < rest.size(); ++i) {
-      if (rest[i] == "--out" && i + 1 < rest.size()) {
-        out_path = rest[++i];
-      } else if (rest[i] == "--frames" && i + 1 < rest.size()) {
-        options.max_frames = std::atoi(rest[++i].c_str());
-        if (options.max_frames < options.min_frames) {
-          std::cerr << info.name << ": --frames: expected at least " << options.min_frames << "\n";
-          return 2;
-        }
-      } else if (log_path.empty() && rest[i].rfind("--", 0) != 0) {
-        log_path = rest[i];
-      } else {
-        std::cerr << info.name << ": unexpected argument '" << rest[i] << "' (see --help)\n";
-        return 2;
-      }
-    }
-    if (log_path.empty()) {
-      std::cerr << info.name << ": no LCM log given (see --help)\n";
-      return 2;
-    }
-    tofguard::estimator::CalibrationResult result;
-    try {
-      result = tofguard::estimator::calibrate_extrinsics(config, log_path, options);
-    } catch (const std::exception& e) {
-      std::cerr << info.name << ": " << e.what() << "\n";
-      return 1;
-    }
-    if (!result.error.empty()) {
-      std::cerr << info.name << ": " << result.error << "\n";
-      return 1;
-    }
-    const std::string yaml = tofguard::estimator::pose_yaml(result.pose);
-    std::cerr << info.name << ": " << result.frames_used << " of " << result.frames_in_log << " frames, "
-              << result.iterations << " iterations, residual " << result.residual_before_mm << " -> "
-              << result.residual_after_mm << " mm, sigma " << result.translation_sigma_m * 1000 << " mm / "
-              << result.rotation_sigma_rad * 180 / 3.141592653589793 << " deg\n";
-    std::cout << yaml;
-    if (!out_path.empty()) {
-      std::ofstream out(out_path);
-      out << yaml;
-      if (!out) {
-        std::cerr << info.name << ": cannot write " << out_path << "\n";
-        return 1;
-      }
-    }
-    return 0;
-  });
+  using namespace tofguard;
+  return deployment::run_process(argc, argv, estimator::calibrate_extrinsics_info(),
+                                 [](const deployment::Config& config, const std::vector<std::string>& arguments) {
+                                   return estimator::run_calibrate_extrinsics(
+                                       deployment::estimator_process_settings(config), arguments);
+                                 });
 }

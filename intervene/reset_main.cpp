@@ -1,84 +1,13 @@
 // tofguard-reset --who NAME --why TEXT: asks tofguard-intervene to release a
-// latched stop and prints whether it was accepted and why not.
-// Exit code: 0 accepted, 1 refused, 3 no answer within the deadline,
-// 2 usage error.
-#include <iostream>
-#include <random>
-
-#include "tofguard/common/clock.hpp"
-#include "tofguard/common/lcm_node.hpp"
-#include "tofguard/common/process.hpp"
-#include "tofguard/reset_reply_t.hpp"
-#include "tofguard/reset_request_t.hpp"
-
-namespace {
-
-constexpr int kNoAnswerExitCode = 3;
-
-int run(const tofguard::Config& config, const std::vector<std::string>& args) {
-  tofguard::reset_request_t request;
-  int64_t timeout_ms = 2000;
-  for (size_t i = 0; i < args.size(); ++i) {
-    const bool has_value = i + 1 < args.size();
-    if (args[i] == "--who" && has_value) {
-      request.who = args[++i];
-    } else if (args[i] == "--why" && has_value) {
-      request.why = args[++i];
-    } else if (args[i] == "--timeout-ms" && has_value) {
-      timeout_ms = std::stoll(args[++i]);
-    } else {
-      std::cerr << "tofguard-reset: unexpected argument '" << args[i]
-                << "' (usage: tofguard-reset [--config FILE] --who NAME --why TEXT [--timeout-ms MS])\n";
-      return tofguard::kConfigErrorExitCode;
-    }
-  }
-  if (request.who.empty() || request.why.empty()) {
-    std::cerr << "tofguard-reset: --who NAME and --why TEXT are both required\n";
-    return tofguard::kConfigErrorExitCode;
-  }
-  lcm::LCM lcm(config.lcm.url);
-  if (!lcm.good()) {
-    std::cerr << "tofguard-reset: cannot open LCM at " << config.lcm.url << "\n";
-    return kNoAnswerExitCode;
-  }
-  request.utime = tofguard::wall_utime();
-  request.request_id = static_cast<int64_t>(std::random_device{}() & 0x7fffffff) << 20 ^ request.utime;
-
-  struct Waiter {
-    int64_t request_id = 0;
-    bool answered = false;
-    tofguard::reset_reply_t reply;
-    void on_reply(const lcm::ReceiveBuffer*, const std::string&, const tofguard::reset_reply_t* r) {
-      if (r->request_id == request_id) {
-        reply = *r;
-        answered = true;
-      }
-    }
-  } waiter;
-  waiter.request_id = request.request_id;
-  lcm.subscribe(config.channels.reset_reply, &Waiter::on_reply, &waiter);
-  lcm.publish(config.channels.reset, &request);
-
-  const int64_t deadline_us = tofguard::monotonic_us() + timeout_ms * 1000;
-  while (!waiter.answered && tofguard::monotonic_us() < deadline_us && !tofguard::stop_requested()) {
-    lcm.handleTimeout(static_cast<int>(std::max<int64_t>(1, (deadline_us - tofguard::monotonic_us()) / 1000)));
-  }
-  if (!waiter.answered) {
-    std::cout << "no answer on " << config.channels.reset_reply << " within " << timeout_ms
-              << " ms: is tofguard-intervene running on " << config.lcm.url << "?" << std::endl;
-    return kNoAnswerExitCode;
-  }
-  std::cout << (waiter.reply.accepted ? "reset accepted" : "reset " + waiter.reply.reason) << std::endl;
-  return waiter.reply.accepted ? 0 : 1;
-}
-
-}  // namespace
+// latched stop (reset_tool.hpp).
+#include "tofguard/deployment/process_runner.hpp"
+#include "tofguard/deployment/process_settings.hpp"
+#include "tofguard/intervene/reset_tool.hpp"
 
 int main(int argc, char** argv) {
-  tofguard::ProcessInfo info{"tofguard-reset",
-                             "Sends a reset request (who and why) to tofguard-intervene and prints\n"
-                             "whether it was accepted and why not. Options: --who NAME --why TEXT\n"
-                             "[--timeout-ms MS]. Exit code 0 accepted, 1 refused, 3 no answer.",
-                             /*config_required=*/false};
-  return tofguard::run_process(argc, argv, info, run);
+  using namespace tofguard;
+  return deployment::run_process(argc, argv, intervene::reset_info(),
+                                 [](const deployment::Config& config, const std::vector<std::string>& arguments) {
+                                   return intervene::run_reset(deployment::reset_tool_settings(config), arguments);
+                                 });
 }

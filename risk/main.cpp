@@ -1,18 +1,13 @@
-// tofguard-risk: wires config + LCM + the library in src/.
-#include <exception>
-#include <iostream>
-
+// tofguard-risk: SAFETY_DISCREPANCY, the inputs' arrival times, heartbeats,
+// MOTION_ESTIMATE, PLANNED_TRAJECTORY -> SAFETY_RISK (risk_process.hpp).
+#include "tofguard/deployment/process_runner.hpp"
+#include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/risk/risk_process.hpp"
 
 int main(int argc, char** argv) {
-  const tofguard::ProcessInfo info = tofguard::risk::process_info();
-  return tofguard::run_process(argc, argv, info,
-                               [&](const tofguard::Config& config, const std::vector<std::string>&) {
-                                 try {
-                                   return tofguard::risk::run_risk(config);
-                                 } catch (const std::exception& e) {
-                                   std::cerr << info.name << ": " << e.what() << "\n";
-                                   return 1;
-                                 }
-                               });
+  using namespace tofguard;
+  return deployment::run_process(argc, argv, risk::process_info(),
+                                 [](const deployment::Config& config, const std::vector<std::string>&) {
+                                   return risk::run_risk(deployment::risk_process_settings(config));
+                                 });
 }

@@ -135,17 +135,18 @@ std::string list_usb_devices() {
   return text;
 }
 
-UvcCamera::UvcCamera(const CameraConfig& config, FrameHandler on_frame)
-    : config_(config),
-      format_(parse_raw_depth_format(config.uvc.format)),
-      radial_to_z_(config.intrinsics),
+UvcCamera::UvcCamera(const CameraSettings& camera, const UvcSettings& uvc, FrameHandler on_frame)
+    : camera_(camera),
+      uvc_(uvc),
+      format_(parse_raw_depth_format(uvc.format)),
+      radial_to_z_(camera.intrinsics),
       on_frame_(std::move(on_frame)) {}
 
 UvcCamera::~UvcCamera() { close(); }
 
 std::string UvcCamera::device_name() const {
-  return hex4(config_.uvc.vendor_id) + ":" + hex4(config_.uvc.product_id) +
-         (config_.uvc.serial.empty() ? "" : " serial " + config_.uvc.serial);
+  return hex4(uvc_.vendor_id) + ":" + hex4(uvc_.product_id) +
+         (uvc_.serial.empty() ? "" : " serial " + uvc_.serial);
 }
 
 UvcOpenResult UvcCamera::open(std::string* message) {
@@ -157,12 +158,12 @@ UvcOpenResult UvcCamera::open(std::string* message) {
     return rc == UVC_ERROR_NO_DEVICE || rc == UVC_ERROR_IO ? UvcOpenResult::kNoDevice
                                                            : UvcOpenResult::kFailed;
   }
-  rc = uvc_find_device(context_, &device_, config_.uvc.vendor_id, config_.uvc.product_id,
-                       config_.uvc.serial.empty() ? nullptr : config_.uvc.serial.c_str());
+  rc = uvc_find_device(context_, &device_, uvc_.vendor_id, uvc_.product_id,
+                       uvc_.serial.empty() ? nullptr : uvc_.serial.c_str());
   if (rc != UVC_SUCCESS) {
     device_ = nullptr;
     close();
-    if (attached_without_permission(config_.uvc.vendor_id, config_.uvc.product_id)) {
+    if (attached_without_permission(uvc_.vendor_id, uvc_.product_id)) {
       *message = "camera " + device_name() + ": permission denied; " + install_hint();
       return UvcOpenResult::kPermissionDenied;
     }
@@ -179,21 +180,21 @@ UvcOpenResult UvcCamera::open(std::string* message) {
                        : std::string("cannot open: ") + uvc_strerror(rc));
     return denied ? UvcOpenResult::kPermissionDenied : UvcOpenResult::kFailed;
   }
-  const Intrinsics& in = config_.intrinsics;
+  const Intrinsics& in = camera_.intrinsics;
   uvc_stream_ctrl_t ctrl;
   std::string why;
   if (format_ == RawDepthFormat::kZ16) {
     rc = stream_ctrl_by_fourcc(handle_, &ctrl, fourcc(format_), in.width, in.height,
-                               config_.rate_hz, &why);
+                               camera_.rate_hz, &why);
   } else {
     rc = uvc_get_stream_ctrl_format_size(handle_, &ctrl, UVC_FRAME_FORMAT_GRAY16, in.width,
-                                         in.height, static_cast<int>(config_.rate_hz + 0.5));
+                                         in.height, static_cast<int>(camera_.rate_hz + 0.5));
   }
   if (rc != UVC_SUCCESS) {
     close();
-    *message = "camera " + device_name() + " cannot stream " + config_.uvc.format + " " +
+    *message = "camera " + device_name() + " cannot stream " + uvc_.format + " " +
                std::to_string(in.width) + "x" + std::to_string(in.height) + " at " +
-               std::to_string(config_.rate_hz) + " Hz: " + (why.empty() ? uvc_strerror(rc) : why);
+               std::to_string(camera_.rate_hz) + " Hz: " + (why.empty() ? uvc_strerror(rc) : why);
     return UvcOpenResult::kFailed;
   }
   rc = uvc_start_streaming(handle_, &ctrl, &UvcCamera::frame_callback, this, 0);
@@ -202,7 +203,7 @@ UvcOpenResult UvcCamera::open(std::string* message) {
     *message = "camera " + device_name() + ": cannot start streaming: " + uvc_strerror(rc);
     return rc == UVC_ERROR_NO_DEVICE ? UvcOpenResult::kNoDevice : UvcOpenResult::kFailed;
   }
-  *message = "streaming " + config_.uvc.format + " from " + device_name();
+  *message = "streaming " + uvc_.format + " from " + device_name();
   return UvcOpenResult::kStreaming;
 }
 
@@ -232,7 +233,7 @@ void UvcCamera::frame_callback(uvc_frame* frame, void* self) {
 }
 
 void UvcCamera::on_uvc_frame(const uvc_frame& frame) {
-  const Intrinsics& in = config_.intrinsics;
+  const Intrinsics& in = camera_.intrinsics;
   const size_t pixels = static_cast<size_t>(in.width) * in.height;
   const int64_t frame_number = frames_seen_++;
   if (frame.width != static_cast<uint32_t>(in.width) ||
@@ -246,8 +247,8 @@ void UvcCamera::on_uvc_frame(const uvc_frame& frame) {
     return;
   }
   std::vector<float> depth_m = raw16_to_distance_m(static_cast<const uint8_t*>(frame.data), pixels,
-                                                   config_.uvc.depth_unit_mm);
-  if (config_.uvc.radial_distance) radial_to_z_.apply(&depth_m);
+                                                   uvc_.depth_unit_mm);
+  if (uvc_.radial_distance) radial_to_z_.apply(&depth_m);
   const int64_t utime = static_cast<int64_t>(frame.capture_time.tv_sec) * 1000000 +
                         frame.capture_time.tv_usec;
   on_frame_(std::move(depth_m), utime, frame_number);

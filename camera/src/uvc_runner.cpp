@@ -21,12 +21,12 @@ struct PendingFrame {
 
 }  // namespace
 
-int run_uvc_camera(const Config& config) {
-  const CameraConfig& camera_config = config.camera;
+int run_uvc_camera(const UvcCameraProcessSettings& settings) {
+  const CameraSettings& camera_config = settings.camera;
   std::mutex mutex;
   std::optional<PendingFrame> pending;
   int64_t overwritten = 0;  // frames replaced before they were published
-  UvcCamera camera(camera_config, [&](std::vector<float> depth_m, int64_t utime, int64_t number) {
+  UvcCamera camera(camera_config, settings.uvc, [&](std::vector<float> depth_m, int64_t utime, int64_t number) {
     std::lock_guard<std::mutex> lock(mutex);
     if (pending) ++overwritten;
     pending = PendingFrame{std::move(depth_m), utime, number};
@@ -41,12 +41,12 @@ int run_uvc_camera(const Config& config) {
   }
   std::cerr << "tofguard-camera: " << message << std::endl;
 
-  LcmNode node(config, "tofguard-camera");
+  LcmNode node(settings.lcm, settings.channels, "tofguard-camera");
   // The frames come as Z (a radial camera's are converted by UvcCamera);
   // the calibration corrects each pixel's distance along its ray.
-  const DepthCalibration calibration(camera_config.depth_calibration.coefficients_m);
+  const DepthCalibration calibration(settings.depth_calibration.coefficients_m);
   const RadialToZ rays(camera_config.intrinsics);
-  const bool calibrated = camera_config.depth_calibration.enabled;
+  const bool calibrated = settings.depth_calibration.enabled;
   const int64_t period_us = static_cast<int64_t>(1e6 / camera_config.rate_hz);
   // No frame for this long: the camera is gone (unplugged, crashed).
   const int64_t lost_after_us = std::max<int64_t>(500000, 5 * period_us);
@@ -78,7 +78,7 @@ int run_uvc_camera(const Config& config) {
       if (calibrated) calibration.apply_z(&frame->depth_m, rays);
       const depth_image_t image = make_depth_image(camera_config.id, camera_config.intrinsics, frame->utime,
                                                    frame->frame_number, calibrated, frame->depth_m);
-      node.images().publish(config.channels.depth, &image);
+      node.images().publish(settings.channels.depth, &image);
       node.counters().frames_out++;
       node.heartbeat().set_last_frame_utime(frame->utime);
     }

@@ -38,12 +38,13 @@ void install_stop_signal_handlers() {
 
 bool stop_requested() { return g_stop_requested; }
 
-LcmNode::LcmNode(const Config& config, const std::string& process_name, double heartbeat_rate_hz)
+LcmNode::LcmNode(const LcmSettings& lcm, const ChannelNames& channels, const std::string& process_name,
+                 double heartbeat_rate_hz)
     : process_name_(process_name),
-      safety_(open_lcm(config.lcm.url)),
-      images_(config.lcm.image_url == config.lcm.url ? nullptr : open_lcm(config.lcm.image_url)),
+      safety_(open_lcm(lcm.url)),
+      images_(lcm.image_url == lcm.url ? nullptr : open_lcm(lcm.image_url)),
       errors_(process_name),
-      heartbeat_(safety_.get(), config.channels.heartbeat, process_name, heartbeat_rate_hz) {
+      heartbeat_(safety_.get(), channels.heartbeat, process_name, heartbeat_rate_hz) {
   // LCM 1.3 joins the multicast groups lazily (first getFileno()/handle()):
   // join now, so nothing sent after construction is missed.
   safety_->getFileno();

@@ -134,6 +134,14 @@ double YamlMap::number(const std::string& key, double min, double max) {
   return result;
 }
 
+int64_t YamlMap::milliseconds_as_us(const std::string& key, double min_ms, double max_ms) {
+  return static_cast<int64_t>(std::llround(number(key, min_ms, max_ms) * 1000.0));
+}
+
+int64_t YamlMap::seconds_as_us(const std::string& key, double min_s, double max_s) {
+  return static_cast<int64_t>(std::llround(number(key, min_s, max_s) * 1e6));
+}
+
 double YamlMap::optional_number(const std::string& key, double default_value, double min,
                                 double max) {
   if (!optional(key)) return default_value;

@@ -399,7 +399,7 @@ void near_arm_surfaces(const depth_image_t& camera, const depth_image_t& rendere
 
 }  // namespace
 
-Parameters parameters_from(const DiscrepancyConfig& config) {
+Parameters parameters_from(const DiscrepancySettings& config) {
   Parameters p;
   p.tolerance.sigma_at_0m_mm = config.noise_sigma_at_0m_mm;
   p.tolerance.sigma_per_m2_mm = config.noise_sigma_per_m2_mm;

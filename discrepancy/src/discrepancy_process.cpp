@@ -17,18 +17,17 @@ ProcessInfo process_info() {
           "image (discrepancy_image_t)."};
 }
 
-int run_discrepancy(const Config& config) {
-  install_stop_signal_handlers();
-  LcmNode node(config, process_info().name);
-  const DiscrepancyConfig& dc = config.discrepancy;
+int run_discrepancy(const DiscrepancyProcessSettings& settings) {
+  LcmNode node(settings.lcm, settings.channels, process_info().name);
+  const DiscrepancySettings& dc = settings.discrepancy;
   const Parameters parameters = parameters_from(dc);
-  FramePairer pairer(static_cast<int64_t>(dc.pair_timeout_ms * 1000), dc.max_pending_frames);
+  FramePairer pairer(dc.pair_timeout_us, dc.max_pending_frames);
   RepeatCounter repeats;
   int64_t judged = 0;
   int64_t unusable = 0;
 
   auto publish = [&](const discrepancy_t& summary) {
-    node.safety().publish(config.channels.discrepancy, &summary);
+    node.safety().publish(settings.channels.discrepancy, &summary);
     node.counters().frames_out++;
     node.heartbeat().set_last_frame_utime(summary.utime);
     (summary.usable ? judged : unusable)++;
@@ -68,11 +67,11 @@ int run_discrepancy(const Config& config) {
     node.counters().frames_dropped += out.dropped_partners;
   };
 
-  const std::string camera_id = config.camera.id;
+  const std::string camera_id = settings.camera_id;
   auto check_camera = [camera_id](const depth_image_t& image) { return check_depth_image_from(image, camera_id); };
 
   node.subscribe<depth_image_t>(
-      node.images(), config.channels.depth,
+      node.images(), settings.channels.depth,
       [&](const depth_image_t& image) {
         PairingOutput out;
         CameraFrame frame{image, depth_hash(image.depth_mm), 0};
@@ -82,7 +81,7 @@ int run_discrepancy(const Config& config) {
       },
       check_camera);
   node.subscribe<depth_image_t>(
-      node.images(), config.channels.rendered,
+      node.images(), settings.channels.rendered,
       [&](const depth_image_t& rendered) {
         PairingOutput out;
         pairer.add_rendered(rendered, monotonic_us(), &out);
@@ -90,7 +89,7 @@ int run_discrepancy(const Config& config) {
       },
       check_depth_image);
   node.subscribe<link_labels_t>(
-      node.images(), config.channels.labels,
+      node.images(), settings.channels.labels,
       [&](const link_labels_t& labels) {
         PairingOutput out;
         pairer.add_labels(labels, monotonic_us(), &out);
@@ -98,7 +97,7 @@ int run_discrepancy(const Config& config) {
       },
       check_link_labels);
   // Expire waiting frames at a tenth of the pairing timeout (at least 1 ms).
-  node.add_timer(std::max<int64_t>(1000, static_cast<int64_t>(dc.pair_timeout_ms * 100)), [&] {
+  node.add_timer(std::max<int64_t>(1000, dc.pair_timeout_us / 10), [&] {
     PairingOutput out;
     pairer.expire(monotonic_us(), &out);
     handle(out);

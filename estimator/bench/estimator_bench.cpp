@@ -11,7 +11,8 @@
 
 #include "tofguard/estimator/motion_estimator.hpp"
 #include "simulated_frames.hpp"
-#include "tofguard/common/config.hpp"
+#include "tofguard/deployment/config.hpp"
+#include "tofguard/deployment/process_settings.hpp"
 
 namespace tofguard::estimator {
 namespace {
@@ -36,7 +37,7 @@ void BM_Estimate(benchmark::State& state) {
   // As tofguard-estimator runs (estimator/main.cpp): no llvmpipe render
   // threads, unless the environment says otherwise.
   setenv("LP_NUM_THREADS", "0", /*overwrite=*/0);
-  const Config config = load_config(std::string(TOFGUARD_SOURCE_DIR) + "/config/sim.yaml", nullptr);
+  const deployment::Config config = deployment::load_config(std::string(TOFGUARD_SOURCE_DIR) + "/config/sim.yaml", nullptr);
   tofguard::test::SimulatedFrames frames(config);
   EstimatorOptions options;
   options.noise_sigma_at_0m_m = config.discrepancy.noise_sigma_at_0m_mm / 1000;

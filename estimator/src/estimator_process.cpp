@@ -1,12 +1,21 @@
 #include "tofguard/estimator/estimator_process.hpp"
 
+#include <unistd.h>
+
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <iostream>
 
 #include "tofguard/renderer/depth_renderer.hpp"
 #include "tofguard/robot_model/kinematics.hpp"
+#include "tofguard/common/config_error.hpp"
 #include "tofguard/common/depth_frame.hpp"
+#include "tofguard/common/lcm_node.hpp"
 #include "tofguard/common/risk_names.hpp"
+#include "tofguard/common/wire_checks.hpp"
 
 namespace tofguard::estimator {
 
@@ -18,29 +27,29 @@ ProcessInfo process_info() {
           "judged a model mismatch, and periodically."};
 }
 
-EstimatorOptions options_from_config(const Config& config) {
+EstimatorOptions options_from_settings(const EstimatorProcessSettings& settings) {
   EstimatorOptions o;
-  o.estimate_joints = config.estimator.estimate_joints;
-  o.estimate_camera = config.estimator.estimate_camera;
-  o.noise_sigma_at_0m_m = std::max(1e-4, config.discrepancy.noise_sigma_at_0m_mm / 1000.0);
-  o.noise_sigma_per_m2_m = config.discrepancy.noise_sigma_per_m2_mm / 1000.0;
-  o.max_iterations = config.estimator.max_iterations;
-  o.pixel_stride = config.estimator.pixel_stride;
+  o.estimate_joints = settings.estimator.estimate_joints;
+  o.estimate_camera = settings.estimator.estimate_camera;
+  o.noise_sigma_at_0m_m = std::max(1e-4, settings.noise_sigma_at_0m_mm / 1000.0);
+  o.noise_sigma_per_m2_m = settings.noise_sigma_per_m2_mm / 1000.0;
+  o.max_iterations = settings.estimator.max_iterations;
+  o.pixel_stride = settings.estimator.pixel_stride;
   return o;
 }
 
-robot_model::SceneModel load_estimator_scene(const Config& config) {
+robot_model::SceneModel load_estimator_scene(const EstimatorProcessSettings& settings) {
   robot_model::SceneOptions options;
   options.geometry = robot_model::GeometrySource::kVisual;
   options.padding_m = 0;
-  options.package_paths = config.robot.package_paths;
-  return robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths, options);
+  options.package_paths = settings.robot.package_paths;
+  return robot_model::load_scene(settings.robot.urdf_path, settings.environment.urdf_paths, options);
 }
 
-EstimatorScheduler::EstimatorScheduler(const Config& config, const robot_model::SceneModel& scene)
-    : config_(config),
+EstimatorScheduler::EstimatorScheduler(const EstimatorProcessSettings& settings, const robot_model::SceneModel& scene)
+    : settings_(settings),
       scene_(scene),
-      state_(robot_state::StateHistorySettings::from_config(config)) {}
+      state_(renderer::state_history_settings(settings.renderer, settings.robot.id, settings.camera)) {}
 
 bool EstimatorScheduler::on_joint_state(const joint_state_t& state) {
   // A frame waiting for its joints may now be ready.
@@ -50,9 +59,9 @@ bool EstimatorScheduler::on_joint_state(const joint_state_t& state) {
 void EstimatorScheduler::on_camera_pose(const camera_pose_t& message) { state_.add_camera_pose(message); }
 
 bool EstimatorScheduler::on_depth(const depth_image_t& frame) {
-  if (frame.camera_id != config_.camera.id) return false;
+  if (frame.camera_id != settings_.camera.id) return false;
   frames_[frame.seq] = frame;
-  while (static_cast<int>(frames_.size()) > config_.estimator.max_pending_frames) {
+  while (static_cast<int>(frames_.size()) > settings_.estimator.max_pending_frames) {
     const int64_t oldest = frames_.begin()->first;
     if (wanted_.count(oldest) > 0) {
       wanted_.erase(oldest);
@@ -82,12 +91,12 @@ bool EstimatorScheduler::passes_warning(const discrepancy_t& d) const {
   // The estimator's own thresholds on the published summary (estimator.
   // warning); tofguard-risk's verdicts add the frames its rules judge a
   // model mismatch (on_risk).
-  return d.mismatch_fraction >= config_.estimator.warning_mismatch_fraction ||
-         d.p95_abs_dis_mm >= config_.estimator.warning_p95_abs_dis_mm;
+  return d.mismatch_fraction >= settings_.estimator.warning_mismatch_fraction ||
+         d.p95_abs_dis_mm >= settings_.estimator.warning_p95_abs_dis_mm;
 }
 
 void EstimatorScheduler::on_discrepancy(const discrepancy_t& d) {
-  if (d.camera_id != config_.camera.id || !d.usable) return;
+  if (d.camera_id != settings_.camera.id || !d.usable) return;
   if (passes_warning(d)) on_warning(d.seq, d.utime);
 }
 
@@ -104,7 +113,7 @@ void EstimatorScheduler::on_risk(const risk_t& r) {
 void EstimatorScheduler::on_warning(int64_t seq, int64_t utime) {
   if (frames_.empty() || seq >= frames_.begin()->first) warning_seqs_.insert(seq);
   if (estimated_.count(seq) > 0) return;
-  const int64_t min_interval_us = static_cast<int64_t>(config_.estimator.warning_min_interval_ms * 1000);
+  const int64_t min_interval_us = settings_.estimator.warning_min_interval_us;
   if (last_warning_utime_ > 0 && utime >= last_warning_utime_ && utime - last_warning_utime_ < min_interval_us) {
     return;  // rate limit (camera time)
   }
@@ -209,7 +218,7 @@ ScheduledWork EstimatorScheduler::build(const depth_image_t& frame, int8_t trigg
   // and pose known, same size and pose frame.
   const bool warning = trigger == motion_estimate_t::TRIGGER_WARNING || warning_seqs_.count(frame.seq) > 0;
   for (auto it = frames_.lower_bound(frame.seq);
-       it != frames_.begin() && static_cast<int>(job.frames.size()) < config_.estimator.frames_per_estimate;) {
+       it != frames_.begin() && static_cast<int>(job.frames.size()) < settings_.estimator.frames_per_estimate;) {
     --it;
     const depth_image_t& earlier = it->second;
     if ((warning_seqs_.count(it->first) > 0) != warning) continue;
@@ -221,8 +230,8 @@ ScheduledWork EstimatorScheduler::build(const depth_image_t& frame, int8_t trigg
   return work;
 }
 
-EstimatorWorker::EstimatorWorker(const robot_model::SceneModel& scene, const Config& config)
-    : scene_(scene), config_(config), thread_([this] { run(); }) {}
+EstimatorWorker::EstimatorWorker(const robot_model::SceneModel& scene, const EstimatorProcessSettings& settings)
+    : scene_(scene), settings_(settings), thread_([this] { run(); }) {}
 
 EstimatorWorker::~EstimatorWorker() {
   {
@@ -269,8 +278,8 @@ void EstimatorWorker::run() {
   std::unique_ptr<MotionEstimator> estimator;
   try {
     // The renderer's GL context belongs to this thread.
-    renderer = std::make_unique<renderer::DepthRenderer>(scene_, config_.renderer.near_m, config_.renderer.far_m);
-    estimator = std::make_unique<MotionEstimator>(scene_, renderer.get(), options_from_config(config_));
+    renderer = std::make_unique<renderer::DepthRenderer>(scene_, settings_.renderer.near_m, settings_.renderer.far_m);
+    estimator = std::make_unique<MotionEstimator>(scene_, renderer.get(), options_from_settings(settings_));
   } catch (const std::exception& e) {
     std::lock_guard<std::mutex> lock(mutex_);
     start_error_ = e.what();
@@ -299,6 +308,112 @@ void EstimatorWorker::run() {
     results_.push_back(std::move(message));
     working_ = false;
   }
+}
+
+int run_estimator(const EstimatorProcessSettings& settings) {
+  const std::string name = process_info().name;
+  // The estimator renders 176x144-sized images a dozen times per frame on
+  // its worker thread: llvmpipe's own render threads cost more in hand-over
+  // than they save at that size (docs/benchmarks.md, motion estimator: 36 ms
+  // per frame without them, 44 ms with). Set before the EGL display is
+  // opened; a value in the environment wins.
+  setenv("LP_NUM_THREADS", "0", /*overwrite=*/0);
+  // The estimate is a diagnosis, not part of the stop path: on a small CPU
+  // it must never take time from the renderer, discrepancy and risk, whose
+  // deadlines stop the arm. Niceness +10 for the process and every thread
+  // it starts (set before any thread exists).
+  errno = 0;
+  if (nice(10) == -1 && errno != 0) {
+    std::cerr << name << ": cannot lower its priority (nice 10): " << std::strerror(errno) << "\n";
+  }
+  robot_model::SceneModel scene;
+  try {
+    scene = load_estimator_scene(settings);
+  } catch (const std::exception& e) {
+    std::cerr << name << ": " << e.what() << "\n";
+    return kConfigErrorExitCode;
+  }
+  EstimatorWorker worker(scene, settings);
+  const std::string worker_error = worker.wait_ready();
+  if (!worker_error.empty()) {
+    std::cerr << name << ": cannot start the estimator: " << worker_error << "\n";
+    return 1;
+  }
+  EstimatorScheduler scheduler(settings, scene);
+  LcmNode node(settings.lcm, settings.channels, name);
+  node.heartbeat().set_status("waiting for frames");
+  int64_t published = 0;
+  int64_t unusable = 0;
+
+  auto dispatch = [&] {
+    for (ScheduledWork& work : scheduler.take_ready()) {
+      if (work.unusable) {
+        node.safety().publish(settings.channels.motion_estimate, &*work.unusable);
+        node.counters().frames_out++;
+        ++unusable;
+        node.errors().report("unusable", "frame " + std::to_string(work.unusable->seq) +
+                                              " not estimated: " + work.unusable->unusable_reason);
+      } else if (work.job && worker.post(std::move(*work.job))) {
+        // Behind: the waiting job was replaced by this newer one.
+        node.counters().frames_dropped++;
+      }
+    }
+  };
+
+  node.subscribe<joint_state_t>(
+      node.safety(), settings.channels.joint_state,
+      [&](const joint_state_t& state) {
+        if (!scheduler.on_joint_state(state)) {
+          node.counters().validation_errors++;
+          node.errors().report(settings.channels.joint_state,
+                               settings.channels.joint_state + ": ignored a message for robot_id '" + state.robot_id +
+                                   "' (expected '" + settings.robot.id + "') or not newer than the last");
+        }
+      },
+      check_joint_state);
+  node.subscribe<camera_pose_t>(
+      node.safety(), settings.channels.camera_pose, [&](const camera_pose_t& pose) { scheduler.on_camera_pose(pose); },
+      check_camera_pose);
+  node.subscribe<depth_image_t>(
+      node.images(), settings.channels.depth,
+      [&](const depth_image_t& frame) {
+        if (scheduler.on_depth(frame)) {
+          node.heartbeat().set_last_frame_utime(frame.utime);
+          dispatch();
+        }
+      },
+      check_depth_image);
+  node.subscribe<discrepancy_t>(
+      node.safety(), settings.channels.discrepancy,
+      [&](const discrepancy_t& d) {
+        scheduler.on_discrepancy(d);
+        dispatch();
+      },
+      check_discrepancy);
+  node.subscribe<risk_t>(
+      node.safety(), settings.channels.risk,
+      [&](const risk_t& r) {
+        scheduler.on_risk(r);
+        dispatch();
+      },
+      check_risk);
+  node.add_timer(settings.estimator.periodic_period_us, [&] {
+    scheduler.request_newest();
+    dispatch();
+  });
+  node.add_timer(5000, [&] {
+    for (const motion_estimate_t& m : worker.take_results()) {
+      node.safety().publish(settings.channels.motion_estimate, &m);
+      node.counters().frames_out++;
+      ++published;
+      if (!m.usable) ++unusable;
+    }
+    node.heartbeat().set_status("estimates " + std::to_string(published) + ", unusable " +
+                                std::to_string(unusable) + ", missed " + std::to_string(scheduler.missed()) +
+                                (worker.busy() ? ", estimating" : ", idle"));
+  });
+  node.run();
+  return 0;
 }
 
 }  // namespace tofguard::estimator

@@ -44,7 +44,7 @@ std::string pose_yaml(const CameraPose& pose) {
   return out.str();
 }
 
-CalibrationResult calibrate_extrinsics(const Config& config, const std::string& log_path,
+CalibrationResult calibrate_extrinsics(const EstimatorProcessSettings& settings, const std::string& log_path,
                                        const CalibrationOptions& options) {
   CalibrationResult result;
   lcm::LogFile log(log_path, "r");
@@ -53,44 +53,45 @@ CalibrationResult calibrate_extrinsics(const Config& config, const std::string& 
     return result;
   }
   // Every joint state first (the frames need the states around them): the
-  // whole log is kept. The camera pose is the config's (CAMERA_POSE is not
+  // whole log is kept. The camera pose is the settings' (CAMERA_POSE is not
   // read: the pose is what is being calibrated).
-  robot_state::StateHistorySettings settings = robot_state::StateHistorySettings::from_config(config);
-  settings.joint_span_us = std::numeric_limits<int64_t>::max() / 4;
-  settings.joint_max_messages = std::numeric_limits<size_t>::max();
-  robot_state::StateHistory history(settings);
+  robot_state::StateHistorySettings state_settings =
+      renderer::state_history_settings(settings.renderer, settings.robot.id, settings.camera);
+  state_settings.joint_span_us = std::numeric_limits<int64_t>::max() / 4;
+  state_settings.joint_max_messages = std::numeric_limits<size_t>::max();
+  robot_state::StateHistory history(state_settings);
   std::vector<depth_image_t> frames;
   int joint_states = 0;
   for (const lcm::LogEvent* event = log.readNextEvent(); event != nullptr; event = log.readNextEvent()) {
-    if (event->channel == config.channels.joint_state) {
+    if (event->channel == settings.channels.joint_state) {
       const auto state = decode_message<joint_state_t>(event->data, event->datalen);
       if (!state || !check_joint_state(*state).empty()) continue;
       if (history.add_joint_state(*state)) ++joint_states;
-    } else if (event->channel == config.channels.depth) {
+    } else if (event->channel == settings.channels.depth) {
       const auto frame = decode_message<depth_image_t>(event->data, event->datalen);
-      if (!frame || !check_depth_image_from(*frame, config.camera.id).empty()) continue;
+      if (!frame || !check_depth_image_from(*frame, settings.camera.id).empty()) continue;
       frames.push_back(*frame);
     }
   }
   result.frames_in_log = static_cast<int>(frames.size());
   if (frames.empty()) {
-    result.error = log_path + ": no " + config.channels.depth + " frames of camera '" + config.camera.id + "'";
+    result.error = log_path + ": no " + settings.channels.depth + " frames of camera '" + settings.camera.id + "'";
     return result;
   }
   if (joint_states == 0) {
-    result.error = log_path + ": no " + config.channels.joint_state + " messages of robot '" + config.robot.id + "'";
+    result.error = log_path + ": no " + settings.channels.joint_state + " messages of robot '" + settings.robot.id + "'";
     return result;
   }
 
-  const robot_model::SceneModel scene = load_estimator_scene(config);
-  const int frame_link = scene.find_link(config.camera.pose.frame_id);
+  const robot_model::SceneModel scene = load_estimator_scene(settings);
+  const int frame_link = scene.find_link(settings.camera.pose.frame_id);
   if (frame_link < 0) {
-    result.error = "camera.pose.frame '" + config.camera.pose.frame_id + "' is not a model link";
+    result.error = "camera.pose.frame '" + settings.camera.pose.frame_id + "' is not a model link";
     return result;
   }
-  const std::string moving = scene.nearest_movable_joint_above(config.camera.pose.frame_id);
+  const std::string moving = scene.nearest_movable_joint_above(settings.camera.pose.frame_id);
   if (!moving.empty()) {
-    result.error = "camera.pose.frame '" + config.camera.pose.frame_id + "' moves with joint '" + moving +
+    result.error = "camera.pose.frame '" + settings.camera.pose.frame_id + "' moves with joint '" + moving +
                    "': only a static camera can be calibrated";
     return result;
   }
@@ -134,7 +135,7 @@ CalibrationResult calibrate_extrinsics(const Config& config, const std::string& 
     result.error = static_poses.unusable_reason;
     return result;
   }
-  const Eigen::Isometry3d frame_from_optical = config.camera.pose.frame_from_optical();
+  const Eigen::Isometry3d frame_from_optical = settings.camera.pose.frame_from_optical();
   const Eigen::Isometry3d world_from_optical = static_poses.world_from_link[frame_link] * frame_from_optical;
 
   std::vector<EstimatorFrame> estimator_frames;
@@ -147,7 +148,7 @@ CalibrationResult calibrate_extrinsics(const Config& config, const std::string& 
     f.depth_m = depth_m_of(d);
     estimator_frames.push_back(std::move(f));
   }
-  EstimatorOptions estimator_options = options_from_config(config);
+  EstimatorOptions estimator_options = options_from_settings(settings);
   estimator_options.estimate_joints = false;
   estimator_options.estimate_camera = true;
   estimator_options.max_iterations = options.max_iterations;
@@ -155,7 +156,7 @@ CalibrationResult calibrate_extrinsics(const Config& config, const std::string& 
   // more slowly than for a frame-to-frame estimate.
   estimator_options.initial_robust_scale_m = options.initial_robust_scale_m;
   estimator_options.robust_scale_factor = options.robust_scale_factor;
-  renderer::DepthRenderer renderer(scene, config.renderer.near_m, config.renderer.far_m);
+  renderer::DepthRenderer renderer(scene, settings.renderer.near_m, settings.renderer.far_m);
   MotionEstimator estimator(scene, &renderer, estimator_options);
   const EstimateResult estimate = estimator.estimate_camera(estimator_frames);
   if (!estimate.usable) {
@@ -168,7 +169,7 @@ CalibrationResult calibrate_extrinsics(const Config& config, const std::string& 
   result.translation_sigma_m = estimate.correction_translation_sigma_m;
   result.rotation_sigma_rad = estimate.correction_rotation_sigma_rad;
   const Eigen::Isometry3d estimated = frame_from_optical * estimate.correction;
-  result.pose.frame_id = config.camera.pose.frame_id;
+  result.pose.frame_id = settings.camera.pose.frame_id;
   result.pose.translation_m = estimated.translation();
   result.pose.rotation = Eigen::Quaterniond(estimated.linear());
   if (!estimate.converged) {

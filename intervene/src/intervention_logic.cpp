@@ -37,7 +37,7 @@ void demand_consistent(const Status& s) {
 
 }  // namespace
 
-InterventionLogic::InterventionLogic(const InterventionConfig& config, int64_t now_us,
+InterventionLogic::InterventionLogic(const InterventionSettings& config, int64_t now_us,
                                      int64_t now_utime)
     : config_(config), risk_arrival_us_(now_us) {
   // Fail-safe start: stopped and latched. The risk deadline runs from now,
@@ -67,7 +67,7 @@ bool InterventionLogic::take_changed() {
 
 bool InterventionLogic::risk_fresh(int64_t now_us) const {
   // Before the first risk, the deadline runs from start-up.
-  return now_us - risk_arrival_us_ <= config_.risk_deadline_ms * 1000;
+  return now_us - risk_arrival_us_ <= config_.risk_deadline_us;
 }
 
 void InterventionLogic::stop(int8_t kind, int8_t cause, const std::string& reason, int64_t now_us,
@@ -138,10 +138,10 @@ void InterventionLogic::tick(int64_t now_us, int64_t now_utime) {
     stop(safety_status_t::STOP_POWER_CUT, risk_t::CAUSE_COMPONENT_FAULT, reason, now_us, now_utime);
   }
   if (status_.stop == safety_status_t::STOP_SOFTWARE &&
-      now_us - stop_started_us_ > config_.stop_deadline_ms * 1000) {
+      now_us - stop_started_us_ > config_.stop_deadline_us) {
     const bool joint_state_fresh =
         joint_state_arrival_us_ >= 0 &&
-        now_us - joint_state_arrival_us_ <= config_.joint_state_deadline_ms * 1000;
+        now_us - joint_state_arrival_us_ <= config_.joint_state_deadline_us;
     if (!joint_state_fresh) {
       stop(safety_status_t::STOP_POWER_CUT, risk_t::CAUSE_SENSOR_FAULT,
            "no fresh JOINT_STATE shows the arm stopped " + ms(now_us - stop_started_us_) +

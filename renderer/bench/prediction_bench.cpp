@@ -11,8 +11,9 @@
 #include <benchmark/benchmark.h>
 
 #include "tofguard/renderer/renderer_process.hpp"
-#include "tofguard/common/config.hpp"
 #include "tofguard/common/depth_frame.hpp"
+#include "tofguard/deployment/config.hpp"
+#include "tofguard/deployment/process_settings.hpp"
 
 namespace tofguard::renderer {
 namespace {
@@ -20,8 +21,8 @@ namespace {
 constexpr int64_t kT0 = 1'700'000'000'000'000;
 constexpr int64_t kPeriodUs = 33'333;
 
-const Config& sim_config() {
-  static const Config config = load_config(std::string(TOFGUARD_SOURCE_DIR) + "/config/sim.yaml", nullptr);
+const deployment::Config& sim_config() {
+  static const deployment::Config config = deployment::load_config(std::string(TOFGUARD_SOURCE_DIR) + "/config/sim.yaml", nullptr);
   return config;
 }
 
@@ -44,7 +45,7 @@ joint_state_t joints_at(int64_t utime) {
 
 // A flat wall 1.5 m away filling the frame (what it shows does not matter).
 depth_image_t frame_at(int64_t utime, int64_t seq) {
-  const CameraConfig& camera = sim_config().camera;
+  const CameraSettings& camera = sim_config().camera;
   return make_depth_image(camera.id, camera.intrinsics, utime, seq, /*calibrated=*/true,
                           std::vector<float>(camera.intrinsics.width * camera.intrinsics.height, 1.5f));
 }
@@ -64,7 +65,7 @@ planned_trajectory_t hold_plan() {
 }
 
 void frame_to_rendered(benchmark::State& state, bool with_plan) {
-  RendererService service(sim_config());
+  RendererService service(deployment::renderer_process_settings(sim_config()));
   if (with_plan) service.on_plan(hold_plan());
   int64_t utime = kT0;
   int64_t seq = 0;

@@ -2,10 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iostream>
 #include <stdexcept>
 #include <vector>
 
+#include "tofguard/common/config_error.hpp"
 #include "tofguard/common/depth_frame.hpp"
+#include "tofguard/common/lcm_node.hpp"
+#include "tofguard/common/wire_checks.hpp"
 
 namespace tofguard::renderer {
 
@@ -16,17 +20,17 @@ ProcessInfo process_info() {
           "Also: tofguard-renderer render --help (one image to PNG files)."};
 }
 
-robot_model::SceneOptions scene_options(const Config& config) {
+robot_model::SceneOptions scene_options(const RendererSettings& renderer, const RobotSettings& robot) {
   robot_model::SceneOptions options;
-  options.geometry = robot_model::parse_geometry_source(config.renderer.geometry);
-  options.padding_m = config.renderer.padding_m;
-  options.package_paths = config.robot.package_paths;
+  options.geometry = robot_model::parse_geometry_source(renderer.geometry);
+  options.padding_m = renderer.padding_m;
+  options.package_paths = robot.package_paths;
   return options;
 }
 
 namespace {
 
-std::unique_ptr<DepthRenderer> make_renderer(const robot_model::SceneModel& scene, const RendererConfig& config) {
+std::unique_ptr<DepthRenderer> make_renderer(const robot_model::SceneModel& scene, const RendererSettings& config) {
   if (config.far_m > kMaxFarM) {
     throw std::invalid_argument("renderer.far_m must be at most " + std::to_string(kMaxFarM) +
                                 " m (depth_mm is int16 millimetres), got " + std::to_string(config.far_m));
@@ -36,11 +40,12 @@ std::unique_ptr<DepthRenderer> make_renderer(const robot_model::SceneModel& scen
 
 }  // namespace
 
-RendererService::RendererService(const Config& config)
-    : config_(config),
-      scene_(robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths, scene_options(config))),
-      renderer_(make_renderer(scene_, config.renderer)),
-      state_(robot_state::StateHistorySettings::from_config(config)) {}
+RendererService::RendererService(const RendererProcessSettings& settings)
+    : settings_(settings),
+      scene_(robot_model::load_scene(settings.robot.urdf_path, settings.environment.urdf_paths,
+                                     scene_options(settings.renderer, settings.robot))),
+      renderer_(make_renderer(scene_, settings.renderer)),
+      state_(state_history_settings(settings.renderer, settings.robot.id, settings.camera)) {}
 
 bool RendererService::on_joint_state(const joint_state_t& state) { return state_.add_joint_state(state); }
 
@@ -91,7 +96,7 @@ void RendererService::learn_period(const depth_image_t& frame) {
 void RendererService::plan_prediction(const depth_image_t& frame) {
   prediction_.reset();
   const int64_t period_us = frame_period_us();
-  if (!config_.renderer.prediction_enabled || period_us <= 0) return;
+  if (!settings_.renderer.prediction_enabled || period_us <= 0) return;
   if (consecutive_misses_ >= kMissesBeforeProbing && ++frames_since_probe_ < kProbeEveryFrames) return;
   frames_since_probe_ = 0;
   const int64_t utime = frame.utime + period_us;
@@ -131,7 +136,7 @@ bool RendererService::prediction_matches(const depth_image_t& frame, const robot
       p.intrinsics.cx != frame.cx || p.intrinsics.cy != frame.cy) {
     return false;
   }
-  const RendererConfig& r = config_.renderer;
+  const RendererSettings& r = settings_.renderer;
   for (const auto& [joint, predicted] : p.joints) {
     const auto actual = joints.find(joint);
     if (actual == joints.end()) return false;
@@ -177,6 +182,90 @@ RenderedFrame RendererService::make_output(const depth_image_t& frame, RenderRes
   out.depth = make_depth_image(frame.camera_id, intrinsics_of(frame), frame.utime, frame.seq, /*calibrated=*/true,
                                result.depth_m);
   return out;
+}
+
+int run_renderer(const RendererProcessSettings& settings) {
+  const std::string name = process_info().name;
+  std::unique_ptr<RendererService> service;
+  try {
+    service = std::make_unique<RendererService>(settings);
+  } catch (const std::exception& e) {
+    // A model that cannot be rendered is a configuration error: nothing is
+    // published, so the risk chain sees this process's heartbeat missing.
+    std::cerr << name << ": " << e.what() << "\n";
+    return kConfigErrorExitCode;
+  }
+  std::cerr << name << ": rendering with " << service->description() << "\n";
+  LcmNode node(settings.lcm, settings.channels, name);
+  node.heartbeat().set_status("waiting for frames");
+
+  node.subscribe<joint_state_t>(
+      node.safety(), settings.channels.joint_state,
+      [&](const joint_state_t& state) {
+        if (!service->on_joint_state(state)) {
+          node.counters().validation_errors++;
+          node.errors().report(settings.channels.joint_state,
+                               settings.channels.joint_state + ": ignored a message for robot_id '" + state.robot_id +
+                                   "' (expected '" + settings.robot.id + "') or not newer than the last");
+        }
+      },
+      check_joint_state);
+  node.subscribe<camera_pose_t>(
+      node.safety(), settings.channels.camera_pose,
+      [&](const camera_pose_t& pose) {
+        if (!service->on_camera_pose(pose)) {
+          node.counters().validation_errors++;
+          node.errors().report(settings.channels.camera_pose, settings.channels.camera_pose + ": utime: expected a pose newer than camera '" +
+                                                                pose.camera_id + "''s newest, got " +
+                                                                std::to_string(pose.utime) + "; ignored");
+        }
+      },
+      check_camera_pose);
+  node.subscribe<planned_trajectory_t>(
+      node.safety(), settings.channels.planned_trajectory, [&](const planned_trajectory_t& plan) { service->on_plan(plan); },
+      check_planned_trajectory);
+  node.subscribe<depth_image_t>(
+      node.images(), settings.channels.depth,
+      [&](const depth_image_t& frame) {
+        if (service->on_depth(frame)) node.counters().frames_dropped++;
+      },
+      check_depth_image);
+
+  // Before rendering, take in everything that has already arrived, so that
+  // the newest joint states and only the newest frame are used (bounded, so
+  // that a flood cannot starve the rendering).
+  const auto drain = [&] {
+    for (int i = 0; i < 1000; ++i) {
+      const bool safety = node.safety().handleTimeout(0) > 0;
+      const bool images = &node.images() != &node.safety() && node.images().handleTimeout(0) > 0;
+      if (!safety && !images) return;
+    }
+  };
+  auto status = [&](const std::string& what) {
+    const RendererService::PredictionStats& p = service->prediction_stats();
+    node.heartbeat().set_status(what + "; prediction: " + std::to_string(p.hits) + " hits, " +
+                                std::to_string(p.misses) + " misses, " + std::to_string(p.without) +
+                                " frames without one, " + std::to_string(p.rendered) + " rendered ahead");
+  };
+  while (node.spin_once(service->has_pending() || service->has_prediction_to_render() ? 0 : 20)) {
+    if (!service->has_pending()) {
+      // Idle: render the next frame ahead from the plan, unless a frame
+      // has come meanwhile.
+      drain();
+      if (!service->has_pending()) service->render_prediction();
+      continue;
+    }
+    drain();
+    const std::optional<RenderedFrame> rendered = service->render_pending();
+    if (!rendered) continue;
+    node.images().publish(settings.channels.labels, &rendered->labels);
+    if (rendered->depth) node.images().publish(settings.channels.rendered, &*rendered->depth);
+    node.counters().frames_out++;
+    node.heartbeat().set_last_frame_utime(rendered->labels.utime);
+    status(rendered->labels.usable ? "rendering" : "frame unusable: " + rendered->labels.unusable_reason);
+    if (!rendered->labels.usable) node.errors().report("unusable", "frame unusable: " + rendered->labels.unusable_reason);
+  }
+  return 0;
 }
 
 }  // namespace tofguard::renderer

@@ -22,7 +22,7 @@ risk_t verdict(int64_t utime, int64_t seq, int8_t level, const FrameFinding& fin
 
 }  // namespace
 
-DecisionRule::DecisionRule(const RiskConfig& risk)
+DecisionRule::DecisionRule(const RiskSettings& risk)
     : debounce_frames_(risk.debounce_frames), sensor_debounce_frames_(risk.sensor_debounce_frames) {}
 
 risk_t DecisionRule::decide(const discrepancy_t& frame, FrameFinding finding,

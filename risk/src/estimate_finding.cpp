@@ -37,7 +37,7 @@ double correction_angle_rad(const motion_estimate_t& e) {
   return 2.0 * std::acos(std::min(1.0, std::abs(e.correction_rotation[0]) / norm));
 }
 
-FrameFinding classify_estimate(const motion_estimate_t& e, const RiskConfig& config, const EstimateContext& context) {
+FrameFinding classify_estimate(const motion_estimate_t& e, const RiskSettings& config, const EstimateContext& context) {
   if (!e.usable || !e.converged) return {};
 
   // The most significant joint, normalised by its threshold.

@@ -9,8 +9,6 @@
 namespace tofguard::risk {
 namespace {
 
-int64_t ms_to_us(double ms) { return static_cast<int64_t>(std::llround(ms * 1000.0)); }
-
 // Estimates kept for frames still to come or waiting, and frames remembered
 // for counting late estimates.
 constexpr size_t kKeptEstimates = 16;
@@ -18,12 +16,12 @@ constexpr size_t kKeptMissedSeqs = 64;
 
 }  // namespace
 
-EstimateGate::EstimateGate(const RiskConfig& risk, std::set<std::string> prismatic_joints)
+EstimateGate::EstimateGate(const RiskSettings& risk, std::set<std::string> prismatic_joints)
     : risk_(risk),
       prismatic_joints_(std::move(prismatic_joints)),
       enabled_(risk.estimate_enabled),
-      wait_us_(ms_to_us(risk.estimate_wait_ms)),
-      max_age_us_(ms_to_us(risk.estimate_max_age_ms)) {}
+      wait_us_(risk.estimate_wait_us),
+      max_age_us_(risk.estimate_max_age_us) {}
 
 std::vector<ClassifiedFrame> EstimateGate::admit(ClassifiedFrame frame, int64_t now_us) {
   waiting_.push_back(WaitingFrame{std::move(frame), now_us + wait_us_});
@@ -78,7 +76,7 @@ void EstimateGate::rename_cause(ClassifiedFrame* c) {
   FrameFinding& finding = c->finding;
   const motion_estimate_t* estimate = estimate_for(frame, /*or_older=*/true);
   if (estimate == nullptr) {
-    finding.detail += " (no motion estimate within " + fixed(risk_.estimate_wait_ms, 0) + " ms)";
+    finding.detail += " (no motion estimate within " + fixed(risk_.estimate_wait_us / 1000.0, 0) + " ms)";
     return;
   }
   EstimateContext context;

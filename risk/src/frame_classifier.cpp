@@ -84,7 +84,7 @@ FrameFinding unusable_frame(const FrameEvidence& e) {
 // Too many pixels without a return (fraction of the image).
 FrameFinding invalid_pixels(const FrameEvidence& e) {
   const discrepancy_t& f = e.frame;
-  const RiskConfig& config = e.config;
+  const RiskSettings& config = e.config;
   if (!(f.invalid_fraction > config.max_invalid_fraction)) return {};
   return finding(risk_t::CAUSE_SENSOR_FAULT, e.context.depth_channel, f.invalid_fraction, config.max_invalid_fraction,
                  "invalid pixels (fraction): " + fixed(100.0 * f.invalid_fraction, 1) + " % have no return, limit " +
@@ -101,7 +101,7 @@ FrameFinding uncalibrated_camera(const FrameEvidence& e) {
 // time): a real ToF camera's noise never repeats.
 FrameFinding frozen_image(const FrameEvidence& e) {
   const discrepancy_t& f = e.frame;
-  const RiskConfig& config = e.config;
+  const RiskSettings& config = e.config;
   if (!e.context.arm_moving || f.repeat_count < config.frozen_repeat_frames) return {};
   return finding(risk_t::CAUSE_SENSOR_FAULT, e.context.depth_channel, f.repeat_count, config.frozen_repeat_frames,
                  "frozen image (repeated frames): the same depth image " + std::to_string(f.repeat_count + 1) +
@@ -113,7 +113,7 @@ FrameFinding frozen_image(const FrameEvidence& e) {
 // CALIBRATION_ERROR: the static environment and the arm disagree broadly.
 FrameFinding calibration_error(const FrameEvidence& e) {
   const discrepancy_t& f = e.frame;
-  const RiskConfig& config = e.config;
+  const RiskSettings& config = e.config;
   const std::vector<LinkView>& visible = e.visible_links();
   const int64_t environment_compared = e.environment_compared();
   if (environment_compared < config.min_environment_pixels) return {};
@@ -154,7 +154,7 @@ FrameFinding calibration_error(const FrameEvidence& e) {
 // hang below one moving joint; the proximal links match. A missing link the
 // URDF does not know is UNCLASSIFIED (never judged safe).
 FrameFinding joint_error_missing_links(const FrameEvidence& e) {
-  const RiskConfig& config = e.config;
+  const RiskSettings& config = e.config;
   const robot_model::KinematicTree& robot = e.robot;
   const std::vector<LinkView>& visible = e.visible_links();
   std::vector<std::string> missing_links;
@@ -213,7 +213,7 @@ FrameFinding joint_error_missing_links(const FrameEvidence& e) {
 // that joint is the suspect. (An object that hides part of a link lands
 // here too: either way the arm stops.)
 FrameFinding joint_error_beside_unexplained_surfaces(const FrameEvidence& e) {
-  const RiskConfig& config = e.config;
+  const RiskSettings& config = e.config;
   const robot_model::KinematicTree& robot = e.robot;
   if (!(e.frame.near_arm_area_m2 >= config.unknown_object_min_area_m2)) return {};
   std::vector<std::string> affected;
@@ -283,7 +283,7 @@ const std::vector<FrameRule>& frame_rules() {
   return rules;
 }
 
-FrameFinding classify_frame(const discrepancy_t& frame, const robot_model::KinematicTree& robot, const RiskConfig& config,
+FrameFinding classify_frame(const discrepancy_t& frame, const robot_model::KinematicTree& robot, const RiskSettings& config,
                             const ClassifierContext& context) {
   const FrameEvidence evidence(frame, robot, config, context);
   for (const FrameRule& rule : frame_rules()) {

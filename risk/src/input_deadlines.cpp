@@ -1,28 +1,21 @@
 #include "tofguard/risk/input_deadlines.hpp"
 
-#include <cmath>
 #include <vector>
 
 #include "tofguard/risk_t.hpp"
 
 namespace tofguard::risk {
-namespace {
-
-int64_t ms_to_us(double ms) { return static_cast<int64_t>(std::llround(ms * 1000.0)); }
-
-}  // namespace
-
-InputDeadlines::InputDeadlines(const RiskConfig& risk, const ChannelNames& channels, int64_t start_us)
-    : depth_{channels.depth, risk_t::CAUSE_SENSOR_FAULT, ms_to_us(risk.depth_deadline_ms), start_us},
-      joint_state_{channels.joint_state, risk_t::CAUSE_SENSOR_FAULT, ms_to_us(risk.joint_state_deadline_ms),
+InputDeadlines::InputDeadlines(const RiskSettings& risk, const ChannelNames& channels, int64_t start_us)
+    : depth_{channels.depth, risk_t::CAUSE_SENSOR_FAULT, risk.depth_deadline_us, start_us},
+      joint_state_{channels.joint_state, risk_t::CAUSE_SENSOR_FAULT, risk.joint_state_deadline_us,
                    start_us},
-      camera_pose_{channels.camera_pose, risk_t::CAUSE_SENSOR_FAULT, ms_to_us(risk.camera_pose_deadline_ms),
+      camera_pose_{channels.camera_pose, risk_t::CAUSE_SENSOR_FAULT, risk.camera_pose_deadline_us,
                    start_us},
       camera_pose_required_(risk.camera_pose_required),
-      discrepancy_{channels.discrepancy, risk_t::CAUSE_COMPONENT_FAULT, ms_to_us(risk.discrepancy_deadline_ms),
+      discrepancy_{channels.discrepancy, risk_t::CAUSE_COMPONENT_FAULT, risk.discrepancy_deadline_us,
                    start_us} {
   for (const std::string& process : risk.required_heartbeats) {
-    heartbeats_[process] = Deadline{process, risk_t::CAUSE_COMPONENT_FAULT, ms_to_us(risk.heartbeat_deadline_ms),
+    heartbeats_[process] = Deadline{process, risk_t::CAUSE_COMPONENT_FAULT, risk.heartbeat_deadline_us,
                                     start_us, /*ever=*/false, /*heartbeat=*/true};
   }
 }

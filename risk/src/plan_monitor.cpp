@@ -11,7 +11,7 @@ constexpr double kRadToDeg = 180.0 / M_PI;
 
 }  // namespace
 
-PlanMonitor::PlanMonitor(const RiskConfig& risk, std::set<std::string> prismatic_joints)
+PlanMonitor::PlanMonitor(const RiskSettings& risk, std::set<std::string> prismatic_joints)
     : enabled_(risk.plan_enabled),
       max_deviation_rad_(risk.plan_max_deviation_deg / kRadToDeg),
       max_deviation_m_(risk.plan_max_deviation_m),

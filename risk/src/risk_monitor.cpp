@@ -15,14 +15,15 @@ ClassifierContext classifier_context(const ChannelNames& channels) {
 
 }  // namespace
 
-RiskMonitor::RiskMonitor(const Config& config, robot_model::KinematicTree robot, int64_t start_us)
-    : risk_config_(config.risk),
-      classifier_context_(classifier_context(config.channels)),
+RiskMonitor::RiskMonitor(const RiskSettings& settings, const ChannelNames& channels, robot_model::KinematicTree robot,
+                         int64_t start_us)
+    : settings_(settings),
+      classifier_context_(classifier_context(channels)),
       robot_(std::move(robot)),
-      deadlines_(config.risk, config.channels, start_us),
-      plan_(config.risk, robot_.prismatic_joint_names),
-      gate_(config.risk, robot_.prismatic_joint_names),
-      decision_(config.risk) {}
+      deadlines_(settings, channels, start_us),
+      plan_(settings, robot_.prismatic_joint_names),
+      gate_(settings, robot_.prismatic_joint_names),
+      decision_(settings) {}
 
 void RiskMonitor::on_joint_state(const joint_state_t& state, int64_t now_us) {
   deadlines_.on_joint_state(now_us);
@@ -45,11 +46,11 @@ ClassifiedFrame RiskMonitor::classify(const discrepancy_t& frame) const {
   if (at_capture != nullptr) {
     double fastest = 0;  // rad/s (m/s for prismatic joints)
     for (double v : at_capture->velocity) fastest = std::max(fastest, std::abs(v));
-    context.arm_moving = fastest >= risk_config_.moving_joint_speed_rad_s;
+    context.arm_moving = fastest >= settings_.moving_joint_speed_rad_s;
   }
   ClassifiedFrame c;
   c.frame = frame;
-  c.finding = classify_frame(frame, robot_, risk_config_, context);
+  c.finding = classify_frame(frame, robot_, settings_, context);
   c.model_mismatch = is_model_mismatch(c.finding.cause);
   // The arm left its plan: only when the camera shows nothing wrong (a
   // camera finding says more).

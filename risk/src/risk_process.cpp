@@ -17,15 +17,15 @@ ProcessInfo process_info() {
           "CAMERA_POSE, SAFETY_HEARTBEAT, MOTION_ESTIMATE, PLANNED_TRAJECTORY -> SAFETY_RISK (risk_t)."};
 }
 
-int run_risk(const Config& config) {
-  install_stop_signal_handlers();
-  RiskMonitor monitor(config, robot_model::load_kinematic_tree(config.robot.urdf_path), monotonic_us());
-  const std::string camera_id = config.camera.id;
-  LcmNode node(config, process_info().name);
+int run_risk(const RiskProcessSettings& settings) {
+  RiskMonitor monitor(settings.risk, settings.channels, robot_model::load_kinematic_tree(settings.robot_urdf_path),
+                      monotonic_us());
+  const std::string camera_id = settings.camera_id;
+  LcmNode node(settings.lcm, settings.channels, process_info().name);
   int64_t dangerous = 0;
 
   auto publish = [&](const risk_t& r) {
-    node.safety().publish(config.channels.risk, &r);
+    node.safety().publish(settings.channels.risk, &r);
     node.counters().frames_out++;
     if (r.seq >= 0) node.heartbeat().set_last_frame_utime(r.utime);
     if (r.level == risk_t::DANGEROUS) ++dangerous;
@@ -42,10 +42,10 @@ int run_risk(const Config& config) {
     for (const risk_t& r : verdicts) publish(r);
   };
   node.subscribe<discrepancy_t>(
-      node.safety(), config.channels.discrepancy,
+      node.safety(), settings.channels.discrepancy,
       [&](const discrepancy_t& d) { publish_all(monitor.on_frame(d, monotonic_us())); }, check_discrepancy);
   node.subscribe<motion_estimate_t>(
-      node.safety(), config.channels.motion_estimate,
+      node.safety(), settings.channels.motion_estimate,
       [&](const motion_estimate_t& e) { publish_all(monitor.on_estimate(e, monotonic_us())); },
       [&](const motion_estimate_t& e) {
         std::string problem = check_motion_estimate(e);
@@ -56,17 +56,17 @@ int run_risk(const Config& config) {
         return problem;
       });
   node.subscribe<planned_trajectory_t>(
-      node.safety(), config.channels.planned_trajectory, [&](const planned_trajectory_t& p) { monitor.on_plan(p); },
+      node.safety(), settings.channels.planned_trajectory, [&](const planned_trajectory_t& p) { monitor.on_plan(p); },
       [&](const planned_trajectory_t& p) {
         std::string problem = check_planned_trajectory(p);
         if (problem.empty()) problem = monitor.check_joint_names(p.joint_name, "joint_name");
         return problem;
       });
   node.subscribe<depth_image_t>(
-      node.images(), config.channels.depth, [&](const depth_image_t&) { monitor.on_depth(monotonic_us()); },
+      node.images(), settings.channels.depth, [&](const depth_image_t&) { monitor.on_depth(monotonic_us()); },
       [camera_id](const depth_image_t& image) { return check_depth_image_from(image, camera_id); });
   node.subscribe<joint_state_t>(
-      node.safety(), config.channels.joint_state,
+      node.safety(), settings.channels.joint_state,
       [&](const joint_state_t& s) { monitor.on_joint_state(s, monotonic_us()); },
       [&](const joint_state_t& s) {
         std::string problem = check_joint_state(s);
@@ -74,12 +74,12 @@ int run_risk(const Config& config) {
         return problem;
       });
   node.subscribe<camera_pose_t>(
-      node.safety(), config.channels.camera_pose, [&](const camera_pose_t&) { monitor.on_camera_pose(monotonic_us()); },
+      node.safety(), settings.channels.camera_pose, [&](const camera_pose_t&) { monitor.on_camera_pose(monotonic_us()); },
       check_camera_pose);
   node.subscribe<heartbeat_t>(
-      node.safety(), config.channels.heartbeat,
+      node.safety(), settings.channels.heartbeat,
       [&](const heartbeat_t& hb) { monitor.on_heartbeat(hb, monotonic_us()); }, check_heartbeat);
-  node.add_timer(static_cast<int64_t>(config.risk.check_period_ms * 1000), [&] {
+  node.add_timer(settings.risk.check_period_us, [&] {
     publish_all(monitor.release_due(monotonic_us()));
     if (const auto timeout = monitor.check_deadlines(monotonic_us())) publish(*timeout);
   });

@@ -1,27 +1,8 @@
 #include "tofguard/robot_state/state_history.hpp"
 
-#include <cmath>
-
 #include "tofguard/common/camera_pose_message.hpp"
 
 namespace tofguard::robot_state {
-namespace {
-
-int64_t ms_to_us(double ms) { return static_cast<int64_t>(std::llround(ms * 1000.0)); }
-
-}  // namespace
-
-StateHistorySettings StateHistorySettings::from_config(const Config& config) {
-  StateHistorySettings s;
-  s.robot_id = config.robot.id;
-  s.joint_max_extrapolation_us = ms_to_us(config.renderer.max_extrapolation_ms);
-  s.camera_pose_history_us = ms_to_us(config.renderer.camera_pose_history_ms);
-  s.camera_pose_max_extrapolation_us = ms_to_us(config.renderer.camera_pose_max_extrapolation_ms);
-  s.camera_pose_max_gap_us = ms_to_us(config.renderer.camera_pose_max_gap_ms);
-  s.static_camera_id = config.camera.id;
-  s.static_camera_pose = config.camera.pose;
-  return s;
-}
 
 StateHistory::StateHistory(const StateHistorySettings& settings)
     : robot_id_(settings.robot_id),

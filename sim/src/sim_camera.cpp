@@ -7,8 +7,6 @@ namespace {
 
 constexpr int64_t kMaxExtrapolationUs = 50000;
 
-int64_t seconds_to_us(double s) { return static_cast<int64_t>(std::llround(s * 1e6)); }
-
 }  // namespace
 
 bool SimulatedCamera::add_true_joint_state(int64_t utime, const std::vector<std::string>& names,
@@ -18,16 +16,17 @@ bool SimulatedCamera::add_true_joint_state(int64_t utime, const std::vector<std:
   return joints_.add(utime, joints);
 }
 
-SimulatedCamera::SimulatedCamera(const CameraConfig& config, SceneRenderer* renderer,
-                                 int64_t start_utime)
-    : config_(config),
+SimulatedCamera::SimulatedCamera(const CameraSettings& camera, const SimCameraSettings& sim,
+                                 SceneRenderer* renderer, int64_t start_utime)
+    : camera_(camera),
+      sim_(sim),
       renderer_(renderer),
       start_utime_(start_utime),
-      model_(config.sim, config.intrinsics),
+      model_(sim, camera.intrinsics),
       joints_(kMaxExtrapolationUs) {
-  for (const SimCameraFaultConfig& f : config.sim.faults) {
-    const int64_t start = start_utime + seconds_to_us(f.start_s);
-    faults_.push_back({f, start, start + seconds_to_us(f.duration_s)});
+  for (const SimCameraFaultSettings& f : sim.faults) {
+    const int64_t start = start_utime + f.start_us;
+    faults_.push_back({f, start, start + f.duration_us});
   }
 }
 
@@ -36,7 +35,7 @@ void SimulatedCamera::clear_faults(int64_t utime) {
 }
 
 CameraPose SimulatedCamera::turned_pose(double pan_rad, double tilt_rad) const {
-  CameraPose pose = config_.pose;
+  CameraPose pose = camera_.pose;
   pose.rotation = (Eigen::Quaterniond(Eigen::AngleAxisd(pan_rad, Eigen::Vector3d::UnitZ())) * pose.rotation *
                    Eigen::Quaterniond(Eigen::AngleAxisd(tilt_rad, Eigen::Vector3d::UnitX())))
                       .normalized();
@@ -44,19 +43,19 @@ CameraPose SimulatedCamera::turned_pose(double pan_rad, double tilt_rad) const {
 }
 
 double SimulatedCamera::true_pan_rad(int64_t utime) const {
-  if (!config_.sim.pan_tilt_enabled) return 0;
+  if (!sim_.pan_tilt_enabled) return 0;
   const double t = (utime - start_utime_) * 1e-6;
-  return config_.sim.pan_amplitude_rad * std::sin(2 * M_PI * t / config_.sim.pan_period_s);
+  return sim_.pan_amplitude_rad * std::sin(2 * M_PI * t / sim_.pan_period_s);
 }
 
 double SimulatedCamera::true_tilt_rad(int64_t utime) const {
-  if (!config_.sim.pan_tilt_enabled) return 0;
+  if (!sim_.pan_tilt_enabled) return 0;
   const double t = (utime - start_utime_) * 1e-6;
-  return config_.sim.tilt_amplitude_rad * std::sin(2 * M_PI * t / config_.sim.tilt_period_s);
+  return sim_.tilt_amplitude_rad * std::sin(2 * M_PI * t / sim_.tilt_period_s);
 }
 
 std::optional<CameraPose> SimulatedCamera::reported_pose(int64_t utime) const {
-  if (!config_.sim.pan_tilt_enabled) return std::nullopt;
+  if (!sim_.pan_tilt_enabled) return std::nullopt;
   double pan = true_pan_rad(utime);
   double tilt = true_tilt_rad(utime);
   for (const ActiveSimFault& f : faults_) {
@@ -121,7 +120,7 @@ SimulatedCamera::Frame SimulatedCamera::capture(int64_t utime, uint64_t frame_in
     return frame;
   }
   const RenderedDepth rendered = renderer_->render(joints.joints, true_pose(utime),
-                                                   config_.intrinsics, boxes(utime));
+                                                   camera_.intrinsics, boxes(utime));
   if (!rendered.usable) {
     frame.outcome = Frame::Outcome::kRenderFailed;
     frame.why = "render failed: " + rendered.unusable_reason;

@@ -22,15 +22,14 @@ namespace {
 // library. Boxes become the renderer's extra objects.
 class UrdfSceneRenderer : public SceneRenderer {
  public:
-  explicit UrdfSceneRenderer(const Config& config) {
+  explicit UrdfSceneRenderer(const SimCameraProcessSettings& settings) {
     robot_model::SceneOptions options;
     // The camera sees the real surfaces: visual geometry, no safety padding.
     options.geometry = robot_model::GeometrySource::kVisual;
     options.padding_m = 0;
-    options.package_paths = config.robot.package_paths;
-    scene_ = robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths, options);
-    renderer_ = std::make_unique<renderer::DepthRenderer>(scene_, config.renderer.near_m,
-                                                          config.renderer.far_m);
+    options.package_paths = settings.robot.package_paths;
+    scene_ = robot_model::load_scene(settings.robot.urdf_path, settings.environment.urdf_paths, options);
+    renderer_ = std::make_unique<renderer::DepthRenderer>(scene_, settings.near_m, settings.far_m);
   }
 
   RenderedDepth render(const std::map<std::string, double>& joints, const CameraPose& pose,
@@ -59,7 +58,6 @@ ActiveSimFault to_fault(const sim_camera_fault_t& m, int64_t now_utime) {
   static const char* kinds[] = {"", "frozen_image", "stall", "pose_drift", "intruding_object"};
   ActiveSimFault f;
   f.fault.kind = kinds[m.kind];
-  f.fault.duration_s = m.duration_s;
   f.fault.drift_translation_m_per_s = Eigen::Vector3d(m.drift_translation_m_per_s);
   f.fault.drift_rotation_rad_per_s = Eigen::Vector3d(m.drift_rotation_rad_per_s);
   f.fault.object_size_m = Eigen::Vector3d(m.object_size_m);
@@ -67,16 +65,17 @@ ActiveSimFault to_fault(const sim_camera_fault_t& m, int64_t now_utime) {
   f.fault.object_velocity_m_per_s = Eigen::Vector3d(m.object_velocity_m_per_s);
   f.start_utime = now_utime;
   f.end_utime = now_utime + static_cast<int64_t>(m.duration_s * 1e6);
+  f.fault.duration_us = f.end_utime - f.start_utime;
   return f;
 }
 
 }  // namespace
 
-int run_sim_camera(const Config& config) {
-  const CameraConfig& camera_config = config.camera;
+int run_sim_camera(const SimCameraProcessSettings& settings) {
+  const CameraSettings& camera_config = settings.camera;
   std::unique_ptr<UrdfSceneRenderer> scene;
   try {
-    scene = std::make_unique<UrdfSceneRenderer>(config);
+    scene = std::make_unique<UrdfSceneRenderer>(settings);
   } catch (const std::exception& e) {
     std::cerr << "tofguard-camera: cannot set up the simulated camera's renderer: " << e.what()
               << std::endl;
@@ -85,23 +84,23 @@ int run_sim_camera(const Config& config) {
   std::cerr << "tofguard-camera: simulated ToF camera " << camera_config.id << " rendering with "
             << scene->description() << std::endl;
 
-  LcmNode node(config, "tofguard-camera");
-  SimulatedCamera sim(camera_config, scene.get(), wall_utime());
-  const camera::DepthCalibration calibration(camera_config.depth_calibration.coefficients_m);
+  LcmNode node(settings.lcm, settings.channels, "tofguard-camera");
+  SimulatedCamera sim(camera_config, settings.sim, scene.get(), wall_utime());
+  const camera::DepthCalibration calibration(settings.depth_calibration.coefficients_m);
   const camera::RadialToZ rays(camera_config.intrinsics);
-  const bool calibrated = camera_config.depth_calibration.enabled;
+  const bool calibrated = settings.depth_calibration.enabled;
 
   node.subscribe<joint_state_t>(
-      node.safety(), config.channels.sim_true_joint_state,
+      node.safety(), settings.channels.sim_true_joint_state,
       [&](const joint_state_t& s) {
         if (!sim.add_true_joint_state(s.utime, s.name, s.position)) {
-          node.errors().report("truth", config.channels.sim_true_joint_state +
+          node.errors().report("truth", settings.channels.sim_true_joint_state +
                                             ": utime not newer than the last state; ignored");
         }
       },
       check_joint_state);
   node.subscribe<sim_camera_fault_t>(
-      node.safety(), config.channels.sim_camera_fault,
+      node.safety(), settings.channels.sim_camera_fault,
       [&](const sim_camera_fault_t& m) {
         if (m.camera_id != camera_config.id) return;  // for another camera
         const int64_t now = wall_utime();
@@ -138,7 +137,7 @@ int run_sim_camera(const Config& config) {
     // the renderer has it when the frame comes (it follows the head).
     if (const std::optional<CameraPose> reported = sim.reported_pose(capture_utime)) {
       const camera_pose_t pose = to_camera_pose_message(camera_config.id, capture_utime, *reported);
-      node.safety().publish(config.channels.camera_pose, &pose);
+      node.safety().publish(settings.channels.camera_pose, &pose);
     }
     const SimulatedCamera::Frame frame = sim.capture(capture_utime, static_cast<uint64_t>(slot));
     if (frame.outcome != SimulatedCamera::Frame::Outcome::kImage) {
@@ -151,7 +150,7 @@ int run_sim_camera(const Config& config) {
     if (calibrated) calibration.apply_z(&depth_m, rays);
     const depth_image_t image = make_depth_image(camera_config.id, camera_config.intrinsics, capture_utime, slot,
                                                  calibrated, depth_m, frame.image.amplitude);
-    node.images().publish(config.channels.depth, &image);
+    node.images().publish(settings.channels.depth, &image);
     node.counters().frames_out++;
     node.heartbeat().set_last_frame_utime(capture_utime);
     node.heartbeat().set_status(frame.frozen ? "publishing (frozen-image fault)" : "publishing");

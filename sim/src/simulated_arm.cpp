@@ -6,7 +6,7 @@
 
 namespace tofguard::sim {
 
-SimulatedArm::SimulatedArm(const JointsSimConfig& config, const std::vector<std::string>& urdf_joints,
+SimulatedArm::SimulatedArm(const JointsSimSettings& config, const std::vector<std::string>& urdf_joints,
                            const std::string& config_file) {
   auto error = [&](const std::string& key, const std::string& what) {
     return ConfigError(config_file + ": joints_sim." + key + ": " + what);

@@ -20,7 +20,7 @@ Eigen::Vector3d back_project(const Intrinsics& in, int u, int v, double z) {
 
 }  // namespace
 
-TofErrorModel::TofErrorModel(const SimCameraConfig& config, const Intrinsics& intrinsics)
+TofErrorModel::TofErrorModel(const SimCameraSettings& config, const Intrinsics& intrinsics)
     : config_(config), intrinsics_(intrinsics), radial_to_z_(intrinsics) {}
 
 double TofErrorModel::systematic_error_m(double r_m) const {

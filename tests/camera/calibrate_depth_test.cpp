@@ -37,7 +37,7 @@ std::string calibration_dir() { return test::output_dir() + "/calibration"; }
 std::string write_captures(const std::vector<double>& distances_m, const std::string& name,
                            uint64_t seed) {
   const Intrinsics in = sim::sim_test::test_intrinsics();
-  SimCameraConfig config = sim::sim_test::test_sim_config();
+  sim::SimCameraSettings config = sim::sim_test::test_sim_config();
   config.seed = seed;
   config.dark_pixel_probability = 0.002;
   const sim::TofErrorModel model(config, in);

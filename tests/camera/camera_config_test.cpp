@@ -3,7 +3,8 @@
 #include <gtest/gtest.h>
 
 #include "test_support.hpp"
-#include "tofguard/common/config.hpp"
+#include "tofguard/deployment/config.hpp"
+#include "tofguard/deployment/process_settings.hpp"
 
 namespace tofguard {
 namespace {
@@ -16,15 +17,15 @@ std::string variant(const std::string& name, const std::string& replace = "",
 
 std::string error_of(const std::string& path) {
   try {
-    load_config(path, nullptr);
+    deployment::load_config(path, nullptr);
   } catch (const ConfigError& e) {
     return e.what();
   }
   return "";
 }
 
-TEST(CameraConfig, EmbeddedDefaultHasTheSimCamera) {
-  const Config c = load_config(test::source_dir() + "/config/sim.yaml", nullptr);
+TEST(CameraSettings, EmbeddedDefaultHasTheSimCamera) {
+  const deployment::Config c = deployment::load_config(test::source_dir() + "/config/sim.yaml", nullptr);
   EXPECT_EQ(c.camera.source, "sim");
   EXPECT_EQ(c.camera.sim.systematic_error_m.size(), 6u);
   EXPECT_DOUBLE_EQ(c.camera.sim.noise_sigma0_mm, 4.75);
@@ -33,8 +34,8 @@ TEST(CameraConfig, EmbeddedDefaultHasTheSimCamera) {
   EXPECT_EQ(c.camera.depth_calibration.coefficients_m.size(), 8u);
 }
 
-TEST(CameraConfig, UvcSection) {
-  const Config c = load_config(
+TEST(CameraSettings, UvcSection) {
+  const deployment::Config c = deployment::load_config(
       variant("uvc_ok", "source: sim",
               "source: uvc\n  uvc: {vendor_id: \"2bc5\", product_id: \"0401\", serial: \"A1\", "
               "format: z16, depth_unit_mm: 0.125, distance: radial}"),
@@ -47,7 +48,7 @@ TEST(CameraConfig, UvcSection) {
   EXPECT_TRUE(c.camera.uvc.radial_distance);
 }
 
-TEST(CameraConfig, RejectsBadCameraKeys) {
+TEST(CameraSettings, RejectsBadCameraKeys) {
   EXPECT_NE(error_of(variant("uvc_missing", "source: sim", "source: uvc"))
                 .find("camera.uvc: missing key, expected a mapping"),
             std::string::npos);
@@ -76,8 +77,8 @@ TEST(CameraConfig, RejectsBadCameraKeys) {
   EXPECT_NE(fault.find("camera.sim.faults[0].kind"), std::string::npos) << fault;
 }
 
-TEST(CameraConfig, Faults) {
-  const Config c = load_config(
+TEST(CameraSettings, Faults) {
+  const deployment::Config c = deployment::load_config(
       variant("faults_ok", "faults: []",
               "faults:\n"
               "      - {kind: pose_drift, start_s: 2, duration_s: 3, translation_m_per_s: [0.01, 0, "

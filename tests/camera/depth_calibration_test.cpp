@@ -68,7 +68,7 @@ TEST(DepthCalibration, SubtractsTheErrorPolynomialAlongTheRay) {
 // leaves millimetres that grow away from the image centre.
 TEST(DepthCalibration, RemovesTheSimulatedRadialErrorEverywhereInTheImage) {
   const Intrinsics in = sim::sim_test::test_intrinsics();
-  SimCameraConfig config = sim::sim_test::test_sim_config();
+  sim::SimCameraSettings config = sim::sim_test::test_sim_config();
   config.noise_sigma0_mm = 0;
   config.noise_sigma_per_m2_mm = 0;
   const sim::TofErrorModel model(config, in);

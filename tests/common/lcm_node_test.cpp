@@ -6,15 +6,22 @@
 #include "sample_messages.hpp"
 #include "test_support.hpp"
 #include "tofguard/common/clock.hpp"
-#include "tofguard/common/config.hpp"
+#include "tofguard/common/lcm_settings.hpp"
 #include "tofguard/common/lcm_node.hpp"
 #include "tofguard/common/wire_checks.hpp"
 
 namespace tofguard::test {
 namespace {
 
-Config test_config() {
-  Config config;
+// The wiring a process gets from the config: both URLs and the default
+// channel names.
+struct TestWiring {
+  LcmSettings lcm;
+  ChannelNames channels;
+};
+
+TestWiring test_config() {
+  TestWiring config;
   config.lcm.url = "udpm://239.255.76.67:7667?ttl=0";
   config.lcm.image_url = derive_image_url(config.lcm.url);
   return config;
@@ -30,8 +37,8 @@ struct HeartbeatListener {
 };
 
 TEST(LcmNode, MalformedMessagesAreCountedAndNeverHandedOn) {
-  const Config config = test_config();
-  LcmNode node(config, "node-under-test");
+  const TestWiring config = test_config();
+  LcmNode node(config.lcm, config.channels, "node-under-test");
   std::vector<depth_image_t> handled;
   node.subscribe<depth_image_t>(
       node.images(), "TOF_DEPTH", [&](const depth_image_t& m) { handled.push_back(m); },
@@ -79,8 +86,8 @@ TEST(LcmNode, MalformedMessagesAreCountedAndNeverHandedOn) {
 }
 
 TEST(LcmNode, HeartbeatsComeAtTheirRateWithoutAnyTraffic) {
-  const Config config = test_config();
-  LcmNode node(config, "quiet-node", /*heartbeat_rate_hz=*/20);
+  const TestWiring config = test_config();
+  LcmNode node(config.lcm, config.channels, "quiet-node", /*heartbeat_rate_hz=*/20);
   lcm::LCM safety(config.lcm.url);
   HeartbeatListener heartbeats;
   safety.subscribe("SAFETY_HEARTBEAT", &HeartbeatListener::on_message, &heartbeats);
@@ -95,7 +102,7 @@ TEST(LcmNode, HeartbeatsComeAtTheirRateWithoutAnyTraffic) {
 }
 
 TEST(LcmNode, TimersFireWhileNothingArrives) {
-  LcmNode node(test_config(), "timer-node");
+  LcmNode node(test_config().lcm, ChannelNames{}, "timer-node");
   int ticks = 0;
   node.add_timer(10'000, [&] { ++ticks; });
   const int64_t start_us = monotonic_us();

@@ -16,6 +16,7 @@
 #include "estimator_test_support.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/joint_state_t.hpp"
+#include "tofguard/deployment/process_settings.hpp"
 
 namespace tofguard::estimator {
 namespace {
@@ -38,7 +39,7 @@ void write_event(lcm::LogFile* log, int64_t utime, const std::string& channel, c
 
 // A log of `poses` (one camera frame each, joint states 5 ms before and
 // after it), frames from the simulated camera at the config's true pose.
-std::string write_log(const std::string& name, const Config& config, const std::vector<robot_model::JointPositions>& poses,
+std::string write_log(const std::string& name, const deployment::Config& config, const std::vector<robot_model::JointPositions>& poses,
                       bool with_depth) {
   const std::string dir = tofguard::test::output_dir() + "/estimator";
   std::filesystem::create_directories(dir);
@@ -98,7 +99,7 @@ std::string yaml_list(const std::vector<double>& v) {
 // Issue 7: within 5 mm and 0.3 degrees. Measured (2026-11-22, distance
 // calibration along the rays): 3.4 mm and 0.07 degrees.
 TEST(CalibrateExtrinsics, ConvergesFromFiveCentimetresAndFiveDegrees) {
-  const Config truth_config = test::sim_config();
+  const deployment::Config truth_config = test::sim_config();
   const std::string log = write_log("calibration.lcm", truth_config, arm_poses(), true);
 
   // The config's pose 5 cm and 5 degrees off the truth.
@@ -113,9 +114,9 @@ TEST(CalibrateExtrinsics, ConvergesFromFiveCentimetresAndFiveDegrees) {
         "translation_m: " + yaml_list({wrong.translation().x(), wrong.translation().y(), wrong.translation().z()})},
        {"rotation_wxyz: [0.302934347, -0.581931466, 0.669435574, -0.348486102]",
         "rotation_wxyz: " + yaml_list({q.w(), q.x(), q.y(), q.z()})}});
-  const Config config = load_config(config_path, nullptr);
+  const deployment::Config config = deployment::load_config(config_path, nullptr);
 
-  const CalibrationResult result = calibrate_extrinsics(config, log, CalibrationOptions());
+  const CalibrationResult result = calibrate_extrinsics(deployment::estimator_process_settings(config), log, CalibrationOptions());
   ASSERT_EQ(result.error, "");
   const Eigen::Isometry3d estimated = result.pose.frame_from_optical();
   const Eigen::Isometry3d error = truth.inverse() * estimated;
@@ -143,7 +144,7 @@ TEST(CalibrateExtrinsics, ConvergesFromFiveCentimetresAndFiveDegrees) {
 }
 
 TEST(CalibrateExtrinsics, OneLineErrors) {
-  const Config config = test::sim_config();
+  const deployment::Config config = test::sim_config();
   const std::string config_path = tofguard::test::source_dir() + "/config/sim.yaml";
   const std::string bin = tofguard::test::bin_dir() + "/tofguard-calibrate-extrinsics";
   std::string err;

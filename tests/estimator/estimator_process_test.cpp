@@ -14,7 +14,8 @@
 
 #include "test_support.hpp"
 #include "tofguard/common/clock.hpp"
-#include "tofguard/common/config.hpp"
+#include "tofguard/deployment/config.hpp"
+#include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/heartbeat_t.hpp"
@@ -46,7 +47,7 @@ std::string rig_config() {
 
 struct Rig {
   std::string config_path = rig_config();
-  Config config = load_config(config_path, nullptr);
+  deployment::Config config = deployment::load_config(config_path, nullptr);
   lcm::LCM safety{config.lcm.url};
   lcm::LCM images{config.lcm.image_url};
   std::vector<motion_estimate_t> estimates;

@@ -4,6 +4,7 @@
 
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/estimator/estimator_process.hpp"
+#include "tofguard/deployment/process_settings.hpp"
 #include "estimator_test_support.hpp"
 
 namespace tofguard::estimator {
@@ -17,7 +18,10 @@ double a4_at(int64_t utime) { return test::side_reach_pose().at("a4") + kA4RadPe
 
 class SchedulerTest : public ::testing::Test {
  protected:
-  SchedulerTest() : config_(test::sim_config()), scene_(load_estimator_scene(config_)), scheduler_(config_, scene_) {
+  SchedulerTest()
+      : config_(deployment::estimator_process_settings(test::sim_config())),
+        scene_(load_estimator_scene(config_)),
+        scheduler_(config_, scene_) {
     // Joint states every 10 ms over the whole test, a4 turning at
     // kA4RadPerS.
     for (int64_t t = kStartUtime - 100'000; t <= kStartUtime + 20 * kFramePeriodUs; t += 10'000) {
@@ -62,7 +66,7 @@ class SchedulerTest : public ::testing::Test {
     return seqs;
   }
 
-  Config config_;
+  estimator::EstimatorProcessSettings config_;
   robot_model::SceneModel scene_;
   EstimatorScheduler scheduler_;
 };

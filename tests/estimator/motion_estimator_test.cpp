@@ -21,7 +21,7 @@ using test::to_deg;
 // significant beyond 3 sigma and 2 degrees): the estimate as published,
 // then classify_estimate. The one rule that decides whether an estimate
 // names a joint or the camera; the tests judge the estimator by it.
-risk::FrameFinding risk_finding(const EstimateResult& r, const Config& config, bool near_arm_evidence = false) {
+risk::FrameFinding risk_finding(const EstimateResult& r, const deployment::Config& config, bool near_arm_evidence = false) {
   EstimateContext context;
   context.utime = 1;
   context.camera_id = config.camera.id;
@@ -35,7 +35,7 @@ risk::FrameFinding risk_finding(const EstimateResult& r, const Config& config, b
 class MotionEstimatorTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    config_ = new Config(test::sim_config());
+    config_ = new deployment::Config(test::sim_config());
     frames_ = new tofguard::test::SimulatedFrames(*config_);
   }
   static void TearDownTestSuite() {
@@ -48,15 +48,15 @@ class MotionEstimatorTest : public ::testing::Test {
     o.noise_sigma_per_m2_m = config_->discrepancy.noise_sigma_per_m2_mm / 1000;
     return o;
   }
-  static Config* config_;
+  static deployment::Config* config_;
   static tofguard::test::SimulatedFrames* frames_;
 };
-Config* MotionEstimatorTest::config_ = nullptr;
+deployment::Config* MotionEstimatorTest::config_ = nullptr;
 tofguard::test::SimulatedFrames* MotionEstimatorTest::frames_ = nullptr;
 
 // The frames of an estimate with an encoder offset on `joint`
 // (SimulatedFrames::frames_with_offset): the sim camera where configured.
-std::vector<EstimatorFrame> frames_with_offset(tofguard::test::SimulatedFrames* frames, const Config& config,
+std::vector<EstimatorFrame> frames_with_offset(tofguard::test::SimulatedFrames* frames, const deployment::Config& config,
                                                const robot_model::JointPositions& truth, const std::string& joint,
                                                double offset_rad, int num_frames, uint64_t* index) {
   return frames->frames_with_offset(truth, test::pose_of(config.camera.pose), config.camera.intrinsics, joint,

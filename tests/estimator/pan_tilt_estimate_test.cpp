@@ -15,6 +15,7 @@
 #include "estimator_test_support.hpp"
 #include "tofguard/sim/sim_camera.hpp"
 #include "tofguard/risk_t.hpp"
+#include "tofguard/deployment/process_settings.hpp"
 
 namespace tofguard::estimator {
 namespace {
@@ -23,18 +24,18 @@ constexpr int64_t kSecond = 1'000'000;
 
 // The head pans 10 degrees and tilts 4 about the configured pose; from 5 s
 // on its reading is off by the given pan and tilt (radians).
-Config pan_tilt_config(double pan_offset_rad, double tilt_offset_rad) {
-  Config config = test::sim_config();
-  SimCameraConfig& sim = config.camera.sim;
+deployment::Config pan_tilt_config(double pan_offset_rad, double tilt_offset_rad) {
+  deployment::Config config = test::sim_config();
+  sim::SimCameraSettings& sim = config.camera.sim;
   sim.pan_tilt_enabled = true;
   sim.pan_amplitude_rad = test::deg(10);
   sim.pan_period_s = 12;
   sim.tilt_amplitude_rad = test::deg(4);
   sim.tilt_period_s = 9;
-  SimCameraFaultConfig offset;
+  sim::SimCameraFaultSettings offset;
   offset.kind = "pan_tilt_offset";
-  offset.start_s = 5;
-  offset.duration_s = 1000;
+  offset.start_us = 5000000;
+  offset.duration_us = 1000000000;
   offset.pan_offset_rad = pan_offset_rad;
   offset.tilt_offset_rad = tilt_offset_rad;
   sim.faults = {offset};
@@ -48,8 +49,8 @@ struct PanTiltCase {
   double reading_error_deg = 0;  // angle between true and reported pose
 };
 
-PanTiltCase estimate_at(const Config& config, tofguard::test::SimulatedFrames* frames, int64_t t_us, uint64_t index) {
-  sim::SimulatedCamera head(config.camera, nullptr, 0);
+PanTiltCase estimate_at(const deployment::Config& config, tofguard::test::SimulatedFrames* frames, int64_t t_us, uint64_t index) {
+  sim::SimulatedCamera head(config.camera, config.camera.sim, nullptr, 0);
   const CameraPose true_pose = head.true_pose(t_us);
   const std::optional<CameraPose> reading = head.reported_pose(t_us);
   EXPECT_TRUE(reading.has_value());
@@ -62,7 +63,7 @@ PanTiltCase estimate_at(const Config& config, tofguard::test::SimulatedFrames* f
   frame.depth_m = frames->capture(joints, test::pose_of(true_pose), frame.intrinsics, index);
   frame.reported_joints = joints;
   frame.world_from_optical = test::pose_of(*reading);
-  MotionEstimator estimator(frames->scene(), &frames->renderer(), options_from_config(config));
+  MotionEstimator estimator(frames->scene(), &frames->renderer(), options_from_settings(deployment::estimator_process_settings(config)));
   const EstimateResult result = estimator.estimate(frame);
   EstimateContext context;
   context.utime = t_us;
@@ -82,7 +83,7 @@ double correction_deg(const motion_estimate_t& m) {
 
 // Before the fault the head turns (pan 10 deg at 3 s) and its reading is
 // right: nothing to correct, no finding.
-void expect_no_finding_before_the_fault(const Config& config, tofguard::test::SimulatedFrames* frames) {
+void expect_no_finding_before_the_fault(const deployment::Config& config, tofguard::test::SimulatedFrames* frames) {
   const PanTiltCase good = estimate_at(config, frames, 3 * kSecond, 1);
   EXPECT_NEAR(good.reading_error_deg, 0, 1e-9);
   ASSERT_TRUE(good.message.usable) << good.message.unusable_reason;
@@ -93,7 +94,7 @@ void expect_no_finding_before_the_fault(const Config& config, tofguard::test::Si
 
 // After it the head's reading is 3 deg off: the correction finds it (at
 // 8 s and 10 s, the head in other positions).
-void expect_calibration_error_after_the_fault(const Config& config, tofguard::test::SimulatedFrames* frames) {
+void expect_calibration_error_after_the_fault(const deployment::Config& config, tofguard::test::SimulatedFrames* frames) {
   uint64_t index = 2;
   for (int64_t t_us : {8 * kSecond, 10 * kSecond}) {
     const PanTiltCase bad = estimate_at(config, frames, t_us, index++);
@@ -109,7 +110,7 @@ void expect_calibration_error_after_the_fault(const Config& config, tofguard::te
 }
 
 TEST(PanTilt, ATiltReadingThatDisagreesWithTheImageIsACalibrationError) {
-  const Config config = pan_tilt_config(0, test::deg(3));
+  const deployment::Config config = pan_tilt_config(0, test::deg(3));
   tofguard::test::SimulatedFrames frames(config);
   expect_no_finding_before_the_fault(config, &frames);
   expect_calibration_error_after_the_fault(config, &frames);
@@ -119,7 +120,7 @@ TEST(PanTilt, ATiltReadingThatDisagreesWithTheImageIsACalibrationError) {
 // and the seat as they were: the wall behind the table is what shows it
 // (docs/estimator.md).
 TEST(PanTilt, APanReadingThatDisagreesWithTheImageIsACalibrationError) {
-  const Config config = pan_tilt_config(test::deg(3), 0);
+  const deployment::Config config = pan_tilt_config(test::deg(3), 0);
   tofguard::test::SimulatedFrames frames(config);
   expect_no_finding_before_the_fault(config, &frames);
   expect_calibration_error_after_the_fault(config, &frames);

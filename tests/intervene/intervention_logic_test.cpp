@@ -12,12 +12,12 @@ namespace {
 constexpr int64_t kMs = 1000;
 constexpr int64_t kUtime0 = 1700000000000000;
 
-InterventionConfig test_config() {
-  InterventionConfig c;
+InterventionSettings test_config() {
+  InterventionSettings c;
   c.publish_rate_hz = 50;
-  c.risk_deadline_ms = 200;
-  c.stop_deadline_ms = 300;
-  c.joint_state_deadline_ms = 100;
+  c.risk_deadline_us = 200000;
+  c.stop_deadline_us = 300000;
+  c.joint_state_deadline_us = 100000;
   c.stopped_velocity = 0.02;
   c.power_cut = "lcm";
   return c;

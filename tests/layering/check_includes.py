@@ -23,8 +23,8 @@ include path finds).
 Usage: check_includes.py [REPO_ROOT]   (default: two folders up from here)
        check_includes.py --self-test   (the rules on a small made-up tree)
 Exit status 0 when every include keeps the rules (known violations in
-KNOWN_VIOLATIONS are listed but allowed), 1 otherwise. Folders that do not
-exist yet (deployment/) are simply not scanned.
+KNOWN_VIOLATIONS are listed but allowed), 1 otherwise. A folder that does
+not exist is simply not scanned.
 """
 import fnmatch
 import os
@@ -74,14 +74,9 @@ ALLOWED_SAME_LAYER = {
 # list as the items land; an entry that no longer matches anything is
 # reported as stale (not an error, so that the removal can land in any order).
 KNOWN_VIOLATIONS = [
-    # The estimator runs the risk classifier's rules (risk::classify_frame on
-    # robot_model's tree) to decide when to estimate. Removed by issue 13
-    # item 6: the estimator triggers on SAFETY_DISCREPANCY / SAFETY_RISK as
-    # published.
-    ("estimator/include/tofguard/estimator/estimator_process.hpp", "tofguard/risk/frame_classifier.hpp",
-     "issue 13 item 6"),
+    # None left: the estimator triggers on SAFETY_RISK as published (issue 13
+    # item 6) and no longer includes risk/.
 ]
-
 SKIP_DIRS = {".git", "node_modules", "__pycache__"}
 INCLUDE = re.compile(r'^\s*#\s*include\s*([<"])([^">]+)[">]')
 

@@ -17,6 +17,7 @@
 #include "tofguard/common/clock.hpp"
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/heartbeat_t.hpp"
+#include "tofguard/deployment/process_settings.hpp"
 
 namespace tofguard::renderer {
 namespace {
@@ -32,7 +33,7 @@ robot_model::JointPositions arm_at(int64_t utime, int64_t t0) {
 }
 
 struct Bench {
-  Config config = load_config(tofguard::test::source_dir() + "/config/sim.yaml", nullptr);
+  deployment::Config config = deployment::load_config(tofguard::test::source_dir() + "/config/sim.yaml", nullptr);
   lcm::LCM safety{config.lcm.url};
   lcm::LCM images{config.lcm.image_url};
   std::map<int64_t, depth_image_t> rendered;  // by seq
@@ -122,8 +123,8 @@ TEST(RendererProcess, RendersFramesAtInterpolatedJointsAndMarksUnusableOnes) {
   EXPECT_EQ(labels.num_robot_links, 10);
 
   // The numbers: the library at the joints interpolated at the frame's utime.
-  const Config& config = bench.config;
-  const robot_model::SceneModel scene = robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths, scene_options(config));
+  const deployment::Config& config = bench.config;
+  const robot_model::SceneModel scene = robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths, scene_options(config.renderer, config.robot));
   DepthRenderer renderer(scene, config.renderer.near_m, config.renderer.far_m);
   const RenderResult expected = renderer.render(arm_at(out.utime, bench.t0), config.camera.pose, config.camera.intrinsics);
   ASSERT_TRUE(expected.usable);
@@ -218,7 +219,7 @@ TEST(RendererProcess, FollowsAMovingCameraAtEachFramesUtime) {
       "renderer-process-moving-camera",
       {tofguard::test::bin_dir() + "/tofguard-renderer", "--config", tofguard::test::source_dir() + "/config/sim.yaml"});
   Bench bench;
-  const Config& config = bench.config;
+  const deployment::Config& config = bench.config;
   // The configured pose panned by `deg` about the world's vertical axis.
   auto panned = [&](double deg) {
     CameraPose p = config.camera.pose;
@@ -280,7 +281,7 @@ TEST(RendererProcess, FollowsAMovingCameraAtEachFramesUtime) {
            return why;
          }();
 
-  const robot_model::SceneModel scene = robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths, scene_options(config));
+  const robot_model::SceneModel scene = robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths, scene_options(config.renderer, config.robot));
   DepthRenderer renderer(scene, config.renderer.near_m, config.renderer.far_m);
   const RenderResult at_mid = renderer.render(arm_at(mid_utime, t0), panned(2), config.camera.intrinsics);
   const RenderResult unpanned = renderer.render(arm_at(mid_utime, t0), panned(0), config.camera.intrinsics);
@@ -311,7 +312,7 @@ TEST(RendererProcess, APlannedFrameIsRenderedAheadAndIdenticalToTheNormalRenderi
       "renderer-process-prediction",
       {tofguard::test::bin_dir() + "/tofguard-renderer", "--config", tofguard::test::source_dir() + "/config/sim.yaml"});
   Bench bench;
-  const Config& config = bench.config;
+  const deployment::Config& config = bench.config;
   ASSERT_TRUE(wait_until([&] { return bench.heartbeat.utime > 0; }, std::chrono::seconds(20), [&] { bench.pump(); }))
       << process.stderr_text();
   // The arm holds still where its plan says, for 10 s.
@@ -369,7 +370,7 @@ TEST(RendererProcess, APlannedFrameIsRenderedAheadAndIdenticalToTheNormalRenderi
 
   // Every rendered frame is the library's rendering at the planned joints:
   // those published from a prediction are identical to the others.
-  const robot_model::SceneModel scene = robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths, scene_options(config));
+  const robot_model::SceneModel scene = robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths, scene_options(config.renderer, config.robot));
   DepthRenderer renderer(scene, config.renderer.near_m, config.renderer.far_m);
   const RenderResult expected = renderer.render(planned, config.camera.pose, config.camera.intrinsics);
   ASSERT_TRUE(expected.usable);

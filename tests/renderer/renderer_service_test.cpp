@@ -5,12 +5,13 @@
 #include <cmath>
 
 #include "tofguard/renderer/renderer_process.hpp"
+#include "tofguard/deployment/process_settings.hpp"
 #include "test_support.hpp"
 
 namespace tofguard::renderer {
 namespace {
 
-Config sim_config() { return load_config(tofguard::test::source_dir() + "/config/sim.yaml", nullptr); }
+deployment::Config sim_config() { return deployment::load_config(tofguard::test::source_dir() + "/config/sim.yaml", nullptr); }
 
 joint_state_t joint_state(int64_t utime, const robot_model::JointPositions& positions, const std::string& robot = "friend-sim") {
   joint_state_t m;
@@ -50,8 +51,8 @@ robot_model::JointPositions arm(double s) {
 }
 
 TEST(RendererService, PublishesTheModelAtTheInterpolatedJointsInMillimetres) {
-  const Config config = sim_config();
-  RendererService service(config);
+  const deployment::Config config = sim_config();
+  RendererService service(deployment::renderer_process_settings(config));
   ASSERT_TRUE(service.on_joint_state(joint_state(1'000'000, arm(1.0))));
   ASSERT_TRUE(service.on_joint_state(joint_state(1'010'000, arm(2.0))));
   const Intrinsics k = config.camera.intrinsics;
@@ -69,7 +70,7 @@ TEST(RendererService, PublishesTheModelAtTheInterpolatedJointsInMillimetres) {
   EXPECT_EQ(out.labels.num_links, static_cast<int>(out.labels.link_name.size()));
 
   // The same as the library at arm(1.25), rounded to millimetres.
-  const robot_model::SceneModel scene = robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths, scene_options(config));
+  const robot_model::SceneModel scene = robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths, scene_options(config.renderer, config.robot));
   DepthRenderer renderer(scene, config.renderer.near_m, config.renderer.far_m);
   const RenderResult expected = renderer.render(arm(1.25), config.camera.pose, k);
   ASSERT_TRUE(expected.usable);
@@ -88,8 +89,8 @@ TEST(RendererService, PublishesTheModelAtTheInterpolatedJointsInMillimetres) {
 }
 
 TEST(RendererService, UnusableFramesPublishOnlyLabelsWithTheReason) {
-  const Config config = sim_config();
-  RendererService service(config);
+  const deployment::Config config = sim_config();
+  RendererService service(deployment::renderer_process_settings(config));
   const Intrinsics k = config.camera.intrinsics;
   RenderedFrame out = service.render(frame(1'000'000, 1, k));
   EXPECT_FALSE(out.labels.usable);
@@ -119,8 +120,8 @@ TEST(RendererService, UnusableFramesPublishOnlyLabelsWithTheReason) {
 }
 
 TEST(RendererService, CameraPoseMessagesReplaceTheStaticPoseOfThatCamera) {
-  const Config config = sim_config();
-  RendererService service(config);
+  const deployment::Config config = sim_config();
+  RendererService service(deployment::renderer_process_settings(config));
   service.on_joint_state(joint_state(1'000'000, arm(1.0)));
   const Intrinsics k = config.camera.intrinsics;
   const RenderedFrame before = service.render(frame(1'000'000, 1, k));
@@ -149,8 +150,8 @@ TEST(RendererService, CameraPoseMessagesReplaceTheStaticPoseOfThatCamera) {
 }
 
 TEST(RendererService, KeepsOnlyTheNewestPendingFrameAndCountsDrops) {
-  const Config config = sim_config();
-  RendererService service(config);
+  const deployment::Config config = sim_config();
+  RendererService service(deployment::renderer_process_settings(config));
   service.on_joint_state(joint_state(1'000'000, arm(1.0)));
   const Intrinsics k = config.camera.intrinsics;
   EXPECT_FALSE(service.has_pending());
@@ -165,13 +166,13 @@ TEST(RendererService, KeepsOnlyTheNewestPendingFrameAndCountsDrops) {
 }
 
 TEST(RendererService, IgnoresOtherRobotsAndRefusesFarBeyondInt16) {
-  Config config = sim_config();
-  RendererService service(config);
+  deployment::Config config = sim_config();
+  RendererService service(deployment::renderer_process_settings(config));
   EXPECT_FALSE(service.on_joint_state(joint_state(1'000'000, arm(1.0), "another-robot")));
   EXPECT_EQ(service.render(frame(1'000'000, 1, config.camera.intrinsics)).labels.unusable_reason,
             "no joint state received yet");
   config.renderer.far_m = 40;
-  EXPECT_THROW(RendererService{config}, std::invalid_argument);
+  EXPECT_THROW(RendererService{deployment::renderer_process_settings(config)}, std::invalid_argument);
 }
 
 }  // namespace

@@ -32,7 +32,8 @@
 #include <string_view>
 
 #include "test_support.hpp"
-#include "tofguard/common/config.hpp"
+#include "tofguard/deployment/config.hpp"
+#include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/heartbeat_t.hpp"
 #include "tofguard/common/risk_names.hpp"
@@ -213,7 +214,7 @@ struct ReplayOutput {
   }
 };
 
-ReplayOutput read_output_log(const std::string& path, const Config& config) {
+ReplayOutput read_output_log(const std::string& path, const deployment::Config& config) {
   ReplayOutput out;
   lcm::LogFile file(path, "r");
   EXPECT_TRUE(file.good()) << path;
@@ -243,7 +244,7 @@ ReplayOutput read_output_log(const std::string& path, const Config& config) {
 class Replay {
  public:
   Replay(const std::string& log, const std::string& run_name)
-      : config_(load_config(replay_config_path(), nullptr)), lcm_(config_.lcm.url) {
+      : config_(deployment::load_config(replay_config_path(), nullptr)), lcm_(config_.lcm.url) {
     output_log_ = output_dir() + "/" + run_name + ".lcmlog";
     std::filesystem::remove(output_log_);
     lcm_.subscribe(config_.channels.heartbeat, &Replay::on_heartbeat, this);
@@ -294,7 +295,7 @@ class Replay {
   }
 
   const ReplayOutput& output() const { return output_; }
-  const Config& config() const { return config_; }
+  const deployment::Config& config() const { return config_; }
   std::string stderr_of_all() const {
     std::string text;
     for (const auto& p : chain_) text += p->stderr_text();
@@ -326,7 +327,7 @@ class Replay {
     safe_streak_ = r->level == risk_t::SAFE ? safe_streak_ + 1 : 0;
   }
 
-  Config config_;
+  deployment::Config config_;
   lcm::LCM lcm_;
   std::string output_log_;
   std::unique_ptr<Subprocess> logger_;
@@ -419,7 +420,7 @@ void replay_twice(const std::string& name, const std::function<void(const InputL
   expect_same_verdicts(input, outputs[0], outputs[1]);
 }
 
-int64_t frame_period_us(const Config& config) { return static_cast<int64_t>(1e6 / config.camera.rate_hz); }
+int64_t frame_period_us(const deployment::Config& config) { return static_cast<int64_t>(1e6 / config.camera.rate_hz); }
 
 // A fault log: motion allowed before the fault, then withdrawn with `cause`
 // within `frames_to_dangerous` frame periods + the processing budget of the
@@ -509,7 +510,7 @@ TEST(Replay, FrozenImageStopsWithSensorFault) {
   replay_twice("frozen-image", [](const InputLog& input, const Replay& replay) {
     // The first repeat has repeat_count 1: frozen_repeat_frames - 1 more
     // frames start the finding, then the sensor debounce.
-    const RiskConfig& risk = replay.config().risk;
+    const risk::RiskSettings& risk = replay.config().risk;
     expect_fault_stop(input, replay, risk_t::CAUSE_SENSOR_FAULT, "TOF_DEPTH",
                       risk.frozen_repeat_frames - 1 + risk.sensor_debounce_frames - 1, /*first_repeat=*/true);
   });
@@ -530,7 +531,7 @@ TEST(Replay, CameraStallStopsWithSensorFaultWithinTheDepthDeadline) {
     // The joint states play on: the stop is the stall's, not the log's end.
     EXPECT_LT(stop->received_us, out.last_input_us);
     const int64_t latency_us = stop->received_us - last_frame.received_us;
-    const int64_t budget_us = static_cast<int64_t>(replay.config().risk.depth_deadline_ms * 1000) + kProcessingBudgetUs;
+    const int64_t budget_us = replay.config().risk.depth_deadline_us + kProcessingBudgetUs;
     std::cout << "camera stall: stop " << latency_us / 1000.0 << " ms after the last frame (budget "
               << budget_us / 1000 << " ms): " << stop->reason << std::endl;
     EXPECT_LE(latency_us, budget_us);

@@ -14,8 +14,8 @@ namespace {
 using risk::DecisionRule;
 using risk::FrameFinding;
 
-RiskConfig debounce(int model_mismatch_frames, int fault_frames) {
-  RiskConfig r;
+risk::RiskSettings debounce(int model_mismatch_frames, int fault_frames) {
+  risk::RiskSettings r;
   r.debounce_frames = model_mismatch_frames;
   r.sensor_debounce_frames = fault_frames;
   return r;

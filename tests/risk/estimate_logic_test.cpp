@@ -13,7 +13,8 @@
 #include "tofguard/robot_model/kinematic_tree.hpp"
 #include "synthetic_estimates.hpp"
 #include "test_support.hpp"
-#include "tofguard/common/config.hpp"
+#include "tofguard/deployment/config.hpp"
+#include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/common/planned_trajectory.hpp"
 #include "tofguard/common/wire_checks.hpp"
 
@@ -30,10 +31,10 @@ constexpr int64_t kMs = 1000;
 
 // config/sim.yaml with a 60 ms wait for a frame's own estimate (sim.yaml
 // waits 0 ms; these tests are about the wait).
-const Config& sim_config() {
-  static const Config config = [] {
-    Config c = load_config(source_dir() + "/config/sim.yaml", nullptr);
-    c.risk.estimate_wait_ms = 60;
+const deployment::Config& sim_config() {
+  static const deployment::Config config = [] {
+    deployment::Config c = deployment::load_config(source_dir() + "/config/sim.yaml", nullptr);
+    c.risk.estimate_wait_us = 60000;
     return c;
   }();
   return config;
@@ -209,7 +210,7 @@ void feed_all(RiskMonitor* m, int64_t now) {
 }
 
 TEST(EstimateWait, AMismatchFrameWaitsForItsEstimateWhichNamesTheCause) {
-  RiskMonitor m(sim_config(), friend_arm(), kStart);
+  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kStart);
   feed_all(&m, kStart);
   const discrepancy_t bad = summary_of(default_arm(16), 100);  // discrepancy rules: JOINT_ERROR a2
   EXPECT_TRUE(m.on_frame(bad, kStart).empty());
@@ -236,9 +237,9 @@ discrepancy_t mismatch_frame(int64_t seq, int64_t after_us) {
   return d;
 }
 
-Config config_with_max_age() {
-  Config config = sim_config();
-  config.risk.estimate_max_age_ms = 400;
+deployment::Config config_with_max_age() {
+  deployment::Config config = sim_config();
+  config.risk.estimate_max_age_us = 400000;
   return config;
 }
 
@@ -246,7 +247,7 @@ TEST(EstimateWait, AFrameWithoutItsOwnEstimateUsesARecentOneAfterTheWait) {
   // The estimator takes longer than a frame period: the estimate of frame
   // 100 serves frame 101 (33 ms later) once 101's own wait is over, but not
   // frame 102, which is more than risk.estimate.max_age_ms after it.
-  RiskMonitor m(config_with_max_age(), friend_arm(), kStart);
+  RiskMonitor m(config_with_max_age().risk, config_with_max_age().channels, friend_arm(), kStart);
   feed_all(&m, kStart);
   const discrepancy_t first = mismatch_frame(100, 0);
   EXPECT_TRUE(m.on_frame(first, kStart).empty());
@@ -275,7 +276,7 @@ TEST(EstimateWait, AnEarlierFramesEstimateThatNamesNoJointOrCameraSaysNothingAbo
   // An estimate of frame 100 that explains nothing and leaves a high
   // residual would, for frame 100 itself, mean an unknown object; for frame
   // 101 (a fault may have begun since) it is no evidence: the rules judge.
-  RiskMonitor m(config_with_max_age(), friend_arm(), kStart);
+  RiskMonitor m(config_with_max_age().risk, config_with_max_age().channels, friend_arm(), kStart);
   feed_all(&m, kStart);
   const discrepancy_t first = mismatch_frame(100, 0);
   EXPECT_TRUE(m.on_frame(first, kStart).empty());
@@ -294,7 +295,7 @@ TEST(EstimateWait, AnEarlierFramesEstimateThatNamesNoJointOrCameraSaysNothingAbo
 }
 
 TEST(EstimateWait, WithoutAnEstimateTheDiscrepancyRulesJudgeAfterTheWaitAndFramesKeepTheirOrder) {
-  RiskMonitor m(sim_config(), friend_arm(), kStart);
+  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kStart);
   feed_all(&m, kStart);
   const discrepancy_t bad = summary_of(default_arm(16), 100);
   const discrepancy_t good = summary_of(default_arm(), 101);
@@ -324,7 +325,7 @@ TEST(EstimateWait, AnEstimateThatExplainsNothingNeverMakesTheFrameSafer) {
     motion_estimate_t e = estimate_for(bad);
     e.converged = converged;
     e.estimated_position[index_of(e, "a4")] += converged ? 0.0 : 20 * kDeg;
-    RiskMonitor fresh(sim_config(), friend_arm(), kStart);
+    RiskMonitor fresh(sim_config().risk, sim_config().channels, friend_arm(), kStart);
     feed_all(&fresh, kStart);
     fresh.on_estimate(e, kStart);  // already there when the frame comes
     const std::vector<risk_t> out = fresh.on_frame(bad, kStart);
@@ -337,7 +338,7 @@ TEST(EstimateWait, AnEstimateThatExplainsNothingNeverMakesTheFrameSafer) {
 }
 
 TEST(EstimateWait, CleanFramesAndSensorFaultsDoNotWaitAndEstimatesCanBeSwitchedOff) {
-  RiskMonitor m(sim_config(), friend_arm(), kStart);
+  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kStart);
   feed_all(&m, kStart);
   const discrepancy_t good = summary_of(default_arm(), 101);
   ASSERT_EQ(m.on_frame(good, kStart).size(), 1u);
@@ -349,9 +350,9 @@ TEST(EstimateWait, CleanFramesAndSensorFaultsDoNotWaitAndEstimatesCanBeSwitchedO
   ASSERT_EQ(fault.size(), 1u);
   EXPECT_EQ(fault[0].cause, risk_t::CAUSE_SENSOR_FAULT);
 
-  Config off = sim_config();
+  deployment::Config off = sim_config();
   off.risk.estimate_enabled = false;
-  RiskMonitor without(off, friend_arm(), kStart);
+  RiskMonitor without(off.risk, off.channels, friend_arm(), kStart);
   feed_all(&without, kStart);
   const auto out = without.on_frame(summary_of(default_arm(16), 100), kStart);
   ASSERT_EQ(out.size(), 1u);
@@ -359,7 +360,7 @@ TEST(EstimateWait, CleanFramesAndSensorFaultsDoNotWaitAndEstimatesCanBeSwitchedO
 }
 
 TEST(EstimateWait, EstimateVerdictsAreDebouncedLikeTheOthers) {
-  RiskMonitor m(sim_config(), friend_arm(), kStart);
+  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kStart);
   std::vector<int8_t> levels;
   for (int i = 0; i < 3; ++i) {
     const int64_t now = kStart + i * 33 * kMs;
@@ -400,7 +401,7 @@ risk_t judged_at_once(RiskMonitor* m, const discrepancy_t& frame, int64_t now) {
 // Each frame is judged with the joint state of its capture time (the
 // newest at or before its utime), whenever it is processed.
 TEST(PlanDeviation, TheJointStateAtTheFramesUtimeAwayFromThePlanIsAFindingDebouncedLikeTheOthers) {
-  RiskMonitor m(sim_config(), friend_arm(), kStart);
+  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kStart);
   const int64_t t0 = 1'700'000'000'000'000;
   feed_all(&m, kStart);
   // a1 planned from 0 to 0.5 rad over 500 ms.
@@ -432,7 +433,7 @@ TEST(PlanDeviation, TheJointStateAtTheFramesUtimeAwayFromThePlanIsAFindingDeboun
 
   // A frame captured before the deviation, judged late (after the deviating
   // joint states came): judged with the joint state of its own time.
-  RiskMonitor late(sim_config(), friend_arm(), kStart);
+  RiskMonitor late(sim_config().risk, sim_config().channels, friend_arm(), kStart);
   feed_all(&late, kStart);
   late.on_plan(plan_a1(t0, 0.0, t0 + 500'000, 0.5));
   late.on_joint_state(joints_at(t0 + 200'000, 0.2), kStart);
@@ -449,9 +450,9 @@ TEST(PlanDeviation, TheJointStateAtTheFramesUtimeAwayFromThePlanIsAFindingDeboun
   m.on_joint_state(joints_at(t0 + 610'000, 2.95), kStart);
   EXPECT_EQ(judged_at_once(&m, frame_at(t0 + 615'000), kStart).level, risk_t::SAFE);
 
-  Config off = sim_config();
+  deployment::Config off = sim_config();
   off.risk.plan_enabled = false;
-  RiskMonitor without(off, friend_arm(), kStart);
+  RiskMonitor without(off.risk, off.channels, friend_arm(), kStart);
   feed_all(&without, kStart);
   without.on_plan(plan_a1(t0, 0.0, t0 + 500'000, 0.5));
   without.on_joint_state(joints_at(t0 + 200'000, 1.0), kStart);
@@ -463,7 +464,7 @@ TEST(PlanDeviation, TheJointStateAtTheFramesUtimeAwayFromThePlanIsAFindingDeboun
 // the finding it was classified with, whatever joint states arrive while it
 // queues.
 TEST(PlanDeviation, AQueuedFrameKeepsTheFindingItWasClassifiedWithOnArrival) {
-  RiskMonitor m(sim_config(), friend_arm(), kStart);
+  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kStart);
   const int64_t t0 = 1'700'000'000'000'000;
   feed_all(&m, kStart);
   m.on_plan(plan_a1(t0, 0.0, t0 + 500'000, 0.5));

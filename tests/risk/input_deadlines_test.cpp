@@ -10,18 +10,19 @@ namespace tofguard::test {
 namespace {
 
 using risk::InputDeadlines;
+using risk::RiskSettings;
 
 constexpr int64_t kStart = 7'000'000'000;  // monotonic, unrelated to any utime
 constexpr int64_t kMs = 1000;
 
-RiskConfig limits() {
-  RiskConfig r;
-  r.depth_deadline_ms = 100;
-  r.joint_state_deadline_ms = 50;
-  r.discrepancy_deadline_ms = 200;
-  r.heartbeat_deadline_ms = 250;
+RiskSettings limits() {
+  RiskSettings r;
+  r.depth_deadline_us = 100 * kMs;
+  r.joint_state_deadline_us = 50 * kMs;
+  r.discrepancy_deadline_us = 200 * kMs;
+  r.heartbeat_deadline_us = 250 * kMs;
   r.camera_pose_required = false;
-  r.camera_pose_deadline_ms = 1000;
+  r.camera_pose_deadline_us = 1000 * kMs;
   r.required_heartbeats = {"tofguard-renderer", "tofguard-camera"};
   return r;
 }
@@ -96,7 +97,7 @@ TEST(InputDeadlines, EachInputHasItsLimitAndCauseInTheDocumentedOrder) {
 TEST(InputDeadlines, TheCameraPoseIsWatchedOnlyWhenRequiredWithItsChannelName) {
   ChannelNames channels;
   channels.camera_pose = "HEAD_POSE";
-  RiskConfig required_limits = limits();
+  RiskSettings required_limits = limits();
   required_limits.camera_pose_required = true;
   InputDeadlines optional(limits(), channels, kStart);
   InputDeadlines required(required_limits, channels, kStart);
@@ -122,9 +123,11 @@ TEST(InputDeadlines, TheCameraPoseIsWatchedOnlyWhenRequiredWithItsChannelName) {
   EXPECT_FALSE(required.first_expired(now).has_value());
 }
 
-TEST(InputDeadlines, MillisecondLimitsAreRoundedToWholeMicroseconds) {
-  RiskConfig r = limits();
-  r.depth_deadline_ms = 33.3334;  // 33333.4 us -> 33333 us
+// The limits are whole microseconds (risk.deadlines_ms rounded once when the
+// file is read, YamlMap::milliseconds_as_us), compared as they are.
+TEST(InputDeadlines, MicrosecondLimitsAreComparedExactly) {
+  RiskSettings r = limits();
+  r.depth_deadline_us = 33'333;  // risk.deadlines_ms.depth: 33.3334
   InputDeadlines d(r, ChannelNames{}, kStart);
   touch_all(&d, kStart);
   EXPECT_FALSE(d.first_expired(kStart + 33'333).has_value());

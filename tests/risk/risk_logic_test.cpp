@@ -9,7 +9,8 @@
 #include "tofguard/risk/risk_monitor.hpp"
 #include "tofguard/robot_model/kinematic_tree.hpp"
 #include "test_support.hpp"
-#include "tofguard/common/config.hpp"
+#include "tofguard/deployment/config.hpp"
+#include "tofguard/deployment/process_settings.hpp"
 
 namespace tofguard::test {
 namespace {
@@ -19,17 +20,17 @@ using risk::classify_frame;
 using risk::FrameFinding;
 using risk::RiskMonitor;
 
-const Config& sim_config() {
-  static const Config config = load_config(source_dir() + "/config/sim.yaml", nullptr);
+const deployment::Config& sim_config() {
+  static const deployment::Config config = deployment::load_config(source_dir() + "/config/sim.yaml", nullptr);
   return config;
 }
 
 // The deadline tests below count on one deadline for the camera and the
 // joint states (sim.yaml's depth deadline is 150 ms since issue 6).
-const Config& config_depth_100ms() {
-  static const Config config = [] {
-    Config c = sim_config();
-    c.risk.depth_deadline_ms = 100;
+const deployment::Config& config_depth_100ms() {
+  static const deployment::Config config = [] {
+    deployment::Config c = sim_config();
+    c.risk.depth_deadline_us = 100000;
     return c;
   }();
   return config;
@@ -264,7 +265,7 @@ risk_t judged_at_once(RiskMonitor* m, const discrepancy_t& frame, int64_t now) {
 }
 
 TEST(RiskMonitor, NothingArrivedIsStaleAfterTheFirstDeadline) {
-  RiskMonitor m(config_depth_100ms(), friend_arm(), kStart);
+  RiskMonitor m(config_depth_100ms().risk, config_depth_100ms().channels, friend_arm(), kStart);
   EXPECT_FALSE(m.check_deadlines(kStart + 100 * kMs).has_value());
   const auto r = m.check_deadlines(kStart + 101 * kMs);
   ASSERT_TRUE(r.has_value());
@@ -279,7 +280,7 @@ TEST(RiskMonitor, NothingArrivedIsStaleAfterTheFirstDeadline) {
 }
 
 TEST(RiskMonitor, EachInputHasItsOwnDeadlineAndCause) {
-  RiskMonitor m(config_depth_100ms(), friend_arm(), kStart);
+  RiskMonitor m(config_depth_100ms().risk, config_depth_100ms().channels, friend_arm(), kStart);
   int64_t now = kStart;
   feed_all(&m, now);
   discrepancy_t d = summary_of(default_arm(), 40);
@@ -345,14 +346,14 @@ TEST(RiskMonitor, EachInputHasItsOwnDeadlineAndCause) {
 }
 
 TEST(RiskMonitor, CameraPoseIsWatchedOnlyWhenRequired) {
-  Config config = sim_config();
-  RiskMonitor optional(config, friend_arm(), kStart);
+  deployment::Config config = sim_config();
+  RiskMonitor optional(config.risk, config.channels, friend_arm(), kStart);
   feed_all(&optional, kStart + 2000 * kMs);
   judged_at_once(&optional, summary_of(default_arm()), kStart + 2000 * kMs);
   EXPECT_FALSE(optional.check_deadlines(kStart + 2000 * kMs).has_value());
 
   config.risk.camera_pose_required = true;
-  RiskMonitor required(config, friend_arm(), kStart);
+  RiskMonitor required(config.risk, config.channels, friend_arm(), kStart);
   feed_all(&required, kStart + 2000 * kMs);
   judged_at_once(&required, summary_of(default_arm()), kStart + 2000 * kMs);
   const auto r = required.check_deadlines(kStart + 2000 * kMs);
@@ -363,7 +364,7 @@ TEST(RiskMonitor, CameraPoseIsWatchedOnlyWhenRequired) {
 }
 
 TEST(RiskMonitor, MismatchIsWarningUntilDebouncedThenDangerousAndClearsOnAGoodFrame) {
-  RiskMonitor m(sim_config(), friend_arm(), kStart);
+  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kStart);
   const discrepancy_t bad = summary_of(default_arm(16), 100);
   const discrepancy_t good = summary_of(default_arm(), 104);
   int64_t now = kStart;
@@ -391,7 +392,7 @@ TEST(RiskMonitor, MismatchIsWarningUntilDebouncedThenDangerousAndClearsOnAGoodFr
 }
 
 TEST(RiskMonitor, SensorFaultsUseTheirOwnDebounce) {
-  RiskMonitor m(sim_config(), friend_arm(), kStart);
+  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kStart);
   discrepancy_t unusable = summary_of(default_arm());
   unusable.usable = false;
   unusable.unusable_kind = discrepancy_t::UNUSABLE_RENDERER;
@@ -402,7 +403,7 @@ TEST(RiskMonitor, SensorFaultsUseTheirOwnDebounce) {
 }
 
 TEST(RiskMonitor, FrozenImageNeedsAMovingArm) {
-  RiskMonitor m(sim_config(), friend_arm(), kStart);
+  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kStart);
   discrepancy_t frozen = summary_of(default_arm());
   frozen.repeat_count = 3;
   m.on_depth(kStart);
@@ -428,14 +429,14 @@ TEST(RiskMonitor, FrozenImageIsJudgedByTheJointStateAtTheFramesCaptureTime) {
   frozen.repeat_count = 3;
   frozen.utime = kCapture;
   {
-    RiskMonitor m(sim_config(), friend_arm(), kStart);
+    RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kStart);
     m.on_depth(kStart);
     m.on_joint_state(joints_at(0.3, kCapture - 10 * kMs), kStart);
     m.on_joint_state(joints_at(0.0, kCapture + 50 * kMs), kStart);  // the arm halted after the capture
     EXPECT_EQ(judged_at_once(&m, frozen, kStart).cause, risk_t::CAUSE_SENSOR_FAULT);
   }
   {
-    RiskMonitor m(sim_config(), friend_arm(), kStart);
+    RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kStart);
     m.on_depth(kStart);
     m.on_joint_state(joints_at(0.0, kCapture - 10 * kMs), kStart);
     m.on_joint_state(joints_at(0.3, kCapture + 50 * kMs), kStart);  // it started after the capture
@@ -444,7 +445,7 @@ TEST(RiskMonitor, FrozenImageIsJudgedByTheJointStateAtTheFramesCaptureTime) {
 }
 
 TEST(RiskMonitor, JointNamesMustBeTheRobotsMovingJoints) {
-  RiskMonitor m(sim_config(), friend_arm(), kStart);
+  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kStart);
   joint_state_t s = joints(0);
   EXPECT_EQ(m.check_joint_names(s), "");
   s.name = {"mount"};

@@ -10,7 +10,8 @@
 #include "synthetic_frames.hpp"
 #include "tofguard/discrepancy/discrepancy_image.hpp"
 #include "tofguard/camera_pose_t.hpp"
-#include "tofguard/common/config.hpp"
+#include "tofguard/deployment/config.hpp"
+#include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/motion_estimate_t.hpp"
 #include "tofguard/planned_trajectory_t.hpp"
@@ -24,7 +25,7 @@ constexpr int kFramePeriodMs = 33;
 
 discrepancy_t summary(int64_t seq, int shift_px) {
   const SyntheticImage model = draw(default_arm());
-  const Config config = load_config(source_dir() + "/config/sim.yaml", nullptr);
+  const deployment::Config config = deployment::load_config(source_dir() + "/config/sim.yaml", nullptr);
   return discrepancy::compute_discrepancy(depth_frame(with_noise(draw(default_arm(shift_px)).depth_mm, seq), seq),
                                           depth_frame(model.depth_mm, seq), labels_frame(model.label, seq),
                                           discrepancy::parameters_from(config.discrepancy))

@@ -1,10 +1,13 @@
-// The state at a frame's utime: the histories' limits from the config, the
+// The state at a frame's utime: the histories' limits from the renderer's
+// settings (renderer::state_history_settings), the
 // joints and camera pose looked up together, messages of other robots
 // ignored, and which of the two makes a frame unusable.
 #include <gtest/gtest.h>
 
 #include "test_support.hpp"
 #include "tofguard/common/camera_pose_message.hpp"
+#include "tofguard/deployment/config.hpp"
+#include "tofguard/renderer/renderer_settings.hpp"
 #include "tofguard/robot_state/state_history.hpp"
 
 namespace tofguard::robot_state {
@@ -12,9 +15,13 @@ namespace {
 
 constexpr int64_t kT0 = 1'700'000'000'000'000;
 
-const Config& sim_config() {
-  static const Config config = load_config(test::source_dir() + "/config/sim.yaml", nullptr);
+const deployment::Config& sim_config() {
+  static const deployment::Config config = deployment::load_config(test::source_dir() + "/config/sim.yaml", nullptr);
   return config;
+}
+
+StateHistorySettings settings_of(const deployment::Config& config) {
+  return renderer::state_history_settings(config.renderer, config.robot.id, config.camera);
 }
 
 joint_state_t joint_state(const std::string& robot_id, int64_t utime, double a1) {
@@ -28,13 +35,15 @@ joint_state_t joint_state(const std::string& robot_id, int64_t utime, double a1)
   return m;
 }
 
-TEST(StateHistorySettings, LimitsComeFromTheRendererSectionInMicroseconds) {
-  Config config = sim_config();
-  config.renderer.max_extrapolation_ms = 12.3456;
-  config.renderer.camera_pose_history_ms = 2000;
-  config.renderer.camera_pose_max_extrapolation_ms = 40.0004;
-  config.renderer.camera_pose_max_gap_ms = 80;
-  const StateHistorySettings s = StateHistorySettings::from_config(config);
+// The durations were converted to microseconds once, when the file was read
+// (YamlMap::milliseconds_as_us, tests/deployment); they are taken as they are.
+TEST(StateHistorySettings, LimitsComeFromTheRendererSettingsInMicroseconds) {
+  deployment::Config config = sim_config();
+  config.renderer.max_extrapolation_us = 12'346;
+  config.renderer.camera_pose_history_us = 2'000'000;
+  config.renderer.camera_pose_max_extrapolation_us = 40'000;
+  config.renderer.camera_pose_max_gap_us = 80'000;
+  const StateHistorySettings s = settings_of(config);
   EXPECT_EQ(s.robot_id, config.robot.id);
   EXPECT_EQ(s.joint_max_extrapolation_us, 12'346);
   EXPECT_EQ(s.camera_pose_history_us, 2'000'000);
@@ -45,8 +54,8 @@ TEST(StateHistorySettings, LimitsComeFromTheRendererSectionInMicroseconds) {
 }
 
 TEST(StateHistory, JointsAndCameraPoseAtAFramesUtime) {
-  const Config& config = sim_config();
-  StateHistory history(StateHistorySettings::from_config(config));
+  const deployment::Config& config = sim_config();
+  StateHistory history(settings_of(config));
   const std::string camera = config.camera.id;
 
   StateAtFrame state = history.at(camera, kT0);

@@ -13,8 +13,9 @@
 #include "test_support.hpp"
 #include "tofguard/common/camera_pose_message.hpp"
 #include "tofguard/common/clock.hpp"
-#include "tofguard/common/config.hpp"
 #include "tofguard/common/depth_frame.hpp"
+#include "tofguard/deployment/config.hpp"
+#include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/heartbeat_t.hpp"
 #include "tofguard/joint_state_t.hpp"
@@ -27,12 +28,12 @@ const std::vector<double> kArm = {-0.3, 0.7, 0.0, 1.1, 0.0, 0.6, 0.0};
 
 struct Rig {
   explicit Rig(const std::string& config_path = source_dir() + "/config/sim.yaml")
-      : config(load_config(config_path, nullptr)) {
+      : config(deployment::load_config(config_path, nullptr)) {
     images.subscribe("TOF_DEPTH", &Rig::on_depth, this);
     safety.subscribe("SAFETY_HEARTBEAT", &Rig::on_heartbeat, this);
     safety.subscribe("CAMERA_POSE", &Rig::on_pose, this);
   }
-  Config config;
+  deployment::Config config;
   lcm::LCM safety{config.lcm.url};
   lcm::LCM images{config.lcm.image_url};
   std::vector<depth_image_t> frames;
@@ -186,8 +187,8 @@ TEST(SimCameraProcess, PanTiltHeadPublishesThePoseOfEachFrameAndAnOffsetReadingD
   camera.signal(SIGTERM);
   EXPECT_EQ(camera.wait(std::chrono::seconds(5)), 0) << camera.stderr_text();
 
-  const Config& config = rig.config;
-  robot_model::SceneOptions options = renderer::scene_options(config);
+  const deployment::Config& config = rig.config;
+  robot_model::SceneOptions options = renderer::scene_options(config.renderer, config.robot);
   options.padding_m = 0;
   const robot_model::SceneModel scene = robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths, options);
   renderer::DepthRenderer renderer(scene, config.renderer.near_m, config.renderer.far_m);

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "sim_test_config.hpp"
+#include "tofguard/deployment/config.hpp"
 
 namespace tofguard::sim {
 namespace {
@@ -41,8 +42,8 @@ class FakeRenderer : public SceneRenderer {
 
 constexpr int64_t kT0 = 1700000000000000;  // some wall time, microseconds
 
-CameraConfig camera_config() {
-  CameraConfig c;
+deployment::CameraSection camera_config() {
+  deployment::CameraSection c;
   c.id = "test-cam";
   c.source = "sim";
   c.rate_hz = 30;
@@ -55,7 +56,7 @@ CameraConfig camera_config() {
 
 TEST(SimulatedCamera, RendersAtTheTrueJointsOfTheCaptureTime) {
   FakeRenderer renderer;
-  SimulatedCamera sim(camera_config(), &renderer, kT0);
+  SimulatedCamera sim(camera_config(), camera_config().sim, &renderer, kT0);
   auto frame = sim.capture(kT0, 0);
   EXPECT_EQ(frame.outcome, SimulatedCamera::Frame::Outcome::kNoJointState);
   EXPECT_EQ(renderer.calls, 0);
@@ -79,7 +80,8 @@ TEST(SimulatedCamera, RendersAtTheTrueJointsOfTheCaptureTime) {
 
 TEST(SimulatedCamera, SameSeedSameFrames) {
   FakeRenderer r1, r2;
-  SimulatedCamera a(camera_config(), &r1, kT0), b(camera_config(), &r2, kT0);
+  SimulatedCamera a(camera_config(), camera_config().sim, &r1, kT0);
+  SimulatedCamera b(camera_config(), camera_config().sim, &r2, kT0);
   for (SimulatedCamera* s : {&a, &b}) s->add_true_joint_state(kT0, {"a1"}, {0.3});
   const auto fa = a.capture(kT0 + 1000, 7);
   const auto fb = b.capture(kT0 + 1000, 7);
@@ -90,28 +92,28 @@ TEST(SimulatedCamera, SameSeedSameFrames) {
 }
 
 TEST(SimulatedCamera, ConfigFaultsStallFreezeDriftAndIntrude) {
-  CameraConfig config = camera_config();
-  SimCameraFaultConfig stall, frozen, drift, object;
+  deployment::CameraSection config = camera_config();
+  SimCameraFaultSettings stall, frozen, drift, object;
   stall.kind = "stall";
-  stall.start_s = 1.0;
-  stall.duration_s = 0.5;
+  stall.start_us = 1000000;
+  stall.duration_us = 500000;
   frozen.kind = "frozen_image";
-  frozen.start_s = 2.0;
-  frozen.duration_s = 1.0;
+  frozen.start_us = 2000000;
+  frozen.duration_us = 1000000;
   drift.kind = "pose_drift";
-  drift.start_s = 4.0;
-  drift.duration_s = 2.0;
+  drift.start_us = 4000000;
+  drift.duration_us = 2000000;
   drift.drift_translation_m_per_s = Eigen::Vector3d(0.01, 0, 0);
   drift.drift_rotation_rad_per_s = Eigen::Vector3d(0, 0, 0.1);
   object.kind = "intruding_object";
-  object.start_s = 7.0;
-  object.duration_s = 1.0;
+  object.start_us = 7000000;
+  object.duration_us = 1000000;
   object.object_size_m = Eigen::Vector3d(0.1, 0.2, 0.3);
   object.object_position_m = Eigen::Vector3d(1, 0, 0.5);
   object.object_velocity_m_per_s = Eigen::Vector3d(0, -0.5, 0);
   config.sim.faults = {stall, frozen, drift, object};
   FakeRenderer renderer;
-  SimulatedCamera sim(config, &renderer, kT0);
+  SimulatedCamera sim(config, config.sim, &renderer, kT0);
   auto at = [&](double s) { return kT0 + static_cast<int64_t>(s * 1e6); };
   // The arm's true states arrive at 100 Hz up to each capture.
   double joints_until_s = 0;
@@ -151,7 +153,7 @@ TEST(SimulatedCamera, ConfigFaultsStallFreezeDriftAndIntrude) {
 
 TEST(SimulatedCamera, RunTimeFaultsAndClear) {
   FakeRenderer renderer;
-  SimulatedCamera sim(camera_config(), &renderer, kT0);
+  SimulatedCamera sim(camera_config(), camera_config().sim, &renderer, kT0);
   sim.add_true_joint_state(kT0, {"a1"}, {0.0});
   ActiveSimFault stall;
   stall.fault.kind = "stall";
@@ -164,12 +166,12 @@ TEST(SimulatedCamera, RunTimeFaultsAndClear) {
 }
 
 TEST(SimulatedCamera, PanTiltHeadTurnsTheCameraAndReportsItsReading) {
-  CameraConfig config = camera_config();
+  deployment::CameraSection config = camera_config();
   // Looking along world x from 1.5 m up.
   config.pose.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitZ())) *
                          Eigen::Quaterniond(Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitX()));
   FakeRenderer renderer;
-  SimulatedCamera fixed(config, &renderer, kT0);
+  SimulatedCamera fixed(config, config.sim, &renderer, kT0);
   EXPECT_FALSE(fixed.reported_pose(kT0).has_value()) << "no head, no reading";
 
   config.sim.pan_tilt_enabled = true;
@@ -177,7 +179,7 @@ TEST(SimulatedCamera, PanTiltHeadTurnsTheCameraAndReportsItsReading) {
   config.sim.pan_period_s = 4;
   config.sim.tilt_amplitude_rad = 4 * M_PI / 180;
   config.sim.tilt_period_s = 8;
-  SimulatedCamera sim(config, &renderer, kT0);
+  SimulatedCamera sim(config, config.sim, &renderer, kT0);
   // 1 s in: pan at its peak (+10 deg), tilt at sin(pi/4) * 4 deg.
   const int64_t t = kT0 + 1'000'000;
   const CameraPose truth = sim.true_pose(t);

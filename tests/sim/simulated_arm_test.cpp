@@ -4,15 +4,16 @@
 
 #include "tofguard/sim/simulated_arm.hpp"
 #include "test_support.hpp"
-#include "tofguard/common/config.hpp"
+#include "tofguard/deployment/config.hpp"
+#include "tofguard/deployment/process_settings.hpp"
 
 namespace tofguard::sim {
 namespace {
 
-JointsSimConfig two_joints() {
-  JointsSimConfig c;
+JointsSimSettings two_joints() {
+  JointsSimSettings c;
   c.rate_hz = 100;
-  c.status_deadline_ms = 100;
+  c.status_deadline_us = 100000;
   c.motion = {{"j2", 0.5, 0.2, 4.0, 0.0}, {"j1", -1.0, 0.0, 1.0, 0.0}};
   c.faults = {{"j2", 0.1745, 2.0}};
   return c;
@@ -55,7 +56,7 @@ TEST(SimulatedArm, EncoderFaultsChangeOnlyTheReportedPosition) {
 }
 
 TEST(SimulatedArm, MotionMustCoverExactlyTheUrdfJoints) {
-  auto message = [](const JointsSimConfig& c, const std::vector<std::string>& joints) {
+  auto message = [](const JointsSimSettings& c, const std::vector<std::string>& joints) {
     try {
       SimulatedArm arm(c, joints, "cfg.yaml");
     } catch (const ConfigError& e) {
@@ -68,7 +69,7 @@ TEST(SimulatedArm, MotionMustCoverExactlyTheUrdfJoints) {
             "missing j3");
   EXPECT_EQ(message(two_joints(), {"j2"}),
             "cfg.yaml: joints_sim.motion.j1: unknown joint, expected one of the URDF's movable joints: j2");
-  JointsSimConfig bad_fault = two_joints();
+  JointsSimSettings bad_fault = two_joints();
   bad_fault.faults[0].joint = "j7";
   EXPECT_EQ(message(bad_fault, {"j1", "j2"}),
             "cfg.yaml: joints_sim.faults: unknown joint 'j7', expected one of: j1, j2");

@@ -79,7 +79,7 @@ TEST(TofErrorModel, NoiseStatisticsOverAFlatWallMatchTheModel) {
 
 TEST(TofErrorModel, SameSeedSameFramesOtherSeedOrFrameDiffers) {
   const Intrinsics in = test_intrinsics();
-  SimCameraConfig config = test_sim_config();
+  SimCameraSettings config = test_sim_config();
   config.dark_pixel_probability = 0.01;
   const TofErrorModel a(config, in), b(config, in);
   config.seed = 2;
@@ -112,7 +112,7 @@ TEST(TofErrorModel, AmplitudeFallsWithDistanceAndLowAmplitudeIsInvalid) {
 
 TEST(TofErrorModel, DarkNoiseInvalidatesTheConfiguredFraction) {
   const Intrinsics in = test_intrinsics();
-  SimCameraConfig config = test_sim_config();
+  SimCameraSettings config = test_sim_config();
   config.dark_pixel_probability = 0.02;
   const TofErrorModel model(config, in);
   int invalid = 0, total = 0;

@@ -8,15 +8,16 @@
 #include "tofguard/estimator/motion_estimator.hpp"
 #include "simulated_frames.hpp"
 #include "test_support.hpp"
-#include "tofguard/common/config.hpp"
+#include "tofguard/deployment/config.hpp"
+#include "tofguard/deployment/process_settings.hpp"
 
 namespace tofguard::estimator::test {
 
 inline double deg(double degrees) { return degrees * M_PI / 180.0; }
 inline double to_deg(double radians) { return radians * 180.0 / M_PI; }
 
-inline Config sim_config() {
-  return load_config(tofguard::test::source_dir() + "/config/sim.yaml", nullptr);
+inline deployment::Config sim_config() {
+  return deployment::load_config(tofguard::test::source_dir() + "/config/sim.yaml", nullptr);
 }
 
 inline Eigen::Isometry3d pose_of(const CameraPose& pose) { return pose.frame_from_optical(); }

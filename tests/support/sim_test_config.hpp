@@ -1,7 +1,8 @@
 #pragma once
 // The simulated camera's settings used by the camera tests: the embedded
 // default's 176x144 camera and an error model like config/sim.yaml's.
-#include "tofguard/common/config.hpp"
+#include "tofguard/common/camera_settings.hpp"
+#include "tofguard/sim/sim_settings.hpp"
 
 namespace tofguard::sim::sim_test {
 
@@ -21,8 +22,8 @@ inline std::vector<double> test_systematic_error_m() {
   return {0.0186286, 0.388128, -0.376992, 0.131278, -0.0179423, 0.000764776};
 }
 
-inline SimCameraConfig test_sim_config() {
-  SimCameraConfig c;
+inline SimCameraSettings test_sim_config() {
+  SimCameraSettings c;
   c.seed = 1;
   c.systematic_error_m = test_systematic_error_m();
   c.noise_sigma0_mm = 4.75;        // 5 mm at 0.5 m

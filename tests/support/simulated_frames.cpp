@@ -3,13 +3,14 @@
 #include <stdexcept>
 
 #include "tofguard/estimator/estimator_process.hpp"
+#include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/robot_model/kinematics.hpp"
 
 namespace tofguard::test {
 
-SimulatedFrames::SimulatedFrames(const Config& config)
+SimulatedFrames::SimulatedFrames(const deployment::Config& config)
     : config_(config),
-      scene_(estimator::load_estimator_scene(config)),
+      scene_(estimator::load_estimator_scene(deployment::estimator_process_settings(config))),
       renderer_(std::make_unique<renderer::DepthRenderer>(scene_, config.renderer.near_m, config.renderer.far_m)),
       calibration_(config.camera.depth_calibration.enabled ? config.camera.depth_calibration.coefficients_m
                                                            : std::vector<double>{}) {}

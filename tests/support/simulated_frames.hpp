@@ -15,7 +15,8 @@
 #include "tofguard/renderer/depth_renderer.hpp"
 #include "tofguard/robot_model/scene_model.hpp"
 #include "tofguard/sim/tof_error_model.hpp"
-#include "tofguard/common/config.hpp"
+#include "tofguard/deployment/config.hpp"
+#include "tofguard/deployment/process_settings.hpp"
 
 namespace tofguard::test {
 
@@ -23,7 +24,7 @@ class SimulatedFrames {
  public:
   // The config's robot and environment (visual geometry, no padding: what
   // the camera sees), its camera's error model and calibration.
-  explicit SimulatedFrames(const Config& config);
+  explicit SimulatedFrames(const deployment::Config& config);
 
   // Calibrated Z in metres (0 = no return), row-major, for `intrinsics`.
   // `frame_index` selects the noise. Throws std::runtime_error when the
@@ -48,7 +49,7 @@ class SimulatedFrames {
   renderer::DepthRenderer& renderer() { return *renderer_; }
 
  private:
-  Config config_;
+  deployment::Config config_;
   robot_model::SceneModel scene_;
   std::unique_ptr<renderer::DepthRenderer> renderer_;
   camera::DepthCalibration calibration_;

@@ -25,7 +25,8 @@
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/camera_pose_t.hpp"
 #include "tofguard/common/clock.hpp"
-#include "tofguard/common/config.hpp"
+#include "tofguard/deployment/config.hpp"
+#include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/motion_estimate_t.hpp"
 #include "tofguard/common/risk_names.hpp"
@@ -42,7 +43,7 @@ constexpr int64_t kStopBudgetUs = 200'000;
 class Chain {
  public:
   Chain() : config_path_(sim_config_variant("e2e-chain")),
-            config_(load_config(config_path_, nullptr)),
+            config_(deployment::load_config(config_path_, nullptr)),
             safety_(config_.lcm.url),
             images_(config_.lcm.image_url) {
     safety_.subscribe(config_.channels.status, &Chain::on_status, this);
@@ -237,7 +238,7 @@ class Chain {
     return risk_level_name(last_risk_.level) + " " + risk_cause_name(last_risk_.cause) + " suspect '" +
            last_risk_.suspect + "' seq " + std::to_string(last_risk_.seq) + " | " + last_risk_.detail;
   }
-  const Config& config() const { return config_; }
+  const deployment::Config& config() const { return config_; }
   // A point `distance_m` from link5's origin along the camera's x axis
   // (image right), at the latest joint state (world frame, metres).
   Eigen::Vector3d object_beside_forearm_m(double distance_m) {
@@ -297,7 +298,7 @@ class Chain {
   }
 
   std::string config_path_;
-  Config config_;
+  deployment::Config config_;
   lcm::LCM safety_;
   lcm::LCM images_;
   std::map<std::string, std::unique_ptr<Subprocess>> processes_;
@@ -450,7 +451,7 @@ TEST(SafetyChainE2E, NominalMotionThenEveryFaultStopsTheArmWithItsCause) {
     chain.bring_to_motion("camera unfrozen");
     if (HasFatalFailure()) return;
   }
-  const double depth_deadline_us = chain.config().risk.depth_deadline_ms * 1000;
+  const int64_t depth_deadline_us = chain.config().risk.depth_deadline_us;
   {
     SCOPED_TRACE("a camera stall");
     chain.camera_fault(sim_camera_fault_t::STALL);
@@ -470,7 +471,7 @@ TEST(SafetyChainE2E, NominalMotionThenEveryFaultStopsTheArmWithItsCause) {
     chain.process("tofguard-joints-sim").signal(SIGSTOP);
     const int64_t latency = chain.stop_latency_since(stalled_us, &stop);
     std::cout << "joint-state stall: stop " << latency / 1000.0 << " ms after the stall" << std::endl;
-    EXPECT_LE(latency, chain.config().risk.joint_state_deadline_ms * 1000 + kStopBudgetUs);
+    EXPECT_LE(latency, chain.config().risk.joint_state_deadline_us + kStopBudgetUs);
     EXPECT_EQ(risk_cause_name(stop.cause), risk_cause_name(risk_t::CAUSE_SENSOR_FAULT)) << stop.reason;
     chain.process("tofguard-joints-sim").signal(SIGCONT);
     chain.bring_to_motion("arm driver back");
@@ -484,7 +485,7 @@ TEST(SafetyChainE2E, NominalMotionThenEveryFaultStopsTheArmWithItsCause) {
     std::cout << "renderer killed: stop " << latency / 1000.0 << " ms after the kill, cause "
               << risk_cause_name(stop.cause) << std::endl;
     // Frames without a rendering go out unusable after pair_timeout_ms.
-    EXPECT_LE(latency, chain.config().discrepancy.pair_timeout_ms * 1000 + depth_deadline_us + kStopBudgetUs);
+    EXPECT_LE(latency, chain.config().discrepancy.pair_timeout_us + depth_deadline_us + kStopBudgetUs);
     EXPECT_TRUE(stop.cause == risk_t::CAUSE_COMPONENT_FAULT || stop.cause == risk_t::CAUSE_SENSOR_FAULT)
         << risk_cause_name(stop.cause) << ": " << stop.reason;
     chain.start("tofguard-renderer");

@@ -3,7 +3,7 @@
 // channels.depth (image URL) at camera.rate_hz with the distance
 // calibration applied, and a heartbeat whose frames_dropped counts every
 // frame that was lost or late.
-#include "tofguard/common/config.hpp"
+#include "tofguard/camera/depth_camera_settings.hpp"
 
 namespace tofguard::camera {
 
@@ -18,6 +18,6 @@ constexpr int kPermissionDeniedExitCode = 4;
 // stops sending frames (unplugged) is reported, closed and reopened every
 // second until it is back; meanwhile nothing is published, so the risk
 // chain sees stale depth and stops the arm.
-int run_uvc_camera(const Config& config);
+int run_uvc_camera(const UvcCameraProcessSettings& settings);
 
 }  // namespace tofguard::camera

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "tofguard/common/config.hpp"
+#include "tofguard/common/camera_settings.hpp"
 
 namespace tofguard::camera {
 

@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "tofguard/camera/depth_conversion.hpp"
-#include "tofguard/common/config.hpp"
+#include "tofguard/camera/depth_camera_settings.hpp"
 
 struct uvc_context;
 struct uvc_device;
@@ -47,7 +47,7 @@ class UvcCamera {
       std::function<void(std::vector<float> depth_m, int64_t utime, int64_t frame_number)>;
 
   // `on_frame` is called on libuvc's thread.
-  UvcCamera(const CameraConfig& config, FrameHandler on_frame);
+  UvcCamera(const CameraSettings& camera, const UvcSettings& uvc, FrameHandler on_frame);
   ~UvcCamera();
   UvcCamera(const UvcCamera&) = delete;
   UvcCamera& operator=(const UvcCamera&) = delete;
@@ -70,7 +70,8 @@ class UvcCamera {
   void on_uvc_frame(const uvc_frame& frame);
   std::string device_name() const;
 
-  CameraConfig config_;
+  CameraSettings camera_;
+  UvcSettings uvc_;
   RawDepthFormat format_;
   RadialToZ radial_to_z_;
   FrameHandler on_frame_;

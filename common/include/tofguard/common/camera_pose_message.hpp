@@ -1,5 +1,5 @@
 #pragma once
-// CameraPose (config.hpp) to and from the wire's camera_pose_t: the same
+// CameraPose (camera_settings.hpp) to and from the wire's camera_pose_t: the same
 // convention (the optical frame's pose in frame_id, p_frame = R * p_optical
 // + t, quaternion w, x, y, z).
 #include <cstdint>

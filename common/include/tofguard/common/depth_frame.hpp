@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "tofguard/common/config.hpp"
+#include "tofguard/common/camera_geometry.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/link_labels_t.hpp"
 

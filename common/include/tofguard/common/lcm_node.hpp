@@ -1,6 +1,6 @@
 #pragma once
 // One process's LCM plumbing: the safety URL and the image URL (see
-// LcmConfig), checked subscriptions that decode, validate and count every
+// LcmSettings), checked subscriptions that decode, validate and count every
 // message, periodic timers on the monotonic clock, a heartbeat on
 // SAFETY_HEARTBEAT, and a clean stop on SIGINT / SIGTERM.
 //
@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "tofguard/common/config.hpp"
+#include "tofguard/common/lcm_settings.hpp"
 #include "tofguard/common/decode.hpp"
 #include "tofguard/common/error_log.hpp"
 #include "tofguard/common/heartbeat.hpp"
@@ -32,8 +32,9 @@ class LcmNode {
  public:
   // Opens both URLs (one LCM instance when they are equal); throws
   // std::runtime_error naming the URL when LCM cannot start. Heartbeats go
-  // out on config.channels.heartbeat at `heartbeat_rate_hz`.
-  LcmNode(const Config& config, const std::string& process_name, double heartbeat_rate_hz = 20);
+  // out on channels.heartbeat at `heartbeat_rate_hz`.
+  LcmNode(const LcmSettings& lcm, const ChannelNames& channels, const std::string& process_name,
+          double heartbeat_rate_hz = 20);
   ~LcmNode();
   LcmNode(const LcmNode&) = delete;
   LcmNode& operator=(const LcmNode&) = delete;

@@ -1,12 +1,8 @@
 #pragma once
-// What every tofguard-<name> main() shares: `--config FILE` and `--help`,
-// the config loaded and validated before anything else, and a config error
-// turned into one line on stderr and exit code 2.
-#include <functional>
+// What a tofguard-<name> process is, for --help and its messages. Each
+// component says it (e.g. risk::process_info()); the one process runner
+// (deployment/process_runner.hpp) parses the command line with it.
 #include <string>
-#include <vector>
-
-#include "tofguard/common/config.hpp"
 
 namespace tofguard {
 
@@ -16,15 +12,13 @@ struct ProcessInfo {
   // One paragraph: what the process does, its channels in and out.
   std::string summary;
   // Tools that only need LCM (e.g. tofguard-reset) may run without --config:
-  // they then get default_wire_config().
+  // they then get the default wire settings (LCM_DEFAULT_URL, default
+  // channel names).
   bool config_required = true;
+  // Tools with options of their own (tofguard-reset --who ...) get the
+  // arguments besides --config; for every other process an argument besides
+  // --config is a usage error (exit code 2).
+  bool takes_arguments = false;
 };
-
-// Parses the command line: `--config FILE` (required), `--help`. Loads the
-// config and calls `body` with it and the remaining arguments. Returns the
-// process's exit code: 0 after --help, 2 for a usage or config error, else
-// what `body` returns.
-int run_process(int argc, char** argv, const ProcessInfo& info,
-                const std::function<int(const Config&, const std::vector<std::string>&)>& body);
 
 }  // namespace tofguard

@@ -5,6 +5,7 @@
 //
 // Every error is a ConfigError whose message is one line:
 //   <file>:<line>: <dotted.key>: expected <what>, got <what was there>
+#include <cstdint>
 #include <optional>
 #include <set>
 #include <string>
@@ -36,6 +37,13 @@ class YamlMap {
   // A finite number in [min, max].
   double number(const std::string& key, double min, double max);
   double optional_number(const std::string& key, double default_value, double min, double max);
+  // A duration written in milliseconds (a `..._ms` key) in [min_ms, max_ms],
+  // converted here, once, to integer microseconds (llround(ms * 1000)): the
+  // monotonic clock is int64 microseconds (clock.hpp), so every deadline
+  // check compares integers.
+  int64_t milliseconds_as_us(const std::string& key, double min_ms, double max_ms);
+  // The same for a duration written in seconds (a `..._s` key).
+  int64_t seconds_as_us(const std::string& key, double min_s, double max_s);
   // A sequence of finite numbers; `size` < 0 means any length.
   std::vector<double> numbers(const std::string& key, int size);
   std::vector<std::string> strings(const std::string& key);

@@ -13,8 +13,8 @@
 
 #include <opencv2/core.hpp>
 
-#include "tofguard/common/config.hpp"
 #include "tofguard/common/depth_frame.hpp"
+#include "tofguard/discrepancy/discrepancy_settings.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/discrepancy_image_t.hpp"
 #include "tofguard/discrepancy_t.hpp"
@@ -52,7 +52,7 @@ struct Parameters {
   double max_depth_mm = 8000;
 };
 
-Parameters parameters_from(const DiscrepancyConfig& config);
+Parameters parameters_from(const DiscrepancySettings& config);
 
 // The result for one frame: the summary that goes on the wire, and the
 // images (for the colour image and for tests).

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "tofguard/common/config.hpp"
 #include "tofguard/common/process.hpp"
+#include "tofguard/discrepancy/discrepancy_settings.hpp"
 
 namespace tofguard::discrepancy {
 
@@ -15,6 +15,6 @@ namespace tofguard::discrepancy {
 ProcessInfo process_info();
 
 // The process body: runs until SIGINT/SIGTERM; returns the exit code.
-int run_discrepancy(const Config& config);
+int run_discrepancy(const DiscrepancyProcessSettings& settings);
 
 }  // namespace tofguard::discrepancy

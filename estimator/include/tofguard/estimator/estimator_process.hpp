@@ -38,7 +38,7 @@
 #include "tofguard/robot_model/scene_model.hpp"
 #include "tofguard/robot_state/state_history.hpp"
 #include "tofguard/camera_pose_t.hpp"
-#include "tofguard/common/config.hpp"
+#include "tofguard/estimator/estimator_settings.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/joint_state_t.hpp"
@@ -50,13 +50,19 @@ namespace tofguard::estimator {
 
 ProcessInfo process_info();
 
+// The process: TOF_DEPTH, JOINT_STATE, CAMERA_POSE, SAFETY_DISCREPANCY, SAFETY_RISK in,
+// MOTION_ESTIMATE out, until SIGINT/SIGTERM. Runs at niceness +10 (a
+// diagnosis must not take time from the stop path). A scene that cannot be
+// loaded is a configuration error (exit code 2).
+int run_estimator(const EstimatorProcessSettings& settings);
+
 // The estimator's options from the config (noise model from
 // `discrepancy`, iterations and stride from `estimator`).
-EstimatorOptions options_from_config(const Config& config);
+EstimatorOptions options_from_settings(const EstimatorProcessSettings& settings);
 
 // The scene the estimator compares with the camera: the robot and the
 // environment as the camera sees them (visual geometry, no padding).
-robot_model::SceneModel load_estimator_scene(const Config& config);
+robot_model::SceneModel load_estimator_scene(const EstimatorProcessSettings& settings);
 
 struct EstimateJob {
   // frames[0] is the frame the estimate is about, the others the frames
@@ -73,7 +79,7 @@ struct ScheduledWork {
 
 class EstimatorScheduler {
  public:
-  EstimatorScheduler(const Config& config, const robot_model::SceneModel& scene);
+  EstimatorScheduler(const EstimatorProcessSettings& settings, const robot_model::SceneModel& scene);
 
   // False (ignored) for another robot's state or one not newer than the
   // last.
@@ -107,7 +113,7 @@ class EstimatorScheduler {
   std::optional<EstimatorFrame> estimator_frame(const depth_image_t& frame, const std::string& frame_id,
                                                 std::string* why) const;
 
-  Config config_;
+  EstimatorProcessSettings settings_;
   const robot_model::SceneModel& scene_;
   robot_state::StateHistory state_;
   std::map<int64_t, depth_image_t> frames_;  // by seq
@@ -123,7 +129,7 @@ class EstimatorScheduler {
 // job waits at most: a newer one replaces it and counts as dropped.
 class EstimatorWorker {
  public:
-  EstimatorWorker(const robot_model::SceneModel& scene, const Config& config);
+  EstimatorWorker(const robot_model::SceneModel& scene, const EstimatorProcessSettings& settings);
   ~EstimatorWorker();
   EstimatorWorker(const EstimatorWorker&) = delete;
   EstimatorWorker& operator=(const EstimatorWorker&) = delete;
@@ -139,7 +145,7 @@ class EstimatorWorker {
   void run();
 
   const robot_model::SceneModel& scene_;
-  Config config_;
+  EstimatorProcessSettings settings_;
   std::mutex mutex_;
   std::condition_variable wake_;
   bool started_ = false;

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "tofguard/estimator/motion_estimator.hpp"
-#include "tofguard/common/config.hpp"
+#include "tofguard/estimator/estimator_settings.hpp"
 
 namespace tofguard::estimator {
 
@@ -40,9 +40,9 @@ struct CalibrationResult {
 };
 
 // Reads `log_path` (TOF_DEPTH of the config's camera, JOINT_STATE of its
-// robot; channel names from the config) and estimates the camera pose,
+// robot; channel names from the settings) and estimates the camera pose,
 // starting from the config's camera.pose.
-CalibrationResult calibrate_extrinsics(const Config& config, const std::string& log_path,
+CalibrationResult calibrate_extrinsics(const EstimatorProcessSettings& settings, const std::string& log_path,
                                        const CalibrationOptions& options);
 
 // The pose as the config's camera.pose YAML block.

@@ -37,7 +37,7 @@
 #include "tofguard/renderer/depth_renderer.hpp"
 #include "tofguard/robot_model/kinematics.hpp"
 #include "tofguard/robot_model/scene_model.hpp"
-#include "tofguard/common/config.hpp"
+#include "tofguard/common/camera_settings.hpp"
 
 namespace tofguard::estimator {
 

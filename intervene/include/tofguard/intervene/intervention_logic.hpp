@@ -22,7 +22,7 @@
 #include <cstdint>
 #include <string>
 
-#include "tofguard/common/config.hpp"
+#include "tofguard/intervene/intervention_settings.hpp"
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/reset_request_t.hpp"
 #include "tofguard/risk_t.hpp"
@@ -48,7 +48,7 @@ struct ResetDecision {
 
 class InterventionLogic {
  public:
-  InterventionLogic(const InterventionConfig& config, int64_t now_us, int64_t now_utime);
+  InterventionLogic(const InterventionSettings& config, int64_t now_us, int64_t now_utime);
 
   void on_risk(const risk_t& risk, int64_t now_us, int64_t now_utime);
   void on_joint_state(const joint_state_t& joints, int64_t now_us);
@@ -66,7 +66,7 @@ class InterventionLogic {
   void stop(int8_t kind, int8_t cause, const std::string& reason, int64_t now_us, int64_t now_utime);
   bool risk_fresh(int64_t now_us) const;
 
-  InterventionConfig config_;
+  InterventionSettings config_;
   Status status_;
   bool changed_ = true;
   int64_t stop_started_us_ = 0;

@@ -28,7 +28,7 @@
 #include "tofguard/renderer/egl_context.hpp"
 #include "tofguard/robot_model/kinematics.hpp"
 #include "tofguard/robot_model/scene_model.hpp"
-#include "tofguard/common/config.hpp"
+#include "tofguard/common/camera_geometry.hpp"
 #include "tofguard/common/depth_frame.hpp"
 
 namespace tofguard::renderer {

@@ -39,6 +39,7 @@
 #include <string>
 
 #include "tofguard/renderer/depth_renderer.hpp"
+#include "tofguard/renderer/renderer_settings.hpp"
 #include "tofguard/robot_state/state_history.hpp"
 #include "tofguard/camera_pose_t.hpp"
 #include "tofguard/depth_image_t.hpp"
@@ -53,12 +54,17 @@ namespace tofguard::renderer {
 // What tofguard-renderer is, for --help.
 ProcessInfo process_info();
 
+// The process: TOF_DEPTH, JOINT_STATE, CAMERA_POSE, PLANNED_TRAJECTORY in,
+// TOF_LABELS and TOF_RENDERED out, until SIGINT/SIGTERM. A model that
+// cannot be loaded or rendered is a configuration error (exit code 2).
+int run_renderer(const RendererProcessSettings& settings);
+
 // The largest far_m whose depth fits int16 millimetres.
 constexpr double kMaxFarM = 32.767;
 
-// The scene options of a config (geometry, padding, package paths). Throws
-// ModelError for a bad geometry word.
-robot_model::SceneOptions scene_options(const Config& config);
+// The scene options of the renderer's settings (geometry, padding) and the
+// robot's package paths. Throws ModelError for a bad geometry word.
+robot_model::SceneOptions scene_options(const RendererSettings& renderer, const RobotSettings& robot);
 
 struct RenderedFrame {
   link_labels_t labels;
@@ -70,7 +76,7 @@ class RendererService {
  public:
   // Loads the model and creates the renderer; throws ModelError,
   // RenderError or std::invalid_argument (e.g. far_m > kMaxFarM).
-  explicit RendererService(const Config& config);
+  explicit RendererService(const RendererProcessSettings& settings);
 
   // Returns false (and ignores it) for a message from another robot or not
   // newer than the last; the caller counts that.
@@ -124,7 +130,7 @@ class RendererService {
   // True when `prediction_` may stand for `frame` rendered at `joints` and `pose`.
   bool prediction_matches(const depth_image_t& frame, const robot_model::JointPositions& joints, const CameraPose& pose) const;
 
-  Config config_;
+  RendererProcessSettings settings_;
   robot_model::SceneModel scene_;
   std::unique_ptr<DepthRenderer> renderer_;
   robot_state::StateHistory state_;

@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <optional>
 
-#include "tofguard/common/config.hpp"
+#include "tofguard/risk/risk_settings.hpp"
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/risk/frame_classifier.hpp"
 #include "tofguard/risk_t.hpp"
@@ -17,7 +17,7 @@ namespace tofguard::risk {
 
 class DecisionRule {
  public:
-  explicit DecisionRule(const RiskConfig& risk);
+  explicit DecisionRule(const RiskSettings& risk);
 
   // The verdict on `frame` (its utime and seq) whose findings are final
   // (rules, estimate and plan applied), judged in frame order: every call

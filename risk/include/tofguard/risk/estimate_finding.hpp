@@ -10,7 +10,7 @@
 #include <string>
 
 #include "tofguard/risk/frame_classifier.hpp"
-#include "tofguard/common/config.hpp"
+#include "tofguard/risk/risk_settings.hpp"
 #include "tofguard/motion_estimate_t.hpp"
 
 namespace tofguard::risk {
@@ -35,7 +35,7 @@ struct EstimateContext {
 //  - neither, yet residual_after_mm > estimate.unexplained_residual_mm or
 //    near-arm evidence: UNKNOWN_OBJECT (score residual_after_mm);
 //  - else no finding (the estimate explains nothing).
-FrameFinding classify_estimate(const motion_estimate_t& estimate, const RiskConfig& config,
+FrameFinding classify_estimate(const motion_estimate_t& estimate, const RiskSettings& config,
                                const EstimateContext& context = {});
 
 // The camera correction's rotation angle, radians (0..pi).

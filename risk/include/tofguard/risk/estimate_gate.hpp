@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "tofguard/common/config.hpp"
+#include "tofguard/risk/risk_settings.hpp"
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/motion_estimate_t.hpp"
 #include "tofguard/risk/frame_classifier.hpp"
@@ -39,7 +39,7 @@ class EstimateGate {
  public:
   // risk.estimate and the thresholds classify_estimate uses;
   // `prismatic_joints` (offsets in metres, all others radians).
-  EstimateGate(const RiskConfig& risk, std::set<std::string> prismatic_joints);
+  EstimateGate(const RiskSettings& risk, std::set<std::string> prismatic_joints);
 
   // A frame arrives at monotonic `now_us`: the frames released now, in
   // arrival order, with their final findings.
@@ -73,7 +73,7 @@ class EstimateGate {
   void rename_cause(ClassifiedFrame* c);
   std::vector<ClassifiedFrame> release(int64_t now_us);
 
-  const RiskConfig risk_;  // classify_estimate's thresholds
+  const RiskSettings risk_;  // classify_estimate's thresholds
   std::set<std::string> prismatic_joints_;
   bool enabled_;
   int64_t wait_us_;

@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "tofguard/robot_model/kinematic_tree.hpp"
-#include "tofguard/common/config.hpp"
 #include "tofguard/common/risk_names.hpp"
+#include "tofguard/risk/risk_settings.hpp"
 #include "tofguard/discrepancy_t.hpp"
 
 namespace tofguard::risk {
@@ -50,13 +50,13 @@ struct LinkView {
 // and the context, with the per-link views every mismatch rule shares.
 class FrameEvidence {
  public:
-  FrameEvidence(const discrepancy_t& frame, const robot_model::KinematicTree& robot, const RiskConfig& config,
+  FrameEvidence(const discrepancy_t& frame, const robot_model::KinematicTree& robot, const RiskSettings& config,
                 const ClassifierContext& context)
       : frame(frame), robot(robot), config(config), context(context) {}
 
   const discrepancy_t& frame;
   const robot_model::KinematicTree& robot;
-  const RiskConfig& config;
+  const RiskSettings& config;
   const ClassifierContext& context;
 
   // The visible robot links, in discrepancy_t order.
@@ -88,7 +88,7 @@ struct FrameRule {
 const std::vector<FrameRule>& frame_rules();
 
 // The first finding of frame_rules(), or none.
-FrameFinding classify_frame(const discrepancy_t& frame, const robot_model::KinematicTree& robot, const RiskConfig& config,
+FrameFinding classify_frame(const discrepancy_t& frame, const robot_model::KinematicTree& robot, const RiskSettings& config,
                             const ClassifierContext& context);
 
 // `value` with `decimals` digits after the point, for detail lines.

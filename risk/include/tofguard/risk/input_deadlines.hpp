@@ -13,16 +13,17 @@
 #include <optional>
 #include <string>
 
-#include "tofguard/common/config.hpp"
+#include "tofguard/common/lcm_settings.hpp"
 #include "tofguard/risk/frame_classifier.hpp"
+#include "tofguard/risk/risk_settings.hpp"
 
 namespace tofguard::risk {
 
 class InputDeadlines {
  public:
-  // Deadlines from risk.deadlines_ms, risk.camera_pose and
+  // Deadlines from risk.deadlines_ms (as read: microseconds), risk.camera_pose and
   // risk.required_heartbeats; `channels` names the watched inputs.
-  InputDeadlines(const RiskConfig& risk, const ChannelNames& channels, int64_t start_us);
+  InputDeadlines(const RiskSettings& risk, const ChannelNames& channels, int64_t start_us);
 
   // Valid arrivals at monotonic `now_us`.
   void on_depth(int64_t now_us) { touch(&depth_, now_us); }

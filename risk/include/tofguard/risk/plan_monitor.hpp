@@ -9,7 +9,7 @@
 #include <set>
 #include <string>
 
-#include "tofguard/common/config.hpp"
+#include "tofguard/risk/risk_settings.hpp"
 #include "tofguard/common/planned_trajectory.hpp"
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/planned_trajectory_t.hpp"
@@ -20,7 +20,7 @@ namespace tofguard::risk {
 class PlanMonitor {
  public:
   // risk.plan; `prismatic_joints` (positions in metres, all others radians).
-  PlanMonitor(const RiskConfig& risk, std::set<std::string> prismatic_joints);
+  PlanMonitor(const RiskSettings& risk, std::set<std::string> prismatic_joints);
 
   // A plan that passed check_planned_trajectory and the joint-name check.
   void on_plan(const planned_trajectory_t& plan) { plan_.add(plan); }

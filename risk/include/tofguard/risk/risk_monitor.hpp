@@ -23,7 +23,8 @@
 #include <string>
 #include <vector>
 
-#include "tofguard/common/config.hpp"
+#include "tofguard/common/lcm_settings.hpp"
+#include "tofguard/risk/risk_settings.hpp"
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/heartbeat_t.hpp"
 #include "tofguard/joint_state_t.hpp"
@@ -42,8 +43,10 @@ namespace tofguard::risk {
 
 class RiskMonitor {
  public:
-  // The deadlines run from `start_us` (monotonic).
-  RiskMonitor(const Config& config, robot_model::KinematicTree robot, int64_t start_us);
+  // `channels` name the inputs in the verdicts' details. The deadlines run
+  // from `start_us` (monotonic).
+  RiskMonitor(const RiskSettings& settings, const ChannelNames& channels, robot_model::KinematicTree robot,
+              int64_t start_us);
 
   // Arrivals of valid messages.
   void on_depth(int64_t now_us) { deadlines_.on_depth(now_us); }
@@ -83,7 +86,7 @@ class RiskMonitor {
   // The verdicts of frames the gate released, in order.
   std::vector<risk_t> judge(std::vector<ClassifiedFrame> released, int64_t now_us);
 
-  const RiskConfig risk_config_;
+  const RiskSettings settings_;
   ClassifierContext classifier_context_;  // channel names; arm_moving set per frame
   robot_model::KinematicTree robot_;
   InputDeadlines deadlines_;

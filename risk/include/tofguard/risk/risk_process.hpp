@@ -4,7 +4,7 @@
 // camera (TOF_DEPTH on the image URL), JOINT_STATE, CAMERA_POSE (when
 // required), the discrepancy stream, and the heartbeats of the required
 // processes.
-#include "tofguard/common/config.hpp"
+#include "tofguard/risk/risk_settings.hpp"
 #include "tofguard/common/process.hpp"
 
 namespace tofguard::risk {
@@ -13,6 +13,6 @@ namespace tofguard::risk {
 ProcessInfo process_info();
 
 // The process body: runs until SIGINT/SIGTERM; returns the exit code.
-int run_risk(const Config& config);
+int run_risk(const RiskProcessSettings& settings);
 
 }  // namespace tofguard::risk

@@ -28,7 +28,7 @@
 #include <map>
 #include <string>
 
-#include "tofguard/common/config.hpp"
+#include "tofguard/common/camera_settings.hpp"
 
 namespace tofguard::robot_state {
 

@@ -3,9 +3,10 @@
 // interpolated, JointHistory) and the camera pose (CAMERA_POSE per
 // camera_id, else the config's static pose, CameraPoseHistory), as the
 // renderer, the estimator and the extrinsics calibration look them up.
-// The histories' limits come from the config's renderer section, read here
-// once (StateHistorySettings::from_config), so that every process that
-// renders or compares the model judges a frame by the same limits.
+// The histories' limits come from the renderer's settings (durations already
+// in microseconds; renderer::state_history_settings builds them), so that
+// every process that renders or compares the model judges a frame by the
+// same limits.
 //
 // Times are utime (microseconds since the Unix epoch, as on the wire).
 #include <cstddef>
@@ -13,7 +14,7 @@
 #include <string>
 
 #include "tofguard/camera_pose_t.hpp"
-#include "tofguard/common/config.hpp"
+#include "tofguard/common/camera_geometry.hpp"
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/robot_model/kinematics.hpp"
 #include "tofguard/robot_state/camera_pose_history.hpp"
@@ -36,10 +37,6 @@ struct StateHistorySettings {
   // The pose used for static_camera_id while no CAMERA_POSE has come for it.
   std::string static_camera_id;
   CameraPose static_camera_pose;
-
-  // robot.id, renderer.max_extrapolation_ms and renderer.camera_pose_*_ms
-  // (rounded to the nearest microsecond), camera.id and camera.pose.
-  static StateHistorySettings from_config(const Config& config);
 };
 
 // The state at one frame's utime. Joints and camera pose are looked up

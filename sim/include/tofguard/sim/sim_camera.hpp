@@ -17,7 +17,8 @@
 
 #include "tofguard/robot_state/joint_history.hpp"
 #include "tofguard/sim/tof_error_model.hpp"
-#include "tofguard/common/config.hpp"
+#include "tofguard/common/camera_settings.hpp"
+#include "tofguard/sim/sim_settings.hpp"
 
 namespace tofguard::sim {
 
@@ -46,7 +47,7 @@ class SceneRenderer {
 
 // One injected fault with absolute times (microseconds since the epoch).
 struct ActiveSimFault {
-  SimCameraFaultConfig fault;
+  SimCameraFaultSettings fault;
   int64_t start_utime = 0;
   int64_t end_utime = 0;
 };
@@ -54,7 +55,8 @@ struct ActiveSimFault {
 class SimulatedCamera {
  public:
   // `start_utime`: when the camera started (config faults count from it).
-  SimulatedCamera(const CameraConfig& config, SceneRenderer* renderer, int64_t start_utime);
+  SimulatedCamera(const CameraSettings& camera, const SimCameraSettings& sim, SceneRenderer* renderer,
+                  int64_t start_utime);
 
   // A true joint state of the simulated arm (SIM_TRUE_JOINT_STATE). The
   // frame's joints are interpolated between the states around its capture
@@ -101,13 +103,14 @@ class SimulatedCamera {
   }
 
   // The config's pose turned by `pan_rad` about the pose frame's z axis and
-  // `tilt_rad` about the optical x axis (SimCameraConfig).
+  // `tilt_rad` about the optical x axis (SimCameraSettings).
   CameraPose turned_pose(double pan_rad, double tilt_rad) const;
   // The head's true pan and tilt at `utime`, radians.
   double true_pan_rad(int64_t utime) const;
   double true_tilt_rad(int64_t utime) const;
 
-  CameraConfig config_;
+  CameraSettings camera_;
+  SimCameraSettings sim_;
   SceneRenderer* renderer_;
   int64_t start_utime_;
   TofErrorModel model_;

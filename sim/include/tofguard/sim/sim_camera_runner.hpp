@@ -1,6 +1,6 @@
 #pragma once
 // tofguard-camera's simulated source.
-#include "tofguard/common/config.hpp"
+#include "tofguard/sim/sim_settings.hpp"
 
 namespace tofguard::sim {
 
@@ -13,6 +13,6 @@ namespace tofguard::sim {
 // joint state, render failure, stall fault) or whose slot was missed
 // because the process was late is counted in frames_dropped; seq counts
 // frame slots, so a lost frame leaves a gap in seq.
-int run_sim_camera(const Config& config);
+int run_sim_camera(const SimCameraProcessSettings& settings);
 
 }  // namespace tofguard::sim

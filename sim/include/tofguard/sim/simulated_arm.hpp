@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "tofguard/common/config.hpp"
+#include "tofguard/sim/sim_settings.hpp"
 
 namespace tofguard::sim {
 
@@ -26,7 +26,7 @@ class SimulatedArm {
   // (robot_model::KinematicTree::actuated_joint_names). Throws ConfigError
   // (naming `config_file` and the joints_sim key) when the motion does not
   // cover exactly those joints or a fault names an unknown joint.
-  SimulatedArm(const JointsSimConfig& config, const std::vector<std::string>& urdf_joints,
+  SimulatedArm(const JointsSimSettings& config, const std::vector<std::string>& urdf_joints,
                const std::string& config_file);
 
   // Advances by dt_s of process time. The motion time advances only while

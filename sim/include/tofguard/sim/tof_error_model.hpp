@@ -27,7 +27,7 @@
 #include <vector>
 
 #include "tofguard/camera/depth_conversion.hpp"
-#include "tofguard/common/config.hpp"
+#include "tofguard/sim/sim_settings.hpp"
 
 namespace tofguard::sim {
 
@@ -42,7 +42,7 @@ struct TofImage {
 
 class TofErrorModel {
  public:
-  TofErrorModel(const SimCameraConfig& config, const Intrinsics& intrinsics);
+  TofErrorModel(const SimCameraSettings& config, const Intrinsics& intrinsics);
 
   // e(r), metres.
   double systematic_error_m(double r_m) const;
@@ -57,7 +57,7 @@ class TofErrorModel {
   const Intrinsics& intrinsics() const { return intrinsics_; }
 
  private:
-  SimCameraConfig config_;
+  SimCameraSettings config_;
   Intrinsics intrinsics_;
   camera::RadialToZ radial_to_z_;
 };

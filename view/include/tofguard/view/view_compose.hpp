@@ -10,6 +10,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "tofguard/common/lcm_settings.hpp"
 #include "tofguard/discrepancy/discrepancy_image.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/link_labels_t.hpp"

@@ -5,7 +5,8 @@
 #include <string>
 
 #include "test_support.hpp"
-#include "tofguard/common/config.hpp"
+#include "tofguard/deployment/config.hpp"
+#include "tofguard/deployment/process_settings.hpp"
 
 namespace tofguard::test {
 namespace {
@@ -20,7 +21,7 @@ std::string sim_variant(const std::string& name, const std::string& from, const 
 
 std::string config_error(const std::string& path) {
   try {
-    load_config(path, nullptr);
+    deployment::load_config(path, nullptr);
   } catch (const ConfigError& e) {
     return e.what();
   }
@@ -28,7 +29,7 @@ std::string config_error(const std::string& path) {
 }
 
 TEST(Config, EmbeddedDefaultLoads) {
-  const Config config = load_config(sim_yaml_path(), nullptr);
+  const deployment::Config config = deployment::load_config(sim_yaml_path(), nullptr);
   EXPECT_EQ(config.robot.id, "friend-sim");
   EXPECT_EQ(config.camera.source, "sim");
   EXPECT_EQ(config.camera.intrinsics.width, 176);
@@ -51,14 +52,28 @@ TEST(Config, EmbeddedDefaultLoads) {
   EXPECT_EQ(config.channels.status, "SAFETY_STATUS");
   EXPECT_EQ(config.robot.urdf_path, source_dir() + "/config/models/friend_arm.urdf");
   ASSERT_EQ(config.environment.urdf_paths.size(), 1u);
-  EXPECT_DOUBLE_EQ(config.renderer.max_extrapolation_ms, 20);
+  EXPECT_EQ(config.renderer.max_extrapolation_us, 20000);
   EXPECT_FALSE(config.camera.sim.pan_tilt_enabled);
   EXPECT_TRUE(config.risk.estimate_enabled);
-  EXPECT_DOUBLE_EQ(config.risk.estimate_wait_ms, 0);
+  EXPECT_EQ(config.risk.estimate_wait_us, 0);
   EXPECT_TRUE(config.risk.plan_enabled);
   EXPECT_TRUE(config.joints_sim.publish_plan);
   EXPECT_TRUE(config.renderer.prediction_enabled);
-  EXPECT_DOUBLE_EQ(config.renderer.camera_pose_max_extrapolation_ms, 40);
+  EXPECT_EQ(config.renderer.camera_pose_max_extrapolation_us, 40000);
+}
+
+// Durations are read once, rounded to the nearest microsecond: what the
+// renderer's state history and risk's deadlines compare.
+TEST(Config, MillisecondsAreRoundedToWholeMicrosecondsOnce) {
+  const std::string path = sim_config_variant(
+      "config-fractional-ms",
+      {{"  max_extrapolation_ms: 20\n", "  max_extrapolation_ms: 12.3456\n"},
+       {"camera_pose: {history_ms: 2000, max_extrapolation_ms: 40,", "camera_pose: {history_ms: 2000, max_extrapolation_ms: 40.0004,"},
+       {"deadlines_ms: {depth: 150,", "deadlines_ms: {depth: 33.3334,"}});
+  const deployment::Config config = deployment::load_config(path, nullptr);
+  EXPECT_EQ(config.renderer.max_extrapolation_us, 12'346);
+  EXPECT_EQ(config.renderer.camera_pose_max_extrapolation_us, 40'000);
+  EXPECT_EQ(config.risk.depth_deadline_us, 33'333);
 }
 
 TEST(Config, LcmUrlComesFromConfigThenEnvironmentThenHostLocalDefault) {
@@ -71,7 +86,7 @@ TEST(Config, LcmUrlComesFromConfigThenEnvironmentThenHostLocalDefault) {
                                        "  url: \"udpm://239.255.76.67:7667?ttl=0\"\n", "");
   // With lcm.url removed, LCM_DEFAULT_URL decides; the image URL names its
   // own port with a big receive buffer.
-  const Config config = load_config(path, "udpm://239.9.9.9:9000?ttl=1");
+  const deployment::Config config = deployment::load_config(path, "udpm://239.9.9.9:9000?ttl=1");
   EXPECT_EQ(config.lcm.url, "udpm://239.9.9.9:9000?ttl=1");
 }
 

@@ -1,0 +1,67 @@
+#include "tofguard/common/lcm_settings.hpp"
+
+#include <regex>
+
+namespace tofguard {
+
+std::string resolve_lcm_url(const std::string& from_config, const char* lcm_default_url_env) {
+  if (!from_config.empty()) return from_config;
+  if (lcm_default_url_env != nullptr && lcm_default_url_env[0] != '\0') {
+    return lcm_default_url_env;
+  }
+  return kHostLocalLcmUrl;
+}
+
+std::string derive_image_url(const std::string& safety_url) {
+  static const std::regex udpm(R"(^udpm://([^:/?]+):(\d+)(\?.*)?$)");
+  std::smatch m;
+  if (!std::regex_match(safety_url, m, udpm)) return safety_url;
+  const int port = std::stoi(m[2].str()) + 1;
+  std::string options = m[3].str();
+  if (options.find("recv_buf_size=") == std::string::npos) {
+    options += options.empty() ? "?recv_buf_size=4194304" : "&recv_buf_size=4194304";
+  }
+  return "udpm://" + m[1].str() + ":" + std::to_string(port) + options;
+}
+
+LcmSettings read_lcm_settings(std::optional<YamlMap> section, const char* lcm_default_url_env) {
+  std::string url;
+  std::string image_url;
+  if (section) {
+    url = section->optional_string("url").value_or("");
+    image_url = section->optional_string("image_url").value_or("");
+    section->finish();
+  }
+  LcmSettings lcm;
+  lcm.url = resolve_lcm_url(url, lcm_default_url_env);
+  lcm.image_url = image_url.empty() ? derive_image_url(lcm.url) : image_url;
+  return lcm;
+}
+
+ChannelNames read_channel_names(YamlMap map) {
+  ChannelNames c;
+  auto name = [&map](const char* key, std::string* out) {
+    if (auto v = map.optional_string(key)) *out = *v;
+  };
+  name("depth", &c.depth);
+  name("joint_state", &c.joint_state);
+  name("camera_pose", &c.camera_pose);
+  name("rendered", &c.rendered);
+  name("labels", &c.labels);
+  name("discrepancy", &c.discrepancy);
+  name("risk", &c.risk);
+  name("status", &c.status);
+  name("reset", &c.reset);
+  name("reset_reply", &c.reset_reply);
+  name("heartbeat", &c.heartbeat);
+  name("power", &c.power);
+  name("motion_estimate", &c.motion_estimate);
+  name("planned_trajectory", &c.planned_trajectory);
+  name("sim_true_joint_state", &c.sim_true_joint_state);
+  name("sim_joint_fault", &c.sim_joint_fault);
+  name("sim_camera_fault", &c.sim_camera_fault);
+  map.finish();
+  return c;
+}
+
+}  // namespace tofguard

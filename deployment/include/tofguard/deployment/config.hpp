@@ -1,0 +1,75 @@
+#pragma once
+// The deployment config: one YAML file per deployment (config/sim.yaml is the
+// embedded default). Every process loads and validates the whole file at
+// start, so that a config error stops every process the same way, with one
+// line naming the file, the key and what was expected (ConfigError, exit
+// code 2), before anything is published.
+//
+// This loader composes the sections; each section's settings struct and
+// reader live beside the component that uses it (renderer_settings.hpp,
+// risk_settings.hpp, ...), the pieces several processes share in common
+// (lcm_settings.hpp, robot_settings.hpp, camera_settings.hpp). Each process
+// is handed only what it needs (process_settings.hpp).
+//
+// Units are in the YAML keys: _m metres, _ms milliseconds, _s seconds, _hz
+// hertz, _mm millimetres. Durations are converted once, here, to integer
+// microseconds (fields named _us). Relative paths are resolved against the
+// config file's folder.
+#include <optional>
+#include <string>
+
+#include "tofguard/camera/depth_camera_settings.hpp"
+#include "tofguard/common/camera_settings.hpp"
+#include "tofguard/common/config_error.hpp"
+#include "tofguard/common/lcm_settings.hpp"
+#include "tofguard/common/robot_settings.hpp"
+#include "tofguard/discrepancy/discrepancy_settings.hpp"
+#include "tofguard/estimator/estimator_settings.hpp"
+#include "tofguard/intervene/intervention_settings.hpp"
+#include "tofguard/launch/launch_settings.hpp"
+#include "tofguard/renderer/renderer_settings.hpp"
+#include "tofguard/risk/risk_settings.hpp"
+#include "tofguard/sim/sim_settings.hpp"
+
+namespace tofguard::deployment {
+
+// The `camera` section: the camera every process shares (id, rate_hz,
+// intrinsics, pose) and the sources' own settings.
+struct CameraSection : CameraSettings {
+  // source: "sim" (the simulated ToF camera) or "uvc" (a USB Video Class
+  // camera).
+  std::string source;
+  // depth_calibration (optional; disabled when absent).
+  camera::DepthCalibrationSettings depth_calibration;
+  // The section named by `source` is required; the other one is validated
+  // and filled when present.
+  camera::UvcSettings uvc;
+  sim::SimCameraSettings sim;
+};
+
+struct Config {
+  std::string file;
+  LcmSettings lcm;
+  ChannelNames channels;
+  RobotSettings robot;
+  EnvironmentSettings environment;
+  CameraSection camera;
+  renderer::RendererSettings renderer;
+  discrepancy::DiscrepancySettings discrepancy;
+  risk::RiskSettings risk;
+  estimator::EstimatorSettings estimator;
+  sim::JointsSimSettings joints_sim;
+  intervene::InterventionSettings intervention;
+  // Optional: only tofguard-launch needs it.
+  std::optional<launch::LaunchSettings> launch;
+};
+
+// Loads and validates `path`; throws ConfigError. `lcm_default_url_env` is
+// the value of LCM_DEFAULT_URL (nullptr when unset).
+Config load_config(const std::string& path, const char* lcm_default_url_env);
+
+// Only the LCM URLs (from LCM_DEFAULT_URL or the host-local default) and the
+// default channel names: for tools that need no deployment config.
+Config default_wire_config(const char* lcm_default_url_env);
+
+}  // namespace tofguard::deployment

@@ -1,0 +1,54 @@
+#include "tofguard/deployment/config.hpp"
+
+#include "tofguard/common/yaml_reader.hpp"
+
+namespace tofguard::deployment {
+
+Config default_wire_config(const char* lcm_default_url_env) {
+  Config config;
+  config.file = "(no config: defaults)";
+  config.lcm = read_lcm_settings(std::nullopt, lcm_default_url_env);
+  return config;
+}
+
+Config load_config(const std::string& path, const char* lcm_default_url_env) {
+  YamlMap root = load_yaml_file(path);
+  Config config;
+  config.file = path;
+  config.lcm = read_lcm_settings(root.optional_map("lcm"), lcm_default_url_env);
+  if (auto channels = root.optional_map("channels")) config.channels = read_channel_names(*channels);
+  config.robot = read_robot_settings(root.map("robot"));
+  config.environment = read_environment_settings(root.optional_map("environment"));
+
+  {
+    YamlMap camera = root.map("camera");
+    CameraSection& c = config.camera;
+    c.id = camera.string("id");
+    c.source = camera.choice("source", {"sim", "uvc"});
+    c.rate_hz = camera.number("rate_hz", 0.1, 1000);
+    YamlMap intrinsics = camera.map("intrinsics");
+    c.intrinsics = read_intrinsics(intrinsics);
+    intrinsics.finish();
+    c.pose = read_camera_pose(camera.map("pose"));
+    if (camera.optional("depth_calibration")) {
+      c.depth_calibration = camera::read_depth_calibration_settings(camera.map("depth_calibration"));
+    }
+    if (c.source == "uvc" || camera.optional("uvc")) c.uvc = camera::read_uvc_settings(camera.map("uvc"));
+    if (c.source == "sim" || camera.optional("sim")) c.sim = sim::read_sim_camera_settings(camera.map("sim"));
+    camera.finish();
+  }
+
+  config.renderer = renderer::read_renderer_settings(root.map("renderer"));
+  // Safety chain sections (required: no silent defaults for thresholds).
+  config.discrepancy = discrepancy::read_discrepancy_settings(root.map("discrepancy"));
+  config.risk = risk::read_risk_settings(root.map("risk"));
+  config.estimator = estimator::read_estimator_settings(root.map("estimator"));
+  config.joints_sim = sim::read_joints_sim_settings(root.map("joints_sim"));
+  config.intervention = intervene::read_intervention_settings(root.map("intervention"));
+  if (auto launch = root.optional_map("launch")) config.launch = launch::read_launch_settings(*launch);
+
+  root.finish();
+  return config;
+}
+
+}  // namespace tofguard::deployment

@@ -1,0 +1,128 @@
+#include "tofguard/deployment/process_settings.hpp"
+
+namespace tofguard::deployment {
+
+renderer::RendererProcessSettings renderer_process_settings(const Config& config) {
+  renderer::RendererProcessSettings s;
+  s.lcm = config.lcm;
+  s.channels = config.channels;
+  s.robot = config.robot;
+  s.environment = config.environment;
+  s.camera = config.camera;
+  s.renderer = config.renderer;
+  return s;
+}
+
+discrepancy::DiscrepancyProcessSettings discrepancy_process_settings(const Config& config) {
+  discrepancy::DiscrepancyProcessSettings s;
+  s.lcm = config.lcm;
+  s.channels = config.channels;
+  s.camera_id = config.camera.id;
+  s.discrepancy = config.discrepancy;
+  return s;
+}
+
+risk::RiskProcessSettings risk_process_settings(const Config& config) {
+  risk::RiskProcessSettings s;
+  s.lcm = config.lcm;
+  s.channels = config.channels;
+  s.robot_urdf_path = config.robot.urdf_path;
+  s.camera_id = config.camera.id;
+  s.risk = config.risk;
+  return s;
+}
+
+estimator::EstimatorProcessSettings estimator_process_settings(const Config& config) {
+  estimator::EstimatorProcessSettings s;
+  s.lcm = config.lcm;
+  s.channels = config.channels;
+  s.robot = config.robot;
+  s.environment = config.environment;
+  s.camera = config.camera;
+  s.renderer = config.renderer;
+  s.noise_sigma_at_0m_mm = config.discrepancy.noise_sigma_at_0m_mm;
+  s.noise_sigma_per_m2_mm = config.discrepancy.noise_sigma_per_m2_mm;
+  s.estimator = config.estimator;
+  return s;
+}
+
+intervene::InterveneProcessSettings intervene_process_settings(const Config& config) {
+  intervene::InterveneProcessSettings s;
+  s.lcm = config.lcm;
+  s.channels = config.channels;
+  s.intervention = config.intervention;
+  return s;
+}
+
+intervene::ResetToolSettings reset_tool_settings(const Config& config) {
+  intervene::ResetToolSettings s;
+  s.lcm = config.lcm;
+  s.channels = config.channels;
+  return s;
+}
+
+sim::JointsSimProcessSettings joints_sim_process_settings(const Config& config) {
+  sim::JointsSimProcessSettings s;
+  s.lcm = config.lcm;
+  s.channels = config.channels;
+  s.robot = config.robot;
+  s.config_file = config.file;
+  s.joints_sim = config.joints_sim;
+  return s;
+}
+
+sim::SimCameraProcessSettings sim_camera_process_settings(const Config& config) {
+  sim::SimCameraProcessSettings s;
+  s.lcm = config.lcm;
+  s.channels = config.channels;
+  s.robot = config.robot;
+  s.environment = config.environment;
+  s.camera = config.camera;
+  s.near_m = config.renderer.near_m;
+  s.far_m = config.renderer.far_m;
+  s.depth_calibration = config.camera.depth_calibration;
+  s.sim = config.camera.sim;
+  return s;
+}
+
+sim::SimFaultToolSettings sim_fault_tool_settings(const Config& config) {
+  sim::SimFaultToolSettings s;
+  s.lcm = config.lcm;
+  s.channels = config.channels;
+  s.camera_id = config.camera.id;
+  return s;
+}
+
+camera::UvcCameraProcessSettings uvc_camera_process_settings(const Config& config) {
+  camera::UvcCameraProcessSettings s;
+  s.lcm = config.lcm;
+  s.channels = config.channels;
+  s.camera = config.camera;
+  s.depth_calibration = config.camera.depth_calibration;
+  s.uvc = config.camera.uvc;
+  return s;
+}
+
+launch::LaunchProcessSettings launch_process_settings(const Config& config) {
+  if (!config.launch) {
+    throw ConfigError(config.file +
+                      ": launch: missing key, expected a mapping with processes, restart settings, log_dir, recorder");
+  }
+  launch::LaunchProcessSettings s;
+  s.config_file = config.file;
+  s.lcm = config.lcm;
+  s.launch = *config.launch;
+  return s;
+}
+
+view::ViewSettings view_settings(const Config& config) {
+  view::ViewSettings s;
+  s.lcm = config.lcm;
+  s.channels = config.channels;
+  s.discrepancy = config.discrepancy;
+  s.far_m = config.renderer.far_m;
+  s.camera_rate_hz = config.camera.rate_hz;
+  return s;
+}
+
+}  // namespace tofguard::deployment

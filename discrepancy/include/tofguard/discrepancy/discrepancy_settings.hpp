@@ -1,0 +1,65 @@
+#pragma once
+// tofguard-discrepancy's settings (config section `discrepancy`,
+// docs/safety-chain.md): how camera and rendered frames are paired and
+// compared. Durations are integer microseconds, converted once when the file
+// is read.
+#include <cstdint>
+#include <string>
+
+#include "tofguard/common/lcm_settings.hpp"
+#include "tofguard/common/yaml_reader.hpp"
+
+namespace tofguard::discrepancy {
+
+struct DiscrepancySettings {
+  // noise.{sigma_at_0m_mm, sigma_per_m2_mm}: camera noise model:
+  // sigma(d) = noise_sigma_at_0m_mm + noise_sigma_per_m2_mm * d^2, d the
+  // camera's depth in metres, sigma in mm.
+  double noise_sigma_at_0m_mm = 0;
+  double noise_sigma_per_m2_mm = 0;
+  // tolerance_sigmas, model_tolerance_mm: a pixel matches when
+  // |I_dis| <= tolerance_sigmas * sigma(d) + model_tolerance_mm (the
+  // model's own inaccuracy), millimetres.
+  double tolerance_sigmas = 0;
+  double model_tolerance_mm = 0;
+  // pair_timeout_ms: a camera frame waits this long (monotonic) for its
+  // rendered frame and labels before it is published as unusable;
+  // microseconds.
+  int64_t pair_timeout_us = 0;
+  // max_pending_frames: at most this many frames of each kind wait for
+  // their partners.
+  int max_pending_frames = 0;
+  // opening_radius_px: radius of the morphological opening applied to the
+  // mismatch mask before blobs and near-arm surfaces are measured, pixels
+  // (0 = none).
+  int opening_radius_px = 0;
+  // silhouette_jump_mm: rendered depth steps larger than this (and the
+  // model's outline) are silhouettes, where a ToF camera mixes foreground
+  // and background (mixed pixels): the pixels on either side of one are
+  // left out of the per-link counts and the blobs, millimetres.
+  double silhouette_jump_mm = 0;
+  // near_arm_m: surfaces nearer than the model within this distance of the
+  // modelled arm count as near the arm, metres.
+  double near_arm_m = 0;
+  // max_depth_mm: the seed score's logical maximum per pixel, millimetres.
+  double max_depth_mm = 0;
+  // colour_image.{enabled, channel, full_scale_mm}: the optional colour
+  // discrepancy image for viewers.
+  bool colour_image_enabled = false;
+  std::string colour_image_channel;
+  double colour_image_full_scale_mm = 0;
+};
+
+// Reads (and finishes) the `discrepancy` section.
+DiscrepancySettings read_discrepancy_settings(YamlMap section);
+
+// Everything tofguard-discrepancy needs.
+struct DiscrepancyProcessSettings {
+  LcmSettings lcm;
+  ChannelNames channels;
+  // camera.id: frames from another camera are rejected.
+  std::string camera_id;
+  DiscrepancySettings discrepancy;
+};
+
+}  // namespace tofguard::discrepancy

@@ -1,0 +1,32 @@
+#include "tofguard/discrepancy/discrepancy_settings.hpp"
+
+namespace tofguard::discrepancy {
+
+DiscrepancySettings read_discrepancy_settings(YamlMap map) {
+  DiscrepancySettings d;
+  {
+    YamlMap noise = map.map("noise");
+    d.noise_sigma_at_0m_mm = noise.number("sigma_at_0m_mm", 0, 1000);
+    d.noise_sigma_per_m2_mm = noise.number("sigma_per_m2_mm", 0, 1000);
+    noise.finish();
+  }
+  d.tolerance_sigmas = map.number("tolerance_sigmas", 0.5, 100);
+  d.model_tolerance_mm = map.number("model_tolerance_mm", 0, 1000);
+  d.pair_timeout_us = map.milliseconds_as_us("pair_timeout_ms", 1, 10000);
+  d.max_pending_frames = static_cast<int>(map.integer("max_pending_frames", 1, 1000));
+  d.opening_radius_px = static_cast<int>(map.integer("opening_radius_px", 0, 10));
+  d.silhouette_jump_mm = map.number("silhouette_jump_mm", 1, 10000);
+  d.near_arm_m = map.number("near_arm_m", 0, 10);
+  d.max_depth_mm = map.number("max_depth_mm", 1, 32767);
+  {
+    YamlMap colour = map.map("colour_image");
+    d.colour_image_enabled = colour.boolean("enabled");
+    d.colour_image_channel = colour.string("channel");
+    d.colour_image_full_scale_mm = colour.number("full_scale_mm", 1, 32767);
+    colour.finish();
+  }
+  map.finish();
+  return d;
+}
+
+}  // namespace tofguard::discrepancy

@@ -1,0 +1,69 @@
+#pragma once
+// tofguard-estimator's settings (config section `estimator`,
+// docs/estimator.md): when to estimate the joint offsets and the camera
+// correction that best explain a camera frame. Durations are integer
+// microseconds, converted once when the file is read.
+#include <cstdint>
+#include <string>
+
+#include "tofguard/common/camera_settings.hpp"
+#include "tofguard/common/lcm_settings.hpp"
+#include "tofguard/common/robot_settings.hpp"
+#include "tofguard/common/yaml_reader.hpp"
+#include "tofguard/renderer/renderer_settings.hpp"
+
+namespace tofguard::estimator {
+
+struct EstimatorSettings {
+  // estimate_joints, estimate_camera: which parameters are estimated.
+  bool estimate_joints = true;
+  bool estimate_camera = true;
+  // warning.{mismatch_fraction, p95_abs_dis_mm}: a frame is estimated at
+  // once (TRIGGER_WARNING) when its discrepancy_t is usable and its
+  // mismatch_fraction reaches warning_mismatch_fraction or its
+  // p95_abs_dis_mm reaches warning_p95_abs_dis_mm.
+  double warning_mismatch_fraction = 0;
+  double warning_p95_abs_dis_mm = 0;
+  // warning.min_interval_ms: at most one warning-triggered frame per this
+  // much camera time (frame utimes): on a small CPU the estimator shares the
+  // cores with the renderer, whose deadline stops the arm. Microseconds.
+  int64_t warning_min_interval_us = 0;
+  // periodic_period_ms: and the newest frame every this often
+  // (TRIGGER_PERIODIC); microseconds.
+  int64_t periodic_period_us = 0;
+  // max_pending_frames: camera frames kept (by seq) until their discrepancy
+  // arrives.
+  int max_pending_frames = 0;
+  // frames_per_estimate: frames estimated jointly
+  // (MotionEstimator::estimate(frames)): the triggering frame and up to
+  // frames_per_estimate - 1 kept frames just before it (at most
+  // max_pending_frames in all).
+  int frames_per_estimate = 0;
+  // max_iterations, pixel_stride: Gauss-Newton iterations (one render each)
+  // of the joints-and-camera stage, and every pixel_stride-th pixel's depth
+  // residual.
+  int max_iterations = 0;
+  int pixel_stride = 0;
+};
+
+// Reads (and finishes) the `estimator` section.
+EstimatorSettings read_estimator_settings(YamlMap section);
+
+// Everything tofguard-estimator (and tofguard-calibrate-extrinsics) needs.
+struct EstimatorProcessSettings {
+  LcmSettings lcm;
+  ChannelNames channels;
+  RobotSettings robot;
+  EnvironmentSettings environment;
+  CameraSettings camera;
+  // The renderer's clip distances and joint / camera-pose history windows:
+  // the estimator renders and looks states up as tofguard-renderer does.
+  renderer::RendererSettings renderer;
+  // discrepancy.noise.{sigma_at_0m_mm, sigma_per_m2_mm}: the camera noise
+  // model the estimator weighs residuals with, millimetres.
+  double noise_sigma_at_0m_mm = 0;
+  double noise_sigma_per_m2_mm = 0;
+  EstimatorSettings estimator;
+};
+
+}  // namespace tofguard::estimator

@@ -1,0 +1,53 @@
+#pragma once
+// tofguard-intervene's settings (config section `intervention`,
+// docs/safety-chain.md). Durations are integer microseconds, converted once
+// when the file is read, so that the deadlines compare integers on the
+// monotonic clock.
+#include <cstdint>
+#include <string>
+
+#include "tofguard/common/lcm_settings.hpp"
+#include "tofguard/common/yaml_reader.hpp"
+
+namespace tofguard::intervene {
+
+struct InterventionSettings {
+  // publish_rate_hz: SAFETY_STATUS rate; a change is published at once as
+  // well.
+  double publish_rate_hz = 0;
+  // risk_deadline_ms: no SAFETY_RISK for this long (monotonic) -> power
+  // cut; microseconds.
+  int64_t risk_deadline_us = 0;
+  // stop_deadline_ms, joint_state_deadline_ms, stopped_velocity: after a
+  // software stop the arm must be still (every |velocity| below
+  // stopped_velocity) within stop_deadline, else power cut. A joint state
+  // older than joint_state_deadline cannot show that. Microseconds.
+  int64_t stop_deadline_us = 0;
+  int64_t joint_state_deadline_us = 0;
+  double stopped_velocity = 0;  // rad/s (or m/s)
+  // power_cut: "lcm" (power_relay_t on channels.power) or "usb_hid_relay".
+  std::string power_cut;
+  // usb_hid_relay.{channel, serial}: USB HID relay board (16c0:05df): which
+  // relay (1-based) switches the arm's power, wired normally open; serial ""
+  // takes the only board.
+  int relay_channel = 1;
+  std::string relay_serial;
+};
+
+// Reads (and finishes) the `intervention` section.
+InterventionSettings read_intervention_settings(YamlMap section);
+
+// Everything tofguard-intervene needs.
+struct InterveneProcessSettings {
+  LcmSettings lcm;
+  ChannelNames channels;
+  InterventionSettings intervention;
+};
+
+// Everything tofguard-reset needs (it runs with or without a config).
+struct ResetToolSettings {
+  LcmSettings lcm;
+  ChannelNames channels;
+};
+
+}  // namespace tofguard::intervene

@@ -1,0 +1,126 @@
+#include "tofguard/launch/launch_process.hpp"
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <iostream>
+
+#include "tofguard/common/clock.hpp"
+#include "tofguard/common/config_error.hpp"
+#include "tofguard/common/lcm_node.hpp"
+#include "tofguard/launch/log_rotation.hpp"
+#include "tofguard/launch/process_group.hpp"
+
+namespace tofguard::launch {
+namespace {
+
+void say(const std::string& line) { std::cout << "tofguard-launch: " << line << std::endl; }
+
+std::string own_dir() {
+  std::error_code ec;
+  const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  return ec ? std::string() : exe.parent_path().string();
+}
+
+}  // namespace
+
+ProcessInfo process_info() {
+  return {"tofguard-launch",
+          "Starts the process group of the deployment config (launch.processes, in order), shows\n"
+          "each process's state, restarts crashed processes with back-off (a process that keeps\n"
+          "crashing is reported and left stopped), records every channel with lcm-logger into\n"
+          "rotating files under launch.log_dir, and stops all of them on Ctrl-C / SIGTERM.\n"
+          "Usage: tofguard-launch CONFIG"};
+}
+
+int run_launch(const LaunchProcessSettings& settings) {
+  const LaunchSettings& launch = settings.launch;
+  const std::string config_path = std::filesystem::absolute(settings.config_file).string();
+
+  // Everything is checked before anything starts.
+  std::vector<ProcessSpec> specs;
+  for (size_t i = 0; i < launch.processes.size(); ++i) {
+    const LaunchedProcess& p = launch.processes[i];
+    ProcessSpec spec;
+    spec.name = p.name;
+    spec.required = p.required;
+    spec.log_path = launch.log_dir + "/" + p.name + ".log";
+    for (std::string arg : p.command) {
+      for (size_t at = arg.find("{config}"); at != std::string::npos; at = arg.find("{config}")) {
+        arg.replace(at, 8, config_path);
+      }
+      spec.argv.push_back(arg);
+    }
+    const std::string program = resolve_program(spec.argv[0], own_dir());
+    if (program.empty()) {
+      throw ConfigError(settings.config_file + ": launch.processes[" + std::to_string(i) +
+                        "].command: expected an executable program, '" + spec.argv[0] +
+                        "' is not beside tofguard-launch (" + own_dir() + ") nor in PATH");
+    }
+    spec.argv[0] = program;
+    specs.push_back(spec);
+  }
+  std::error_code ec;
+  std::filesystem::create_directories(launch.log_dir, ec);
+  if (ec) {
+    throw ConfigError(settings.config_file + ": launch.log_dir: expected a folder that can be created, " +
+                      launch.log_dir + ": " + ec.message());
+  }
+  const std::string recordings = launch.log_dir + "/recordings";
+  if (launch.recorder.enabled) {
+    std::filesystem::create_directories(recordings, ec);
+    const std::string logger = resolve_program("lcm-logger", "");
+    if (logger.empty()) {
+      std::cerr << "tofguard-launch: lcm-logger not found in PATH (liblcm-bin): run scripts/install-deps\n";
+      return kConfigErrorExitCode;
+    }
+    // The black box: never required, so a full disk or a crashed logger
+    // never stops the safety chain. A new file every max_file_mb.
+    const std::string split = std::to_string(launch.recorder.max_file_mb);
+    for (const auto& [which, url] : {std::pair<std::string, std::string>{"safety", settings.lcm.url},
+                                     std::pair<std::string, std::string>{"images", settings.lcm.image_url}}) {
+      ProcessSpec spec;
+      spec.name = "recorder-" + which;
+      spec.required = false;
+      spec.log_path = launch.log_dir + "/" + spec.name + ".log";
+      spec.argv = {logger, "--lcm-url=" + url, "-q", "-i", "--split-mb=" + split, "-s",
+                   recordings + "/" + which + "-%Y%m%d-%H%M%S.lcmlog"};
+      specs.push_back(spec);
+    }
+  }
+
+  RestartPolicy policy;
+  policy.initial_delay_us = launch.restart_backoff_initial_us;
+  policy.max_delay_us = launch.restart_backoff_max_us;
+  policy.max_restarts = launch.max_restarts;
+  policy.window_us = launch.restart_window_us;
+  ProcessGroup group(specs, policy, say);
+  say("starting " + std::to_string(specs.size()) + " processes from " + settings.config_file + "; logs in " +
+      launch.log_dir);
+  group.start_all(monotonic_us());
+  std::cout << group.status_table() << std::flush;
+
+  int64_t next_prune_us = 0;
+  while (!stop_requested()) {
+    const int64_t now_us = monotonic_us();
+    group.poll(now_us);
+    if (launch.recorder.enabled && now_us >= next_prune_us) {
+      next_prune_us = now_us + 5'000'000;
+      const auto doomed = files_to_delete(
+          list_log_files(recordings), static_cast<uint64_t>(launch.recorder.max_total_mb * 1e6),
+          static_cast<int64_t>(launch.recorder.max_age_h * 3600), wall_utime() / 1'000'000);
+      for (const auto& path : doomed) {
+        std::filesystem::remove(path, ec);
+        say("recorder: deleted " + path + " (size or age limit)");
+      }
+    }
+    usleep(20000);  // the supervision period: a crash is noticed within 20 ms
+  }
+  say("stopping every process");
+  group.stop_all(3000);
+  std::cout << group.status_table() << std::flush;
+  say("all processes stopped");
+  return 0;
+}
+
+}  // namespace tofguard::launch

@@ -1,0 +1,108 @@
+#pragma once
+// tofguard-risk's settings (config section `risk`, docs/safety-chain.md):
+// deadlines, thresholds and debouncing. Durations are integer microseconds,
+// converted once when the file is read (YamlMap::milliseconds_as_us), so
+// that every deadline check compares integers on the monotonic clock.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "tofguard/common/lcm_settings.hpp"
+#include "tofguard/common/yaml_reader.hpp"
+
+namespace tofguard::risk {
+
+struct RiskSettings {
+  // check_period_ms: how often deadlines are checked (and timeouts
+  // re-published); microseconds.
+  int64_t check_period_us = 0;
+  // deadlines_ms.{depth, discrepancy, joint_state, heartbeat} and
+  // camera_pose.deadline_ms: staleness deadlines on the receiver's
+  // monotonic clock (time since the last valid arrival); microseconds.
+  int64_t depth_deadline_us = 0;
+  int64_t discrepancy_deadline_us = 0;
+  int64_t joint_state_deadline_us = 0;
+  // camera_pose.required: CAMERA_POSE must keep coming.
+  bool camera_pose_required = false;
+  int64_t camera_pose_deadline_us = 0;
+  int64_t heartbeat_deadline_us = 0;
+  // required_heartbeats: processes (heartbeat_t.process) whose heartbeat
+  // must keep coming.
+  std::vector<std::string> required_heartbeats;
+  // debounce_frames: a model mismatch (joint, calibration, object,
+  // unclassified) is WARNING until it has held for this many consecutive
+  // frames, then DANGEROUS.
+  int debounce_frames = 0;
+  // sensor_debounce_frames: the same for per-frame sensor faults (unusable
+  // frame, invalid pixels, uncalibrated, frozen).
+  int sensor_debounce_frames = 0;
+  // sensor.*: sensor faults.
+  double max_invalid_fraction = 0;
+  bool calibrated_required = true;
+  int frozen_repeat_frames = 0;
+  double moving_joint_speed_rad_s = 0;
+  // joint_error.* and calibration_error.*: classification
+  // (docs/safety-chain.md).
+  int min_link_pixels = 0;
+  double link_mismatch_fraction = 0;
+  // joint_error.link_missing_fraction.
+  double joint_link_missing_fraction = 0;
+  // joint_error.link_affected_{fraction, min_pixels}: a link on the way down
+  // to the missing links counts as moved (and the joint above it is blamed)
+  // when this fraction of it, and at least this many pixels, mismatch.
+  double joint_link_affected_fraction = 0;
+  int joint_link_affected_min_pixels = 0;
+  int min_environment_pixels = 0;
+  // calibration_error.environment_mismatch_fraction, robot_link_fraction.
+  double calibration_environment_mismatch_fraction = 0;
+  double calibration_robot_link_fraction = 0;
+  double unknown_object_min_area_m2 = 0;
+  double unclassified_blob_area_m2 = 0;
+
+  // estimate.*: the motion estimate (MOTION_ESTIMATE, docs/safety-chain.md):
+  // a frame with a model mismatch waits at most estimate_wait (monotonic,
+  // from its arrival; estimate.wait_ms) for the estimate of its seq, which
+  // then names the cause. Microseconds.
+  bool estimate_enabled = false;
+  int64_t estimate_wait_us = 0;
+  // estimate.max_age_ms: the estimator takes longer than a frame period on a
+  // small CPU, so the newest estimate of an earlier frame of the same
+  // camera, at most estimate_max_age older (camera utimes, not wall clock),
+  // also serves a frame whose own estimate has not come: the frame does not
+  // wait then. Fail safe either way: an estimate only renames a mismatch's
+  // cause. Microseconds.
+  int64_t estimate_max_age_us = 0;
+  // A joint offset or camera correction is significant when it exceeds
+  // estimate_sigmas times its 1-sigma uncertainty and the minimum.
+  double estimate_sigmas = 0;
+  double estimate_min_joint_offset_deg = 0;
+  double estimate_min_joint_offset_m = 0;  // prismatic joints
+  double estimate_min_translation_m = 0;
+  double estimate_min_rotation_deg = 0;
+  // Neither significant, yet the residual after the estimate is above this:
+  // something the model lacks (an unknown object), millimetres.
+  double estimate_unexplained_residual_mm = 0;
+
+  // plan.*: the plan (PLANNED_TRAJECTORY): a joint state inside the plan's
+  // time span further than this from the plan at its utime is "the arm left
+  // its plan" (degrees; metres for prismatic joints).
+  bool plan_enabled = false;
+  double plan_max_deviation_deg = 0;
+  double plan_max_deviation_m = 0;
+};
+
+// Reads (and finishes) the `risk` section.
+RiskSettings read_risk_settings(YamlMap section);
+
+// Everything tofguard-risk needs.
+struct RiskProcessSettings {
+  LcmSettings lcm;
+  ChannelNames channels;
+  // robot.urdf: the arm's kinematic tree (which joint moves which link).
+  std::string robot_urdf_path;
+  // camera.id: frames and estimates of another camera are rejected.
+  std::string camera_id;
+  RiskSettings risk;
+};
+
+}  // namespace tofguard::risk

@@ -1,0 +1,75 @@
+#include "tofguard/risk/risk_settings.hpp"
+
+namespace tofguard::risk {
+
+RiskSettings read_risk_settings(YamlMap map) {
+  RiskSettings r;
+  r.check_period_us = map.milliseconds_as_us("check_period_ms", 1, 1000);
+  r.debounce_frames = static_cast<int>(map.integer("debounce_frames", 1, 1000));
+  r.sensor_debounce_frames = static_cast<int>(map.integer("sensor_debounce_frames", 1, 1000));
+  {
+    YamlMap deadlines = map.map("deadlines_ms");
+    r.depth_deadline_us = deadlines.milliseconds_as_us("depth", 1, 60000);
+    r.discrepancy_deadline_us = deadlines.milliseconds_as_us("discrepancy", 1, 60000);
+    r.joint_state_deadline_us = deadlines.milliseconds_as_us("joint_state", 1, 60000);
+    r.heartbeat_deadline_us = deadlines.milliseconds_as_us("heartbeat", 1, 60000);
+    deadlines.finish();
+  }
+  {
+    YamlMap pose = map.map("camera_pose");
+    r.camera_pose_required = pose.boolean("required");
+    r.camera_pose_deadline_us = pose.milliseconds_as_us("deadline_ms", 1, 600000);
+    pose.finish();
+  }
+  r.required_heartbeats = map.strings("required_heartbeats");
+  {
+    YamlMap sensor = map.map("sensor");
+    r.max_invalid_fraction = sensor.number("max_invalid_fraction", 0, 1);
+    r.calibrated_required = sensor.boolean("calibrated_required");
+    r.frozen_repeat_frames = static_cast<int>(sensor.integer("frozen_repeat_frames", 1, 1000));
+    r.moving_joint_speed_rad_s = sensor.number("moving_joint_speed_rad_s", 0, 100);
+    sensor.finish();
+  }
+  {
+    YamlMap joint = map.map("joint_error");
+    r.min_link_pixels = static_cast<int>(joint.integer("min_link_pixels", 1, 1000000));
+    r.link_mismatch_fraction = joint.number("link_mismatch_fraction", 0.01, 1);
+    r.joint_link_missing_fraction = joint.number("link_missing_fraction", 0.01, 1);
+    r.joint_link_affected_fraction = joint.number("link_affected_fraction", 0.001, 1);
+    r.joint_link_affected_min_pixels = static_cast<int>(joint.integer("link_affected_min_pixels", 1, 100000));
+    joint.finish();
+  }
+  {
+    YamlMap calibration = map.map("calibration_error");
+    r.min_environment_pixels = static_cast<int>(calibration.integer("min_environment_pixels", 1, 100000000));
+    r.calibration_environment_mismatch_fraction = calibration.number("environment_mismatch_fraction", 0.01, 1);
+    r.calibration_robot_link_fraction = calibration.number("robot_link_fraction", 0, 1);
+    calibration.finish();
+  }
+  r.unknown_object_min_area_m2 = map.number("unknown_object_min_area_m2", 1e-6, 100);
+  r.unclassified_blob_area_m2 = map.number("unclassified_blob_area_m2", 1e-6, 100);
+  {
+    YamlMap estimate = map.map("estimate");
+    r.estimate_enabled = estimate.boolean("enabled");
+    r.estimate_wait_us = estimate.milliseconds_as_us("wait_ms", 0, 1000);
+    r.estimate_max_age_us = estimate.milliseconds_as_us("max_age_ms", 0, 10000);
+    r.estimate_sigmas = estimate.number("sigmas", 0, 100);
+    r.estimate_min_joint_offset_deg = estimate.number("min_joint_offset_deg", 0, 180);
+    r.estimate_min_joint_offset_m = estimate.number("min_joint_offset_m", 0, 10);
+    r.estimate_min_translation_m = estimate.number("min_translation_m", 0, 10);
+    r.estimate_min_rotation_deg = estimate.number("min_rotation_deg", 0, 180);
+    r.estimate_unexplained_residual_mm = estimate.number("unexplained_residual_mm", 0, 10000);
+    estimate.finish();
+  }
+  {
+    YamlMap plan = map.map("plan");
+    r.plan_enabled = plan.boolean("enabled");
+    r.plan_max_deviation_deg = plan.number("max_deviation_deg", 0.01, 180);
+    r.plan_max_deviation_m = plan.number("max_deviation_m", 1e-4, 10);
+    plan.finish();
+  }
+  map.finish();
+  return r;
+}
+
+}  // namespace tofguard::risk

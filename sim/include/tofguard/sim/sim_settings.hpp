@@ -1,0 +1,181 @@
+#pragma once
+// The simulator's settings: the simulated arm (config section `joints_sim`)
+// and the simulated ToF camera (config section `camera.sim`). Durations on
+// the clock are integer microseconds, converted once when the file is read;
+// the arm's motion parameters stay in seconds (they describe a sine, not a
+// deadline).
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "tofguard/camera/depth_camera_settings.hpp"
+#include "tofguard/common/camera_settings.hpp"
+#include "tofguard/common/lcm_settings.hpp"
+#include "tofguard/common/robot_settings.hpp"
+#include "tofguard/common/yaml_reader.hpp"
+
+namespace tofguard::sim {
+
+// ---- The simulated arm (joints_sim) ----
+
+// One joint's periodic motion (joints_sim.motion.<joint>):
+// position = center + amplitude * sin(2*pi*t/period_s + phase), radians (or
+// metres for a prismatic joint); t is the arm's motion time, which stands
+// still while the arm is halted.
+struct JointMotion {
+  std::string joint;
+  double center = 0;
+  double amplitude = 0;
+  double period_s = 1;
+  double phase_rad = 0;
+};
+
+// An encoder fault of the simulated arm (joints_sim.faults): from `at_s`
+// seconds of motion time after start, joint `joint` reports `offset` (rad or
+// m) more than its true position.
+struct EncoderFault {
+  std::string joint;
+  double offset = 0;
+  double at_s = 0;
+};
+
+struct JointsSimSettings {
+  // rate_hz: JOINT_STATE rate.
+  double rate_hz = 0;
+  // status_deadline_ms: the arm halts when the newest SAFETY_STATUS
+  // withdraws permission or arrived longer ago than this (monotonic clock);
+  // microseconds.
+  int64_t status_deadline_us = 0;
+  // motion: every movable joint of the URDF, in the order published.
+  std::vector<JointMotion> motion;
+  // faults (optional).
+  std::vector<EncoderFault> faults;
+  // plan.{publish, rate_hz, horizon_ms, step_ms}: the arm's own plan on
+  // PLANNED_TRAJECTORY (what an arm controller publishes): plan_rate_hz
+  // plans a second, each from now to plan_horizon ahead in steps of
+  // plan_step, in the reported (encoder) positions; a halted arm plans to
+  // stay where it is. Microseconds.
+  bool publish_plan = false;
+  double plan_rate_hz = 0;
+  int64_t plan_horizon_us = 0;
+  int64_t plan_step_us = 0;
+};
+
+// Reads (and finishes) the `joints_sim` section.
+JointsSimSettings read_joints_sim_settings(YamlMap section);
+
+// Everything tofguard-joints-sim needs.
+struct JointsSimProcessSettings {
+  LcmSettings lcm;
+  ChannelNames channels;
+  RobotSettings robot;
+  // The config file's path, for the errors SimulatedArm finds against the
+  // URDF.
+  std::string config_file;
+  JointsSimSettings joints_sim;
+};
+
+// ---- The simulated ToF camera (camera.sim) ----
+
+// One fault the simulated camera injects (camera.sim.faults), at
+// start..start+duration after the camera started.
+struct SimCameraFaultSettings {
+  // kind: "frozen_image" (the last image repeats), "stall" (no frames),
+  // "pose_drift" (the true camera pose moves away from the calibrated one),
+  // "intruding_object" (a box appears in the scene), "pan_tilt_offset"
+  // (the pan-tilt head's reading, published on CAMERA_POSE, is off from
+  // its true pan and tilt; needs camera.sim.pan_tilt).
+  std::string kind;
+  // start_s, duration_s: microseconds.
+  int64_t start_us = 0;
+  int64_t duration_us = 0;
+  // pose_drift: velocity of the optical frame's origin in the pose's frame,
+  // m/s, and rotation rate about the optical frame's axes, rad/s.
+  Eigen::Vector3d drift_translation_m_per_s = Eigen::Vector3d::Zero();
+  Eigen::Vector3d drift_rotation_rad_per_s = Eigen::Vector3d::Zero();
+  // intruding_object: an axis-aligned box in the world frame (the robot's
+  // root link), its size, its centre at the fault's start and its velocity.
+  Eigen::Vector3d object_size_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d object_position_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d object_velocity_m_per_s = Eigen::Vector3d::Zero();
+  // pan_tilt_offset (pan_offset_deg, tilt_offset_deg): reported minus true
+  // pan and tilt, radians.
+  double pan_offset_rad = 0;
+  double tilt_offset_rad = 0;
+};
+
+// The simulated ToF camera's error model (camera.sim, required when
+// camera.source is sim). Distances r are radial (along the pixel's ray),
+// metres.
+struct SimCameraSettings {
+  uint64_t seed = 0;
+  // systematic_error_m: systematic error e(r) = sum_i systematic_error_m[i]
+  // * r^i, metres; the camera measures r + e(r).
+  std::vector<double> systematic_error_m;
+  // noise.{sigma0_mm, sigma_per_m2_mm}: Gaussian noise:
+  // sigma(r) = noise_sigma0_mm + noise_sigma_per_m2_mm * r^2.
+  double noise_sigma0_mm = 0;
+  double noise_sigma_per_m2_mm = 0;
+  // amplitude.at_1m: amplitude of a surface seen perpendicularly at 1 m
+  // (camera units); it falls with 1/r^2 and the cosine of the incidence
+  // angle.
+  double amplitude_at_1m = 0;
+  // amplitude.min_valid: pixels whose amplitude is below this are invalid
+  // (depth 0).
+  double min_valid_amplitude = 0;
+  // amplitude.dark_pixel_probability: chance per pixel and frame of an
+  // invalid pixel from dark noise.
+  double dark_pixel_probability = 0;
+  // mixed_pixels.{jump_m, probability}: a depth step larger than this
+  // between 4-neighbours is a silhouette; silhouette pixels mix both
+  // surfaces with this probability.
+  double mixed_pixel_jump_m = 0;
+  double mixed_pixel_probability = 0;
+  std::vector<SimCameraFaultSettings> faults;
+  // Pan-tilt head (camera.sim.pan_tilt; absent: a fixed camera). The camera
+  // turns about the configured pose: pan about the pose frame's z axis
+  // (through the optical centre, right hand rule: positive turns left seen
+  // from above when z is up), then tilt about the optical x axis (positive
+  // looks up):
+  //   R(t) = Rz(pan(t)) * R_configured * Rx(tilt(t)),  translation fixed,
+  //   pan(t) = pan_amplitude * sin(2 pi t / pan_period_s),
+  //   tilt(t) = tilt_amplitude * sin(2 pi t / tilt_period_s),
+  // t seconds since the camera started. The head's reading (what
+  // CAMERA_POSE reports per frame) equals the true pan and tilt unless a
+  // pan_tilt_offset fault adds to it.
+  bool pan_tilt_enabled = false;
+  double pan_amplitude_rad = 0;
+  double pan_period_s = 1;
+  double tilt_amplitude_rad = 0;
+  double tilt_period_s = 1;
+};
+
+// Reads (and finishes) the `camera.sim` section.
+SimCameraSettings read_sim_camera_settings(YamlMap section);
+
+// Everything tofguard-camera needs with camera.source sim.
+struct SimCameraProcessSettings {
+  LcmSettings lcm;
+  ChannelNames channels;
+  RobotSettings robot;
+  EnvironmentSettings environment;
+  CameraSettings camera;
+  // renderer.{near_m, far_m}: the simulated camera renders the scene with
+  // the renderer's clip distances, metres.
+  double near_m = 0;
+  double far_m = 0;
+  camera::DepthCalibrationSettings depth_calibration;
+  SimCameraSettings sim;
+};
+
+// Everything tofguard-sim-fault needs (it runs with or without a config).
+struct SimFaultToolSettings {
+  LcmSettings lcm;
+  ChannelNames channels;
+  // camera.id: the camera a camera fault is for ("" without a config).
+  std::string camera_id;
+};
+
+}  // namespace tofguard::sim

@@ -1,0 +1,132 @@
+#include "tofguard/sim/sim_settings.hpp"
+
+#include <cmath>
+
+namespace tofguard::sim {
+namespace {
+
+Eigen::Vector3d vector3(YamlMap& map, const std::string& key, double limit) {
+  const auto v = map.numbers(key, 3);
+  for (double x : v) {
+    if (std::abs(x) > limit) {
+      map.fail(key, "3 numbers each in [-" + std::to_string(limit) + ", " +
+                        std::to_string(limit) + "]",
+               std::to_string(x));
+    }
+  }
+  return Eigen::Vector3d(v[0], v[1], v[2]);
+}
+
+SimCameraFaultSettings read_sim_fault(YamlMap map) {
+  SimCameraFaultSettings f;
+  f.kind = map.choice("kind", {"frozen_image", "stall", "pose_drift", "intruding_object", "pan_tilt_offset"});
+  f.start_us = map.seconds_as_us("start_s", 0, 1e6);
+  f.duration_us = map.seconds_as_us("duration_s", 0, 1e6);
+  if (f.kind == "pose_drift") {
+    f.drift_translation_m_per_s = vector3(map, "translation_m_per_s", 10);
+    f.drift_rotation_rad_per_s = vector3(map, "rotation_rad_per_s", 10);
+  } else if (f.kind == "intruding_object") {
+    f.object_size_m = vector3(map, "size_m", 10);
+    if (f.object_size_m.minCoeff() <= 0) map.fail("size_m", "3 sizes > 0");
+    f.object_position_m = vector3(map, "position_m", 100);
+    if (map.optional("velocity_m_per_s")) {
+      f.object_velocity_m_per_s = vector3(map, "velocity_m_per_s", 10);
+    }
+  } else if (f.kind == "pan_tilt_offset") {
+    f.pan_offset_rad = map.number("pan_offset_deg", -180, 180) * M_PI / 180.0;
+    f.tilt_offset_rad = map.number("tilt_offset_deg", -90, 90) * M_PI / 180.0;
+  }
+  map.finish();
+  return f;
+}
+
+}  // namespace
+
+SimCameraSettings read_sim_camera_settings(YamlMap map) {
+  SimCameraSettings c;
+  c.seed = static_cast<uint64_t>(map.integer("seed", 0, INT64_MAX));
+  c.systematic_error_m = map.numbers("systematic_error_m", -1);
+  if (c.systematic_error_m.empty() || c.systematic_error_m.size() > 10) {
+    map.fail("systematic_error_m", "1 to 10 polynomial coefficients (ascending powers, metres)",
+             std::to_string(c.systematic_error_m.size()) + " coefficients");
+  }
+  {
+    YamlMap noise = map.map("noise");
+    c.noise_sigma0_mm = noise.number("sigma0_mm", 0, 1000);
+    c.noise_sigma_per_m2_mm = noise.number("sigma_per_m2_mm", 0, 1000);
+    noise.finish();
+  }
+  {
+    YamlMap amplitude = map.map("amplitude");
+    c.amplitude_at_1m = amplitude.number("at_1m", 1, 32767);
+    c.min_valid_amplitude = amplitude.number("min_valid", 0, 32767);
+    c.dark_pixel_probability = amplitude.number("dark_pixel_probability", 0, 1);
+    amplitude.finish();
+  }
+  {
+    YamlMap mixed = map.map("mixed_pixels");
+    c.mixed_pixel_jump_m = mixed.number("jump_m", 1e-3, 100);
+    c.mixed_pixel_probability = mixed.number("probability", 0, 1);
+    mixed.finish();
+  }
+  if (map.optional("faults")) {
+    for (YamlMap& fault : map.maps("faults")) c.faults.push_back(read_sim_fault(fault));
+  }
+  if (auto pan_tilt = map.optional_map("pan_tilt")) {
+    c.pan_tilt_enabled = true;
+    c.pan_amplitude_rad = pan_tilt->number("pan_amplitude_deg", 0, 180) * M_PI / 180.0;
+    c.pan_period_s = pan_tilt->number("pan_period_s", 0.1, 1e6);
+    c.tilt_amplitude_rad = pan_tilt->number("tilt_amplitude_deg", 0, 90) * M_PI / 180.0;
+    c.tilt_period_s = pan_tilt->number("tilt_period_s", 0.1, 1e6);
+    pan_tilt->finish();
+  }
+  for (const SimCameraFaultSettings& f : c.faults) {
+    if (f.kind == "pan_tilt_offset" && !c.pan_tilt_enabled) {
+      map.fail("faults", "a pan_tilt_offset fault only with camera.sim.pan_tilt (a camera with a pan-tilt head)");
+    }
+  }
+  map.finish();
+  return c;
+}
+
+JointsSimSettings read_joints_sim_settings(YamlMap map) {
+  JointsSimSettings sim;
+  sim.rate_hz = map.number("rate_hz", 1, 1000);
+  sim.status_deadline_us = map.milliseconds_as_us("status_deadline_ms", 1, 10000);
+  YamlMap motion = map.map("motion");
+  for (const auto& joint : motion.keys()) {
+    YamlMap m = motion.map(joint);
+    JointMotion jm;
+    jm.joint = joint;
+    jm.center = m.number("center", -100, 100);
+    jm.amplitude = m.number("amplitude", 0, 100);
+    jm.period_s = m.number("period_s", 0.01, 1e6);
+    jm.phase_rad = m.optional_number("phase_rad", 0, -100, 100);
+    m.finish();
+    sim.motion.push_back(jm);
+  }
+  motion.finish();
+  if (map.optional("faults")) {
+    for (auto& f : map.maps("faults")) {
+      EncoderFault fault;
+      fault.joint = f.string("joint");
+      fault.offset = f.number("offset", -100, 100);
+      fault.at_s = f.number("at_s", 0, 1e9);
+      f.finish();
+      sim.faults.push_back(fault);
+    }
+  }
+  {
+    YamlMap plan = map.map("plan");
+    sim.publish_plan = plan.boolean("publish");
+    sim.plan_rate_hz = plan.number("rate_hz", 0.1, 1000);
+    sim.plan_horizon_us = plan.milliseconds_as_us("horizon_ms", 1, 60000);
+    sim.plan_step_us = plan.milliseconds_as_us("step_ms", 1, 10000);
+    if (sim.plan_step_us > sim.plan_horizon_us) plan.fail("step_ms", "a step no longer than horizon_ms");
+    plan.finish();
+  }
+  map.finish();
+  return sim;
+}
+
+}  // namespace tofguard::sim

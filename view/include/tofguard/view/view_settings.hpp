@@ -1,0 +1,20 @@
+#pragma once
+// What tofguard-view needs from the deployment config.
+#include "tofguard/common/lcm_settings.hpp"
+#include "tofguard/discrepancy/discrepancy_settings.hpp"
+
+namespace tofguard::view {
+
+struct ViewSettings {
+  LcmSettings lcm;
+  ChannelNames channels;
+  // The discrepancy rules, to colour the discrepancy image as
+  // tofguard-discrepancy judges it.
+  discrepancy::DiscrepancySettings discrepancy;
+  // renderer.far_m: the depth images' full scale, metres.
+  double far_m = 0;
+  // camera.rate_hz: an exported video's frame rate.
+  double camera_rate_hz = 0;
+};
+
+}  // namespace tofguard::view
