@@ -35,8 +35,7 @@ const char* kUsage =
 
 int main(int argc, char** argv) {
   using namespace tofguard::camera;
-  std::string captures_path, roi_text, intrinsics_text, channel = "TOF_DEPTH", yaml_path,
-      plot_path;
+  std::string captures_path, roi_text, intrinsics_text, channel = "TOF_DEPTH", yaml_path, plot_path;
   int degree = 5;
   const std::vector<std::string> args(argv + 1, argv + argc);
   for (size_t i = 0; i < args.size(); ++i) {
@@ -46,8 +45,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (i + 1 >= args.size()) {
-      std::cerr << "tofguard-calibrate-depth: " << a << ": unknown option or missing value\n"
-                << kUsage;
+      std::cerr << "tofguard-calibrate-depth: " << a << ": unknown option or missing value\n" << kUsage;
       return 2;
     }
     const std::string& value = args[++i];
@@ -67,8 +65,8 @@ int main(int argc, char** argv) {
       char* end = nullptr;
       const long d = std::strtol(value.c_str(), &end, 10);
       if (*end != '\0' || d < 0 || d > 9) {
-        std::cerr << "tofguard-calibrate-depth: --degree: expected an integer in [0, 9], got \""
-                  << value << "\"\n";
+        std::cerr << "tofguard-calibrate-depth: --degree: expected an integer in [0, 9], got \"" << value
+                  << "\"\n";
         return 2;
       }
       degree = static_cast<int>(d);

@@ -9,11 +9,12 @@
 
 int main(int argc, char** argv) {
   using namespace tofguard;
-  return deployment::run_process(argc, argv, camera::process_info(),
-                                 [](const deployment::Config& config, const std::vector<std::string>&) {
-                                   if (config.camera.source == "uvc") {
-                                     return camera::run_uvc_camera(deployment::uvc_camera_process_settings(config));
-                                   }
-                                   return sim::run_sim_camera(deployment::sim_camera_process_settings(config));
-                                 });
+  return deployment::run_process(
+      argc, argv, camera::process_info(),
+      [](const deployment::Config& config, const std::vector<std::string>&) {
+        if (config.camera.source == "uvc") {
+          return camera::run_uvc_camera(deployment::uvc_camera_process_settings(config));
+        }
+        return sim::run_sim_camera(deployment::sim_camera_process_settings(config));
+      });
 }

@@ -6,8 +6,9 @@
 
 int main(int argc, char** argv) {
   using namespace tofguard;
-  return deployment::run_process(argc, argv, discrepancy::process_info(),
-                                 [](const deployment::Config& config, const std::vector<std::string>&) {
-                                   return discrepancy::run_discrepancy(deployment::discrepancy_process_settings(config));
-                                 });
+  return deployment::run_process(
+      argc, argv, discrepancy::process_info(),
+      [](const deployment::Config& config, const std::vector<std::string>&) {
+        return discrepancy::run_discrepancy(deployment::discrepancy_process_settings(config));
+      });
 }

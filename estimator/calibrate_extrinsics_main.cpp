@@ -6,9 +6,9 @@
 
 int main(int argc, char** argv) {
   using namespace tofguard;
-  return deployment::run_process(argc, argv, estimator::calibrate_extrinsics_info(),
-                                 [](const deployment::Config& config, const std::vector<std::string>& arguments) {
-                                   return estimator::run_calibrate_extrinsics(
-                                       deployment::estimator_process_settings(config), arguments);
-                                 });
+  return deployment::run_process(
+      argc, argv, estimator::calibrate_extrinsics_info(),
+      [](const deployment::Config& config, const std::vector<std::string>& arguments) {
+        return estimator::run_calibrate_extrinsics(deployment::estimator_process_settings(config), arguments);
+      });
 }

@@ -6,8 +6,9 @@
 
 int main(int argc, char** argv) {
   using namespace tofguard;
-  return deployment::run_process(argc, argv, intervene::process_info(),
-                                 [](const deployment::Config& config, const std::vector<std::string>&) {
-                                   return intervene::run_intervene(deployment::intervene_process_settings(config));
-                                 });
+  return deployment::run_process(
+      argc, argv, intervene::process_info(),
+      [](const deployment::Config& config, const std::vector<std::string>&) {
+        return intervene::run_intervene(deployment::intervene_process_settings(config));
+      });
 }

@@ -6,8 +6,9 @@
 
 int main(int argc, char** argv) {
   using namespace tofguard;
-  return deployment::run_process(argc, argv, intervene::reset_info(),
-                                 [](const deployment::Config& config, const std::vector<std::string>& arguments) {
-                                   return intervene::run_reset(deployment::reset_tool_settings(config), arguments);
-                                 });
+  return deployment::run_process(
+      argc, argv, intervene::reset_info(),
+      [](const deployment::Config& config, const std::vector<std::string>& arguments) {
+        return intervene::run_reset(deployment::reset_tool_settings(config), arguments);
+      });
 }

@@ -15,8 +15,9 @@ int main(int argc, char** argv) {
   if (argc >= 2 && std::string(argv[1]) == "render") {
     return renderer::run_render_cli(std::vector<std::string>(argv + 2, argv + argc), std::cout, std::cerr);
   }
-  return deployment::run_process(argc, argv, renderer::process_info(),
-                                 [](const deployment::Config& config, const std::vector<std::string>&) {
-                                   return renderer::run_renderer(deployment::renderer_process_settings(config));
-                                 });
+  return deployment::run_process(
+      argc, argv, renderer::process_info(),
+      [](const deployment::Config& config, const std::vector<std::string>&) {
+        return renderer::run_renderer(deployment::renderer_process_settings(config));
+      });
 }

@@ -5,8 +5,9 @@
 
 int main(int argc, char** argv) {
   using namespace tofguard;
-  return deployment::run_process(argc, argv, sim::joints_sim_info(),
-                                 [](const deployment::Config& config, const std::vector<std::string>&) {
-                                   return sim::run_joints_sim(deployment::joints_sim_process_settings(config));
-                                 });
+  return deployment::run_process(
+      argc, argv, sim::joints_sim_info(),
+      [](const deployment::Config& config, const std::vector<std::string>&) {
+        return sim::run_joints_sim(deployment::joints_sim_process_settings(config));
+      });
 }

@@ -4,8 +4,9 @@
 
 int main(int argc, char** argv) {
   using namespace tofguard;
-  return deployment::run_process(argc, argv, spy::process_info(),
-                                 [](const deployment::Config& config, const std::vector<std::string>& arguments) {
-                                   return spy::run_spy(config.lcm, arguments);
-                                 });
+  return deployment::run_process(
+      argc, argv, spy::process_info(),
+      [](const deployment::Config& config, const std::vector<std::string>& arguments) {
+        return spy::run_spy(config.lcm, arguments);
+      });
 }

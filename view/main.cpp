@@ -6,8 +6,9 @@
 
 int main(int argc, char** argv) {
   using namespace tofguard;
-  return deployment::run_process(argc, argv, view::process_info(),
-                                 [](const deployment::Config& config, const std::vector<std::string>& arguments) {
-                                   return view::run_view(deployment::view_settings(config), arguments);
-                                 });
+  return deployment::run_process(
+      argc, argv, view::process_info(),
+      [](const deployment::Config& config, const std::vector<std::string>& arguments) {
+        return view::run_view(deployment::view_settings(config), arguments);
+      });
 }

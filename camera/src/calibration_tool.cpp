@@ -15,9 +15,9 @@
 #include <opencv2/imgproc.hpp>
 
 #include "tofguard/camera/depth_calibration.hpp"
-#include "tofguard/depth_image_t.hpp"
 #include "tofguard/common/camera_geometry.hpp"
 #include "tofguard/common/wire_checks.hpp"
+#include "tofguard/depth_image_t.hpp"
 
 namespace fs = std::filesystem;
 
@@ -38,8 +38,8 @@ bool parse_double(const std::string& text, double* out) {
 }
 
 std::string roi_text(const Roi& roi) {
-  return std::to_string(roi.u0) + "," + std::to_string(roi.v0) + "," + std::to_string(roi.width) +
-         "," + std::to_string(roi.height);
+  return std::to_string(roi.u0) + "," + std::to_string(roi.v0) + "," + std::to_string(roi.width) + "," +
+         std::to_string(roi.height);
 }
 
 // Checks the frame size against the capture's and the ROI.
@@ -50,14 +50,13 @@ void check_frame(const CaptureSpec& capture, const std::string& frame_name, int 
     samples->height = height;
     if (roi.u0 < 0 || roi.v0 < 0 || roi.u0 + roi.width > width || roi.v0 + roi.height > height) {
       throw CalibrationInputError(capture.where + ": ROI " + roi_text(roi) + " lies outside the " +
-                                  std::to_string(width) + "x" + std::to_string(height) +
-                                  " image of " + frame_name);
+                                  std::to_string(width) + "x" + std::to_string(height) + " image of " +
+                                  frame_name);
     }
   } else if (width != samples->width || height != samples->height) {
-    throw CalibrationInputError(capture.where + ": " + frame_name + " is " + std::to_string(width) +
-                                "x" + std::to_string(height) + ", expected " +
-                                std::to_string(samples->width) + "x" +
-                                std::to_string(samples->height) + " like the capture's first frame");
+    throw CalibrationInputError(capture.where + ": " + frame_name + " is " + std::to_string(width) + "x" +
+                                std::to_string(height) + ", expected " + std::to_string(samples->width) +
+                                "x" + std::to_string(samples->height) + " like the capture's first frame");
   }
   ++samples->frames;
 }
@@ -84,16 +83,15 @@ void take_roi(const Pixel* data, int width, int height, const PixelRays& rays, c
   }
 }
 
-void load_png_folder(const CaptureSpec& capture, const Roi& roi,
-                     const std::optional<PixelRays>& rays, CaptureSamples* samples) {
+void load_png_folder(const CaptureSpec& capture, const Roi& roi, const std::optional<PixelRays>& rays,
+                     CaptureSamples* samples) {
   std::vector<fs::path> files;
   for (const auto& entry : fs::directory_iterator(capture.path)) {
     if (entry.is_regular_file() && entry.path().extension() == ".png") files.push_back(entry.path());
   }
   std::sort(files.begin(), files.end());
   if (files.empty()) {
-    throw CalibrationInputError(capture.where + ": folder " + capture.path +
-                                " holds no .png frames");
+    throw CalibrationInputError(capture.where + ": folder " + capture.path + " holds no .png frames");
   }
   if (!rays) {
     throw CalibrationInputError(capture.where + ": PNG frames in " + capture.path +
@@ -168,12 +166,11 @@ std::vector<CaptureSpec> read_capture_list(const std::string& csv_path) {
     const size_t comma = line.rfind(',');
     CaptureSpec spec;
     spec.where = where;
-    const bool parsed = comma != std::string::npos &&
-                        parse_double(trim(line.substr(comma + 1)), &spec.true_distance_mm);
+    const bool parsed =
+        comma != std::string::npos && parse_double(trim(line.substr(comma + 1)), &spec.true_distance_mm);
     if (!parsed) {
       if (number == 1) continue;  // a header
-      throw CalibrationInputError(where + ": expected \"capture,true_distance_mm\", got \"" + line +
-                                  "\"");
+      throw CalibrationInputError(where + ": expected \"capture,true_distance_mm\", got \"" + line + "\"");
     }
     if (!(spec.true_distance_mm > 0 && spec.true_distance_mm < 32767)) {
       throw CalibrationInputError(where + ": true_distance_mm: expected a distance in (0, 32767) mm, got " +
@@ -195,8 +192,7 @@ Roi parse_roi(const std::string& text) {
   char c1 = 0, c2 = 0, c3 = 0;
   std::istringstream in(text);
   in >> roi.u0 >> c1 >> roi.v0 >> c2 >> roi.width >> c3 >> roi.height;
-  if (in.fail() || !in.eof() || c1 != ',' || c2 != ',' || c3 != ',' || roi.width <= 0 ||
-      roi.height <= 0) {
+  if (in.fail() || !in.eof() || c1 != ',' || c2 != ',' || c3 != ',' || roi.width <= 0 || roi.height <= 0) {
     throw CalibrationInputError("--roi: expected U0,V0,WIDTH,HEIGHT in pixels (width, height > 0), got \"" +
                                 text + "\"");
   }
@@ -212,8 +208,8 @@ PixelRays parse_pixel_rays(const std::string& text) {
   // on the rays alone (one pixel stands in for the size).
   if (in.fail() || !in.eof() || c1 != ',' || c2 != ',' || c3 != ',' ||
       Intrinsics::check(1, 1, rays.fx, rays.fy, rays.cx, rays.cy)) {
-    throw CalibrationInputError(
-        "--intrinsics: expected FX,FY,CX,CY in pixels (fx, fy > 0), got \"" + text + "\"");
+    throw CalibrationInputError("--intrinsics: expected FX,FY,CX,CY in pixels (fx, fy > 0), got \"" + text +
+                                "\"");
   }
   return rays;
 }
@@ -254,8 +250,8 @@ CalibrationResult calibrate(const std::vector<CaptureSpec>& captures,
     }
   }
   // Mean and standard deviation of calibrated_z(Z, f) - true Z over a group.
-  auto stats = [&](const std::vector<size_t>& group, double truth_mm, auto calibrated_z,
-                   double* mean_error, double* std_dev) {
+  auto stats = [&](const std::vector<size_t>& group, double truth_mm, auto calibrated_z, double* mean_error,
+                   double* std_dev) {
     double sum = 0, sum2 = 0;
     int64_t n = 0;
     for (size_t i : group) {
@@ -273,8 +269,8 @@ CalibrationResult calibrate(const std::vector<CaptureSpec>& captures,
   for (const auto& group : groups) {
     DistanceStats row;
     row.true_distance_mm = captures[group.front()].true_distance_mm;
-    row.samples = stats(group, row.true_distance_mm, [](double z, double) { return z; },
-                        &row.mean_error_mm, &row.std_mm);
+    row.samples = stats(
+        group, row.true_distance_mm, [](double z, double) { return z; }, &row.mean_error_mm, &row.std_mm);
     row.mean_measured_mm = row.true_distance_mm + row.mean_error_mm;
     // Along the rays: the plane at true Z lies at true Z / f on each ray.
     double radial_sum_mm = 0, radial_error_sum_mm = 0;
@@ -295,11 +291,12 @@ CalibrationResult calibrate(const std::vector<CaptureSpec>& captures,
   const DepthCalibration calibration(result.coefficients_m);
   for (size_t g = 0; g < groups.size(); ++g) {
     DistanceStats& row = result.rows[g];
-    stats(groups[g], row.true_distance_mm,
-          [&](double z_mm, double f) {
-            return 1e3 * calibration.apply_z(static_cast<float>(z_mm * 1e-3), static_cast<float>(f));
-          },
-          &row.mean_error_after_mm, &row.std_after_mm);
+    stats(
+        groups[g], row.true_distance_mm,
+        [&](double z_mm, double f) {
+          return 1e3 * calibration.apply_z(static_cast<float>(z_mm * 1e-3), static_cast<float>(f));
+        },
+        &row.mean_error_after_mm, &row.std_after_mm);
   }
   return result;
 }
@@ -310,8 +307,8 @@ std::string format_table(const CalibrationResult& result) {
   out << "true_mm   samples   measured_mm   error_mm   std_mm   error_after_mm   std_after_mm\n";
   for (const auto& r : result.rows) {
     out << std::setw(7) << r.true_distance_mm << std::setw(10) << r.samples << std::setw(14)
-        << r.mean_measured_mm << std::setw(11) << r.mean_error_mm << std::setw(9) << r.std_mm
-        << std::setw(17) << r.mean_error_after_mm << std::setw(15) << r.std_after_mm << "\n";
+        << r.mean_measured_mm << std::setw(11) << r.mean_error_mm << std::setw(9) << r.std_mm << std::setw(17)
+        << r.mean_error_after_mm << std::setw(15) << r.std_after_mm << "\n";
   }
   return out.str();
 }
@@ -393,12 +390,11 @@ void draw_plot(const CalibrationResult& result, const std::string& png_path) {
          [](const DistanceStats& r) { return r.std_mm; }, before_colour);
   series([](const DistanceStats& r) { return r.mean_error_after_mm; },
          [](const DistanceStats& r) { return r.std_after_mm; }, after_colour);
-  cv::putText(canvas, "before calibration (mean, +-1 std)", cv::Point(left + 10, top + 20), font,
-              0.55, before_colour, 2);
-  cv::putText(canvas, "after calibration (mean, +-1 std)", cv::Point(left + 10, top + 45), font,
-              0.55, after_colour, 2);
-  cv::putText(canvas, "ToF distance error vs distance", cv::Point(width / 2 - 150, 30), font, 0.7,
-              black, 2);
+  cv::putText(canvas, "before calibration (mean, +-1 std)", cv::Point(left + 10, top + 20), font, 0.55,
+              before_colour, 2);
+  cv::putText(canvas, "after calibration (mean, +-1 std)", cv::Point(left + 10, top + 45), font, 0.55,
+              after_colour, 2);
+  cv::putText(canvas, "ToF distance error vs distance", cv::Point(width / 2 - 150, 30), font, 0.7, black, 2);
   bool written = false;
   try {
     written = cv::imwrite(png_path, canvas);

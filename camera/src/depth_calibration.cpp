@@ -14,8 +14,7 @@ double evaluate_polynomial(const std::vector<double>& coefficients, double x) {
   return y;
 }
 
-std::vector<double> fit_polynomial(const std::vector<double>& x, const std::vector<double>& y,
-                                   int degree) {
+std::vector<double> fit_polynomial(const std::vector<double>& x, const std::vector<double>& y, int degree) {
   if (degree < 0) throw std::invalid_argument("polynomial degree " + std::to_string(degree));
   if (x.size() != y.size()) throw std::invalid_argument("fit_polynomial: x and y differ in size");
   const std::set<double> distinct(x.begin(), x.end());

@@ -17,8 +17,7 @@ const char* fourcc(RawDepthFormat format) {
   return format == RawDepthFormat::kZ16 ? "Z16 " : "Y16 ";
 }
 
-std::vector<float> raw16_to_distance_m(const uint8_t* bytes, size_t pixel_count,
-                                       double depth_unit_mm) {
+std::vector<float> raw16_to_distance_m(const uint8_t* bytes, size_t pixel_count, double depth_unit_mm) {
   std::vector<float> out(pixel_count);
   const double metres_per_count = depth_unit_mm * 1e-3;
   for (size_t i = 0; i < pixel_count; ++i) {

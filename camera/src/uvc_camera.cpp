@@ -1,9 +1,9 @@
 #include "tofguard/camera/uvc_camera.hpp"
 
-#include <cstdio>
-#include <cstring>
 #include <libusb-1.0/libusb.h>
 #include <libuvc/libuvc.h>
+#include <cstdio>
+#include <cstring>
 
 namespace tofguard::camera {
 namespace {
@@ -44,9 +44,8 @@ int first_streaming_interface(uvc_device_handle_t* handle) {
 // Fills `ctrl` for a format libuvc has no enum for (Z16): looks the format
 // up by FourCC in the first VideoStreaming interface's descriptors and
 // probes the frame of the wanted size with the interval nearest the rate.
-uvc_error_t stream_ctrl_by_fourcc(uvc_device_handle_t* handle, uvc_stream_ctrl_t* ctrl,
-                                  const char* fourcc, int width, int height, double rate_hz,
-                                  std::string* why) {
+uvc_error_t stream_ctrl_by_fourcc(uvc_device_handle_t* handle, uvc_stream_ctrl_t* ctrl, const char* fourcc,
+                                  int width, int height, double rate_hz, std::string* why) {
   for (const uvc_format_desc_t* format = uvc_get_format_descs(handle); format != nullptr;
        format = format->next) {
     if (format->bDescriptorSubtype != UVC_VS_FORMAT_UNCOMPRESSED ||
@@ -108,8 +107,7 @@ std::string list_usb_devices() {
   const ssize_t count = libusb_get_device_list(usb, &list);
   std::string text;
   if (count < 0) {
-    text = std::string("cannot list USB devices: libusb: ") +
-           libusb_error_name(static_cast<int>(count));
+    text = std::string("cannot list USB devices: libusb: ") + libusb_error_name(static_cast<int>(count));
   } else if (count == 0) {
     text = "USB devices found: none";
   } else {
@@ -175,26 +173,25 @@ UvcOpenResult UvcCamera::open(std::string* message) {
     handle_ = nullptr;
     const bool denied = rc == UVC_ERROR_ACCESS;
     close();
-    *message = "camera " + device_name() + ": " +
-               (denied ? "permission denied; " + install_hint()
-                       : std::string("cannot open: ") + uvc_strerror(rc));
+    *message =
+        "camera " + device_name() + ": " +
+        (denied ? "permission denied; " + install_hint() : std::string("cannot open: ") + uvc_strerror(rc));
     return denied ? UvcOpenResult::kPermissionDenied : UvcOpenResult::kFailed;
   }
   const Intrinsics& in = camera_.intrinsics;
   uvc_stream_ctrl_t ctrl;
   std::string why;
   if (format_ == RawDepthFormat::kZ16) {
-    rc = stream_ctrl_by_fourcc(handle_, &ctrl, fourcc(format_), in.width, in.height,
-                               camera_.rate_hz, &why);
+    rc = stream_ctrl_by_fourcc(handle_, &ctrl, fourcc(format_), in.width, in.height, camera_.rate_hz, &why);
   } else {
-    rc = uvc_get_stream_ctrl_format_size(handle_, &ctrl, UVC_FRAME_FORMAT_GRAY16, in.width,
-                                         in.height, static_cast<int>(camera_.rate_hz + 0.5));
+    rc = uvc_get_stream_ctrl_format_size(handle_, &ctrl, UVC_FRAME_FORMAT_GRAY16, in.width, in.height,
+                                         static_cast<int>(camera_.rate_hz + 0.5));
   }
   if (rc != UVC_SUCCESS) {
     close();
-    *message = "camera " + device_name() + " cannot stream " + uvc_.format + " " +
-               std::to_string(in.width) + "x" + std::to_string(in.height) + " at " +
-               std::to_string(camera_.rate_hz) + " Hz: " + (why.empty() ? uvc_strerror(rc) : why);
+    *message = "camera " + device_name() + " cannot stream " + uvc_.format + " " + std::to_string(in.width) +
+               "x" + std::to_string(in.height) + " at " + std::to_string(camera_.rate_hz) +
+               " Hz: " + (why.empty() ? uvc_strerror(rc) : why);
     return UvcOpenResult::kFailed;
   }
   rc = uvc_start_streaming(handle_, &ctrl, &UvcCamera::frame_callback, this, 0);
@@ -236,21 +233,20 @@ void UvcCamera::on_uvc_frame(const uvc_frame& frame) {
   const Intrinsics& in = camera_.intrinsics;
   const size_t pixels = static_cast<size_t>(in.width) * in.height;
   const int64_t frame_number = frames_seen_++;
-  if (frame.width != static_cast<uint32_t>(in.width) ||
-      frame.height != static_cast<uint32_t>(in.height) || frame.data_bytes != 2 * pixels) {
+  if (frame.width != static_cast<uint32_t>(in.width) || frame.height != static_cast<uint32_t>(in.height) ||
+      frame.data_bytes != 2 * pixels) {
     ++frames_malformed_;
     std::lock_guard<std::mutex> lock(error_mutex_);
-    last_error_ = "UVC frame dropped: " + std::to_string(frame.width) + "x" +
-                  std::to_string(frame.height) + ", " + std::to_string(frame.data_bytes) +
-                  " bytes, expected " + std::to_string(in.width) + "x" + std::to_string(in.height) +
-                  ", " + std::to_string(2 * pixels) + " bytes";
+    last_error_ = "UVC frame dropped: " + std::to_string(frame.width) + "x" + std::to_string(frame.height) +
+                  ", " + std::to_string(frame.data_bytes) + " bytes, expected " + std::to_string(in.width) +
+                  "x" + std::to_string(in.height) + ", " + std::to_string(2 * pixels) + " bytes";
     return;
   }
-  std::vector<float> depth_m = raw16_to_distance_m(static_cast<const uint8_t*>(frame.data), pixels,
-                                                   uvc_.depth_unit_mm);
+  std::vector<float> depth_m =
+      raw16_to_distance_m(static_cast<const uint8_t*>(frame.data), pixels, uvc_.depth_unit_mm);
   if (uvc_.radial_distance) radial_to_z_.apply(&depth_m);
-  const int64_t utime = static_cast<int64_t>(frame.capture_time.tv_sec) * 1000000 +
-                        frame.capture_time.tv_usec;
+  const int64_t utime =
+      static_cast<int64_t>(frame.capture_time.tv_sec) * 1000000 + frame.capture_time.tv_usec;
   on_frame_(std::move(depth_m), utime, frame_number);
 }
 

@@ -17,8 +17,7 @@ constexpr uint8_t kErr = 0x40;
 std::optional<UvcPayloadHeader> parse_uvc_payload_header(const uint8_t* payload, size_t size,
                                                          std::string* error) {
   if (size < 2) {
-    *error = "UVC payload of " + std::to_string(size) +
-             " bytes: expected at least the 2-byte header";
+    *error = "UVC payload of " + std::to_string(size) + " bytes: expected at least the 2-byte header";
     return std::nullopt;
   }
   UvcPayloadHeader h;
@@ -32,9 +31,9 @@ std::optional<UvcPayloadHeader> parse_uvc_payload_header(const uint8_t* payload,
   h.error = (info & kErr) != 0;
   const size_t needed = 2 + (h.has_pts ? 4 : 0) + (h.has_scr ? 6 : 0);
   if (h.length < needed || h.length > size) {
-    *error = "UVC payload header: bHeaderLength " + std::to_string(h.length) +
-             ", expected between " + std::to_string(needed) + " (for its PTS/SCR flags) and " +
-             std::to_string(size) + " (the payload's size)";
+    *error = "UVC payload header: bHeaderLength " + std::to_string(h.length) + ", expected between " +
+             std::to_string(needed) + " (for its PTS/SCR flags) and " + std::to_string(size) +
+             " (the payload's size)";
     return std::nullopt;
   }
   if (h.has_pts) {
@@ -67,12 +66,11 @@ void UvcFrameAssembler::finish_frame(std::vector<AssembledFrame>* out) {
     last_error_ = "UVC frame dropped: a payload had the ERR bit or a malformed header";
   } else if (frame_oversize_) {
     ++counters_.frames_oversize;
-    last_error_ = "UVC frame dropped: more than the expected " + std::to_string(frame_bytes_) +
-                  " bytes";
+    last_error_ = "UVC frame dropped: more than the expected " + std::to_string(frame_bytes_) + " bytes";
   } else if (got < frame_bytes_) {
     ++counters_.frames_short;
-    last_error_ = "UVC frame dropped: " + std::to_string(got) + " bytes, expected " +
-                  std::to_string(frame_bytes_);
+    last_error_ =
+        "UVC frame dropped: " + std::to_string(got) + " bytes, expected " + std::to_string(frame_bytes_);
   } else {
     ++counters_.frames_delivered;
     out->push_back(current_);

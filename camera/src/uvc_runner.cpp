@@ -4,10 +4,10 @@
 
 #include "tofguard/camera/camera_sources.hpp"
 #include "tofguard/camera/depth_calibration.hpp"
-#include "tofguard/common/depth_frame.hpp"
-#include "tofguard/common/clock.hpp"
-#include "tofguard/common/lcm_node.hpp"
 #include "tofguard/camera/uvc_camera.hpp"
+#include "tofguard/common/clock.hpp"
+#include "tofguard/common/depth_frame.hpp"
+#include "tofguard/common/lcm_node.hpp"
 
 namespace tofguard::camera {
 namespace {
@@ -26,11 +26,12 @@ int run_uvc_camera(const UvcCameraProcessSettings& settings) {
   std::mutex mutex;
   std::optional<PendingFrame> pending;
   int64_t overwritten = 0;  // frames replaced before they were published
-  UvcCamera camera(camera_config, settings.uvc, [&](std::vector<float> depth_m, int64_t utime, int64_t number) {
-    std::lock_guard<std::mutex> lock(mutex);
-    if (pending) ++overwritten;
-    pending = PendingFrame{std::move(depth_m), utime, number};
-  });
+  UvcCamera camera(camera_config, settings.uvc,
+                   [&](std::vector<float> depth_m, int64_t utime, int64_t number) {
+                     std::lock_guard<std::mutex> lock(mutex);
+                     if (pending) ++overwritten;
+                     pending = PendingFrame{std::move(depth_m), utime, number};
+                   });
   std::string message;
   const UvcOpenResult opened = camera.open(&message);
   if (opened != UvcOpenResult::kStreaming) {
@@ -84,8 +85,7 @@ int run_uvc_camera(const UvcCameraProcessSettings& settings) {
     }
     if (camera.is_open() && now_us - last_frame_us > lost_after_us) {
       std::cerr << "tofguard-camera: camera " << camera_config.id << ": no frame for "
-                << (now_us - last_frame_us) / 1000 << " ms (unplugged?); reopening every 1 s"
-                << std::endl;
+                << (now_us - last_frame_us) / 1000 << " ms (unplugged?); reopening every 1 s" << std::endl;
       node.heartbeat().set_status("camera lost: no frames, retrying");
       camera.close();
       next_retry_us = now_us;
@@ -93,8 +93,7 @@ int run_uvc_camera(const UvcCameraProcessSettings& settings) {
     if (!camera.is_open() && now_us >= next_retry_us) {
       std::string why;
       if (camera.open(&why) == UvcOpenResult::kStreaming) {
-        std::cerr << "tofguard-camera: camera " << camera_config.id << " is back: " << why
-                  << std::endl;
+        std::cerr << "tofguard-camera: camera " << camera_config.id << " is back: " << why << std::endl;
         node.heartbeat().set_status("streaming");
         last_frame_us = monotonic_us();
       } else {

@@ -36,8 +36,8 @@ Intrinsics::Intrinsics(int width_px, int height_px, double fx_px, double fy_px, 
   TOFGUARD_DEMAND(!v, "intrinsics: " + v->line());
 }
 
-std::optional<Violation> Intrinsics::check(int width_px, int height_px, double fx_px, double fy_px, double cx_px,
-                                           double cy_px) {
+std::optional<Violation> Intrinsics::check(int width_px, int height_px, double fx_px, double fy_px,
+                                           double cx_px, double cy_px) {
   if (auto v = check_side("width", width_px)) return v;
   if (auto v = check_side("height", height_px)) return v;
   // Written so that NaN fails too.
@@ -48,8 +48,8 @@ std::optional<Violation> Intrinsics::check(int width_px, int height_px, double f
   return std::nullopt;
 }
 
-std::optional<Intrinsics> Intrinsics::make(int width_px, int height_px, double fx_px, double fy_px, double cx_px,
-                                           double cy_px, std::string* why) {
+std::optional<Intrinsics> Intrinsics::make(int width_px, int height_px, double fx_px, double fy_px,
+                                           double cx_px, double cy_px, std::string* why) {
   if (auto v = check(width_px, height_px, fx_px, fy_px, cx_px, cy_px)) {
     if (why) *why = v->line();
     return std::nullopt;
@@ -67,11 +67,13 @@ std::optional<Violation> UnitQuaternion::check(const Eigen::Quaterniond& q, doub
                                                const std::string& field) {
   const double wxyz[4] = {q.w(), q.x(), q.y(), q.z()};
   for (int i = 0; i < 4; ++i) {
-    if (!std::isfinite(wxyz[i])) return refuse(field + "[" + std::to_string(i) + "]", "a finite number", text(wxyz[i]));
+    if (!std::isfinite(wxyz[i]))
+      return refuse(field + "[" + std::to_string(i) + "]", "a finite number", text(wxyz[i]));
   }
   const double norm = q.norm();
   if (!(std::abs(norm - 1.0) <= tolerance)) {
-    return refuse(field, "a unit quaternion w, x, y, z (norm 1 within " + text(tolerance) + ")", "norm " + text(norm));
+    return refuse(field, "a unit quaternion w, x, y, z (norm 1 within " + text(tolerance) + ")",
+                  "norm " + text(norm));
   }
   return std::nullopt;
 }
@@ -85,7 +87,8 @@ std::optional<UnitQuaternion> UnitQuaternion::make(const Eigen::Quaterniond& q, 
   return UnitQuaternion(q, tolerance);
 }
 
-CameraPose::CameraPose(std::string frame, const Eigen::Vector3d& translation, const UnitQuaternion& rotation_in_frame)
+CameraPose::CameraPose(std::string frame, const Eigen::Vector3d& translation,
+                       const UnitQuaternion& rotation_in_frame)
     : frame_id(std::move(frame)), translation_m(translation), rotation(rotation_in_frame.quaternion()) {
   const std::optional<Violation> v = check(frame_id, translation_m, rotation, kConfigQuaternionTolerance);
   TOFGUARD_DEMAND(!v, "camera pose: " + v->line());
@@ -96,7 +99,8 @@ std::optional<Violation> CameraPose::check(const std::string& frame, const Eigen
   if (frame.empty()) return refuse("frame_id", "a URDF link name", "an empty string");
   for (int i = 0; i < 3; ++i) {
     if (!std::isfinite(translation[i])) {
-      return refuse("translation[" + std::to_string(i) + "]", "a finite number of metres", text(translation[i]));
+      return refuse("translation[" + std::to_string(i) + "]", "a finite number of metres",
+                    text(translation[i]));
     }
   }
   return UnitQuaternion::check(rotation_in_frame, tolerance, "rotation");

@@ -18,9 +18,10 @@ camera_pose_t to_camera_pose_message(const std::string& camera_id, int64_t utime
 CameraPose from_camera_pose_message(const camera_pose_t& m) {
   // The message passed check_camera_pose (a checked subscription); the
   // constructors DEMAND what it checked.
-  return CameraPose(m.frame_id, Eigen::Vector3d(m.translation[0], m.translation[1], m.translation[2]),
-                    UnitQuaternion(Eigen::Quaterniond(m.rotation[0], m.rotation[1], m.rotation[2], m.rotation[3]),
-                                   kWireQuaternionTolerance));
+  return CameraPose(
+      m.frame_id, Eigen::Vector3d(m.translation[0], m.translation[1], m.translation[2]),
+      UnitQuaternion(Eigen::Quaterniond(m.rotation[0], m.rotation[1], m.rotation[2], m.rotation[3]),
+                     kWireQuaternionTolerance));
 }
 
 }  // namespace tofguard

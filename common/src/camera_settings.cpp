@@ -32,7 +32,8 @@ CameraPose read_camera_pose(YamlMap map) {
     map.fail(v->field, v->expected, v->got);
   }
   map.finish();
-  return CameraPose(frame, Eigen::Vector3d(t[0], t[1], t[2]), UnitQuaternion(rotation, kConfigQuaternionTolerance));
+  return CameraPose(frame, Eigen::Vector3d(t[0], t[1], t[2]),
+                    UnitQuaternion(rotation, kConfigQuaternionTolerance));
 }
 
 }  // namespace tofguard

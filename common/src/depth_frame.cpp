@@ -40,13 +40,13 @@ Intrinsics intrinsics_of(const depth_image_t& image) {
 depth_image_t make_depth_image(const std::string& camera_id, const Intrinsics& intrinsics, int64_t utime,
                                int64_t seq, bool calibrated, const std::vector<float>& depth_m,
                                const std::vector<float>& amplitude) {
-  const size_t n =
-      static_cast<size_t>(std::max(intrinsics.width, 0)) * static_cast<size_t>(std::max(intrinsics.height, 0));
+  const size_t n = static_cast<size_t>(std::max(intrinsics.width, 0)) *
+                   static_cast<size_t>(std::max(intrinsics.height, 0));
   if (depth_m.size() != n || (!amplitude.empty() && amplitude.size() != n)) {
     throw std::invalid_argument("make_depth_image: " + std::to_string(depth_m.size()) + " depths / " +
-                                std::to_string(amplitude.size()) + " amplitudes, expected " + std::to_string(n) +
-                                " (" + std::to_string(intrinsics.width) + "x" + std::to_string(intrinsics.height) +
-                                ")");
+                                std::to_string(amplitude.size()) + " amplitudes, expected " +
+                                std::to_string(n) + " (" + std::to_string(intrinsics.width) + "x" +
+                                std::to_string(intrinsics.height) + ")");
   }
   depth_image_t image;
   image.utime = utime;
@@ -74,7 +74,8 @@ std::vector<float> depth_m_of(const depth_image_t& image) { return depth_m_from_
 
 namespace {
 
-link_labels_t labels_header(const depth_image_t& frame, int num_robot_links, std::vector<std::string> link_names) {
+link_labels_t labels_header(const depth_image_t& frame, int num_robot_links,
+                            std::vector<std::string> link_names) {
   if (num_robot_links < 0 || static_cast<size_t>(num_robot_links) > link_names.size()) {
     throw std::invalid_argument("make_link_labels: num_robot_links " + std::to_string(num_robot_links) +
                                 ", expected 0.." + std::to_string(link_names.size()));
@@ -95,9 +96,10 @@ link_labels_t labels_header(const depth_image_t& frame, int num_robot_links, std
 
 }  // namespace
 
-link_labels_t make_link_labels(const depth_image_t& frame, int num_robot_links, std::vector<std::string> link_names,
-                               std::vector<int16_t> labels) {
-  const size_t n = static_cast<size_t>(std::max(frame.width, 0)) * static_cast<size_t>(std::max(frame.height, 0));
+link_labels_t make_link_labels(const depth_image_t& frame, int num_robot_links,
+                               std::vector<std::string> link_names, std::vector<int16_t> labels) {
+  const size_t n =
+      static_cast<size_t>(std::max(frame.width, 0)) * static_cast<size_t>(std::max(frame.height, 0));
   if (labels.size() != n) {
     throw std::invalid_argument("make_link_labels: " + std::to_string(labels.size()) + " labels, expected " +
                                 std::to_string(n) + " (" + std::to_string(frame.width) + "x" +

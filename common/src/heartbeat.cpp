@@ -9,8 +9,8 @@
 
 namespace tofguard {
 
-HeartbeatPublisher::HeartbeatPublisher(lcm::LCM* lcm, std::string channel,
-                                       std::string process_name, double rate_hz)
+HeartbeatPublisher::HeartbeatPublisher(lcm::LCM* lcm, std::string channel, std::string process_name,
+                                       double rate_hz)
     : lcm_(lcm),
       channel_(std::move(channel)),
       process_name_(std::move(process_name)),

@@ -25,7 +25,8 @@ void PlannedTrajectory::add(const planned_trajectory_t& plan) {
                 points_.end());
   points_.erase(points_.begin(), std::lower_bound(points_.begin(), points_.end(), first - keep_us_,
                                                   [](const Point& p, int64_t t) { return p.utime < t; }));
-  if (last_kept && (points_.empty() || points_.back().utime < last_kept->utime)) points_.push_back(*last_kept);
+  if (last_kept && (points_.empty() || points_.back().utime < last_kept->utime))
+    points_.push_back(*last_kept);
   for (int i = 0; i < plan.num_points; ++i) points_.push_back({plan.point_utime[i], plan.position[i]});
 }
 

@@ -30,14 +30,16 @@ std::string check_names(const std::vector<std::string>& names, const std::string
   for (size_t i = 0; i < names.size(); ++i) {
     const std::string at = field + "[" + std::to_string(i) + "]";
     if (names[i].empty()) return at + ": expected a joint name, got an empty string";
-    if (!seen.insert(names[i]).second) return at + ": expected unique joint names, got '" + names[i] + "' twice";
+    if (!seen.insert(names[i]).second)
+      return at + ": expected unique joint names, got '" + names[i] + "' twice";
   }
   return "";
 }
 
 // The rule is UnitQuaternion::check (camera_geometry.hpp).
 std::string check_unit_quaternion(const double q[4], const std::string& field) {
-  const auto v = UnitQuaternion::check(Eigen::Quaterniond(q[0], q[1], q[2], q[3]), kWireQuaternionTolerance, field);
+  const auto v =
+      UnitQuaternion::check(Eigen::Quaterniond(q[0], q[1], q[2], q[3]), kWireQuaternionTolerance, field);
   return v ? v->line() : "";
 }
 
@@ -53,10 +55,10 @@ std::string check_depth_image(const depth_image_t& image) {
     return expected("num_pixels", "width*height = " + std::to_string(pixels), image.num_pixels);
   }
   if (image.num_amplitude != 0 && image.num_amplitude != pixels) {
-    return expected("num_amplitude", "0 or width*height = " + std::to_string(pixels),
-                    image.num_amplitude);
+    return expected("num_amplitude", "0 or width*height = " + std::to_string(pixels), image.num_amplitude);
   }
-  if (auto v = Intrinsics::check(image.width, image.height, image.fx, image.fy, image.cx, image.cy)) return v->line();
+  if (auto v = Intrinsics::check(image.width, image.height, image.fx, image.fy, image.cx, image.cy))
+    return v->line();
   return "";
 }
 
@@ -143,7 +145,8 @@ std::string check_motion_estimate(const motion_estimate_t& e) {
     return expected("trigger", "one of the TRIGGER_ constants (0..2)", e.trigger);
   }
   if (!e.usable) {
-    if (e.unusable_reason.empty()) return "unusable_reason: expected a reason for an unusable estimate, got an empty string";
+    if (e.unusable_reason.empty())
+      return "unusable_reason: expected a reason for an unusable estimate, got an empty string";
     return "";
   }
   if (e.num_frames < 1) return expected("num_frames", "a count of frames >= 1", e.num_frames);
@@ -178,7 +181,8 @@ std::string check_motion_estimate(const motion_estimate_t& e) {
     return problem;
   }
   if (!std::isfinite(e.correction_translation_sigma_m) || e.correction_translation_sigma_m < 0) {
-    return expected("correction_translation_sigma_m", "a finite sigma >= 0", e.correction_translation_sigma_m);
+    return expected("correction_translation_sigma_m", "a finite sigma >= 0",
+                    e.correction_translation_sigma_m);
   }
   if (!std::isfinite(e.correction_rotation_sigma_rad) || e.correction_rotation_sigma_rad < 0) {
     return expected("correction_rotation_sigma_rad", "a finite sigma >= 0", e.correction_rotation_sigma_rad);
@@ -206,9 +210,10 @@ std::string check_planned_trajectory(const planned_trajectory_t& plan) {
       return expected("point_utime" + at, "a time > 0", static_cast<double>(plan.point_utime[i]));
     }
     if (i > 0 && plan.point_utime[i] <= plan.point_utime[i - 1]) {
-      return expected("point_utime" + at, "strictly increasing times, previous " +
-                                             std::to_string(plan.point_utime[i - 1]) + ", got",
-                      static_cast<double>(plan.point_utime[i]));
+      return expected(
+          "point_utime" + at,
+          "strictly increasing times, previous " + std::to_string(plan.point_utime[i - 1]) + ", got",
+          static_cast<double>(plan.point_utime[i]));
     }
     for (int j = 0; j < plan.num_joints; ++j) {
       if (!std::isfinite(plan.position[i][j])) {
@@ -253,15 +258,17 @@ std::string check_heartbeat(const heartbeat_t& hb) {
 }
 
 std::string check_sim_camera_fault(const sim_camera_fault_t& f) {
-  auto finite3 = [](const double v[3]) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); };
+  auto finite3 = [](const double v[3]) {
+    return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
+  };
   if (f.kind < sim_camera_fault_t::CLEAR || f.kind > sim_camera_fault_t::INTRUDING_OBJECT) {
     return "kind: expected 0..4, got " + std::to_string(f.kind);
   }
   if (f.kind != sim_camera_fault_t::CLEAR && !(f.duration_s > 0 && f.duration_s < 1e6)) {
     return "duration_s: expected a duration in (0, 1e6) s, got " + std::to_string(f.duration_s);
   }
-  if (!finite3(f.drift_translation_m_per_s) || !finite3(f.drift_rotation_rad_per_s) || !finite3(f.object_size_m) ||
-      !finite3(f.object_position_m) || !finite3(f.object_velocity_m_per_s)) {
+  if (!finite3(f.drift_translation_m_per_s) || !finite3(f.drift_rotation_rad_per_s) ||
+      !finite3(f.object_size_m) || !finite3(f.object_position_m) || !finite3(f.object_velocity_m_per_s)) {
     return "vectors: expected finite numbers";
   }
   if (f.kind == sim_camera_fault_t::INTRUDING_OBJECT &&
@@ -273,7 +280,8 @@ std::string check_sim_camera_fault(const sim_camera_fault_t& f) {
 
 std::string check_sim_joint_fault(const sim_joint_fault_t& f) {
   if (f.joint.empty()) return "joint: expected a joint name, got an empty string";
-  if (!std::isfinite(f.offset)) return expected("offset", "a finite offset (rad, or m for a prismatic joint)", f.offset);
+  if (!std::isfinite(f.offset))
+    return expected("offset", "a finite offset (rad, or m for a prismatic joint)", f.offset);
   return "";
 }
 

@@ -43,18 +43,15 @@ std::string YamlMap::key_path(const std::string& key) const {
   return key_path_.empty() ? key : key_path_ + "." + key;
 }
 
-void YamlMap::fail(const std::string& key, const std::string& expected,
-                   const std::string& got) const {
+void YamlMap::fail(const std::string& key, const std::string& expected, const std::string& got) const {
   YAML::Node at = node_[key];
-  std::string message = location(file_, at.IsDefined() ? at : node_) + ": " + key_path(key) +
-                        ": expected " + expected;
+  std::string message =
+      location(file_, at.IsDefined() ? at : node_) + ": " + key_path(key) + ": expected " + expected;
   if (!got.empty()) message += ", got " + got;
   throw ConfigError(message);
 }
 
-bool YamlMap::has(const std::string& key) const {
-  return node_[key].IsDefined() && !node_[key].IsNull();
-}
+bool YamlMap::has(const std::string& key) const { return node_[key].IsDefined() && !node_[key].IsNull(); }
 
 bool YamlMap::optional(const std::string& key) {
   read_keys_.insert(key);
@@ -66,8 +63,7 @@ YAML::Node YamlMap::required_node(const std::string& key, const std::string& exp
   const YAML::Node& node = node_;  // const lookup: never inserts the key
   YAML::Node value = node[key];
   if (!value.IsDefined() || value.IsNull()) {
-    throw ConfigError(location(file_, node_) + ": " + key_path(key) + ": missing key, expected " +
-                      expected);
+    throw ConfigError(location(file_, node_) + ": " + key_path(key) + ": missing key, expected " + expected);
   }
   return value;
 }
@@ -142,20 +138,17 @@ int64_t YamlMap::seconds_as_us(const std::string& key, double min_s, double max_
   return static_cast<int64_t>(std::llround(number(key, min_s, max_s) * 1e6));
 }
 
-double YamlMap::optional_number(const std::string& key, double default_value, double min,
-                                double max) {
+double YamlMap::optional_number(const std::string& key, double default_value, double min, double max) {
   if (!optional(key)) return default_value;
   return number(key, min, max);
 }
 
 std::vector<double> YamlMap::numbers(const std::string& key, int size) {
   const std::string expected =
-      size < 0 ? std::string("a list of numbers")
-               : "a list of " + std::to_string(size) + " numbers";
+      size < 0 ? std::string("a list of numbers") : "a list of " + std::to_string(size) + " numbers";
   YAML::Node value = required_node(key, expected);
   if (!value.IsSequence() || (size >= 0 && static_cast<int>(value.size()) != size)) {
-    fail(key, expected,
-         value.IsSequence() ? std::to_string(value.size()) + " entries" : describe(value));
+    fail(key, expected, value.IsSequence() ? std::to_string(value.size()) + " entries" : describe(value));
   }
   std::vector<double> result;
   for (const auto& item : value) {
@@ -282,8 +275,7 @@ YamlMap load_yaml_file(const std::string& path) {
   if (!root.IsMap()) {
     throw ConfigError(path + ": expected a YAML mapping at the top, got " + describe(root));
   }
-  const std::string base_dir =
-      std::filesystem::absolute(path).parent_path().lexically_normal().string();
+  const std::string base_dir = std::filesystem::absolute(path).parent_path().lexically_normal().string();
   return YamlMap(root, path, base_dir, "");
 }
 

@@ -105,8 +105,9 @@ camera::UvcCameraProcessSettings uvc_camera_process_settings(const Config& confi
 
 launch::LaunchProcessSettings launch_process_settings(const Config& config) {
   if (!config.launch) {
-    throw ConfigError(config.file +
-                      ": launch: missing key, expected a mapping with processes, restart settings, log_dir, recorder");
+    throw ConfigError(
+        config.file +
+        ": launch: missing key, expected a mapping with processes, restart settings, log_dir, recorder");
   }
   launch::LaunchProcessSettings s;
   s.config_file = config.file;

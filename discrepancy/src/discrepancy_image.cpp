@@ -43,12 +43,14 @@ class Histogram {
   // The element at index floor(q*(size-1)).
   float quantile(double q) const {
     if (count_ == 0) return 0.0f;
-    return static_cast<float>(value_at_rank(static_cast<int64_t>(std::floor(q * static_cast<double>(count_ - 1)))));
+    return static_cast<float>(
+        value_at_rank(static_cast<int64_t>(std::floor(q * static_cast<double>(count_ - 1)))));
   }
   // Adds the counts of |value| to `abs` (in place: no histogram is
   // allocated or freed while a frame is scored, see DisHistograms).
   void add_folded_to(Histogram* abs) const {
-    for (int v = -kHistogramMm; v <= kHistogramMm; ++v) abs->bins_[std::abs(v) + kHistogramMm] += bins_[v + kHistogramMm];
+    for (int v = -kHistogramMm; v <= kHistogramMm; ++v)
+      abs->bins_[std::abs(v) + kHistogramMm] += bins_[v + kHistogramMm];
     abs->count_ += count_;
   }
 
@@ -71,11 +73,11 @@ std::string mismatch_reason(const depth_image_t& camera, const depth_image_t& re
     why << "rendered frame is " << rendered.width << "x" << rendered.height << ", camera frame "
         << camera.width << "x" << camera.height;
   } else if (labels.width != camera.width || labels.height != camera.height) {
-    why << "labels are " << labels.width << "x" << labels.height << ", camera frame " << camera.width
-        << "x" << camera.height;
+    why << "labels are " << labels.width << "x" << labels.height << ", camera frame " << camera.width << "x"
+        << camera.height;
   } else if (rendered.camera_id != camera.camera_id || labels.camera_id != camera.camera_id) {
-    why << "camera_id: rendered '" << rendered.camera_id << "', labels '" << labels.camera_id
-        << "', camera '" << camera.camera_id << "'";
+    why << "camera_id: rendered '" << rendered.camera_id << "', labels '" << labels.camera_id << "', camera '"
+        << camera.camera_id << "'";
   } else if (!same_intrinsics(camera, rendered)) {
     why << "rendered intrinsics fx " << rendered.fx << " fy " << rendered.fy << " cx " << rendered.cx
         << " cy " << rendered.cy << " differ from the camera's fx " << camera.fx << " fy " << camera.fy
@@ -168,8 +170,8 @@ struct PixelClasses {
 // frame->dis_mm (allocated by the caller), with the masks and totals the
 // later stages need into `p` (fresh).
 void classify_pixels(const depth_image_t& camera, const depth_image_t& rendered, const link_labels_t& labels,
-                     const std::vector<uint8_t>& silhouette, const Tolerance& tolerance, DiscrepancyFrame* frame,
-                     PixelClasses* classes) {
+                     const std::vector<uint8_t>& silhouette, const Tolerance& tolerance,
+                     DiscrepancyFrame* frame, PixelClasses* classes) {
   PixelClasses& p = *classes;
   const int num_links = labels.num_links;
   const int num_robot_links = labels.num_robot_links;
@@ -299,7 +301,9 @@ DisHistograms per_link_statistics(const DiscrepancyFrame& frame, const depth_ima
 class PixelFootprint {
  public:
   PixelFootprint(const depth_image_t& camera, const depth_image_t& rendered)
-      : tof_(camera.depth_mm.data()), gen_(rendered.depth_mm.data()), inv_fx_fy_(1.0 / (camera.fx * camera.fy)) {}
+      : tof_(camera.depth_mm.data()),
+        gen_(rendered.depth_mm.data()),
+        inv_fx_fy_(1.0 / (camera.fx * camera.fy)) {}
   double m2(int i) const {
     const double z_m = metres_from_mm(tof_[i] > 0 ? tof_[i] : gen_[i]);
     return z_m * z_m * inv_fx_fy_;
@@ -343,9 +347,9 @@ void largest_blob(const cv::Mat1b& mismatch_mask, int opening_radius_px, const P
 // it is the 3-D distance to the modelled arm point at the nearest robot
 // pixel in the image (an approximation of the distance to the arm's visible
 // surface). Pixel count, area (m^2) and smallest distance (m; -1: none).
-void near_arm_surfaces(const depth_image_t& camera, const depth_image_t& rendered, const DiscrepancyFrame& frame,
-                       const PixelClasses& classes, const Parameters& parameters, const PixelFootprint& footprint,
-                       discrepancy_t* s) {
+void near_arm_surfaces(const depth_image_t& camera, const depth_image_t& rendered,
+                       const DiscrepancyFrame& frame, const PixelClasses& classes,
+                       const Parameters& parameters, const PixelFootprint& footprint, discrepancy_t* s) {
   const cv::Mat1b candidates = opened(classes.nearer_mask, parameters.opening_radius_px);
   s->near_arm_min_distance_m = -1;
   if (!classes.any_robot || cv::countNonZero(candidates) == 0) return;
@@ -356,7 +360,8 @@ void near_arm_surfaces(const depth_image_t& camera, const depth_image_t& rendere
   const uint8_t* pixel_class = frame.pixel_class.ptr<uint8_t>();
   cv::Mat1f distance_px;
   cv::Mat1i nearest;
-  cv::distanceTransform(classes.not_robot, distance_px, nearest, cv::DIST_L2, cv::DIST_MASK_5, cv::DIST_LABEL_PIXEL);
+  cv::distanceTransform(classes.not_robot, distance_px, nearest, cv::DIST_L2, cv::DIST_MASK_5,
+                        cv::DIST_LABEL_PIXEL);
   // Each robot pixel carries its own label: label -> pixel index.
   std::vector<int> pixel_of_label;
   const int* nearest_label = nearest.ptr<int>();
@@ -434,8 +439,8 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
                                      const link_labels_t& labels, const Parameters& parameters) {
   DiscrepancyFrame frame;
   if (!labels.usable) {
-    frame.summary = unusable_summary(camera, discrepancy_t::UNUSABLE_RENDERER,
-                                     "renderer: " + labels.unusable_reason);
+    frame.summary =
+        unusable_summary(camera, discrepancy_t::UNUSABLE_RENDERER, "renderer: " + labels.unusable_reason);
     return frame;
   }
   if (const std::string why = mismatch_reason(camera, rendered, labels); !why.empty()) {
@@ -450,8 +455,8 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
   TOFGUARD_DEMAND(camera.depth_mm.size() == static_cast<size_t>(num_pixels) &&
                       rendered.depth_mm.size() == static_cast<size_t>(num_pixels) &&
                       labels.label.size() == static_cast<size_t>(num_pixels),
-                  "frame seq " + std::to_string(camera.seq) + ": image arrays do not hold width*height = " +
-                      std::to_string(num_pixels) + " pixels");
+                  "frame seq " + std::to_string(camera.seq) +
+                      ": image arrays do not hold width*height = " + std::to_string(num_pixels) + " pixels");
   if (const std::string why = check_labels(labels); !why.empty()) {
     frame.summary = unusable_summary(camera, discrepancy_t::UNUSABLE_MISMATCHED, why);
     return frame;

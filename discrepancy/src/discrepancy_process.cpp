@@ -2,11 +2,11 @@
 
 #include <algorithm>
 
-#include "tofguard/discrepancy/discrepancy_image.hpp"
-#include "tofguard/discrepancy/frame_pairer.hpp"
 #include "tofguard/common/clock.hpp"
 #include "tofguard/common/lcm_node.hpp"
 #include "tofguard/common/wire_checks.hpp"
+#include "tofguard/discrepancy/discrepancy_image.hpp"
+#include "tofguard/discrepancy/frame_pairer.hpp"
 
 namespace tofguard::discrepancy {
 
@@ -31,23 +31,23 @@ int run_discrepancy(const DiscrepancyProcessSettings& settings) {
     node.counters().frames_out++;
     node.heartbeat().set_last_frame_utime(summary.utime);
     (summary.usable ? judged : unusable)++;
-    node.heartbeat().set_status("ok: " + std::to_string(judged) + " frames compared, " +
-                                std::to_string(unusable) + " unusable" +
-                                (node.errors().last().empty() ? "" : "; last error: " + node.errors().last()));
+    node.heartbeat().set_status(
+        "ok: " + std::to_string(judged) + " frames compared, " + std::to_string(unusable) + " unusable" +
+        (node.errors().last().empty() ? "" : "; last error: " + node.errors().last()));
   };
 
   auto handle = [&](PairingOutput& out) {
     for (PairedFrame& pair : out.paired) {
       const int64_t start_us = monotonic_us();
       const depth_image_t empty{};
-      DiscrepancyFrame frame =
-          compute_discrepancy(pair.camera.image, pair.rendered ? *pair.rendered : empty, pair.labels, parameters);
+      DiscrepancyFrame frame = compute_discrepancy(pair.camera.image, pair.rendered ? *pair.rendered : empty,
+                                                   pair.labels, parameters);
       frame.summary.depth_hash = pair.camera.depth_hash;
       frame.summary.repeat_count = pair.camera.repeat_count;
       frame.summary.compute_us = static_cast<int32_t>(monotonic_us() - start_us);
       if (!frame.summary.usable && frame.summary.unusable_kind == discrepancy_t::UNUSABLE_MISMATCHED) {
-        node.errors().report("pair", "seq " + std::to_string(frame.summary.seq) + ": " +
-                                         frame.summary.unusable_reason);
+        node.errors().report(
+            "pair", "seq " + std::to_string(frame.summary.seq) + ": " + frame.summary.unusable_reason);
       }
       publish(frame.summary);
       if (dc.colour_image_enabled) {
@@ -68,7 +68,9 @@ int run_discrepancy(const DiscrepancyProcessSettings& settings) {
   };
 
   const std::string camera_id = settings.camera_id;
-  auto check_camera = [camera_id](const depth_image_t& image) { return check_depth_image_from(image, camera_id); };
+  auto check_camera = [camera_id](const depth_image_t& image) {
+    return check_depth_image_from(image, camera_id);
+  };
 
   node.subscribe<depth_image_t>(
       node.images(), settings.channels.depth,

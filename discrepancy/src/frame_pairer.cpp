@@ -13,8 +13,8 @@ FramePairer::Pending* FramePairer::entry(int64_t seq, int64_t now_us, PairingOut
   if (it != pending_.end()) return &it->second;
   // Room for one more: push out the oldest seq first.
   while (pending_.size() >= max_pending_) {
-    give_up(pending_.begin(), "pushed out by newer frames (more than " +
-                                  std::to_string(max_pending_) + " waiting)", out);
+    give_up(pending_.begin(),
+            "pushed out by newer frames (more than " + std::to_string(max_pending_) + " waiting)", out);
   }
   Pending& fresh = pending_[seq];
   fresh.first_arrival_us = now_us;
@@ -34,7 +34,8 @@ void FramePairer::add_camera(CameraFrame frame, int64_t now_us, PairingOutput* o
 }
 
 template <class Part>
-void FramePairer::add_partner(std::optional<Part> Pending::*slot, Part part, int64_t now_us, PairingOutput* out) {
+void FramePairer::add_partner(std::optional<Part> Pending::*slot, Part part, int64_t now_us,
+                              PairingOutput* out) {
   const int64_t seq = part.seq;
   Pending* p = entry(seq, now_us, out);
   if (p == nullptr || (p->*slot).has_value()) {

@@ -9,10 +9,10 @@
 #include <cstdlib>
 #include <vector>
 
-#include "tofguard/estimator/motion_estimator.hpp"
 #include "simulated_frames.hpp"
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/deployment/process_settings.hpp"
+#include "tofguard/estimator/motion_estimator.hpp"
 
 namespace tofguard::estimator {
 namespace {
@@ -37,14 +37,15 @@ void BM_Estimate(benchmark::State& state) {
   // As tofguard-estimator runs (estimator/main.cpp): no llvmpipe render
   // threads, unless the environment says otherwise.
   setenv("LP_NUM_THREADS", "0", /*overwrite=*/0);
-  const deployment::Config config = deployment::load_config(std::string(TOFGUARD_SOURCE_DIR) + "/config/sim.yaml", nullptr);
+  const deployment::Config config =
+      deployment::load_config(std::string(TOFGUARD_SOURCE_DIR) + "/config/sim.yaml", nullptr);
   tofguard::test::SimulatedFrames frames(config);
   EstimatorOptions options;
   options.noise_sigma_at_0m_m = config.discrepancy.noise_sigma_at_0m_mm / 1000;
   options.noise_sigma_per_m2_m = config.discrepancy.noise_sigma_per_m2_mm / 1000;
   MotionEstimator estimator(frames.scene(), &frames.renderer(), options);
   const robot_model::JointPositions truth = {{"a1", -0.6}, {"a2", 1.3}, {"a3", -0.4}, {"a4", 1.2},
-                                          {"a5", 0.6},  {"a6", 1.0}, {"a7", -0.4}};
+                                             {"a5", 0.6},  {"a6", 1.0}, {"a7", -0.4}};
   const Eigen::Isometry3d camera = config.camera.pose.frame_from_optical();
   const Intrinsics intrinsics =
       scaled(config.camera.intrinsics, static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));

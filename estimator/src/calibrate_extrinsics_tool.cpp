@@ -9,8 +9,10 @@
 namespace tofguard::estimator {
 
 ProcessInfo calibrate_extrinsics_info() {
-  ProcessInfo info{"tofguard-calibrate-extrinsics",
-      "Estimates the camera's pose (extrinsic calibration) from an LCM log with TOF_DEPTH and JOINT_STATE of the "
+  ProcessInfo info{
+      "tofguard-calibrate-extrinsics",
+      "Estimates the camera's pose (extrinsic calibration) from an LCM log with TOF_DEPTH and JOINT_STATE of "
+      "the "
       "arm moving with known joint angles, starting from the config's camera.pose; prints the YAML block for "
       "camera.pose. Usage: tofguard-calibrate-extrinsics --config FILE LOG [--out FILE] [--frames N]"};
   info.takes_arguments = true;

@@ -9,22 +9,23 @@
 #include <cstring>
 #include <iostream>
 
-#include "tofguard/renderer/depth_renderer.hpp"
-#include "tofguard/robot_model/kinematics.hpp"
 #include "tofguard/common/config_error.hpp"
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/common/lcm_node.hpp"
 #include "tofguard/common/risk_names.hpp"
 #include "tofguard/common/wire_checks.hpp"
+#include "tofguard/renderer/depth_renderer.hpp"
+#include "tofguard/robot_model/kinematics.hpp"
 
 namespace tofguard::estimator {
 
 ProcessInfo process_info() {
-  return {"tofguard-estimator",
-          "Estimates which joint offsets and which camera-pose correction best explain the camera's depth image "
-          "(docs/estimator.md): TOF_DEPTH, JOINT_STATE, CAMERA_POSE, SAFETY_DISCREPANCY, SAFETY_RISK -> "
-          "MOTION_ESTIMATE, for every frame whose discrepancy passes the warning level or that tofguard-risk "
-          "judged a model mismatch, and periodically."};
+  return {
+      "tofguard-estimator",
+      "Estimates which joint offsets and which camera-pose correction best explain the camera's depth image "
+      "(docs/estimator.md): TOF_DEPTH, JOINT_STATE, CAMERA_POSE, SAFETY_DISCREPANCY, SAFETY_RISK -> "
+      "MOTION_ESTIMATE, for every frame whose discrepancy passes the warning level or that tofguard-risk "
+      "judged a model mismatch, and periodically."};
 }
 
 EstimatorOptions options_from_settings(const EstimatorProcessSettings& settings) {
@@ -46,7 +47,8 @@ robot_model::SceneModel load_estimator_scene(const EstimatorProcessSettings& set
   return robot_model::load_scene(settings.robot.urdf_path, settings.environment.urdf_paths, options);
 }
 
-EstimatorScheduler::EstimatorScheduler(const EstimatorProcessSettings& settings, const robot_model::SceneModel& scene)
+EstimatorScheduler::EstimatorScheduler(const EstimatorProcessSettings& settings,
+                                       const robot_model::SceneModel& scene)
     : settings_(settings),
       scene_(scene),
       state_(renderer::state_history_settings(settings.renderer, settings.robot.id, settings.camera)) {}
@@ -114,7 +116,8 @@ void EstimatorScheduler::on_warning(int64_t seq, int64_t utime) {
   if (frames_.empty() || seq >= frames_.begin()->first) warning_seqs_.insert(seq);
   if (estimated_.count(seq) > 0) return;
   const int64_t min_interval_us = settings_.estimator.warning_min_interval_us;
-  if (last_warning_utime_ > 0 && utime >= last_warning_utime_ && utime - last_warning_utime_ < min_interval_us) {
+  if (last_warning_utime_ > 0 && utime >= last_warning_utime_ &&
+      utime - last_warning_utime_ < min_interval_us) {
     return;  // rate limit (camera time)
   }
   last_warning_utime_ = utime;
@@ -218,7 +221,8 @@ ScheduledWork EstimatorScheduler::build(const depth_image_t& frame, int8_t trigg
   // and pose known, same size and pose frame.
   const bool warning = trigger == motion_estimate_t::TRIGGER_WARNING || warning_seqs_.count(frame.seq) > 0;
   for (auto it = frames_.lower_bound(frame.seq);
-       it != frames_.begin() && static_cast<int>(job.frames.size()) < settings_.estimator.frames_per_estimate;) {
+       it != frames_.begin() &&
+       static_cast<int>(job.frames.size()) < settings_.estimator.frames_per_estimate;) {
     --it;
     const depth_image_t& earlier = it->second;
     if ((warning_seqs_.count(it->first) > 0) != warning) continue;
@@ -230,7 +234,8 @@ ScheduledWork EstimatorScheduler::build(const depth_image_t& frame, int8_t trigg
   return work;
 }
 
-EstimatorWorker::EstimatorWorker(const robot_model::SceneModel& scene, const EstimatorProcessSettings& settings)
+EstimatorWorker::EstimatorWorker(const robot_model::SceneModel& scene,
+                                 const EstimatorProcessSettings& settings)
     : scene_(scene), settings_(settings), thread_([this] { run(); }) {}
 
 EstimatorWorker::~EstimatorWorker() {
@@ -278,7 +283,8 @@ void EstimatorWorker::run() {
   std::unique_ptr<MotionEstimator> estimator;
   try {
     // The renderer's GL context belongs to this thread.
-    renderer = std::make_unique<renderer::DepthRenderer>(scene_, settings_.renderer.near_m, settings_.renderer.far_m);
+    renderer = std::make_unique<renderer::DepthRenderer>(scene_, settings_.renderer.near_m,
+                                                         settings_.renderer.far_m);
     estimator = std::make_unique<MotionEstimator>(scene_, renderer.get(), options_from_settings(settings_));
   } catch (const std::exception& e) {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -352,7 +358,7 @@ int run_estimator(const EstimatorProcessSettings& settings) {
         node.counters().frames_out++;
         ++unusable;
         node.errors().report("unusable", "frame " + std::to_string(work.unusable->seq) +
-                                              " not estimated: " + work.unusable->unusable_reason);
+                                             " not estimated: " + work.unusable->unusable_reason);
       } else if (work.job && worker.post(std::move(*work.job))) {
         // Behind: the waiting job was replaced by this newer one.
         node.counters().frames_dropped++;
@@ -366,14 +372,15 @@ int run_estimator(const EstimatorProcessSettings& settings) {
         if (!scheduler.on_joint_state(state)) {
           node.counters().validation_errors++;
           node.errors().report(settings.channels.joint_state,
-                               settings.channels.joint_state + ": ignored a message for robot_id '" + state.robot_id +
-                                   "' (expected '" + settings.robot.id + "') or not newer than the last");
+                               settings.channels.joint_state + ": ignored a message for robot_id '" +
+                                   state.robot_id + "' (expected '" + settings.robot.id +
+                                   "') or not newer than the last");
         }
       },
       check_joint_state);
   node.subscribe<camera_pose_t>(
-      node.safety(), settings.channels.camera_pose, [&](const camera_pose_t& pose) { scheduler.on_camera_pose(pose); },
-      check_camera_pose);
+      node.safety(), settings.channels.camera_pose,
+      [&](const camera_pose_t& pose) { scheduler.on_camera_pose(pose); }, check_camera_pose);
   node.subscribe<depth_image_t>(
       node.images(), settings.channels.depth,
       [&](const depth_image_t& frame) {

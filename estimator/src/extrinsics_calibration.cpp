@@ -8,14 +8,14 @@
 #include <memory>
 #include <sstream>
 
-#include "tofguard/estimator/estimator_process.hpp"
-#include "tofguard/renderer/depth_renderer.hpp"
-#include "tofguard/robot_state/state_history.hpp"
 #include "tofguard/common/decode.hpp"
 #include "tofguard/common/depth_frame.hpp"
-#include "tofguard/depth_image_t.hpp"
-#include "tofguard/joint_state_t.hpp"
 #include "tofguard/common/wire_checks.hpp"
+#include "tofguard/depth_image_t.hpp"
+#include "tofguard/estimator/estimator_process.hpp"
+#include "tofguard/joint_state_t.hpp"
+#include "tofguard/renderer/depth_renderer.hpp"
+#include "tofguard/robot_state/state_history.hpp"
 
 namespace tofguard::estimator {
 
@@ -75,11 +75,13 @@ CalibrationResult calibrate_extrinsics(const EstimatorProcessSettings& settings,
   }
   result.frames_in_log = static_cast<int>(frames.size());
   if (frames.empty()) {
-    result.error = log_path + ": no " + settings.channels.depth + " frames of camera '" + settings.camera.id + "'";
+    result.error =
+        log_path + ": no " + settings.channels.depth + " frames of camera '" + settings.camera.id + "'";
     return result;
   }
   if (joint_states == 0) {
-    result.error = log_path + ": no " + settings.channels.joint_state + " messages of robot '" + settings.robot.id + "'";
+    result.error =
+        log_path + ": no " + settings.channels.joint_state + " messages of robot '" + settings.robot.id + "'";
     return result;
   }
 
@@ -124,9 +126,10 @@ CalibrationResult calibrate_extrinsics(const EstimatorProcessSettings& settings,
   }
   result.frames_used = static_cast<int>(chosen.size());
   if (result.frames_used < options.min_frames) {
-    result.error = log_path + ": too few frames with distinct arm poses (" + std::to_string(result.frames_used) +
-                   " at least " + std::to_string(options.min_pose_distance_rad) + " rad apart, of " +
-                   std::to_string(frames.size()) + " frames; need " + std::to_string(options.min_frames) + ")";
+    result.error =
+        log_path + ": too few frames with distinct arm poses (" + std::to_string(result.frames_used) +
+        " at least " + std::to_string(options.min_pose_distance_rad) + " rad apart, of " +
+        std::to_string(frames.size()) + " frames; need " + std::to_string(options.min_frames) + ")";
     return result;
   }
 
@@ -173,9 +176,10 @@ CalibrationResult calibrate_extrinsics(const EstimatorProcessSettings& settings,
   result.pose.translation_m = estimated.translation();
   result.pose.rotation = Eigen::Quaterniond(estimated.linear());
   if (!estimate.converged) {
-    result.error = "did not converge in " + std::to_string(estimate.iterations) +
-                   " iterations (residual " + std::to_string(result.residual_before_mm) + " -> " +
-                   std::to_string(result.residual_after_mm) + " mm): is the initial pose within ~5 cm / 5 deg?";
+    result.error = "did not converge in " + std::to_string(estimate.iterations) + " iterations (residual " +
+                   std::to_string(result.residual_before_mm) + " -> " +
+                   std::to_string(result.residual_after_mm) +
+                   " mm): is the initial pose within ~5 cm / 5 deg?";
   }
   return result;
 }

@@ -162,13 +162,16 @@ MotionEstimator::MotionEstimator(const robot_model::SceneModel& scene, renderer:
     : scene_(scene), renderer_(renderer), options_(options) {
   if (renderer_ == nullptr) throw std::invalid_argument("MotionEstimator: renderer is null");
   const EstimatorOptions& o = options_;
-  if (o.pixel_stride < 1 || !(o.final_robust_scale_m > 0) || !(o.initial_robust_scale_m >= o.final_robust_scale_m) ||
+  if (o.pixel_stride < 1 || !(o.final_robust_scale_m > 0) ||
+      !(o.initial_robust_scale_m >= o.final_robust_scale_m) ||
       !(o.robust_scale_factor > 0 && o.robust_scale_factor < 1) || !(o.gate_scales >= 1) ||
-      o.max_iterations < 1 || !(o.final_damping >= 0) || o.max_working_pixels < 64 || o.coarse_pixel_stride < 1 || !(o.coarse_skip_step >= 0) || o.max_camera_iterations < 1 || !(o.step_tolerance > 0) ||
-      !(o.joint_search_step_rad > 0) || !(o.joint_search_range_rad >= 0) || o.joint_search_rounds < 0 ||
-      o.min_joint_points < 1 || !(o.max_joint_sigma > 0) || !(o.sigma_scale > 0) || !(o.residual_clip_m > 0) ||
-      !(o.noise_sigma_at_0m_m > 0) || !(o.model_sigma_m >= 0) || !(o.noise_sigma_per_m2_m >= 0) || !(o.normal_jump_m > 0) || !(o.contour_jump_fraction > 0) ||
-      !(o.final_contour_scale_px > 0) || !(o.contour_sigma_px > 0)) {
+      o.max_iterations < 1 || !(o.final_damping >= 0) || o.max_working_pixels < 64 ||
+      o.coarse_pixel_stride < 1 || !(o.coarse_skip_step >= 0) || o.max_camera_iterations < 1 ||
+      !(o.step_tolerance > 0) || !(o.joint_search_step_rad > 0) || !(o.joint_search_range_rad >= 0) ||
+      o.joint_search_rounds < 0 || o.min_joint_points < 1 || !(o.max_joint_sigma > 0) ||
+      !(o.sigma_scale > 0) || !(o.residual_clip_m > 0) || !(o.noise_sigma_at_0m_m > 0) ||
+      !(o.model_sigma_m >= 0) || !(o.noise_sigma_per_m2_m >= 0) || !(o.normal_jump_m > 0) ||
+      !(o.contour_jump_fraction > 0) || !(o.final_contour_scale_px > 0) || !(o.contour_sigma_px > 0)) {
     throw std::invalid_argument("MotionEstimator: options out of range");
   }
   num_params_ = static_cast<int>(scene_.actuated_joint_names.size());
@@ -200,7 +203,8 @@ std::string MotionEstimator::check_frame(const EstimatorFrame& frame) const {
   if (const auto v = frame.intrinsics.check()) return "intrinsics: " + v->line();
   const size_t pixels = static_cast<size_t>(frame.intrinsics.width) * frame.intrinsics.height;
   if (frame.depth_m.size() != pixels) {
-    return "depth image: expected " + std::to_string(pixels) + " pixels, got " + std::to_string(frame.depth_m.size());
+    return "depth image: expected " + std::to_string(pixels) + " pixels, got " +
+           std::to_string(frame.depth_m.size());
   }
   for (const std::string& name : scene_.actuated_joint_names) {
     const auto found = frame.reported_joints.find(name);
@@ -214,7 +218,7 @@ std::string MotionEstimator::check_frame(const EstimatorFrame& frame) const {
 namespace {
 
 robot_model::JointPositions joints_at(const robot_model::SceneModel& scene, const EstimatorFrame& frame,
-                                   const std::vector<double>& offsets) {
+                                      const std::vector<double>& offsets) {
   robot_model::JointPositions joints = frame.reported_joints;
   for (size_t k = 0; k < offsets.size(); ++k) joints[scene.actuated_joint_names[k]] += offsets[k];
   return joints;
@@ -229,7 +233,8 @@ std::vector<JointAxis> joint_axes(const robot_model::SceneModel& scene, const ro
   std::vector<JointAxis> axes(scene.joints.size());
   for (size_t j = 0; j < scene.joints.size(); ++j) {
     const robot_model::Joint& joint = scene.joints[j];
-    const Eigen::Isometry3d world_from_joint = poses.world_from_link[joint.parent_link] * joint.parent_from_joint;
+    const Eigen::Isometry3d world_from_joint =
+        poses.world_from_link[joint.parent_link] * joint.parent_from_joint;
     axes[j].axis_world = world_from_joint.linear() * joint.axis;
     axes[j].origin_world = world_from_joint.translation();
   }
@@ -314,9 +319,9 @@ struct MotionEstimator::RenderedView {
 };
 
 void MotionEstimator::add_residual(const RenderedView& view, const std::vector<ChainJoint>& chain,
-                                   const Eigen::Vector3d& m, const Eigen::Vector3d& world, const Eigen::Vector3d& g,
-                                   double residual, double weight, bool count_joint_points, double d_depth_offset,
-                                   Linearization* lin) const {
+                                   const Eigen::Vector3d& m, const Eigen::Vector3d& world,
+                                   const Eigen::Vector3d& g, double residual, double weight,
+                                   bool count_joint_points, double d_depth_offset, Linearization* lin) const {
   const int n = num_params_;
   const Eigen::Vector3d g_cross_m = g.cross(m);
   if (chain.empty() || !view.joints_free) {
@@ -342,8 +347,8 @@ void MotionEstimator::add_residual(const RenderedView& view, const std::vector<C
   }
 }
 
-void MotionEstimator::add_contour_term(const RenderedView& view, const std::vector<ChainJoint>& chain, int u, int v,
-                                       Linearization* lin) const {
+void MotionEstimator::add_contour_term(const RenderedView& view, const std::vector<ChainJoint>& chain, int u,
+                                       int v, Linearization* lin) const {
   const Intrinsics& in = view.frame.intrinsics;
   const int width = in.width;
   const std::vector<float>& model = view.rendered.depth_m;
@@ -372,12 +377,13 @@ void MotionEstimator::add_contour_term(const RenderedView& view, const std::vect
   // d(e)/d(m) = outward^T * d(pixel)/d(m).
   const Eigen::Vector3d g(outward.x() * in.fx * inv_z, outward.y() * in.fy * inv_z,
                           -(outward.x() * in.fx * m.x() + outward.y() * in.fy * m.y()) * inv_z * inv_z);
-  add_residual(view, chain, m, view.world_from_optical * m, g, e, tukey * view.contour_weight, false, 0.0, lin);
+  add_residual(view, chain, m, view.world_from_optical * m, g, e, tukey * view.contour_weight, false, 0.0,
+               lin);
   ++lin->num_contour_inliers;
 }
 
-void MotionEstimator::add_depth_term(const RenderedView& view, const std::vector<ChainJoint>& chain, int link, int u,
-                                     int v, Linearization* lin, std::vector<Sample>* samples) const {
+void MotionEstimator::add_depth_term(const RenderedView& view, const std::vector<ChainJoint>& chain, int link,
+                                     int u, int v, Linearization* lin, std::vector<Sample>* samples) const {
   const Intrinsics& in = view.frame.intrinsics;
   const int width = in.width;
   const std::vector<float>& model = view.rendered.depth_m;
@@ -395,8 +401,9 @@ void MotionEstimator::add_depth_term(const RenderedView& view, const std::vector
   }
   if (!smooth) return;
   const Eigen::Vector3d m = view.back_project(u, v, z_model);
-  Eigen::Vector3d normal = (view.back_project(u + 1, v, model[right]) - view.back_project(u - 1, v, model[left]))
-                               .cross(view.back_project(u, v + 1, model[down]) - view.back_project(u, v - 1, model[up]));
+  Eigen::Vector3d normal =
+      (view.back_project(u + 1, v, model[right]) - view.back_project(u - 1, v, model[left]))
+          .cross(view.back_project(u, v + 1, model[down]) - view.back_project(u, v - 1, model[up]));
   const double normal_norm = normal.norm();
   if (!(normal_norm > 0)) return;
   normal /= normal_norm;
@@ -431,10 +438,11 @@ void MotionEstimator::add_depth_term(const RenderedView& view, const std::vector
                true, robot ? -normal.dot(ray) : 0.0, lin);
 }
 
-std::string MotionEstimator::linearize(const EstimatorFrame& frame, const State& state, double scale, int stride,
-                                       PointSet points, bool joints_free, Linearization* lin,
+std::string MotionEstimator::linearize(const EstimatorFrame& frame, const State& state, double scale,
+                                       int stride, PointSet points, bool joints_free, Linearization* lin,
                                        std::vector<Sample>* samples) {
-  const robot_model::LinkPoses poses = robot_model::forward_kinematics(scene_, joints_at(scene_, frame, state.joint_offsets));
+  const robot_model::LinkPoses poses =
+      robot_model::forward_kinematics(scene_, joints_at(scene_, frame, state.joint_offsets));
   if (!poses.usable) return poses.unusable_reason;
   const Eigen::Isometry3d world_from_optical = frame.world_from_optical * state.correction;
   const renderer::RenderResult rendered = renderer_->render_at(poses, world_from_optical, frame.intrinsics);
@@ -464,7 +472,8 @@ std::string MotionEstimator::linearize(const EstimatorFrame& frame, const State&
   for (int v = 1; v + 1 < height; ++v) {
     for (int u = 1; u + 1 < width; ++u) {
       const size_t i = static_cast<size_t>(v) * width + u;
-      const int link = link_of_label(rendered.labels[i], scene_.num_robot_links, static_cast<int>(scene_.links.size()));
+      const int link =
+          link_of_label(rendered.labels[i], scene_.num_robot_links, static_cast<int>(scene_.links.size()));
       if (link < 0) continue;
       const std::vector<ChainJoint>& chain = chains_[link];
       if (points == PointSet::kStatic && !chain.empty()) continue;
@@ -519,20 +528,22 @@ std::string MotionEstimator::solve(const std::vector<const EstimatorFrame*>& fra
   const int coarse_stride = std::max(options_.pixel_stride, options_.coarse_pixel_stride);
   int level = 0;  // the robust scale's step in its schedule
   for (int it = 0; it < max_iterations; ++it, ++level) {
-    const double scale = std::max(options_.final_robust_scale_m,
-                                  options_.initial_robust_scale_m * std::pow(options_.robust_scale_factor, level));
+    const double scale =
+        std::max(options_.final_robust_scale_m,
+                 options_.initial_robust_scale_m * std::pow(options_.robust_scale_factor, level));
     const bool final_scale = scale <= options_.final_robust_scale_m * (1 + 1e-9);
     lin.reset(n);
     for (const EstimatorFrame* frame : frames) {
-      const std::string error = linearize(*frame, *state, scale, final_scale ? options_.pixel_stride : coarse_stride,
-                                          points, joints_free, &lin, nullptr);
+      const std::string error =
+          linearize(*frame, *state, scale, final_scale ? options_.pixel_stride : coarse_stride, points,
+                    joints_free, &lin, nullptr);
       if (!error.empty()) return error;
     }
     ++*iterations;
     *final_lin = lin;
     const std::vector<int> active =
         active_parameters(lin.hessian, lin.joint_points, n, joints_free, camera_free,
-                        joints_free && options_.estimate_robot_depth_offset, options_.min_joint_points);
+                          joints_free && options_.estimate_robot_depth_offset, options_.min_joint_points);
     if (active.empty()) {
       *converged = true;
       return "";
@@ -565,8 +576,10 @@ std::string MotionEstimator::solve(const std::vector<const EstimatorFrame*>& fra
     }
     Eigen::Vector3d v = full.segment<3>(n);
     Eigen::Vector3d w = full.segment<3>(n + 3);
-    if (v.norm() > options_.max_camera_translation_step_m) v *= options_.max_camera_translation_step_m / v.norm();
-    if (w.norm() > options_.max_camera_rotation_step_rad) w *= options_.max_camera_rotation_step_rad / w.norm();
+    if (v.norm() > options_.max_camera_translation_step_m)
+      v *= options_.max_camera_translation_step_m / v.norm();
+    if (w.norm() > options_.max_camera_rotation_step_rad)
+      w *= options_.max_camera_rotation_step_rad / w.norm();
     largest = std::max({largest, v.cwiseAbs().maxCoeff(), w.cwiseAbs().maxCoeff()});
     state->robot_depth_offset_m += std::clamp(full[n + 6], -0.02, 0.02);
     state->correction = state->correction * twist_exp(v, w);
@@ -590,7 +603,8 @@ int MotionEstimator::search_joints(const EstimatorFrame& frame, State* state, st
   const double tolerance_floor = options_.final_robust_scale_m;
   int moves = 0;
   std::vector<double> grid;
-  const int steps = static_cast<int>(std::floor(options_.joint_search_range_rad / options_.joint_search_step_rad));
+  const int steps =
+      static_cast<int>(std::floor(options_.joint_search_range_rad / options_.joint_search_step_rad));
   for (int s = -steps; s <= steps; ++s) {
     if (s != 0) grid.push_back(s * options_.joint_search_step_rad);
   }
@@ -598,10 +612,11 @@ int MotionEstimator::search_joints(const EstimatorFrame& frame, State* state, st
     std::vector<Sample> samples;
     Linearization scratch;
     scratch.reset(num_params_);
-    *error = linearize(frame, *state, options_.final_robust_scale_m, options_.pixel_stride, PointSet::kAll, false,
-                       &scratch, &samples);
+    *error = linearize(frame, *state, options_.final_robust_scale_m, options_.pixel_stride, PointSet::kAll,
+                       false, &scratch, &samples);
     if (!error->empty()) return moves;
-    const robot_model::LinkPoses base = robot_model::forward_kinematics(scene_, joints_at(scene_, frame, state->joint_offsets));
+    const robot_model::LinkPoses base =
+        robot_model::forward_kinematics(scene_, joints_at(scene_, frame, state->joint_offsets));
     const Eigen::Isometry3d optical_from_world = (frame.world_from_optical * state->correction).inverse();
 
     // +1 for a point the camera sees where the model puts it, -1 for one
@@ -662,7 +677,8 @@ int MotionEstimator::search_joints(const EstimatorFrame& frame, State* state, st
       for (double offset : grid) {
         std::vector<double> offsets = state->joint_offsets;
         offsets[k] += offset;
-        const robot_model::LinkPoses poses = robot_model::forward_kinematics(scene_, joints_at(scene_, frame, offsets));
+        const robot_model::LinkPoses poses =
+            robot_model::forward_kinematics(scene_, joints_at(scene_, frame, offsets));
         if (!poses.usable) continue;
         for (size_t l = 0; l < moved.size(); ++l) {
           moved[l] = poses.world_from_link[l] * base.world_from_link[l].inverse();
@@ -685,8 +701,8 @@ int MotionEstimator::search_joints(const EstimatorFrame& frame, State* state, st
   return moves;
 }
 
-EstimateResult MotionEstimator::finish(const EstimatorFrame& frame, const State& state, const Linearization& lin,
-                                       bool camera_free, bool joints_free) const {
+EstimateResult MotionEstimator::finish(const EstimatorFrame& frame, const State& state,
+                                       const Linearization& lin, bool camera_free, bool joints_free) const {
   EstimateResult result;
   result.usable = true;
   const int n = num_params_;
@@ -778,7 +794,8 @@ EstimateResult MotionEstimator::estimate_frames(const std::vector<const Estimato
   if (full_frames.empty()) return fail("no frames");
   for (size_t f = 0; f < full_frames.size(); ++f) {
     const std::string problem = check_frame(*full_frames[f]);
-    if (!problem.empty()) return fail(full_frames.size() > 1 ? "frame " + std::to_string(f) + ": " + problem : problem);
+    if (!problem.empty())
+      return fail(full_frames.size() > 1 ? "frame " + std::to_string(f) + ": " + problem : problem);
     if (full_frames[f]->intrinsics.width != full_frames[0]->intrinsics.width ||
         full_frames[f]->intrinsics.height != full_frames[0]->intrinsics.height) {
       return fail("frame " + std::to_string(f) + ": image size differs from frame 0's");
@@ -806,8 +823,8 @@ EstimateResult MotionEstimator::estimate_frames(const std::vector<const Estimato
   // The residual before: the estimate's own frame at the reported values.
   Linearization before;
   before.reset(num_params_);
-  std::string error = linearize(frame, state, options_.final_robust_scale_m, options_.pixel_stride, PointSet::kAll,
-                                false, &before, nullptr);
+  std::string error = linearize(frame, state, options_.final_robust_scale_m, options_.pixel_stride,
+                                PointSet::kAll, false, &before, nullptr);
   if (!error.empty()) return fail(error);
 
   const bool joints_free = options_.estimate_joints;
@@ -817,8 +834,8 @@ EstimateResult MotionEstimator::estimate_frames(const std::vector<const Estimato
   Linearization lin = before;
   if (joints_free && camera_free) {
     // The camera first from what no joint moves.
-    error = solve(frames, false, true, PointSet::kStatic, options_.max_camera_iterations, &state, &lin, &converged,
-                  &iterations);
+    error = solve(frames, false, true, PointSet::kStatic, options_.max_camera_iterations, &state, &lin,
+                  &converged, &iterations);
     if (!error.empty()) return fail("camera: " + error);
   }
   int moves = 0;
@@ -862,16 +879,15 @@ EstimateResult MotionEstimator::estimate_camera(const std::vector<EstimatorFrame
   Linearization before;
   before.reset(num_params_);
   for (const EstimatorFrame* frame : pointers) {
-    const std::string error =
-        linearize(*frame, state, options_.final_robust_scale_m, options_.pixel_stride, PointSet::kAll, false, &before,
-                  nullptr);
+    const std::string error = linearize(*frame, state, options_.final_robust_scale_m, options_.pixel_stride,
+                                        PointSet::kAll, false, &before, nullptr);
     if (!error.empty()) return fail(error);
   }
   Linearization lin = before;
   int iterations = 0;
   bool converged = false;
-  const std::string error =
-      solve(pointers, false, true, PointSet::kAll, options_.max_iterations, &state, &lin, &converged, &iterations);
+  const std::string error = solve(pointers, false, true, PointSet::kAll, options_.max_iterations, &state,
+                                  &lin, &converged, &iterations);
   if (!error.empty()) return fail(error);
   EstimateResult result = finish(frames[0], state, lin, true, false);
   result.converged = converged;

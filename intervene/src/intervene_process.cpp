@@ -96,20 +96,20 @@ int run_intervene(const InterveneProcessSettings& settings) {
       check_risk);
   node.subscribe<joint_state_t>(
       node.safety(), settings.channels.joint_state,
-      [&](const joint_state_t& joints) { logic.on_joint_state(joints, monotonic_us()); },
-      check_joint_state);
-  node.subscribe<reset_request_t>(node.safety(), settings.channels.reset, [&](const reset_request_t& request) {
-    const ResetDecision decision = logic.on_reset(request, monotonic_us(), wall_utime());
-    reset_reply_t reply;
-    reply.utime = wall_utime();
-    reply.request_id = request.request_id;
-    reply.accepted = decision.accepted;
-    reply.reason = decision.reason;
-    std::cerr << "tofguard-intervene: reset from '" << request.who << "' (" << request.why
-              << "): " << decision.reason << std::endl;
-    publish_if_changed();
-    node.safety().publish(settings.channels.reset_reply, &reply);
-  });
+      [&](const joint_state_t& joints) { logic.on_joint_state(joints, monotonic_us()); }, check_joint_state);
+  node.subscribe<reset_request_t>(
+      node.safety(), settings.channels.reset, [&](const reset_request_t& request) {
+        const ResetDecision decision = logic.on_reset(request, monotonic_us(), wall_utime());
+        reset_reply_t reply;
+        reply.utime = wall_utime();
+        reply.request_id = request.request_id;
+        reply.accepted = decision.accepted;
+        reply.reason = decision.reason;
+        std::cerr << "tofguard-intervene: reset from '" << request.who << "' (" << request.why
+                  << "): " << decision.reason << std::endl;
+        publish_if_changed();
+        node.safety().publish(settings.channels.reset_reply, &reply);
+      });
   node.add_timer(static_cast<int64_t>(1e6 / settings.intervention.publish_rate_hz), [&] {
     logic.tick(monotonic_us(), wall_utime());
     logic.take_changed();

@@ -28,7 +28,8 @@ std::string describe(const risk_t& risk) {
 // under a power cut. A robot controller reading motion_allowed alone must
 // see the same decision as one reading stop or latched.
 void demand_consistent(const Status& s) {
-  TOFGUARD_DEMAND(s.motion_allowed == (s.stop == safety_status_t::STOP_NONE) && s.motion_allowed == !s.latched &&
+  TOFGUARD_DEMAND(s.motion_allowed == (s.stop == safety_status_t::STOP_NONE) &&
+                      s.motion_allowed == !s.latched &&
                       (s.power_enabled || s.stop == safety_status_t::STOP_POWER_CUT),
                   "inconsistent status: motion_allowed " + std::to_string(s.motion_allowed) + ", stop " +
                       std::to_string(s.stop) + ", latched " + std::to_string(s.latched) + ", power_enabled " +
@@ -37,8 +38,7 @@ void demand_consistent(const Status& s) {
 
 }  // namespace
 
-InterventionLogic::InterventionLogic(const InterventionSettings& config, int64_t now_us,
-                                     int64_t now_utime)
+InterventionLogic::InterventionLogic(const InterventionSettings& config, int64_t now_us, int64_t now_utime)
     : config_(config), risk_arrival_us_(now_us) {
   // Fail-safe start: stopped and latched. The risk deadline runs from now,
   // so a chain that never starts ends in a power cut.
@@ -119,45 +119,41 @@ void InterventionLogic::on_joint_state(const joint_state_t& joints, int64_t now_
   joint_state_arrival_us_ = now_us;
 }
 
-void InterventionLogic::on_actuator_result(const std::string& error, int64_t now_us,
-                                           int64_t now_utime) {
+void InterventionLogic::on_actuator_result(const std::string& error, int64_t now_us, int64_t now_utime) {
   if (error == actuator_error_) return;
   actuator_error_ = error;
   if (!error.empty()) {
-    stop(safety_status_t::STOP_SOFTWARE, risk_t::CAUSE_COMPONENT_FAULT,
-         "power-cut actuator error: " + error, now_us, now_utime);
+    stop(safety_status_t::STOP_SOFTWARE, risk_t::CAUSE_COMPONENT_FAULT, "power-cut actuator error: " + error,
+         now_us, now_utime);
   }
   changed_ = true;
 }
 
 void InterventionLogic::tick(int64_t now_us, int64_t now_utime) {
   if (!risk_fresh(now_us)) {
-    const std::string reason =
-        received_risk_ ? "SAFETY_RISK stale: none for " + ms(now_us - risk_arrival_us_)
-                       : "no SAFETY_RISK received for " + ms(now_us - risk_arrival_us_);
+    const std::string reason = received_risk_
+                                   ? "SAFETY_RISK stale: none for " + ms(now_us - risk_arrival_us_)
+                                   : "no SAFETY_RISK received for " + ms(now_us - risk_arrival_us_);
     stop(safety_status_t::STOP_POWER_CUT, risk_t::CAUSE_COMPONENT_FAULT, reason, now_us, now_utime);
   }
   if (status_.stop == safety_status_t::STOP_SOFTWARE &&
       now_us - stop_started_us_ > config_.stop_deadline_us) {
     const bool joint_state_fresh =
-        joint_state_arrival_us_ >= 0 &&
-        now_us - joint_state_arrival_us_ <= config_.joint_state_deadline_us;
+        joint_state_arrival_us_ >= 0 && now_us - joint_state_arrival_us_ <= config_.joint_state_deadline_us;
     if (!joint_state_fresh) {
       stop(safety_status_t::STOP_POWER_CUT, risk_t::CAUSE_SENSOR_FAULT,
-           "no fresh JOINT_STATE shows the arm stopped " + ms(now_us - stop_started_us_) +
-               " after the stop",
+           "no fresh JOINT_STATE shows the arm stopped " + ms(now_us - stop_started_us_) + " after the stop",
            now_us, now_utime);
     } else if (max_speed_ > config_.stopped_velocity) {
       std::ostringstream reason;
-      reason << "arm still moving " << ms(now_us - stop_started_us_) << " after the stop ("
-             << fastest_joint_ << " at " << max_speed_ << ")";
+      reason << "arm still moving " << ms(now_us - stop_started_us_) << " after the stop (" << fastest_joint_
+             << " at " << max_speed_ << ")";
       stop(safety_status_t::STOP_POWER_CUT, status_.cause, reason.str(), now_us, now_utime);
     }
   }
 }
 
-ResetDecision InterventionLogic::on_reset(const reset_request_t& request, int64_t now_us,
-                                          int64_t now_utime) {
+ResetDecision InterventionLogic::on_reset(const reset_request_t& request, int64_t now_us, int64_t now_utime) {
   if (request.who.empty() || request.why.empty()) {
     return {false, "refused: a reset needs who and why"};
   }

@@ -30,8 +30,7 @@ bool hid_relay_is_on(const std::array<uint8_t, 8>& state_report, int channel) {
   return (state_report[7] >> (channel - 1)) & 1;
 }
 
-UsbHidRelay::UsbHidRelay(int channel, std::string serial)
-    : channel_(channel), serial_(std::move(serial)) {
+UsbHidRelay::UsbHidRelay(int channel, std::string serial) : channel_(channel), serial_(std::move(serial)) {
   if (libusb_init(&usb_) != 0) usb_ = nullptr;
 }
 
@@ -63,19 +62,19 @@ std::string UsbHidRelay::open() {
     libusb_device_handle* handle = nullptr;
     const int r = libusb_open(devices[i], &handle);
     if (r != 0) {
-      problem = r == LIBUSB_ERROR_ACCESS
-                    ? "USB HID relay 16c0:05df: permission denied (install "
-                      "scripts/udev/99-tofguard-relay.rules into /etc/udev/rules.d/)"
-                    : usb_error("USB HID relay 16c0:05df: cannot open", r);
+      problem = r == LIBUSB_ERROR_ACCESS ? "USB HID relay 16c0:05df: permission denied (install "
+                                           "scripts/udev/99-tofguard-relay.rules into /etc/udev/rules.d/)"
+                                         : usb_error("USB HID relay 16c0:05df: cannot open", r);
       continue;
     }
     if (!serial_.empty()) {
       std::array<uint8_t, 8> state{};
       const int n = libusb_control_transfer(
-          handle, LIBUSB_ENDPOINT_IN | LIBUSB_REQUEST_TYPE_CLASS | LIBUSB_RECIPIENT_INTERFACE,
-          kGetReport, kFeatureReport0, 0, state.data(), state.size(), kTimeoutMs);
+          handle, LIBUSB_ENDPOINT_IN | LIBUSB_REQUEST_TYPE_CLASS | LIBUSB_RECIPIENT_INTERFACE, kGetReport,
+          kFeatureReport0, 0, state.data(), state.size(), kTimeoutMs);
       // The board's serial is the first five bytes of its state report.
-      if (n < 5 || std::string(reinterpret_cast<char*>(state.data()), strnlen(reinterpret_cast<char*>(state.data()), 5)) != serial_) {
+      if (n < 5 || std::string(reinterpret_cast<char*>(state.data()),
+                               strnlen(reinterpret_cast<char*>(state.data()), 5)) != serial_) {
         libusb_close(handle);
         continue;
       }
@@ -86,10 +85,10 @@ std::string UsbHidRelay::open() {
   if (boards.size() != 1) {
     for (auto* h : boards) libusb_close(h);
     if (boards.empty()) {
-      return problem.empty() ? "USB HID relay 16c0:05df" +
-                                   (serial_.empty() ? std::string() : " with serial " + serial_) +
-                                   " not found"
-                             : problem;
+      return problem.empty()
+                 ? "USB HID relay 16c0:05df" + (serial_.empty() ? std::string() : " with serial " + serial_) +
+                       " not found"
+                 : problem;
     }
     return "USB HID relay: " + std::to_string(boards.size()) +
            " boards 16c0:05df found: set intervention.usb_hid_relay.serial";
@@ -111,25 +110,24 @@ std::string UsbHidRelay::set_power(bool enabled, const std::string&) {
   }
   auto report = hid_relay_report(channel_, enabled);
   int r = libusb_control_transfer(
-      handle_, LIBUSB_ENDPOINT_OUT | LIBUSB_REQUEST_TYPE_CLASS | LIBUSB_RECIPIENT_INTERFACE,
-      kSetReport, kFeatureReport0, 0, report.data(), report.size(), kTimeoutMs);
+      handle_, LIBUSB_ENDPOINT_OUT | LIBUSB_REQUEST_TYPE_CLASS | LIBUSB_RECIPIENT_INTERFACE, kSetReport,
+      kFeatureReport0, 0, report.data(), report.size(), kTimeoutMs);
   if (r < 0) {
     close();  // unplugged or broken: reopen next time
     return usb_error("USB HID relay: cannot switch the relay", r);
   }
   // Read the state back: the command only counts when the board confirms it.
   std::array<uint8_t, 8> state{};
-  r = libusb_control_transfer(
-      handle_, LIBUSB_ENDPOINT_IN | LIBUSB_REQUEST_TYPE_CLASS | LIBUSB_RECIPIENT_INTERFACE,
-      kGetReport, kFeatureReport0, 0, state.data(), state.size(), kTimeoutMs);
+  r = libusb_control_transfer(handle_,
+                              LIBUSB_ENDPOINT_IN | LIBUSB_REQUEST_TYPE_CLASS | LIBUSB_RECIPIENT_INTERFACE,
+                              kGetReport, kFeatureReport0, 0, state.data(), state.size(), kTimeoutMs);
   if (r < 8) {
     close();
     return r < 0 ? usb_error("USB HID relay: cannot read the relay state", r)
                  : "USB HID relay: short state report";
   }
   if (hid_relay_is_on(state, channel_) != enabled) {
-    return "USB HID relay: relay " + std::to_string(channel_) + " did not switch " +
-           (enabled ? "on" : "off");
+    return "USB HID relay: relay " + std::to_string(channel_) + " did not switch " + (enabled ? "on" : "off");
   }
   return "";
 }

@@ -83,7 +83,12 @@ int run_launch(const LaunchProcessSettings& settings) {
       spec.name = "recorder-" + which;
       spec.required = false;
       spec.log_path = launch.log_dir + "/" + spec.name + ".log";
-      spec.argv = {logger, "--lcm-url=" + url, "-q", "-i", "--split-mb=" + split, "-s",
+      spec.argv = {logger,
+                   "--lcm-url=" + url,
+                   "-q",
+                   "-i",
+                   "--split-mb=" + split,
+                   "-s",
                    recordings + "/" + which + "-%Y%m%d-%H%M%S.lcmlog"};
       specs.push_back(spec);
     }

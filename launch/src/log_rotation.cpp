@@ -1,7 +1,7 @@
 #include "tofguard/launch/log_rotation.hpp"
 
-#include <algorithm>
 #include <sys/stat.h>
+#include <algorithm>
 
 #include <filesystem>
 

@@ -29,11 +29,16 @@ struct ProcessGroup::Managed {
 
 std::string state_name(ProcessState state) {
   switch (state) {
-    case ProcessState::kNotStarted: return "not started";
-    case ProcessState::kRunning: return "running";
-    case ProcessState::kWaitingToRestart: return "restarting";
-    case ProcessState::kGaveUp: return "FAILED (left stopped)";
-    case ProcessState::kStopped: return "stopped";
+    case ProcessState::kNotStarted:
+      return "not started";
+    case ProcessState::kRunning:
+      return "running";
+    case ProcessState::kWaitingToRestart:
+      return "restarting";
+    case ProcessState::kGaveUp:
+      return "FAILED (left stopped)";
+    case ProcessState::kStopped:
+      return "stopped";
   }
   return "?";
 }
@@ -142,8 +147,9 @@ void ProcessGroup::poll(int64_t now_us) {
       const auto delay_us = p->restarts.on_exit(now_us);
       if (!delay_us) {
         p->state = ProcessState::kGaveUp;
-        report_(p->spec.name + ": " + p->last_exit + "; crashed " + std::to_string(p->restarts.recent_restarts()) +
-                " times recently: left stopped" + (p->spec.required ? " (REQUIRED: the arm stays stopped)" : ""));
+        report_(p->spec.name + ": " + p->last_exit + "; crashed " +
+                std::to_string(p->restarts.recent_restarts()) + " times recently: left stopped" +
+                (p->spec.required ? " (REQUIRED: the arm stays stopped)" : ""));
         continue;
       }
       p->state = ProcessState::kWaitingToRestart;

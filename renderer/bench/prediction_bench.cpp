@@ -10,10 +10,10 @@
 //       --benchmark_report_aggregates_only=true   (one command line)
 #include <benchmark/benchmark.h>
 
-#include "tofguard/renderer/renderer_process.hpp"
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/deployment/process_settings.hpp"
+#include "tofguard/renderer/renderer_process.hpp"
 
 namespace tofguard::renderer {
 namespace {
@@ -22,7 +22,8 @@ constexpr int64_t kT0 = 1'700'000'000'000'000;
 constexpr int64_t kPeriodUs = 33'333;
 
 const deployment::Config& sim_config() {
-  static const deployment::Config config = deployment::load_config(std::string(TOFGUARD_SOURCE_DIR) + "/config/sim.yaml", nullptr);
+  static const deployment::Config config =
+      deployment::load_config(std::string(TOFGUARD_SOURCE_DIR) + "/config/sim.yaml", nullptr);
   return config;
 }
 
@@ -72,7 +73,8 @@ void frame_to_rendered(benchmark::State& state, bool with_plan) {
   int64_t next_joint_utime = kT0 - 100'000;
   auto next_frame = [&] {
     utime += kPeriodUs;
-    for (; next_joint_utime <= utime + 10'000; next_joint_utime += 10'000) service.on_joint_state(joints_at(next_joint_utime));
+    for (; next_joint_utime <= utime + 10'000; next_joint_utime += 10'000)
+      service.on_joint_state(joints_at(next_joint_utime));
     return frame_at(utime, ++seq);
   };
   // Two frames to learn the period.

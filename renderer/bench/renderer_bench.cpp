@@ -33,14 +33,15 @@ BenchScene* friend_arm() {
   static std::unique_ptr<BenchScene> scene = [] {
     auto s = std::make_unique<BenchScene>();
     const std::string models = std::string(TOFGUARD_SOURCE_DIR) + "/config/models/";
-    const robot_model::SceneModel model = robot_model::load_scene(models + "friend_arm.urdf", {models + "wheelchair_environment.urdf"}, {});
+    const robot_model::SceneModel model =
+        robot_model::load_scene(models + "friend_arm.urdf", {models + "wheelchair_environment.urdf"}, {});
     s->renderer = std::make_unique<DepthRenderer>(model, 0.1, 8.0);
     s->joints = model.actuated_joint_names;
     s->pose.frame_id = "world";
     s->pose.translation_m = Eigen::Vector3d(-0.35, -0.20, 1.55);
     s->pose.rotation = Eigen::Quaterniond(0.298836239, -0.640856382, 0.640856382, -0.298836239);
-    std::cerr << "friend_arm + environment: " << model.num_triangles() << " triangles, " << model.shapes.size()
-              << " shapes; " << s->renderer->description() << "\n";
+    std::cerr << "friend_arm + environment: " << model.num_triangles() << " triangles, "
+              << model.shapes.size() << " shapes; " << s->renderer->description() << "\n";
     return s;
   }();
   return scene.get();
@@ -48,7 +49,8 @@ BenchScene* friend_arm() {
 
 BenchScene* iiwa14() {
   static std::unique_ptr<BenchScene> scene = []() -> std::unique_ptr<BenchScene> {
-    const auto urdf = std::filesystem::path(TOFGUARD_SOURCE_DIR).parent_path() / "shared/robots/iiwa14/urdf/"
+    const auto urdf = std::filesystem::path(TOFGUARD_SOURCE_DIR).parent_path() /
+                      "shared/robots/iiwa14/urdf/"
                       "iiwa14_no_collision_relative.urdf";
     if (!std::filesystem::exists(urdf)) return nullptr;
     auto s = std::make_unique<BenchScene>();
@@ -61,9 +63,10 @@ BenchScene* iiwa14() {
     s->pose.rotation = Eigen::Quaterniond(0.5, -0.5, -0.5, 0.5);
     int closed = 0;
     for (const robot_model::TriangleMesh& mesh : model.meshes) closed += mesh.closed_outward;
-    std::cerr << "iiwa14 visual: " << model.num_triangles() << " triangles, " << model.shapes.size() << " shapes, "
-              << closed - robot_model::kNumUnitMeshes << " of " << model.meshes.size() - robot_model::kNumUnitMeshes
-              << " meshes closed (back faces culled); " << s->renderer->description() << "\n";
+    std::cerr << "iiwa14 visual: " << model.num_triangles() << " triangles, " << model.shapes.size()
+              << " shapes, " << closed - robot_model::kNumUnitMeshes << " of "
+              << model.meshes.size() - robot_model::kNumUnitMeshes << " meshes closed (back faces culled); "
+              << s->renderer->description() << "\n";
     return s;
   }();
   return scene.get();
@@ -93,7 +96,8 @@ void render_loop(benchmark::State& state, BenchScene* scene) {
   int i = 0;
   size_t seen = 0;
   for (auto _ : state) {
-    for (size_t j = 0; j < scene->joints.size(); ++j) joints[scene->joints[j]] = 0.3 + 0.001 * (i % 100) * (j + 1);
+    for (size_t j = 0; j < scene->joints.size(); ++j)
+      joints[scene->joints[j]] = 0.3 + 0.001 * (i % 100) * (j + 1);
     const RenderResult r = scene->renderer->render(joints, scene->pose, k);
     if (!r.usable) {
       state.SkipWithError(r.unusable_reason.c_str());

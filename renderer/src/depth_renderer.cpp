@@ -75,7 +75,8 @@ ExtraObject ExtraObject::box(const Eigen::Vector3d& edges_m, const Eigen::Isomet
 ExtraObject ExtraObject::sphere(double radius_m, const Eigen::Isometry3d& world_from_object) {
   return {Kind::kSphere, Eigen::Vector3d(radius_m, radius_m, radius_m), world_from_object};
 }
-ExtraObject ExtraObject::cylinder(double radius_m, double length_m, const Eigen::Isometry3d& world_from_object) {
+ExtraObject ExtraObject::cylinder(double radius_m, double length_m,
+                                  const Eigen::Isometry3d& world_from_object) {
   return {Kind::kCylinder, Eigen::Vector3d(radius_m, radius_m, length_m), world_from_object};
 }
 
@@ -150,8 +151,8 @@ struct DepthRenderer::Impl {
     std::vector<uint32_t> indices;
     for (const robot_model::TriangleMesh& mesh : scene.meshes) {
       const uint32_t base = static_cast<uint32_t>(vertices.size() / 3);
-      ranges.push_back(
-          {static_cast<GLsizei>(mesh.indices.size()), indices.size() * sizeof(uint32_t), mesh.closed_outward});
+      ranges.push_back({static_cast<GLsizei>(mesh.indices.size()), indices.size() * sizeof(uint32_t),
+                        mesh.closed_outward});
       for (const Eigen::Vector3f& v : mesh.vertices) vertices.insert(vertices.end(), {v.x(), v.y(), v.z()});
       for (uint32_t i : mesh.indices) indices.push_back(base + i);
     }
@@ -238,7 +239,8 @@ struct DepthRenderer::Impl {
       return result;
     };
     if (!poses.usable) return unusable(poses.unusable_reason);
-    if (poses.world_from_link.size() != scene.links.size()) return unusable("link poses do not match the scene");
+    if (poses.world_from_link.size() != scene.links.size())
+      return unusable("link poses do not match the scene");
     // A caller of this public API may hand in intrinsics it assembled field
     // by field: refused as unusable, not DEMANDed.
     if (const auto v = intrinsics.check()) return unusable("intrinsics: " + v->line());
@@ -273,10 +275,9 @@ struct DepthRenderer::Impl {
     for (const robot_model::Shape& shape : scene.shapes) {
       // SceneModel::links: the robot's first, then the environment's.
       const int label = label_of_link(shape.link_index, scene.num_robot_links);
-      const Eigen::Matrix4d optical_from_mesh = (optical_from_world * poses.world_from_link[shape.link_index] *
-                                                 shape.link_from_shape)
-                                                    .matrix() *
-                                                shape.scale.homogeneous().asDiagonal();
+      const Eigen::Matrix4d optical_from_mesh =
+          (optical_from_world * poses.world_from_link[shape.link_index] * shape.link_from_shape).matrix() *
+          shape.scale.homogeneous().asDiagonal();
       draw(shape.mesh_index, optical_from_mesh, label);
     }
     for (size_t i = 0; i < extra_objects.size(); ++i) {
@@ -298,9 +299,10 @@ struct DepthRenderer::Impl {
                     "readback buffer does not match the " + std::to_string(intrinsics.width) + "x" +
                         std::to_string(intrinsics.height) + " framebuffer");
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
-    glReadPixels(0, 0, intrinsics.width, intrinsics.height, read_channels == 2 ? GL_RG_INTEGER : GL_RGBA_INTEGER,
-                 GL_UNSIGNED_INT, readback.data());
-    if (const GLenum error = glGetError(); error != GL_NO_ERROR) return unusable("GL: " + gl_error_text(error));
+    glReadPixels(0, 0, intrinsics.width, intrinsics.height,
+                 read_channels == 2 ? GL_RG_INTEGER : GL_RGBA_INTEGER, GL_UNSIGNED_INT, readback.data());
+    if (const GLenum error = glGetError(); error != GL_NO_ERROR)
+      return unusable("GL: " + gl_error_text(error));
 
     result.depth_m.resize(pixels);
     result.labels.resize(pixels);
@@ -338,14 +340,16 @@ struct DepthRenderer::Impl {
 DepthRenderer::DepthRenderer(const robot_model::SceneModel& scene, double near_m, double far_m)
     : DepthRenderer(scene, near_m, far_m, egl_platform_from_environment()) {}
 
-DepthRenderer::DepthRenderer(const robot_model::SceneModel& scene, double near_m, double far_m, EglPlatform platform) {
+DepthRenderer::DepthRenderer(const robot_model::SceneModel& scene, double near_m, double far_m,
+                             EglPlatform platform) {
   if (!(std::isfinite(near_m) && std::isfinite(far_m) && near_m > 0 && far_m > near_m)) {
-    throw std::invalid_argument("DepthRenderer: need 0 < near_m < far_m, got near_m " + std::to_string(near_m) +
-                                ", far_m " + std::to_string(far_m));
+    throw std::invalid_argument("DepthRenderer: need 0 < near_m < far_m, got near_m " +
+                                std::to_string(near_m) + ", far_m " + std::to_string(far_m));
   }
   if (scene.num_robot_links >= kMaxLabelledRobotLinks ||
       static_cast<int>(scene.links.size()) - scene.num_robot_links >= kMaxLabelledEnvironmentLinks) {
-    throw std::invalid_argument("DepthRenderer: at most 999 robot links and 1000 environment links can be labelled");
+    throw std::invalid_argument(
+        "DepthRenderer: at most 999 robot links and 1000 environment links can be labelled");
   }
   impl_ = std::make_unique<Impl>(scene, near_m, far_m, platform);
 }
@@ -353,7 +357,8 @@ DepthRenderer::DepthRenderer(const robot_model::SceneModel& scene, double near_m
 DepthRenderer::~DepthRenderer() = default;
 
 RenderResult DepthRenderer::render(const robot_model::JointPositions& joints, const CameraPose& camera_pose,
-                                   const Intrinsics& intrinsics, const std::vector<ExtraObject>& extra_objects) {
+                                   const Intrinsics& intrinsics,
+                                   const std::vector<ExtraObject>& extra_objects) {
   robot_model::LinkPoses poses = robot_model::forward_kinematics(impl_->scene, joints);
   Eigen::Isometry3d world_from_optical = Eigen::Isometry3d::Identity();
   if (poses.usable) {
@@ -370,8 +375,10 @@ RenderResult DepthRenderer::render(const robot_model::JointPositions& joints, co
   return impl_->render_at(poses, world_from_optical, intrinsics, extra_objects);
 }
 
-RenderResult DepthRenderer::render_at(const robot_model::LinkPoses& link_poses, const Eigen::Isometry3d& world_from_optical,
-                                      const Intrinsics& intrinsics, const std::vector<ExtraObject>& extra_objects) {
+RenderResult DepthRenderer::render_at(const robot_model::LinkPoses& link_poses,
+                                      const Eigen::Isometry3d& world_from_optical,
+                                      const Intrinsics& intrinsics,
+                                      const std::vector<ExtraObject>& extra_objects) {
   return impl_->render_at(link_poses, world_from_optical, intrinsics, extra_objects);
 }
 

@@ -69,8 +69,8 @@ EGLContext create_context(EGLDisplay display, std::string* why) {
     release();
     return EGL_NO_CONTEXT;
   }
-  const EGLint config_attributes[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_ES3_BIT, EGL_SURFACE_TYPE, EGL_PBUFFER_BIT,
-                                      EGL_NONE};
+  const EGLint config_attributes[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_ES3_BIT, EGL_SURFACE_TYPE,
+                                      EGL_PBUFFER_BIT, EGL_NONE};
   EGLConfig config = nullptr;
   EGLint num_configs = 0;
   if (!eglChooseConfig(display, config_attributes, &config, 1, &num_configs) || num_configs < 1) {
@@ -101,10 +101,12 @@ EGLContext create_context(EGLDisplay display, std::string* why) {
 
 EglPlatform egl_platform_from_environment() {
   const char* value = std::getenv("TOFGUARD_EGL_PLATFORM");
-  if (value == nullptr || std::strcmp(value, "") == 0 || std::strcmp(value, "auto") == 0) return EglPlatform::kAuto;
+  if (value == nullptr || std::strcmp(value, "") == 0 || std::strcmp(value, "auto") == 0)
+    return EglPlatform::kAuto;
   if (std::strcmp(value, "device") == 0) return EglPlatform::kDevice;
   if (std::strcmp(value, "surfaceless") == 0) return EglPlatform::kSurfaceless;
-  throw RenderError(std::string("TOFGUARD_EGL_PLATFORM must be auto, device or surfaceless, got '") + value + "'");
+  throw RenderError(std::string("TOFGUARD_EGL_PLATFORM must be auto, device or surfaceless, got '") + value +
+                    "'");
 }
 
 EglContext::EglContext(EglPlatform platform) {
@@ -112,13 +114,15 @@ EglContext::EglContext(EglPlatform platform) {
   const auto get_platform_display =
       reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
   if (get_platform_display == nullptr || !has_extension(client_extensions, "EGL_EXT_platform_base")) {
-    throw RenderError("EGL: no EGL_EXT_platform_base (eglGetPlatformDisplayEXT); cannot render without a display");
+    throw RenderError(
+        "EGL: no EGL_EXT_platform_base (eglGetPlatformDisplayEXT); cannot render without a display");
   }
   std::string tried;
   const auto note = [&](const std::string& what) { tried += (tried.empty() ? "" : "; ") + what; };
 
   if (platform != EglPlatform::kSurfaceless) {
-    const auto query_devices = reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
+    const auto query_devices =
+        reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
     const auto query_device_string =
         reinterpret_cast<PFNEGLQUERYDEVICESTRINGEXTPROC>(eglGetProcAddress("eglQueryDeviceStringEXT"));
     EGLint num_devices = 0;
@@ -156,7 +160,8 @@ EglContext::EglContext(EglPlatform platform) {
     if (!has_extension(client_extensions, "EGL_MESA_platform_surfaceless")) {
       note("surfaceless platform: no EGL_MESA_platform_surfaceless");
     } else {
-      const EGLDisplay display = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+      const EGLDisplay display =
+          get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
       std::string why;
       context_ = create_context(display, &why);
       if (context_ != EGL_NO_CONTEXT) {
@@ -174,7 +179,8 @@ EglContext::EglContext(EglPlatform platform) {
 
 EglContext::~EglContext() {
   if (context_ == EGL_NO_CONTEXT) return;
-  if (eglGetCurrentContext() == context_) eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+  if (eglGetCurrentContext() == context_)
+    eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
   eglDestroyContext(display_, context_);
   std::lock_guard<std::mutex> lock(display_mutex);
   if (--display_users[display_] == 0) {

@@ -34,7 +34,8 @@ std::vector<double> parse_numbers(const std::string& option, const std::string& 
     values.push_back(value);
   }
   if (values.size() != count) {
-    throw UsageError(option + ": expected " + std::to_string(count) + " comma-separated numbers, got '" + text + "'");
+    throw UsageError(option + ": expected " + std::to_string(count) + " comma-separated numbers, got '" +
+                     text + "'");
   }
   return values;
 }
@@ -49,7 +50,8 @@ int whole(const std::string& option, double value) {
 }  // namespace
 
 std::string render_cli_usage() {
-  return "usage: tofguard-renderer render --urdf ROBOT.urdf [--env ENV.urdf ...] [--geometry visual|collision]\n"
+  return "usage: tofguard-renderer render --urdf ROBOT.urdf [--env ENV.urdf ...] [--geometry "
+         "visual|collision]\n"
          "         [--padding METRES] [--package-path DIR ...] [--joint NAME=VALUE ...]\n"
          "         --camera-pose x,y,z,qw,qx,qy,qz [--frame LINK] --intrinsics W,H,fx,fy,cx,cy\n"
          "         [--near METRES] [--far METRES] --out DEPTH.png [--labels LABELS.png]\n"
@@ -89,7 +91,8 @@ int run_render_cli(const std::vector<std::string>& args, std::ostream& out, std:
         options.package_paths.push_back(value);
       } else if (option == "--joint") {
         const size_t equals = value.find('=');
-        if (equals == std::string::npos || equals == 0) throw UsageError("--joint: expected NAME=VALUE, got '" + value + "'");
+        if (equals == std::string::npos || equals == 0)
+          throw UsageError("--joint: expected NAME=VALUE, got '" + value + "'");
         joints[value.substr(0, equals)] = parse_numbers(option, value.substr(equals + 1), 1)[0];
       } else if (option == "--camera-pose") {
         const std::vector<double> v = parse_numbers(option, value, 7);
@@ -158,9 +161,10 @@ int run_render_cli(const std::vector<std::string>& args, std::ostream& out, std:
       err << "tofguard-renderer render: cannot write " << labels_path << "\n";
       return 1;
     }
-    out << "wrote " << out_path << (labels_path.empty() ? "" : " and " + labels_path) << ": " << result.width << "x"
-        << result.height << ", " << robot_pixels << " robot pixels, " << environment_pixels
-        << " environment pixels, " << scene.num_triangles() << " triangles (" << renderer.description() << ")\n";
+    out << "wrote " << out_path << (labels_path.empty() ? "" : " and " + labels_path) << ": " << result.width
+        << "x" << result.height << ", " << robot_pixels << " robot pixels, " << environment_pixels
+        << " environment pixels, " << scene.num_triangles() << " triangles (" << renderer.description()
+        << ")\n";
     return 0;
   } catch (const std::exception& e) {
     err << "tofguard-renderer render: " << e.what() << "\n";

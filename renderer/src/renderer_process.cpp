@@ -14,10 +14,11 @@
 namespace tofguard::renderer {
 
 ProcessInfo process_info() {
-  return {"tofguard-renderer",
-          "Renders the arm's model at the reported joint angles from the camera's pose: TOF_DEPTH, JOINT_STATE, "
-          "CAMERA_POSE, PLANNED_TRAJECTORY (rendering the next frame ahead) -> TOF_RENDERED, TOF_LABELS.\n"
-          "Also: tofguard-renderer render --help (one image to PNG files)."};
+  return {
+      "tofguard-renderer",
+      "Renders the arm's model at the reported joint angles from the camera's pose: TOF_DEPTH, JOINT_STATE, "
+      "CAMERA_POSE, PLANNED_TRAJECTORY (rendering the next frame ahead) -> TOF_RENDERED, TOF_LABELS.\n"
+      "Also: tofguard-renderer render --help (one image to PNG files)."};
 }
 
 robot_model::SceneOptions scene_options(const RendererSettings& renderer, const RobotSettings& robot) {
@@ -30,7 +31,8 @@ robot_model::SceneOptions scene_options(const RendererSettings& renderer, const 
 
 namespace {
 
-std::unique_ptr<DepthRenderer> make_renderer(const robot_model::SceneModel& scene, const RendererSettings& config) {
+std::unique_ptr<DepthRenderer> make_renderer(const robot_model::SceneModel& scene,
+                                             const RendererSettings& config) {
   if (config.far_m > kMaxFarM) {
     throw std::invalid_argument("renderer.far_m must be at most " + std::to_string(kMaxFarM) +
                                 " m (depth_mm is int16 millimetres), got " + std::to_string(config.far_m));
@@ -128,12 +130,14 @@ void RendererService::render_prediction() {
   prediction_stats_.rendered++;
 }
 
-bool RendererService::prediction_matches(const depth_image_t& frame, const robot_model::JointPositions& joints,
+bool RendererService::prediction_matches(const depth_image_t& frame,
+                                         const robot_model::JointPositions& joints,
                                          const CameraPose& pose) const {
   const Prediction& p = *prediction_;
-  if (!p.rendered || !p.result.usable || p.camera_id != frame.camera_id || p.intrinsics.width != frame.width ||
-      p.intrinsics.height != frame.height || p.intrinsics.fx != frame.fx || p.intrinsics.fy != frame.fy ||
-      p.intrinsics.cx != frame.cx || p.intrinsics.cy != frame.cy) {
+  if (!p.rendered || !p.result.usable || p.camera_id != frame.camera_id ||
+      p.intrinsics.width != frame.width || p.intrinsics.height != frame.height ||
+      p.intrinsics.fx != frame.fx || p.intrinsics.fy != frame.fy || p.intrinsics.cx != frame.cx ||
+      p.intrinsics.cy != frame.cy) {
     return false;
   }
   const RendererSettings& r = settings_.renderer;
@@ -141,7 +145,7 @@ bool RendererService::prediction_matches(const depth_image_t& frame, const robot
     const auto actual = joints.find(joint);
     if (actual == joints.end()) return false;
     const double tolerance = scene_.is_prismatic_joint(joint) ? r.prediction_joint_tolerance_m
-                                                            : r.prediction_joint_tolerance_deg * kDegToRad;
+                                                              : r.prediction_joint_tolerance_deg * kDegToRad;
     if (!(std::abs(actual->second - predicted) <= tolerance)) return false;
   }
   return pose.frame_id == p.pose.frame_id &&
@@ -173,14 +177,15 @@ RenderedFrame RendererService::render(const depth_image_t& frame) {
 RenderedFrame RendererService::make_output(const depth_image_t& frame, RenderResult result) const {
   RenderedFrame out;
   if (!result.usable) {
-    out.labels = make_unusable_link_labels(frame, scene_.num_robot_links, scene_.link_names(), result.unusable_reason);
+    out.labels =
+        make_unusable_link_labels(frame, scene_.num_robot_links, scene_.link_names(), result.unusable_reason);
     return out;
   }
   out.labels = make_link_labels(frame, scene_.num_robot_links, scene_.link_names(), std::move(result.labels));
   // The model's depth is exact: calibrated (no distance calibration to
   // apply), no amplitude.
-  out.depth = make_depth_image(frame.camera_id, intrinsics_of(frame), frame.utime, frame.seq, /*calibrated=*/true,
-                               result.depth_m);
+  out.depth = make_depth_image(frame.camera_id, intrinsics_of(frame), frame.utime, frame.seq,
+                               /*calibrated=*/true, result.depth_m);
   return out;
 }
 
@@ -205,8 +210,9 @@ int run_renderer(const RendererProcessSettings& settings) {
         if (!service->on_joint_state(state)) {
           node.counters().validation_errors++;
           node.errors().report(settings.channels.joint_state,
-                               settings.channels.joint_state + ": ignored a message for robot_id '" + state.robot_id +
-                                   "' (expected '" + settings.robot.id + "') or not newer than the last");
+                               settings.channels.joint_state + ": ignored a message for robot_id '" +
+                                   state.robot_id + "' (expected '" + settings.robot.id +
+                                   "') or not newer than the last");
         }
       },
       check_joint_state);
@@ -215,15 +221,16 @@ int run_renderer(const RendererProcessSettings& settings) {
       [&](const camera_pose_t& pose) {
         if (!service->on_camera_pose(pose)) {
           node.counters().validation_errors++;
-          node.errors().report(settings.channels.camera_pose, settings.channels.camera_pose + ": utime: expected a pose newer than camera '" +
-                                                                pose.camera_id + "''s newest, got " +
-                                                                std::to_string(pose.utime) + "; ignored");
+          node.errors().report(settings.channels.camera_pose,
+                               settings.channels.camera_pose +
+                                   ": utime: expected a pose newer than camera '" + pose.camera_id +
+                                   "''s newest, got " + std::to_string(pose.utime) + "; ignored");
         }
       },
       check_camera_pose);
   node.subscribe<planned_trajectory_t>(
-      node.safety(), settings.channels.planned_trajectory, [&](const planned_trajectory_t& plan) { service->on_plan(plan); },
-      check_planned_trajectory);
+      node.safety(), settings.channels.planned_trajectory,
+      [&](const planned_trajectory_t& plan) { service->on_plan(plan); }, check_planned_trajectory);
   node.subscribe<depth_image_t>(
       node.images(), settings.channels.depth,
       [&](const depth_image_t& frame) {
@@ -263,7 +270,8 @@ int run_renderer(const RendererProcessSettings& settings) {
     node.counters().frames_out++;
     node.heartbeat().set_last_frame_utime(rendered->labels.utime);
     status(rendered->labels.usable ? "rendering" : "frame unusable: " + rendered->labels.unusable_reason);
-    if (!rendered->labels.usable) node.errors().report("unusable", "frame unusable: " + rendered->labels.unusable_reason);
+    if (!rendered->labels.usable)
+      node.errors().report("unusable", "frame unusable: " + rendered->labels.unusable_reason);
   }
   return 0;
 }

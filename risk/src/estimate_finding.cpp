@@ -37,7 +37,8 @@ double correction_angle_rad(const motion_estimate_t& e) {
   return 2.0 * std::acos(std::min(1.0, std::abs(e.correction_rotation[0]) / norm));
 }
 
-FrameFinding classify_estimate(const motion_estimate_t& e, const RiskSettings& config, const EstimateContext& context) {
+FrameFinding classify_estimate(const motion_estimate_t& e, const RiskSettings& config,
+                               const EstimateContext& context) {
   if (!e.usable || !e.converged) return {};
 
   // The most significant joint, normalised by its threshold.
@@ -49,8 +50,8 @@ FrameFinding classify_estimate(const motion_estimate_t& e, const RiskSettings& c
     o.prismatic = context.prismatic_joints.count(o.joint) > 0;
     o.offset = e.estimated_position[i] - e.reported_position[i];
     o.sigma = e.position_sigma[i];
-    const double minimum = o.prismatic ? config.estimate_min_joint_offset_m
-                                       : config.estimate_min_joint_offset_deg / kRadToDeg;
+    const double minimum =
+        o.prismatic ? config.estimate_min_joint_offset_m : config.estimate_min_joint_offset_deg / kRadToDeg;
     o.threshold = std::max(config.estimate_sigmas * o.sigma, minimum);
     if (!(std::abs(o.offset) > o.threshold)) continue;
     o.ratio = o.threshold > 0 ? std::abs(o.offset) / o.threshold : HUGE_VAL;
@@ -91,7 +92,8 @@ FrameFinding classify_estimate(const motion_estimate_t& e, const RiskSettings& c
     f.detail = "camera pose off by " + fixed(translation_m * 100.0, 1) + " cm and " +
                fixed(angle_rad * kRadToDeg, 1) + "° (seen vs configured; estimate, " +
                (translation_significant ? "cm" : "deg") + ")" + residual;
-    if (joint) f.detail += "; joint " + joint->joint + " also off by " + in_units(joint->offset, joint->prismatic, 1);
+    if (joint)
+      f.detail += "; joint " + joint->joint + " also off by " + in_units(joint->offset, joint->prismatic, 1);
     return f;
   }
   if (joint) {
@@ -103,8 +105,9 @@ FrameFinding classify_estimate(const motion_estimate_t& e, const RiskSettings& c
     f.threshold = joint->threshold * scale;
     f.detail = "joint " + joint->joint + " reads " + in_units(std::abs(joint->offset), joint->prismatic, 1) +
                (joint->offset > 0 ? " less" : " more") + " than seen (estimate, " +
-               (joint->prismatic ? "mm" : "deg") + "): offset " + in_units(joint->offset, joint->prismatic, 1) +
-               " ± " + in_units(joint->sigma, joint->prismatic, 1) + residual;
+               (joint->prismatic ? "mm" : "deg") + "): offset " +
+               in_units(joint->offset, joint->prismatic, 1) + " ± " +
+               in_units(joint->sigma, joint->prismatic, 1) + residual;
     return f;
   }
   const bool unexplained = e.residual_after_mm > config.estimate_unexplained_residual_mm;

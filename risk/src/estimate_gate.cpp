@@ -46,7 +46,8 @@ const motion_estimate_t* EstimateGate::estimate_for(const discrepancy_t& frame, 
   // Else the newest of an earlier frame within max_age (camera utimes).
   const motion_estimate_t* newest = nullptr;
   for (const motion_estimate_t& e : estimates_) {
-    if (e.camera_id != frame.camera_id || e.utime > frame.utime || frame.utime - e.utime > max_age_us_) continue;
+    if (e.camera_id != frame.camera_id || e.utime > frame.utime || frame.utime - e.utime > max_age_us_)
+      continue;
     if (!newest || e.utime > newest->utime) newest = &e;
   }
   return newest;
@@ -87,7 +88,8 @@ void EstimateGate::rename_cause(ClassifiedFrame* c) {
   // or the camera): that it explained nothing says nothing about this frame,
   // which may show a fault that began after it.
   const bool own = estimate->seq == frame.seq;
-  if (!own && refined.cause != risk_t::CAUSE_JOINT_ERROR && refined.cause != risk_t::CAUSE_CALIBRATION_ERROR) {
+  if (!own && refined.cause != risk_t::CAUSE_JOINT_ERROR &&
+      refined.cause != risk_t::CAUSE_CALIBRATION_ERROR) {
     refined = FrameFinding{};
   }
   if (refined.cause != risk_t::CAUSE_NONE) {
@@ -99,10 +101,11 @@ void EstimateGate::rename_cause(ClassifiedFrame* c) {
     finding = std::move(refined);
   } else {
     stats_.explained_nothing++;
-    finding.detail += " (estimate explains nothing: " +
-                      (estimate->usable ? std::string(estimate->converged ? "no significant offset" : "not converged")
-                                        : "unusable, " + estimate->unusable_reason) +
-                      ")";
+    finding.detail +=
+        " (estimate explains nothing: " +
+        (estimate->usable ? std::string(estimate->converged ? "no significant offset" : "not converged")
+                          : "unusable, " + estimate->unusable_reason) +
+        ")";
   }
 }
 

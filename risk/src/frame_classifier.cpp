@@ -23,13 +23,14 @@ void FrameEvidence::build_link_views() const {
   // robot from environment links at num_robot_links; a discrepancy that
   // passed its wire check has them consistent. (Checked here, after the
   // sensor rules: an unusable frame carries no per-link arrays.)
-  TOFGUARD_DEMAND(frame.num_robot_links >= 0 && frame.num_robot_links <= frame.num_links && frame.num_links >= 0 &&
+  TOFGUARD_DEMAND(frame.num_robot_links >= 0 && frame.num_robot_links <= frame.num_links &&
+                      frame.num_links >= 0 &&
                       frame.link_name.size() == static_cast<size_t>(frame.num_links) &&
                       frame.link_compared.size() == static_cast<size_t>(frame.num_links) &&
                       frame.link_match.size() == static_cast<size_t>(frame.num_links) &&
                       frame.link_farther.size() == static_cast<size_t>(frame.num_links),
-                  "discrepancy seq " + std::to_string(frame.seq) + ": per-link arrays do not match num_links " +
-                      std::to_string(frame.num_links));
+                  "discrepancy seq " + std::to_string(frame.seq) +
+                      ": per-link arrays do not match num_links " + std::to_string(frame.num_links));
   for (int i = 0; i < frame.num_links; ++i) {
     if (i >= frame.num_robot_links) {
       environment_compared_ += frame.link_compared[i];
@@ -40,7 +41,8 @@ void FrameEvidence::build_link_views() const {
     LinkView view;
     view.name = frame.link_name[i];
     view.compared = frame.link_compared[i];
-    view.mismatch = static_cast<double>(frame.link_compared[i] - frame.link_match[i]) / frame.link_compared[i];
+    view.mismatch =
+        static_cast<double>(frame.link_compared[i] - frame.link_match[i]) / frame.link_compared[i];
     view.missing = static_cast<double>(frame.link_farther[i]) / frame.link_compared[i];
     visible_.push_back(view);
   }
@@ -78,7 +80,8 @@ FrameFinding unusable_frame(const FrameEvidence& e) {
     return finding(risk_t::CAUSE_COMPONENT_FAULT, "tofguard-renderer", 1, 0,
                    "frame not rendered in time: " + f.unusable_reason);
   }
-  return finding(risk_t::CAUSE_SENSOR_FAULT, e.context.labels_channel, 1, 0, "frame unusable: " + f.unusable_reason);
+  return finding(risk_t::CAUSE_SENSOR_FAULT, e.context.labels_channel, 1, 0,
+                 "frame unusable: " + f.unusable_reason);
 }
 
 // Too many pixels without a return (fraction of the image).
@@ -86,9 +89,10 @@ FrameFinding invalid_pixels(const FrameEvidence& e) {
   const discrepancy_t& f = e.frame;
   const RiskSettings& config = e.config;
   if (!(f.invalid_fraction > config.max_invalid_fraction)) return {};
-  return finding(risk_t::CAUSE_SENSOR_FAULT, e.context.depth_channel, f.invalid_fraction, config.max_invalid_fraction,
-                 "invalid pixels (fraction): " + fixed(100.0 * f.invalid_fraction, 1) + " % have no return, limit " +
-                     fixed(100.0 * config.max_invalid_fraction, 1) + " %");
+  return finding(risk_t::CAUSE_SENSOR_FAULT, e.context.depth_channel, f.invalid_fraction,
+                 config.max_invalid_fraction,
+                 "invalid pixels (fraction): " + fixed(100.0 * f.invalid_fraction, 1) +
+                     " % have no return, limit " + fixed(100.0 * config.max_invalid_fraction, 1) + " %");
 }
 
 FrameFinding uncalibrated_camera(const FrameEvidence& e) {
@@ -103,9 +107,10 @@ FrameFinding frozen_image(const FrameEvidence& e) {
   const discrepancy_t& f = e.frame;
   const RiskSettings& config = e.config;
   if (!e.context.arm_moving || f.repeat_count < config.frozen_repeat_frames) return {};
-  return finding(risk_t::CAUSE_SENSOR_FAULT, e.context.depth_channel, f.repeat_count, config.frozen_repeat_frames,
-                 "frozen image (repeated frames): the same depth image " + std::to_string(f.repeat_count + 1) +
-                     " times in a row while the arm moves");
+  return finding(risk_t::CAUSE_SENSOR_FAULT, e.context.depth_channel, f.repeat_count,
+                 config.frozen_repeat_frames,
+                 "frozen image (repeated frames): the same depth image " +
+                     std::to_string(f.repeat_count + 1) + " times in a row while the arm moves");
 }
 
 // ---- What the mismatch looks like ----
@@ -120,7 +125,8 @@ FrameFinding calibration_error(const FrameEvidence& e) {
   const double environment_mismatch = static_cast<double>(environment_compared - e.environment_match()) /
                                       static_cast<double>(environment_compared);
   int mismatching_links = 0;
-  for (const LinkView& link : visible) mismatching_links += link.mismatch >= config.link_mismatch_fraction ? 1 : 0;
+  for (const LinkView& link : visible)
+    mismatching_links += link.mismatch >= config.link_mismatch_fraction ? 1 : 0;
   const double robot_fraction =
       visible.empty() ? 1.0 : static_cast<double>(mismatching_links) / static_cast<double>(visible.size());
   // A link fixed to the robot's root (its base) cannot be moved by any
@@ -134,20 +140,21 @@ FrameFinding calibration_error(const FrameEvidence& e) {
       fixed_link_mismatching = link.name;
     }
   }
-  const bool broad_mismatch =
-      robot_fraction >= config.calibration_robot_link_fraction &&
-      (environment_mismatch >= config.calibration_environment_mismatch_fraction || !fixed_link_mismatching.empty());
+  const bool broad_mismatch = robot_fraction >= config.calibration_robot_link_fraction &&
+                              (environment_mismatch >= config.calibration_environment_mismatch_fraction ||
+                               !fixed_link_mismatching.empty());
   if (!broad_mismatch) return {};
-  return finding(risk_t::CAUSE_CALIBRATION_ERROR, "", environment_mismatch,
-                 config.calibration_environment_mismatch_fraction,
-                 "camera pose or calibration off (environment mismatch fraction): " +
-                     fixed(100.0 * environment_mismatch, 1) + " % of the environment and " +
-                     std::to_string(mismatching_links) + "/" + std::to_string(visible.size()) +
-                     " visible links mismatch" +
-                     (fixed_link_mismatching.empty() ? std::string()
-                                                     : ", the fixed " + fixed_link_mismatching + " among them") +
-                     "; median I_dis environment " + fixed(f.environment_median_dis_mm, 0) + " mm, arm " +
-                     fixed(f.robot_median_dis_mm, 0) + " mm");
+  return finding(
+      risk_t::CAUSE_CALIBRATION_ERROR, "", environment_mismatch,
+      config.calibration_environment_mismatch_fraction,
+      "camera pose or calibration off (environment mismatch fraction): " +
+          fixed(100.0 * environment_mismatch, 1) + " % of the environment and " +
+          std::to_string(mismatching_links) + "/" + std::to_string(visible.size()) +
+          " visible links mismatch" +
+          (fixed_link_mismatching.empty() ? std::string()
+                                          : ", the fixed " + fixed_link_mismatching + " among them") +
+          "; median I_dis environment " + fixed(f.environment_median_dis_mm, 0) + " mm, arm " +
+          fixed(f.robot_median_dis_mm, 0) + " mm");
 }
 
 // JOINT_ERROR: the arm is missing where the model has it, on links that all
@@ -195,8 +202,8 @@ FrameFinding joint_error_missing_links(const FrameEvidence& e) {
       for (const std::string& l : missing_links) links += (links.empty() ? "" : ", ") + l;
       return finding(risk_t::CAUSE_JOINT_ERROR, joint, score, config.joint_link_missing_fraction,
                      "joint " + joint + " reads other than seen (mismatch fraction): the arm mismatches at " +
-                         fixed(100.0 * score, 1) + " % of the modelled pixels of " + links + ", all distal to " +
-                         joint);
+                         fixed(100.0 * score, 1) + " % of the modelled pixels of " + links +
+                         ", all distal to " + joint);
     }
   }
   if (!unknown.empty()) {
@@ -283,8 +290,8 @@ const std::vector<FrameRule>& frame_rules() {
   return rules;
 }
 
-FrameFinding classify_frame(const discrepancy_t& frame, const robot_model::KinematicTree& robot, const RiskSettings& config,
-                            const ClassifierContext& context) {
+FrameFinding classify_frame(const discrepancy_t& frame, const robot_model::KinematicTree& robot,
+                            const RiskSettings& config, const ClassifierContext& context) {
   const FrameEvidence evidence(frame, robot, config, context);
   for (const FrameRule& rule : frame_rules()) {
     FrameFinding f = rule.apply(evidence);

@@ -7,16 +7,16 @@
 namespace tofguard::risk {
 InputDeadlines::InputDeadlines(const RiskSettings& risk, const ChannelNames& channels, int64_t start_us)
     : depth_{channels.depth, risk_t::CAUSE_SENSOR_FAULT, risk.depth_deadline_us, start_us},
-      joint_state_{channels.joint_state, risk_t::CAUSE_SENSOR_FAULT, risk.joint_state_deadline_us,
-                   start_us},
-      camera_pose_{channels.camera_pose, risk_t::CAUSE_SENSOR_FAULT, risk.camera_pose_deadline_us,
-                   start_us},
+      joint_state_{channels.joint_state, risk_t::CAUSE_SENSOR_FAULT, risk.joint_state_deadline_us, start_us},
+      camera_pose_{channels.camera_pose, risk_t::CAUSE_SENSOR_FAULT, risk.camera_pose_deadline_us, start_us},
       camera_pose_required_(risk.camera_pose_required),
       discrepancy_{channels.discrepancy, risk_t::CAUSE_COMPONENT_FAULT, risk.discrepancy_deadline_us,
                    start_us} {
   for (const std::string& process : risk.required_heartbeats) {
-    heartbeats_[process] = Deadline{process, risk_t::CAUSE_COMPONENT_FAULT, risk.heartbeat_deadline_us,
-                                    start_us, /*ever=*/false, /*heartbeat=*/true};
+    heartbeats_[process] =
+        Deadline{process,           risk_t::CAUSE_COMPONENT_FAULT, risk.heartbeat_deadline_us, start_us,
+                 /*ever=*/false,
+                 /*heartbeat=*/true};
   }
 }
 
@@ -45,9 +45,9 @@ std::optional<FrameFinding> InputDeadlines::first_expired(int64_t now_us) const 
     f.suspect = d->what;
     f.score = static_cast<double>(age_us) / 1000.0;
     f.threshold = static_cast<double>(d->limit_us) / 1000.0;
-    f.detail = d->what + (d->heartbeat ? " heartbeat" : "") + " stale (age ms): " +
-               (d->ever ? "nothing for " : "nothing since start, ") + std::to_string(age_us / 1000) +
-               " ms, deadline " + std::to_string(d->limit_us / 1000) + " ms";
+    f.detail = d->what + (d->heartbeat ? " heartbeat" : "") +
+               " stale (age ms): " + (d->ever ? "nothing for " : "nothing since start, ") +
+               std::to_string(age_us / 1000) + " ms, deadline " + std::to_string(d->limit_us / 1000) + " ms";
     return f;
   }
   return std::nullopt;

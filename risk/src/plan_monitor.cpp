@@ -39,8 +39,9 @@ std::optional<FrameFinding> PlanMonitor::deviation(const joint_state_t& state) c
     f.suspect = state.name[i];
     f.score = deviation * scale;
     f.threshold = limit * scale;
-    f.detail = "arm left its plan (" + std::string(prismatic ? "mm" : "deg") + "): " + state.name[i] + " is " +
-               fixed(deviation * scale, 1) + unit + " from the plan (limit " + fixed(limit * scale, 1) + unit + ")";
+    f.detail = "arm left its plan (" + std::string(prismatic ? "mm" : "deg") + "): " + state.name[i] +
+               " is " + fixed(deviation * scale, 1) + unit + " from the plan (limit " +
+               fixed(limit * scale, 1) + unit + ")";
     worst = f;
   }
   return worst;

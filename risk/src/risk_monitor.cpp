@@ -15,8 +15,8 @@ ClassifierContext classifier_context(const ChannelNames& channels) {
 
 }  // namespace
 
-RiskMonitor::RiskMonitor(const RiskSettings& settings, const ChannelNames& channels, robot_model::KinematicTree robot,
-                         int64_t start_us)
+RiskMonitor::RiskMonitor(const RiskSettings& settings, const ChannelNames& channels,
+                         robot_model::KinematicTree robot, int64_t start_us)
     : settings_(settings),
       classifier_context_(classifier_context(channels)),
       robot_(std::move(robot)),
@@ -30,11 +30,12 @@ void RiskMonitor::on_joint_state(const joint_state_t& state, int64_t now_us) {
   joint_states_.add(state);
 }
 
-std::string RiskMonitor::check_joint_names(const std::vector<std::string>& names, const std::string& field) const {
+std::string RiskMonitor::check_joint_names(const std::vector<std::string>& names,
+                                           const std::string& field) const {
   for (size_t i = 0; i < names.size(); ++i) {
     if (!robot_.is_movable_joint(names[i])) {
-      return field + "[" + std::to_string(i) + "]: expected a moving joint of the robot's URDF, got '" + names[i] +
-             "'";
+      return field + "[" + std::to_string(i) + "]: expected a moving joint of the robot's URDF, got '" +
+             names[i] + "'";
     }
   }
   return "";
@@ -55,7 +56,8 @@ ClassifiedFrame RiskMonitor::classify(const discrepancy_t& frame) const {
   // The arm left its plan: only when the camera shows nothing wrong (a
   // camera finding says more).
   if (c.finding.cause == risk_t::CAUSE_NONE && at_capture != nullptr) {
-    if (std::optional<FrameFinding> deviation = plan_.deviation(*at_capture)) c.finding = std::move(*deviation);
+    if (std::optional<FrameFinding> deviation = plan_.deviation(*at_capture))
+      c.finding = std::move(*deviation);
   }
   return c;
 }
@@ -79,7 +81,9 @@ std::vector<risk_t> RiskMonitor::on_estimate(const motion_estimate_t& estimate, 
   return judge(gate_.add_estimate(estimate, now_us), now_us);
 }
 
-std::vector<risk_t> RiskMonitor::release_due(int64_t now_us) { return judge(gate_.release_due(now_us), now_us); }
+std::vector<risk_t> RiskMonitor::release_due(int64_t now_us) {
+  return judge(gate_.release_due(now_us), now_us);
+}
 
 std::optional<risk_t> RiskMonitor::check_deadlines(int64_t now_us) const {
   const std::optional<FrameFinding> expired = deadlines_.first_expired(now_us);

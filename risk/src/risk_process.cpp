@@ -3,23 +3,24 @@
 #include <algorithm>
 #include <cmath>
 
-#include "tofguard/risk/risk_monitor.hpp"
 #include "tofguard/camera_pose_t.hpp"
 #include "tofguard/common/clock.hpp"
 #include "tofguard/common/lcm_node.hpp"
 #include "tofguard/common/wire_checks.hpp"
+#include "tofguard/risk/risk_monitor.hpp"
 
 namespace tofguard::risk {
 
 ProcessInfo process_info() {
-  return {"tofguard-risk",
-          "Classifies the risk of every frame and fires deadlines: SAFETY_DISCREPANCY, TOF_DEPTH, JOINT_STATE, "
-          "CAMERA_POSE, SAFETY_HEARTBEAT, MOTION_ESTIMATE, PLANNED_TRAJECTORY -> SAFETY_RISK (risk_t)."};
+  return {
+      "tofguard-risk",
+      "Classifies the risk of every frame and fires deadlines: SAFETY_DISCREPANCY, TOF_DEPTH, JOINT_STATE, "
+      "CAMERA_POSE, SAFETY_HEARTBEAT, MOTION_ESTIMATE, PLANNED_TRAJECTORY -> SAFETY_RISK (risk_t)."};
 }
 
 int run_risk(const RiskProcessSettings& settings) {
-  RiskMonitor monitor(settings.risk, settings.channels, robot_model::load_kinematic_tree(settings.robot_urdf_path),
-                      monotonic_us());
+  RiskMonitor monitor(settings.risk, settings.channels,
+                      robot_model::load_kinematic_tree(settings.robot_urdf_path), monotonic_us());
   const std::string camera_id = settings.camera_id;
   LcmNode node(settings.lcm, settings.channels, process_info().name);
   int64_t dangerous = 0;
@@ -30,12 +31,12 @@ int run_risk(const RiskProcessSettings& settings) {
     if (r.seq >= 0) node.heartbeat().set_last_frame_utime(r.utime);
     if (r.level == risk_t::DANGEROUS) ++dangerous;
     const RiskMonitor::EstimateStats& e = monitor.estimate_stats();
-    node.heartbeat().set_status("last verdict: level " + std::to_string(r.level) + " cause " +
-                                std::to_string(r.cause) + " (" + r.detail + "); " + std::to_string(dangerous) +
-                                " dangerous so far; estimates: " + std::to_string(e.received) + " received, " +
-                                std::to_string(e.used) + " used, " + std::to_string(e.explained_nothing) +
-                                " explained nothing, " + std::to_string(e.missing) + " missing, " +
-                                std::to_string(e.late) + " late");
+    node.heartbeat().set_status(
+        "last verdict: level " + std::to_string(r.level) + " cause " + std::to_string(r.cause) + " (" +
+        r.detail + "); " + std::to_string(dangerous) +
+        " dangerous so far; estimates: " + std::to_string(e.received) + " received, " +
+        std::to_string(e.used) + " used, " + std::to_string(e.explained_nothing) + " explained nothing, " +
+        std::to_string(e.missing) + " missing, " + std::to_string(e.late) + " late");
   };
 
   auto publish_all = [&](const std::vector<risk_t>& verdicts) {
@@ -56,7 +57,8 @@ int run_risk(const RiskProcessSettings& settings) {
         return problem;
       });
   node.subscribe<planned_trajectory_t>(
-      node.safety(), settings.channels.planned_trajectory, [&](const planned_trajectory_t& p) { monitor.on_plan(p); },
+      node.safety(), settings.channels.planned_trajectory,
+      [&](const planned_trajectory_t& p) { monitor.on_plan(p); },
       [&](const planned_trajectory_t& p) {
         std::string problem = check_planned_trajectory(p);
         if (problem.empty()) problem = monitor.check_joint_names(p.joint_name, "joint_name");
@@ -74,8 +76,8 @@ int run_risk(const RiskProcessSettings& settings) {
         return problem;
       });
   node.subscribe<camera_pose_t>(
-      node.safety(), settings.channels.camera_pose, [&](const camera_pose_t&) { monitor.on_camera_pose(monotonic_us()); },
-      check_camera_pose);
+      node.safety(), settings.channels.camera_pose,
+      [&](const camera_pose_t&) { monitor.on_camera_pose(monotonic_us()); }, check_camera_pose);
   node.subscribe<heartbeat_t>(
       node.safety(), settings.channels.heartbeat,
       [&](const heartbeat_t& hb) { monitor.on_heartbeat(hb, monotonic_us()); }, check_heartbeat);

@@ -42,7 +42,8 @@ RiskSettings read_risk_settings(YamlMap map) {
   {
     YamlMap calibration = map.map("calibration_error");
     r.min_environment_pixels = static_cast<int>(calibration.integer("min_environment_pixels", 1, 100000000));
-    r.calibration_environment_mismatch_fraction = calibration.number("environment_mismatch_fraction", 0.01, 1);
+    r.calibration_environment_mismatch_fraction =
+        calibration.number("environment_mismatch_fraction", 0.01, 1);
     r.calibration_robot_link_fraction = calibration.number("robot_link_fraction", 0, 1);
     calibration.finish();
   }

@@ -45,8 +45,9 @@ urdf::ModelInterfaceSharedPtr parse_urdf_file(const std::string& path) {
   }
   console_bridge::restorePreviousOutputHandler();
   if (!model || !handler.errors.empty()) {
-    throw ModelError(path + ": malformed URDF: " +
-                     (handler.errors.empty() ? std::string("urdfdom could not parse it") : one_line(handler.errors)));
+    throw ModelError(
+        path + ": malformed URDF: " +
+        (handler.errors.empty() ? std::string("urdfdom could not parse it") : one_line(handler.errors)));
   }
   return model;
 }
@@ -55,10 +56,9 @@ Eigen::Isometry3d to_isometry(const urdf::Pose& pose) {
   Eigen::Isometry3d result = Eigen::Isometry3d::Identity();
   result.translation() = Eigen::Vector3d(pose.position.x, pose.position.y, pose.position.z);
   // urdfdom turns rpy into this quaternion (R = Rz(yaw) * Ry(pitch) * Rx(roll)).
-  result.linear() =
-      Eigen::Quaterniond(pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z)
-          .normalized()
-          .toRotationMatrix();
+  result.linear() = Eigen::Quaterniond(pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z)
+                        .normalized()
+                        .toRotationMatrix();
   return result;
 }
 
@@ -119,7 +119,8 @@ class TreeBuilder {
         entry.parent_joint = add_joint(*link->parent_joint, parent_link, link_index, path, is_environment);
         joint_index[link->parent_joint->name] = entry.parent_joint;
       }
-      for (const auto& visual : link->visual_array) entry.visuals.push_back(to_geometry(visual->geometry, visual->origin));
+      for (const auto& visual : link->visual_array)
+        entry.visuals.push_back(to_geometry(visual->geometry, visual->origin));
       if (link->visual_array.empty() && link->visual) {
         entry.visuals.push_back(to_geometry(link->visual->geometry, link->visual->origin));
       }
@@ -152,10 +153,18 @@ class TreeBuilder {
     joint.child_link = child_link;
     joint.parent_from_joint = to_isometry(source.parent_to_joint_origin_transform);
     switch (source.type) {
-      case urdf::Joint::FIXED: joint.type = JointType::kFixed; break;
-      case urdf::Joint::REVOLUTE: joint.type = JointType::kRevolute; break;
-      case urdf::Joint::CONTINUOUS: joint.type = JointType::kContinuous; break;
-      case urdf::Joint::PRISMATIC: joint.type = JointType::kPrismatic; break;
+      case urdf::Joint::FIXED:
+        joint.type = JointType::kFixed;
+        break;
+      case urdf::Joint::REVOLUTE:
+        joint.type = JointType::kRevolute;
+        break;
+      case urdf::Joint::CONTINUOUS:
+        joint.type = JointType::kContinuous;
+        break;
+      case urdf::Joint::PRISMATIC:
+        joint.type = JointType::kPrismatic;
+        break;
       default:
         throw ModelError(path + ": joint '" + source.name +
                          "': type not supported (fixed, revolute, continuous and prismatic are)");
@@ -174,7 +183,8 @@ class TreeBuilder {
     if (source.limits) {
       // urdfdom requires <limit> for revolute and prismatic joints; a
       // continuous joint's lower/upper mean nothing.
-      joint.limits.has_position_limits = joint.type == JointType::kRevolute || joint.type == JointType::kPrismatic;
+      joint.limits.has_position_limits =
+          joint.type == JointType::kRevolute || joint.type == JointType::kPrismatic;
       if (joint.limits.has_position_limits) {
         joint.limits.lower = source.limits->lower;
         joint.limits.upper = source.limits->upper;
@@ -229,7 +239,8 @@ class TreeBuilder {
 
 }  // namespace
 
-KinematicTree load_kinematic_tree(const std::string& robot_urdf, const std::vector<std::string>& environment_urdfs) {
+KinematicTree load_kinematic_tree(const std::string& robot_urdf,
+                                  const std::vector<std::string>& environment_urdfs) {
   TreeBuilder builder;
   builder.add_urdf(robot_urdf, false);
   for (const std::string& path : environment_urdfs) builder.add_urdf(path, true);
@@ -255,7 +266,8 @@ bool KinematicTree::is_robot_link(const std::string& link) const {
 }
 
 bool KinematicTree::is_movable_joint(const std::string& joint) const {
-  return std::find(movable_joint_names.begin(), movable_joint_names.end(), joint) != movable_joint_names.end();
+  return std::find(movable_joint_names.begin(), movable_joint_names.end(), joint) !=
+         movable_joint_names.end();
 }
 
 std::vector<int> KinematicTree::chain_to_root(const std::string& link) const {

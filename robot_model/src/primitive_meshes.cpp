@@ -51,7 +51,9 @@ TriangleMesh unit_sphere() {
     }
   }
   const uint32_t south = add_vertex(mesh, 0, 0, -1);
-  const auto at = [&](int ring, int j) { return ring_start[ring] + static_cast<uint32_t>(j % kSphereSegments); };
+  const auto at = [&](int ring, int j) {
+    return ring_start[ring] + static_cast<uint32_t>(j % kSphereSegments);
+  };
   for (int j = 0; j < kSphereSegments; ++j) {
     add_triangle(mesh, north, at(0, j), at(0, j + 1));
     add_triangle(mesh, south, at(rings - 2, j + 1), at(rings - 2, j));

@@ -6,10 +6,10 @@
 #include <map>
 #include <tuple>
 
-#include <assimp/Importer.hpp>
 #include <assimp/config.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#include <assimp/Importer.hpp>
 
 #include "tofguard/common/error_log.hpp"
 #include "tofguard/robot_model/primitive_meshes.hpp"
@@ -78,13 +78,15 @@ class SceneBuilder {
             throw ModelError(where + "cylinder radius and length must be positive");
           }
           shape.mesh_index = kUnitCylinder;
-          shape.scale = Eigen::Vector3d(geometry.radius_m + pad, geometry.radius_m + pad, geometry.length_m + 2 * pad);
+          shape.scale =
+              Eigen::Vector3d(geometry.radius_m + pad, geometry.radius_m + pad, geometry.length_m + 2 * pad);
           break;
         }
         case GeometryElement::Kind::kMesh: {
           const Eigen::Vector3d& scale = geometry.mesh_scale;
           if (!std::isfinite(scale.sum()) || scale.cwiseAbs().minCoeff() <= 0) {
-            throw ModelError(where + "mesh '" + geometry.mesh_uri + "': scale must be three non-zero numbers");
+            throw ModelError(where + "mesh '" + geometry.mesh_uri +
+                             "': scale must be three non-zero numbers");
           }
           shape.mesh_index =
               mesh_for(resolve_uri(geometry.mesh_uri, urdf_folder, where), geometry.mesh_uri, scale, where);
@@ -125,7 +127,8 @@ class SceneBuilder {
     return path;
   }
 
-  int mesh_for(const fs::path& path, const std::string& uri, const Eigen::Vector3d& scale, const std::string& where) {
+  int mesh_for(const fs::path& path, const std::string& uri, const Eigen::Vector3d& scale,
+               const std::string& where) {
     const auto key = std::make_tuple(fs::canonical(path).string(), scale.x(), scale.y(), scale.z());
     const auto cached = mesh_cache_.find(key);
     if (cached != mesh_cache_.end()) return cached->second;
@@ -143,10 +146,10 @@ class SceneBuilder {
     // texture coordinates and colours, vertices that share a position are
     // joined, so a closed surface is seen to be closed (see orient()).
     importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-    importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
-                                                            aiComponent_COLORS | aiComponent_TEXCOORDS |
-                                                            aiComponent_BONEWEIGHTS | aiComponent_ANIMATIONS |
-                                                            aiComponent_TEXTURES | aiComponent_MATERIALS);
+    importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS,
+                                aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
+                                    aiComponent_COLORS | aiComponent_TEXCOORDS | aiComponent_BONEWEIGHTS |
+                                    aiComponent_ANIMATIONS | aiComponent_TEXTURES | aiComponent_MATERIALS);
     const aiScene* scene = importer.ReadFile(
         path.string(), aiProcess_RemoveComponent | aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
                            aiProcess_PreTransformVertices | aiProcess_SortByPType);
@@ -188,7 +191,8 @@ class SceneBuilder {
     }
     for (const auto& [edge, count] : directed_edges) {
       const auto reverse = directed_edges.find({edge.second, edge.first});
-      if (count != 1 || reverse == directed_edges.end() || reverse->second != 1) return;  // open or inconsistent
+      if (count != 1 || reverse == directed_edges.end() || reverse->second != 1)
+        return;  // open or inconsistent
     }
     // Signed volume by the divergence theorem: positive when wound outward.
     double volume6 = 0;
@@ -200,7 +204,8 @@ class SceneBuilder {
     }
     if (volume6 == 0) return;
     if (volume6 < 0) {
-      for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) std::swap(mesh.indices[t + 1], mesh.indices[t + 2]);
+      for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3)
+        std::swap(mesh.indices[t + 1], mesh.indices[t + 2]);
     }
     mesh.closed_outward = true;
   }

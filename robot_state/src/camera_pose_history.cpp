@@ -40,7 +40,8 @@ bool CameraPoseHistory::add(const std::string& camera_id, int64_t utime, const C
   if (!camera.poses.empty() && camera.poses.back().pose.frame_id != pose.frame_id) camera = Camera{};
   if (!camera.poses.empty() && utime <= camera.poses.back().utime) return false;
   camera.poses.push_back({utime, pose});
-  while (camera.poses.size() > 2 && camera.poses.front().utime < utime - history_us_) camera.poses.pop_front();
+  while (camera.poses.size() > 2 && camera.poses.front().utime < utime - history_us_)
+    camera.poses.pop_front();
   return true;
 }
 
@@ -64,7 +65,8 @@ CameraPose CameraPoseHistory::blend(const Sample& a, const Sample& b, int64_t ut
   // The rotation from a to b (in frame_id), scaled by s: exact slerp for
   // 0 <= s <= 1, and the same angular velocity beyond.
   const Eigen::AngleAxisd step(b.pose.rotation * a.pose.rotation.inverse());
-  pose.rotation = (Eigen::Quaterniond(Eigen::AngleAxisd(step.angle() * s, step.axis())) * a.pose.rotation).normalized();
+  pose.rotation =
+      (Eigen::Quaterniond(Eigen::AngleAxisd(step.angle() * s, step.axis())) * a.pose.rotation).normalized();
   return pose;
 }
 
@@ -100,8 +102,9 @@ PoseAtTime CameraPoseHistory::at(const std::string& camera_id, int64_t utime) co
     const int64_t behind_us = oldest.utime - utime;
     if (poses.size() >= 2 && motion(oldest, poses[1]) && behind_us > max_extrapolation_us_) {
       result.usable = false;
-      result.unusable_reason = "frame is " + ms(behind_us) + " older than the oldest camera pose kept of moving camera '" +
-                               camera_id + "' (limit " + ms(max_extrapolation_us_) + ")";
+      result.unusable_reason = "frame is " + ms(behind_us) +
+                               " older than the oldest camera pose kept of moving camera '" + camera_id +
+                               "' (limit " + ms(max_extrapolation_us_) + ")";
     } else {
       result.pose = oldest.pose;
     }

@@ -12,7 +12,8 @@ JointHistory::JointHistory(int64_t max_extrapolation_us, int64_t span_us, size_t
 bool JointHistory::add(int64_t utime, const robot_model::JointPositions& positions) {
   if (!history_.empty() && utime <= history_.back().utime) return false;
   history_.push_back({utime, positions});
-  while (history_.size() > max_messages_ || (history_.size() > 2 && history_.front().utime < utime - span_us_)) {
+  while (history_.size() > max_messages_ ||
+         (history_.size() > 2 && history_.front().utime < utime - span_us_)) {
     history_.pop_front();
   }
   return true;
@@ -41,16 +42,17 @@ JointsAtTime JointHistory::at(int64_t utime) const {
     const int64_t ahead_us = utime - newest.utime;
     if (ahead_us > max_extrapolation_us_) {
       result.unusable_reason = "newest joint state is " + std::to_string(ahead_us / 1000.0) +
-                               " ms older than the frame (limit " + std::to_string(max_extrapolation_us_ / 1000.0) +
-                               " ms)";
+                               " ms older than the frame (limit " +
+                               std::to_string(max_extrapolation_us_ / 1000.0) + " ms)";
       return result;
     }
-    result.joints = history_.size() >= 2 ? blend(history_[history_.size() - 2], newest, utime) : newest.positions;
+    result.joints =
+        history_.size() >= 2 ? blend(history_[history_.size() - 2], newest, utime) : newest.positions;
   } else if (utime < oldest.utime) {
     const int64_t behind_us = oldest.utime - utime;
     if (behind_us > max_extrapolation_us_) {
-      result.unusable_reason = "frame is " + std::to_string(behind_us / 1000.0) +
-                               " ms older than the oldest joint state kept";
+      result.unusable_reason =
+          "frame is " + std::to_string(behind_us / 1000.0) + " ms older than the oldest joint state kept";
       return result;
     }
     result.joints = oldest.positions;

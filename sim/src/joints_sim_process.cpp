@@ -56,22 +56,27 @@ int run_joints_sim(const JointsSimProcessSettings& settings) {
 
   bool status_allows = false;
   int64_t status_arrival_us = -1;
-  node.subscribe<safety_status_t>(node.safety(), settings.channels.status, [&](const safety_status_t& s) {
-    status_allows = s.motion_allowed;
-    status_arrival_us = monotonic_us();
-  }, check_safety_status);
-  node.subscribe<sim_joint_fault_t>(node.safety(), settings.channels.sim_joint_fault,
-                                    [&](const sim_joint_fault_t& fault) {
-    if (!arm->set_encoder_offset(fault.joint, fault.offset)) {
-      node.counters().validation_errors++;
-      node.errors().report(settings.channels.sim_joint_fault,
-                           settings.channels.sim_joint_fault + ": joint: expected a joint of the arm, got '" +
-                               fault.joint + "'");
-      return;
-    }
-    std::cerr << "tofguard-joints-sim: encoder fault on " << fault.joint << ": offset " << fault.offset
-              << std::endl;
-  }, check_sim_joint_fault);
+  node.subscribe<safety_status_t>(
+      node.safety(), settings.channels.status,
+      [&](const safety_status_t& s) {
+        status_allows = s.motion_allowed;
+        status_arrival_us = monotonic_us();
+      },
+      check_safety_status);
+  node.subscribe<sim_joint_fault_t>(
+      node.safety(), settings.channels.sim_joint_fault,
+      [&](const sim_joint_fault_t& fault) {
+        if (!arm->set_encoder_offset(fault.joint, fault.offset)) {
+          node.counters().validation_errors++;
+          node.errors().report(settings.channels.sim_joint_fault,
+                               settings.channels.sim_joint_fault +
+                                   ": joint: expected a joint of the arm, got '" + fault.joint + "'");
+          return;
+        }
+        std::cerr << "tofguard-joints-sim: encoder fault on " << fault.joint << ": offset " << fault.offset
+                  << std::endl;
+      },
+      check_sim_joint_fault);
 
   const int64_t period_us = static_cast<int64_t>(1e6 / settings.joints_sim.rate_hz);
   int64_t last_step_us = monotonic_us();
@@ -96,8 +101,8 @@ int run_joints_sim(const JointsSimProcessSettings& settings) {
   };
   node.add_timer(period_us, [&] {
     const int64_t now_us = monotonic_us();
-    const bool allowed = status_allows && status_arrival_us >= 0 &&
-                         now_us - status_arrival_us <= sim.status_deadline_us;
+    const bool allowed =
+        status_allows && status_arrival_us >= 0 && now_us - status_arrival_us <= sim.status_deadline_us;
     arm->step((now_us - last_step_us) * 1e-6, allowed);
     last_step_us = now_us;
     const int64_t utime = wall_utime();

@@ -77,8 +77,8 @@ CameraPose SimulatedCamera::true_pose(int64_t utime) const {
     const Eigen::Vector3d rotation = f.fault.drift_rotation_rad_per_s * dt;
     if (rotation.norm() > 0) {
       // About the optical frame's own axes: applied on the right.
-      pose.rotation = pose.rotation * Eigen::Quaterniond(Eigen::AngleAxisd(
-                                          rotation.norm(), rotation.normalized()));
+      pose.rotation =
+          pose.rotation * Eigen::Quaterniond(Eigen::AngleAxisd(rotation.norm(), rotation.normalized()));
     }
   }
   return pose;
@@ -119,8 +119,8 @@ SimulatedCamera::Frame SimulatedCamera::capture(int64_t utime, uint64_t frame_in
     frame.why = "true joint state: " + joints.unusable_reason;
     return frame;
   }
-  const RenderedDepth rendered = renderer_->render(joints.joints, true_pose(utime),
-                                                   camera_.intrinsics, boxes(utime));
+  const RenderedDepth rendered =
+      renderer_->render(joints.joints, true_pose(utime), camera_.intrinsics, boxes(utime));
   if (!rendered.usable) {
     frame.outcome = Frame::Outcome::kRenderFailed;
     frame.why = "render failed: " + rendered.unusable_reason;

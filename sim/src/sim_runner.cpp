@@ -2,18 +2,18 @@
 #include <iostream>
 #include <memory>
 
-#include "tofguard/sim/sim_camera_runner.hpp"
 #include "tofguard/camera/depth_calibration.hpp"
+#include "tofguard/common/camera_pose_message.hpp"
+#include "tofguard/common/clock.hpp"
 #include "tofguard/common/depth_frame.hpp"
+#include "tofguard/common/lcm_node.hpp"
+#include "tofguard/common/wire_checks.hpp"
+#include "tofguard/joint_state_t.hpp"
 #include "tofguard/renderer/depth_renderer.hpp"
 #include "tofguard/robot_model/scene_model.hpp"
 #include "tofguard/sim/sim_camera.hpp"
-#include "tofguard/common/clock.hpp"
-#include "tofguard/common/camera_pose_message.hpp"
-#include "tofguard/joint_state_t.hpp"
-#include "tofguard/common/lcm_node.hpp"
+#include "tofguard/sim/sim_camera_runner.hpp"
 #include "tofguard/sim_camera_fault_t.hpp"
-#include "tofguard/common/wire_checks.hpp"
 
 namespace tofguard::sim {
 namespace {
@@ -36,8 +36,8 @@ class UrdfSceneRenderer : public SceneRenderer {
                        const Intrinsics& intrinsics, const std::vector<SimBox>& boxes) override {
     std::vector<renderer::ExtraObject> extra;
     for (const SimBox& box : boxes) {
-      extra.push_back(renderer::ExtraObject::box(
-          box.size_m, Eigen::Isometry3d(Eigen::Translation3d(box.center_m))));
+      extra.push_back(
+          renderer::ExtraObject::box(box.size_m, Eigen::Isometry3d(Eigen::Translation3d(box.center_m))));
     }
     renderer::RenderResult result = renderer_->render(joints, pose, intrinsics, extra);
     RenderedDepth out;
@@ -77,8 +77,7 @@ int run_sim_camera(const SimCameraProcessSettings& settings) {
   try {
     scene = std::make_unique<UrdfSceneRenderer>(settings);
   } catch (const std::exception& e) {
-    std::cerr << "tofguard-camera: cannot set up the simulated camera's renderer: " << e.what()
-              << std::endl;
+    std::cerr << "tofguard-camera: cannot set up the simulated camera's renderer: " << e.what() << std::endl;
     return 1;
   }
   std::cerr << "tofguard-camera: simulated ToF camera " << camera_config.id << " rendering with "
@@ -111,8 +110,8 @@ int run_sim_camera(const SimCameraProcessSettings& settings) {
         }
         const ActiveSimFault fault = to_fault(m, now);
         sim.inject(fault);
-        std::cerr << "tofguard-camera: fault " << fault.fault.kind << " for " << m.duration_s
-                  << " s" << std::endl;
+        std::cerr << "tofguard-camera: fault " << fault.fault.kind << " for " << m.duration_s << " s"
+                  << std::endl;
       },
       check_sim_camera_fault);
 
@@ -128,8 +127,7 @@ int run_sim_camera(const SimCameraProcessSettings& settings) {
     if (slot <= last_slot) return;
     if (slot > last_slot + 1) {
       node.counters().frames_dropped += slot - last_slot - 1;
-      node.errors().report("late", "late: " + std::to_string(slot - last_slot - 1) +
-                                       " frame slot(s) missed");
+      node.errors().report("late", "late: " + std::to_string(slot - last_slot - 1) + " frame slot(s) missed");
     }
     last_slot = slot;
     const int64_t capture_utime = wall_utime() - period_us;
@@ -148,8 +146,8 @@ int run_sim_camera(const SimCameraProcessSettings& settings) {
     }
     std::vector<float> depth_m = frame.image.depth_m;
     if (calibrated) calibration.apply_z(&depth_m, rays);
-    const depth_image_t image = make_depth_image(camera_config.id, camera_config.intrinsics, capture_utime, slot,
-                                                 calibrated, depth_m, frame.image.amplitude);
+    const depth_image_t image = make_depth_image(camera_config.id, camera_config.intrinsics, capture_utime,
+                                                 slot, calibrated, depth_m, frame.image.amplitude);
     node.images().publish(settings.channels.depth, &image);
     node.counters().frames_out++;
     node.heartbeat().set_last_frame_utime(capture_utime);

@@ -9,8 +9,7 @@ Eigen::Vector3d vector3(YamlMap& map, const std::string& key, double limit) {
   const auto v = map.numbers(key, 3);
   for (double x : v) {
     if (std::abs(x) > limit) {
-      map.fail(key, "3 numbers each in [-" + std::to_string(limit) + ", " +
-                        std::to_string(limit) + "]",
+      map.fail(key, "3 numbers each in [-" + std::to_string(limit) + ", " + std::to_string(limit) + "]",
                std::to_string(x));
     }
   }
@@ -82,7 +81,8 @@ SimCameraSettings read_sim_camera_settings(YamlMap map) {
   }
   for (const SimCameraFaultSettings& f : c.faults) {
     if (f.kind == "pan_tilt_offset" && !c.pan_tilt_enabled) {
-      map.fail("faults", "a pan_tilt_offset fault only with camera.sim.pan_tilt (a camera with a pan-tilt head)");
+      map.fail("faults",
+               "a pan_tilt_offset fault only with camera.sim.pan_tilt (a camera with a pan-tilt head)");
     }
   }
   map.finish();

@@ -22,8 +22,8 @@ SimulatedArm::SimulatedArm(const JointsSimSettings& config, const std::vector<st
     auto it = std::find_if(config.motion.begin(), config.motion.end(),
                            [&](const JointMotion& m) { return m.joint == joint; });
     if (it == config.motion.end()) {
-      throw error("motion", "expected an entry for every movable joint of the URDF (" + all +
-                                "), missing " + joint);
+      throw error("motion",
+                  "expected an entry for every movable joint of the URDF (" + all + "), missing " + joint);
     }
     motion_.push_back(*it);
   }
@@ -89,7 +89,8 @@ std::vector<double> SimulatedArm::planned_reported_positions(double ahead_s) con
   const double t = motion_time_s_ + (moving_ ? ahead_s : 0.0);
   for (size_t i = 0; i < motion_.size(); ++i) {
     const JointMotion& m = motion_[i];
-    positions[i] = m.center + m.amplitude * std::sin(2 * M_PI / m.period_s * t + m.phase_rad) + offsets_.at(m.joint);
+    positions[i] =
+        m.center + m.amplitude * std::sin(2 * M_PI / m.period_s * t + m.phase_rad) + offsets_.at(m.joint);
   }
   return positions;
 }

@@ -7,8 +7,8 @@
 
 #include <Eigen/Core>
 
-#include "tofguard/sim/deterministic_random.hpp"
 #include "tofguard/camera/depth_calibration.hpp"
+#include "tofguard/sim/deterministic_random.hpp"
 
 namespace tofguard::sim {
 namespace {

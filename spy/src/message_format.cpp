@@ -10,6 +10,7 @@
 
 #include "tofguard/camera_pose_t.hpp"
 #include "tofguard/common/decode.hpp"
+#include "tofguard/common/risk_names.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/heartbeat_t.hpp"
@@ -20,7 +21,6 @@
 #include "tofguard/power_relay_t.hpp"
 #include "tofguard/reset_reply_t.hpp"
 #include "tofguard/reset_request_t.hpp"
-#include "tofguard/common/risk_names.hpp"
 #include "tofguard/risk_t.hpp"
 #include "tofguard/safety_status_t.hpp"
 #include "tofguard/sim_camera_fault_t.hpp"
@@ -35,8 +35,8 @@ std::string format(const depth_image_t& m) {
   int valid = 0;
   for (int16_t d : m.depth_mm) valid += d > 0;
   std::ostringstream s;
-  s << "utime=" << m.utime << " seq=" << m.seq << " camera=" << m.camera_id << " " << m.width << "x" << m.height
-    << " valid=" << std::fixed << std::setprecision(1)
+  s << "utime=" << m.utime << " seq=" << m.seq << " camera=" << m.camera_id << " " << m.width << "x"
+    << m.height << " valid=" << std::fixed << std::setprecision(1)
     << (m.num_pixels > 0 ? 100.0 * valid / m.num_pixels : 0.0) << "% calibrated=" << yes_no(m.calibrated);
   return s.str();
 }
@@ -51,9 +51,9 @@ std::string format(const joint_state_t& m) {
 std::string format(const camera_pose_t& m) {
   std::ostringstream s;
   s << "utime=" << m.utime << " camera=" << m.camera_id << " frame=" << m.frame_id << std::fixed
-    << std::setprecision(4) << " t=[" << m.translation[0] << "," << m.translation[1] << "," << m.translation[2]
-    << "] q_wxyz=[" << m.rotation[0] << "," << m.rotation[1] << "," << m.rotation[2] << "," << m.rotation[3]
-    << "]";
+    << std::setprecision(4) << " t=[" << m.translation[0] << "," << m.translation[1] << ","
+    << m.translation[2] << "] q_wxyz=[" << m.rotation[0] << "," << m.rotation[1] << "," << m.rotation[2]
+    << "," << m.rotation[3] << "]";
   return s.str();
 }
 
@@ -106,12 +106,12 @@ std::string format(const discrepancy_t& m) {
   std::ostringstream s;
   s << "utime=" << m.utime << " seq=" << m.seq << " usable=" << yes_no(m.usable);
   if (!m.usable) return s.str() + " (" + m.unusable_reason + ")";
-  s << std::fixed << std::setprecision(1) << " match=" << m.num_match << " robot_missing=" << m.num_robot_missing
-    << " occluded=" << m.num_occluded << " unexpected=" << m.num_unexpected_surface
-    << " env_missing=" << m.num_environment_missing << " invalid=" << m.num_invalid
-    << " median_abs_dis_mm=" << m.median_abs_dis_mm << " robot_median_mm=" << m.robot_median_dis_mm
-    << " env_median_mm=" << m.environment_median_dis_mm << " blob_px=" << m.largest_blob_pixels
-    << " near_arm_px=" << m.near_arm_pixels << " |";
+  s << std::fixed << std::setprecision(1) << " match=" << m.num_match
+    << " robot_missing=" << m.num_robot_missing << " occluded=" << m.num_occluded
+    << " unexpected=" << m.num_unexpected_surface << " env_missing=" << m.num_environment_missing
+    << " invalid=" << m.num_invalid << " median_abs_dis_mm=" << m.median_abs_dis_mm
+    << " robot_median_mm=" << m.robot_median_dis_mm << " env_median_mm=" << m.environment_median_dis_mm
+    << " blob_px=" << m.largest_blob_pixels << " near_arm_px=" << m.near_arm_pixels << " |";
   for (int i = 0; i < m.num_links; ++i) {
     if (m.link_compared[i] == 0) continue;
     s << " " << m.link_name[i] << "=" << m.link_match[i] << "/" << m.link_compared[i] << "(far "
@@ -134,16 +134,18 @@ std::string format(const motion_estimate_t& m) {
     << " usable=" << yes_no(m.usable);
   if (!m.usable) return s.str() + " (" + m.unusable_reason + ")";
   constexpr double kDeg = 180.0 / 3.14159265358979323846;
-  s << " converged=" << yes_no(m.converged) << " iterations=" << m.iterations << " frames=" << m.num_frames << std::fixed << std::setprecision(1)
-    << " residual_mm=" << m.residual_before_mm << "->" << m.residual_after_mm << " |";
+  s << " converged=" << yes_no(m.converged) << " iterations=" << m.iterations << " frames=" << m.num_frames
+    << std::fixed << std::setprecision(1) << " residual_mm=" << m.residual_before_mm << "->"
+    << m.residual_after_mm << " |";
   for (int i = 0; i < m.num_joints; ++i) {
     if (!m.observable[i]) continue;
-    s << " " << m.joint_name[i] << "=" << std::showpos << (m.estimated_position[i] - m.reported_position[i]) * kDeg
-      << std::noshowpos << "±" << m.position_sigma[i] * kDeg << "°";
+    s << " " << m.joint_name[i] << "=" << std::showpos
+      << (m.estimated_position[i] - m.reported_position[i]) * kDeg << std::noshowpos << "±"
+      << m.position_sigma[i] * kDeg << "°";
   }
   const double w = std::min(1.0, std::abs(m.correction_rotation[0]));
-  s << " | camera_mm=" << m.correction_translation[0] * 1000 << "," << m.correction_translation[1] * 1000 << ","
-    << m.correction_translation[2] * 1000 << " camera_deg=" << 2 * std::acos(w) * kDeg
+  s << " | camera_mm=" << m.correction_translation[0] * 1000 << "," << m.correction_translation[1] * 1000
+    << "," << m.correction_translation[2] * 1000 << " camera_deg=" << 2 * std::acos(w) * kDeg
     << " compute_ms=" << m.compute_us / 1000.0;
   return s.str();
 }
@@ -178,10 +180,13 @@ std::pair<int64_t, std::pair<std::string, Formatter>> entry() {
 
 const std::map<int64_t, std::pair<std::string, Formatter>>& formatters() {
   static const std::map<int64_t, std::pair<std::string, Formatter>> table = {
-      entry<depth_image_t>(),   entry<joint_state_t>(),     entry<camera_pose_t>(), entry<risk_t>(),
-      entry<safety_status_t>(), entry<heartbeat_t>(),       entry<link_labels_t>(), entry<reset_request_t>(),
-      entry<reset_reply_t>(),   entry<power_relay_t>(),     entry<sim_joint_fault_t>(),
-      entry<discrepancy_t>(),   entry<motion_estimate_t>(), entry<planned_trajectory_t>(),
+      entry<depth_image_t>(),      entry<joint_state_t>(),
+      entry<camera_pose_t>(),      entry<risk_t>(),
+      entry<safety_status_t>(),    entry<heartbeat_t>(),
+      entry<link_labels_t>(),      entry<reset_request_t>(),
+      entry<reset_reply_t>(),      entry<power_relay_t>(),
+      entry<sim_joint_fault_t>(),  entry<discrepancy_t>(),
+      entry<motion_estimate_t>(),  entry<planned_trajectory_t>(),
       entry<sim_camera_fault_t>(),
   };
   return table;
@@ -209,8 +214,8 @@ std::string format_message(const std::string& channel, const void* data, int siz
     if (auto text = it->second.second(data, size)) return channel + " " + it->second.first + " " + *text;
   }
   std::ostringstream s;
-  s << channel << " ? fingerprint 0x" << std::hex << std::setw(16) << std::setfill('0') << static_cast<uint64_t>(hash)
-    << std::dec << " (" << size << " bytes)";
+  s << channel << " ? fingerprint 0x" << std::hex << std::setw(16) << std::setfill('0')
+    << static_cast<uint64_t>(hash) << std::dec << " (" << size << " bytes)";
   return s.str();
 }
 

@@ -88,7 +88,8 @@ int run_spy(const LcmSettings& lcm_settings, const std::vector<std::string>& arg
   lcm::LCM safety(lcm_settings.url);
   lcm::LCM images(lcm_settings.image_url);
   if (!safety.good() || !images.good()) {
-    std::cerr << "tofguard-spy: cannot open LCM at " << lcm_settings.url << " / " << lcm_settings.image_url << "\n";
+    std::cerr << "tofguard-spy: cannot open LCM at " << lcm_settings.url << " / " << lcm_settings.image_url
+              << "\n";
     return 3;
   }
   safety.subscribe(".*", &Receiver::on_message, &receiver);
@@ -97,7 +98,8 @@ int run_spy(const LcmSettings& lcm_settings, const std::vector<std::string>& arg
   // handle(): do it now, so "listening" is true when it is printed.
   safety.getFileno();
   images.getFileno();
-  std::cout << "tofguard-spy: listening on " << lcm_settings.url << " and " << lcm_settings.image_url << std::endl;
+  std::cout << "tofguard-spy: listening on " << lcm_settings.url << " and " << lcm_settings.image_url
+            << std::endl;
 
   int64_t next_draw_us = 0;
   while (!stop_requested()) {
@@ -109,7 +111,8 @@ int run_spy(const LcmSettings& lcm_settings, const std::vector<std::string>& arg
     if (!receiver.lines && monotonic_us() >= next_draw_us) {
       next_draw_us = monotonic_us() + 250'000;
       // Clear the screen and draw from the top.
-      std::cout << "\033[H\033[2J" << "tofguard-spy  " << lcm_settings.url << "  (Ctrl-C to quit)\n\n"
+      std::cout << "\033[H\033[2J"
+                << "tofguard-spy  " << lcm_settings.url << "  (Ctrl-C to quit)\n\n"
                 << receiver.board.render(monotonic_us(), wall_utime());
       if (!receiver.footer_file.empty()) std::cout << "\n" << last_lines(receiver.footer_file, 6);
       std::cout << std::flush;

@@ -3,11 +3,11 @@
 #include <iomanip>
 #include <sstream>
 
-#include "tofguard/spy/message_format.hpp"
 #include "tofguard/common/decode.hpp"
+#include "tofguard/common/risk_names.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/link_labels_t.hpp"
-#include "tofguard/common/risk_names.hpp"
+#include "tofguard/spy/message_format.hpp"
 
 namespace tofguard::spy {
 namespace {

@@ -13,9 +13,9 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
-#include "tofguard/camera/depth_calibration.hpp"
 #include "sim_test_config.hpp"
 #include "test_support.hpp"
+#include "tofguard/camera/depth_calibration.hpp"
 #include "tofguard/sim/tof_error_model.hpp"
 
 namespace tofguard::camera {
@@ -34,8 +34,7 @@ const char* kRaysText = "221.0,220.5,87.3,71.8";
 std::string calibration_dir() { return test::output_dir() + "/calibration"; }
 
 // Writes one PNG folder per distance and the capture list; returns its path.
-std::string write_captures(const std::vector<double>& distances_m, const std::string& name,
-                           uint64_t seed) {
+std::string write_captures(const std::vector<double>& distances_m, const std::string& name, uint64_t seed) {
   const Intrinsics in = sim::sim_test::test_intrinsics();
   sim::SimCameraSettings config = sim::sim_test::test_sim_config();
   config.seed = seed;
@@ -128,17 +127,15 @@ TEST(CalibrateDepth, ToolWritesTableYamlAndPlot) {
   const std::string plot = calibration_dir() + "/tool/out.png";
   std::string out, err;
   ASSERT_EQ(test::run_command("calibrate_depth_tool",
-                              {test::bin_dir() + "/tofguard-calibrate-depth", "--captures", csv,
-                               "--roi", "67,52,40,40", "--intrinsics", kRaysText, "--yaml", yaml,
-                               "--plot", plot},
+                              {test::bin_dir() + "/tofguard-calibrate-depth", "--captures", csv, "--roi",
+                               "67,52,40,40", "--intrinsics", kRaysText, "--yaml", yaml, "--plot", plot},
                               &out, &err),
             0)
       << err;
   EXPECT_NE(out.find("true_mm   samples   measured_mm"), std::string::npos) << out;
   EXPECT_NE(out.find("\n 5000.0"), std::string::npos) << out;
   const std::string snippet = test::read_file(yaml);
-  EXPECT_NE(snippet.find("depth_calibration:\n    degree: 5\n    coefficients_m: ["),
-            std::string::npos)
+  EXPECT_NE(snippet.find("depth_calibration:\n    degree: 5\n    coefficients_m: ["), std::string::npos)
       << snippet;
   const cv::Mat image = cv::imread(plot, cv::IMREAD_COLOR);
   ASSERT_FALSE(image.empty());
@@ -167,16 +164,14 @@ std::string tool_error(const std::string& name, const std::vector<std::string>& 
 
 TEST(CalibrateDepth, BadInputGivesOneClearLine) {
   const std::string csv = write_captures({1.0, 2.0, 3.0}, "few", 13);
-  const std::string few = tool_error("calibrate_few", {"--captures", csv, "--roi", "67,52,40,40",
-                                                       "--intrinsics", kRaysText});
+  const std::string few =
+      tool_error("calibrate_few", {"--captures", csv, "--roi", "67,52,40,40", "--intrinsics", kRaysText});
   EXPECT_NE(few.find("a degree-5 calibration needs at least 6 different distances, the list has 3"),
             std::string::npos)
       << few;
   const std::string outside =
-      tool_error("calibrate_roi", {"--captures", csv, "--roi", "150,100,40,40", "--intrinsics",
-                                   kRaysText});
-  EXPECT_NE(outside.find("ROI 150,100,40,40 lies outside the 176x144 image"), std::string::npos)
-      << outside;
+      tool_error("calibrate_roi", {"--captures", csv, "--roi", "150,100,40,40", "--intrinsics", kRaysText});
+  EXPECT_NE(outside.find("ROI 150,100,40,40 lies outside the 176x144 image"), std::string::npos) << outside;
   const std::string missing_csv = calibration_dir() + "/missing.csv";
   test::write_file(missing_csv, "capture,true_distance_mm\nnowhere,1000\n");
   const std::string missing =
@@ -186,12 +181,10 @@ TEST(CalibrateDepth, BadInputGivesOneClearLine) {
   const std::string roi = tool_error("calibrate_roi_text", {"--captures", csv, "--roi", "1,2,3"});
   EXPECT_NE(roi.find("--roi: expected U0,V0,WIDTH,HEIGHT"), std::string::npos) << roi;
   const std::string no_rays = tool_error("calibrate_no_rays", {"--captures", csv, "--roi", "67,52,40,40"});
-  EXPECT_NE(no_rays.find("carry no intrinsics: give --intrinsics FX,FY,CX,CY"), std::string::npos)
-      << no_rays;
+  EXPECT_NE(no_rays.find("carry no intrinsics: give --intrinsics FX,FY,CX,CY"), std::string::npos) << no_rays;
   const std::string bad_rays = tool_error(
       "calibrate_bad_rays", {"--captures", csv, "--roi", "67,52,40,40", "--intrinsics", "221,0,87,71"});
-  EXPECT_NE(bad_rays.find("--intrinsics: expected FX,FY,CX,CY in pixels"), std::string::npos)
-      << bad_rays;
+  EXPECT_NE(bad_rays.find("--intrinsics: expected FX,FY,CX,CY in pixels"), std::string::npos) << bad_rays;
 }
 
 }  // namespace

@@ -9,8 +9,7 @@
 namespace tofguard {
 namespace {
 
-std::string variant(const std::string& name, const std::string& replace = "",
-                    const std::string& with = "") {
+std::string variant(const std::string& name, const std::string& replace = "", const std::string& with = "") {
   if (replace.empty()) return test::sim_config_variant(name);
   return test::sim_config_variant(name, {{replace, with}});
 }
@@ -52,28 +51,25 @@ TEST(CameraSettings, RejectsBadCameraKeys) {
   EXPECT_NE(error_of(variant("uvc_missing", "source: sim", "source: uvc"))
                 .find("camera.uvc: missing key, expected a mapping"),
             std::string::npos);
-  const std::string bad_id = error_of(variant(
-      "uvc_bad_id", "source: sim",
-      "source: uvc\n  uvc: {vendor_id: 11205, product_id: \"0401\", format: z16, "
-      "depth_unit_mm: 1, distance: z}"));
-  EXPECT_NE(bad_id.find("camera.uvc.vendor_id: expected a USB id as 4 hex digits"),
-            std::string::npos)
+  const std::string bad_id =
+      error_of(variant("uvc_bad_id", "source: sim",
+                       "source: uvc\n  uvc: {vendor_id: 11205, product_id: \"0401\", format: z16, "
+                       "depth_unit_mm: 1, distance: z}"));
+  EXPECT_NE(bad_id.find("camera.uvc.vendor_id: expected a USB id as 4 hex digits"), std::string::npos)
       << bad_id;
-  const std::string unknown =
-      error_of(variant("sim_unknown", "    seed: 1", "    seed: 1\n    sead: 2"));
+  const std::string unknown = error_of(variant("sim_unknown", "    seed: 1", "    seed: 1\n    sead: 2"));
   EXPECT_NE(unknown.find("camera.sim.sead"), std::string::npos) << unknown;
-  const std::string range = error_of(
-      variant("sim_range", "dark_pixel_probability: 0.002", "dark_pixel_probability: 2"));
+  const std::string range =
+      error_of(variant("sim_range", "dark_pixel_probability: 0.002", "dark_pixel_probability: 2"));
   EXPECT_NE(range.find("camera.sim.amplitude.dark_pixel_probability: expected a number in [0, 1]"),
             std::string::npos)
       << range;
-  const std::string degree =
-      error_of(variant("cal_degree", "    degree: 7", "    degree: 6"));
+  const std::string degree = error_of(variant("cal_degree", "    degree: 7", "    degree: 6"));
   EXPECT_NE(degree.find("camera.depth_calibration.coefficients_m: expected a list of 7 numbers"),
             std::string::npos)
       << degree;
-  const std::string fault = error_of(
-      variant("fault_kind", "faults: []", "faults: [{kind: melt, start_s: 1, duration_s: 1}]"));
+  const std::string fault =
+      error_of(variant("fault_kind", "faults: []", "faults: [{kind: melt, start_s: 1, duration_s: 1}]"));
   EXPECT_NE(fault.find("camera.sim.faults[0].kind"), std::string::npos) << fault;
 }
 

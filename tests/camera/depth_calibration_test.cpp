@@ -16,8 +16,7 @@ TEST(Polynomial, EvaluatesAscendingPowers) {
 }
 
 TEST(Polynomial, FitRecoversAFifthOrderPolynomial) {
-  const std::vector<double> truth = {0.0186286, 0.388128, -0.376992, 0.131278, -0.0179423,
-                                     0.000764776};
+  const std::vector<double> truth = {0.0186286, 0.388128, -0.376992, 0.131278, -0.0179423, 0.000764776};
   std::vector<double> x, y;
   for (double d = 0.5; d <= 5.0001; d += 0.25) {
     x.push_back(d);

@@ -7,8 +7,8 @@
 
 #include <gtest/gtest.h>
 
-#include "tofguard/camera/camera_sources.hpp"
 #include "test_support.hpp"
+#include "tofguard/camera/camera_sources.hpp"
 
 namespace tofguard::camera {
 namespace {
@@ -32,12 +32,10 @@ TEST(UvcCamera, ListsUsbDevicesInOneLine) {
 TEST(UvcCamera, NoMatchingDeviceIsOneLineAndExitCode3) {
   std::string out, err;
   const int rc = test::run_command(
-      "camera_no_device", {test::bin_dir() + "/tofguard-camera", "--config", uvc_config()}, &out,
-      &err);
+      "camera_no_device", {test::bin_dir() + "/tofguard-camera", "--config", uvc_config()}, &out, &err);
   EXPECT_EQ(rc, kNoDeviceExitCode) << err;
   EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
-  EXPECT_EQ(err.rfind("tofguard-camera: no UVC camera fffe:fffd serial X1 attached; ", 0), 0u)
-      << err;
+  EXPECT_EQ(err.rfind("tofguard-camera: no UVC camera fffe:fffd serial X1 attached; ", 0), 0u) << err;
   EXPECT_TRUE(err.find("USB devices found:") != std::string::npos ||
               err.find("cannot list USB devices") != std::string::npos)
       << err;

@@ -25,8 +25,8 @@ std::vector<AssembledFrame> push(UvcFrameAssembler* a, const std::vector<uint8_t
 
 TEST(UvcPayloadHeader, ParsesFlagsAndPts) {
   // 12-byte header: PTS 0x12345678 and a 6-byte SCR.
-  const std::vector<uint8_t> p = {12, kFid | kEof | kPts | kScr | kEoh, 0x78, 0x56, 0x34, 0x12,
-                                  1, 2, 3, 4, 5, 6, 0xAA, 0xBB};
+  const std::vector<uint8_t> p = {
+      12, kFid | kEof | kPts | kScr | kEoh, 0x78, 0x56, 0x34, 0x12, 1, 2, 3, 4, 5, 6, 0xAA, 0xBB};
   std::string error;
   const auto h = parse_uvc_payload_header(p.data(), p.size(), &error);
   ASSERT_TRUE(h) << error;

@@ -70,13 +70,17 @@ TEST(UnitQuaternion, NormalisesWithinTheToleranceAndRefusesBeyond) {
   const auto refused = UnitQuaternion::check(almost, kConfigQuaternionTolerance, "rotation_wxyz");
   ASSERT_TRUE(refused.has_value());
   EXPECT_EQ(refused->field, "rotation_wxyz");
-  EXPECT_EQ(refused->line(), "rotation_wxyz: expected a unit quaternion w, x, y, z (norm 1 within 1e-06), got norm 1.0005");
+  EXPECT_EQ(refused->line(),
+            "rotation_wxyz: expected a unit quaternion w, x, y, z (norm 1 within 1e-06), got norm 1.0005");
 
-  EXPECT_FALSE(UnitQuaternion::make(Eigen::Quaterniond(2, 0, 0, 0), kWireQuaternionTolerance, "rotation", &why));
+  EXPECT_FALSE(
+      UnitQuaternion::make(Eigen::Quaterniond(2, 0, 0, 0), kWireQuaternionTolerance, "rotation", &why));
   EXPECT_EQ(why, "rotation: expected a unit quaternion w, x, y, z (norm 1 within 0.001), got norm 2");
-  EXPECT_FALSE(UnitQuaternion::make(Eigen::Quaterniond(0, 0, 0, 0), kWireQuaternionTolerance, "rotation", &why));
+  EXPECT_FALSE(
+      UnitQuaternion::make(Eigen::Quaterniond(0, 0, 0, 0), kWireQuaternionTolerance, "rotation", &why));
   // A non-finite component is named by its index in w, x, y, z order.
-  EXPECT_FALSE(UnitQuaternion::make(Eigen::Quaterniond(1, 0, kNaN, 0), kWireQuaternionTolerance, "rotation", &why));
+  EXPECT_FALSE(
+      UnitQuaternion::make(Eigen::Quaterniond(1, 0, kNaN, 0), kWireQuaternionTolerance, "rotation", &why));
   EXPECT_EQ(why, "rotation[2]: expected a finite number, got nan");
 
   EXPECT_TRUE(UnitQuaternion().quaternion().isApprox(Eigen::Quaterniond::Identity()));
@@ -94,18 +98,21 @@ TEST(CameraPose, ChecksFrameTranslationAndRotation) {
   EXPECT_FALSE(pose->check());
   EXPECT_TRUE(pose->frame_from_optical().isApprox(Eigen::Translation3d(t) * r));
 
-  const auto line = [](const std::string& frame, const Eigen::Vector3d& translation, const Eigen::Quaterniond& q) {
+  const auto line = [](const std::string& frame, const Eigen::Vector3d& translation,
+                       const Eigen::Quaterniond& q) {
     const auto v = CameraPose::check(frame, translation, q, kWireQuaternionTolerance);
     return v ? v->line() : "";
   };
   EXPECT_EQ(line("", t, r), "frame_id: expected a URDF link name, got an empty string");
-  EXPECT_EQ(line("base_link", Eigen::Vector3d(0, kInf, 0), r), "translation[1]: expected a finite number of metres, got inf");
+  EXPECT_EQ(line("base_link", Eigen::Vector3d(0, kInf, 0), r),
+            "translation[1]: expected a finite number of metres, got inf");
   EXPECT_EQ(line("base_link", t, Eigen::Quaterniond(0.5, 0, 0, 0)),
             "rotation: expected a unit quaternion w, x, y, z (norm 1 within 0.001), got norm 0.5");
   // Not set yet (no frame): refused.
   EXPECT_EQ(CameraPose().check()->field, "frame_id");
   // Accepted within the tolerance and stored normalised.
-  const auto scaled = CameraPose::make("base_link", t, Eigen::Quaterniond(r.coeffs() * 1.0004), kWireQuaternionTolerance, &why);
+  const auto scaled = CameraPose::make("base_link", t, Eigen::Quaterniond(r.coeffs() * 1.0004),
+                                       kWireQuaternionTolerance, &why);
   ASSERT_TRUE(scaled.has_value()) << why;
   EXPECT_NEAR(scaled->rotation.norm(), 1.0, 1e-15);
 }
@@ -114,10 +121,12 @@ TEST(CameraPose, ChecksFrameTranslationAndRotation) {
 // broken one must stop the process, with the file, line, condition and the
 // reason on stderr.
 TEST(CameraGeometryDeathTest, ConstructorsDemandTheirInvariants) {
-  EXPECT_DEATH(Intrinsics(176, 144, -1.0, 220.0, 87.0, 71.0),
-               "tofguard: internal invariant failed: .*camera_geometry.cpp:[0-9]+: !v: intrinsics: fx: expected a "
-               "focal length > 0 px, got -1");
-  EXPECT_DEATH(UnitQuaternion(Eigen::Quaterniond(2, 0, 0, 0)), "quaternion: expected a unit quaternion w, x, y, z \\(norm 1 within 0.001\\), got norm 2");
+  EXPECT_DEATH(
+      Intrinsics(176, 144, -1.0, 220.0, 87.0, 71.0),
+      "tofguard: internal invariant failed: .*camera_geometry.cpp:[0-9]+: !v: intrinsics: fx: expected a "
+      "focal length > 0 px, got -1");
+  EXPECT_DEATH(UnitQuaternion(Eigen::Quaterniond(2, 0, 0, 0)),
+               "quaternion: expected a unit quaternion w, x, y, z \\(norm 1 within 0.001\\), got norm 2");
   EXPECT_DEATH(CameraPose("", Eigen::Vector3d::Zero(), UnitQuaternion()),
                "camera pose: frame_id: expected a URDF link name");
   EXPECT_DEATH(CameraPose("base_link", Eigen::Vector3d(kNaN, 0, 0), UnitQuaternion()), "translation\\[0\\]");
@@ -126,9 +135,10 @@ TEST(CameraGeometryDeathTest, ConstructorsDemandTheirInvariants) {
 TEST(DemandDeathTest, AbortsWithFileLineConditionAndMessage) {
   const int pixels = 12;
   const int expected_pixels = 3 * 5;
-  EXPECT_DEATH(TOFGUARD_DEMAND(pixels == expected_pixels, "depth has " + std::to_string(pixels) + " pixels"),
-               "tofguard: internal invariant failed: .*camera_geometry_test.cpp:[0-9]+: pixels == expected_pixels: "
-               "depth has 12 pixels");
+  EXPECT_DEATH(
+      TOFGUARD_DEMAND(pixels == expected_pixels, "depth has " + std::to_string(pixels) + " pixels"),
+      "tofguard: internal invariant failed: .*camera_geometry_test.cpp:[0-9]+: pixels == expected_pixels: "
+      "depth has 12 pixels");
   // Always on: the condition is evaluated in every build type, and the
   // message only when it fails.
   int evaluated = 0;

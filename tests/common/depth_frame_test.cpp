@@ -28,7 +28,7 @@ TEST(DepthFrame, MillimetresRoundToNearestAndNeverInventDistances) {
   EXPECT_EQ(depth_mm_from_m(1.2346), 1235);  // nearest millimetre
   EXPECT_EQ(depth_mm_from_m(1.2344), 1234);
   EXPECT_EQ(depth_mm_from_m(0.0015), 2);  // halves round away from zero
-  EXPECT_EQ(depth_mm_from_m(0.0004), 0);     // rounds to 0: no return
+  EXPECT_EQ(depth_mm_from_m(0.0004), 0);  // rounds to 0: no return
   EXPECT_EQ(depth_mm_from_m(0.0), 0);
   EXPECT_EQ(depth_mm_from_m(-1.0), 0);
   EXPECT_EQ(depth_mm_from_m(32.767), kMaxDepthMm);
@@ -54,8 +54,8 @@ TEST(DepthFrame, MetresRoundTripThroughTheWireToTheMillimetre) {
 }
 
 TEST(DepthFrame, MakeDepthImagePacksTheFrame) {
-  const depth_image_t m =
-      make_depth_image("cam", two_by_two(), 123, 7, true, {1.2345f, 0.0f, 40.0f, -1.0f}, {10.4f, -3.0f, 1e6f, 5.0f});
+  const depth_image_t m = make_depth_image("cam", two_by_two(), 123, 7, true, {1.2345f, 0.0f, 40.0f, -1.0f},
+                                           {10.4f, -3.0f, 1e6f, 5.0f});
   EXPECT_EQ(m.utime, 123);
   EXPECT_EQ(m.seq, 7);
   EXPECT_EQ(m.camera_id, "cam");
@@ -80,7 +80,8 @@ TEST(DepthFrame, MakeDepthImagePacksTheFrame) {
 TEST(DepthFrame, MakeDepthImageRejectsBadSizes) {
   EXPECT_THROW(make_depth_image("cam", two_by_two(), 1, 0, false, {1}), std::invalid_argument);
   EXPECT_THROW(make_depth_image("cam", two_by_two(), 1, 0, false, {1, 1, 1, 1, 1}), std::invalid_argument);
-  EXPECT_THROW(make_depth_image("cam", two_by_two(), 1, 0, false, {1, 1, 1, 1}, {1, 2}), std::invalid_argument);
+  EXPECT_THROW(make_depth_image("cam", two_by_two(), 1, 0, false, {1, 1, 1, 1}, {1, 2}),
+               std::invalid_argument);
   Intrinsics negative = two_by_two();
   negative.width = -2;
   EXPECT_THROW(make_depth_image("cam", negative, 1, 0, false, {1, 1, 1, 1}), std::invalid_argument);

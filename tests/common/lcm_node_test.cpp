@@ -6,8 +6,8 @@
 #include "sample_messages.hpp"
 #include "test_support.hpp"
 #include "tofguard/common/clock.hpp"
-#include "tofguard/common/lcm_settings.hpp"
 #include "tofguard/common/lcm_node.hpp"
+#include "tofguard/common/lcm_settings.hpp"
 #include "tofguard/common/wire_checks.hpp"
 
 namespace tofguard::test {
@@ -41,8 +41,7 @@ TEST(LcmNode, MalformedMessagesAreCountedAndNeverHandedOn) {
   LcmNode node(config.lcm, config.channels, "node-under-test");
   std::vector<depth_image_t> handled;
   node.subscribe<depth_image_t>(
-      node.images(), "TOF_DEPTH", [&](const depth_image_t& m) { handled.push_back(m); },
-      check_depth_image);
+      node.images(), "TOF_DEPTH", [&](const depth_image_t& m) { handled.push_back(m); }, check_depth_image);
 
   lcm::LCM publisher(config.lcm.image_url);
   ASSERT_TRUE(publisher.good());
@@ -73,12 +72,12 @@ TEST(LcmNode, MalformedMessagesAreCountedAndNeverHandedOn) {
   EXPECT_NE(node.errors().last().find("TOF_DEPTH"), std::string::npos);
 
   // The heartbeat reports the same counters.
-  ASSERT_TRUE(wait_until(
-      [&] { return heartbeats.count > 0 && heartbeats.last.decode_errors == 2; }, std::chrono::seconds(5),
-      [&] {
-        node.spin_once(10);
-        safety.handleTimeout(0);
-      }));
+  ASSERT_TRUE(wait_until([&] { return heartbeats.count > 0 && heartbeats.last.decode_errors == 2; },
+                         std::chrono::seconds(5),
+                         [&] {
+                           node.spin_once(10);
+                           safety.handleTimeout(0);
+                         }));
   EXPECT_EQ(heartbeats.last.process, "node-under-test");
   EXPECT_EQ(heartbeats.last.frames_in, 1);
   EXPECT_EQ(heartbeats.last.validation_errors, 1);
@@ -92,10 +91,11 @@ TEST(LcmNode, HeartbeatsComeAtTheirRateWithoutAnyTraffic) {
   HeartbeatListener heartbeats;
   safety.subscribe("SAFETY_HEARTBEAT", &HeartbeatListener::on_message, &heartbeats);
   const int64_t start_us = monotonic_us();
-  ASSERT_TRUE(wait_until([&] { return heartbeats.count >= 10; }, std::chrono::seconds(5), [&] {
-    node.spin_once(10);
-    safety.handleTimeout(0);
-  }));
+  ASSERT_TRUE(wait_until([&] { return heartbeats.count >= 10; }, std::chrono::seconds(5),
+                         [&] {
+                           node.spin_once(10);
+                           safety.handleTimeout(0);
+                         }));
   // 10 heartbeats at 20 Hz take about 450 ms; consecutive seq numbers.
   EXPECT_GE(monotonic_us() - start_us, 400'000);
   EXPECT_EQ(heartbeats.last.seq, heartbeats.count - 1);

@@ -66,10 +66,10 @@ TEST(Config, EmbeddedDefaultLoads) {
 // renderer's state history and risk's deadlines compare.
 TEST(Config, MillisecondsAreRoundedToWholeMicrosecondsOnce) {
   const std::string path = sim_config_variant(
-      "config-fractional-ms",
-      {{"  max_extrapolation_ms: 20\n", "  max_extrapolation_ms: 12.3456\n"},
-       {"camera_pose: {history_ms: 2000, max_extrapolation_ms: 40,", "camera_pose: {history_ms: 2000, max_extrapolation_ms: 40.0004,"},
-       {"deadlines_ms: {depth: 150,", "deadlines_ms: {depth: 33.3334,"}});
+      "config-fractional-ms", {{"  max_extrapolation_ms: 20\n", "  max_extrapolation_ms: 12.3456\n"},
+                               {"camera_pose: {history_ms: 2000, max_extrapolation_ms: 40,",
+                                "camera_pose: {history_ms: 2000, max_extrapolation_ms: 40.0004,"},
+                               {"deadlines_ms: {depth: 150,", "deadlines_ms: {depth: 33.3334,"}});
   const deployment::Config config = deployment::load_config(path, nullptr);
   EXPECT_EQ(config.renderer.max_extrapolation_us, 12'346);
   EXPECT_EQ(config.renderer.camera_pose_max_extrapolation_us, 40'000);
@@ -82,8 +82,7 @@ TEST(Config, LcmUrlComesFromConfigThenEnvironmentThenHostLocalDefault) {
   EXPECT_EQ(resolve_lcm_url("", nullptr), "udpm://239.255.76.67:7667?ttl=0");
   EXPECT_EQ(resolve_lcm_url("", ""), "udpm://239.255.76.67:7667?ttl=0");
 
-  const std::string path = sim_variant("no-lcm-section",
-                                       "  url: \"udpm://239.255.76.67:7667?ttl=0\"\n", "");
+  const std::string path = sim_variant("no-lcm-section", "  url: \"udpm://239.255.76.67:7667?ttl=0\"\n", "");
   // With lcm.url removed, LCM_DEFAULT_URL decides; the image URL names its
   // own port with a big receive buffer.
   const deployment::Config config = deployment::load_config(path, "udpm://239.9.9.9:9000?ttl=1");
@@ -93,8 +92,7 @@ TEST(Config, LcmUrlComesFromConfigThenEnvironmentThenHostLocalDefault) {
 TEST(Config, ImageUrlIsDerivedOnTheNextPortWithABigBuffer) {
   EXPECT_EQ(derive_image_url("udpm://239.255.76.67:7667?ttl=0"),
             "udpm://239.255.76.67:7668?ttl=0&recv_buf_size=4194304");
-  EXPECT_EQ(derive_image_url("udpm://239.255.76.67:7667"),
-            "udpm://239.255.76.67:7668?recv_buf_size=4194304");
+  EXPECT_EQ(derive_image_url("udpm://239.255.76.67:7667"), "udpm://239.255.76.67:7668?recv_buf_size=4194304");
   EXPECT_EQ(derive_image_url("udpm://239.1.2.3:100?recv_buf_size=100"),
             "udpm://239.1.2.3:101?recv_buf_size=100");
   EXPECT_EQ(derive_image_url("memq://"), "memq://");
@@ -125,35 +123,60 @@ INSTANTIATE_TEST_SUITE_P(
     Mistakes, ConfigErrors,
     ::testing::Values(
         BadConfig{"missing-key", "  id: friend-sim\n", "", {"robot.id", "missing key", "expected a string"}},
-        BadConfig{"unknown-key", "  rate_hz: 30\n", "  rate_hz: 30\n  exposure_us: 300\n",
+        BadConfig{"unknown-key",
+                  "  rate_hz: 30\n",
+                  "  rate_hz: 30\n  exposure_us: 300\n",
                   {"camera.exposure_us", "unknown key", "expected one of", "rate_hz"}},
-        BadConfig{"unknown-section", "renderer:\n", "rendering:\n  x: 1\nrenderer:\n",
+        BadConfig{"unknown-section",
+                  "renderer:\n",
+                  "rendering:\n  x: 1\nrenderer:\n",
                   {"rendering", "unknown key"}},
-        BadConfig{"wrong-type", "rate_hz: 30", "rate_hz: fast",
+        BadConfig{"wrong-type",
+                  "rate_hz: 30",
+                  "rate_hz: fast",
                   {"camera.rate_hz", "expected a number in", "'fast'"}},
-        BadConfig{"wrong-type-int", "width: 176", "width: 176.5",
+        BadConfig{"wrong-type-int",
+                  "width: 176",
+                  "width: 176.5",
                   {"camera.intrinsics.width", "expected an integer", "'176.5'"}},
-        BadConfig{"out-of-range", "far_m: 8.0", "far_m: 0.05",
+        BadConfig{"out-of-range",
+                  "far_m: 8.0",
+                  "far_m: 0.05",
                   {"renderer.far_m", "expected a distance greater than near_m"}},
-        BadConfig{"bad-choice", "source: sim", "source: kinect",
+        BadConfig{"bad-choice",
+                  "source: sim",
+                  "source: kinect",
                   {"camera.source", "expected one of sim, uvc", "'kinect'"}},
-        BadConfig{"missing-path", "models/friend_arm.urdf", "models/no_such_arm.urdf",
+        BadConfig{"missing-path",
+                  "models/friend_arm.urdf",
+                  "models/no_such_arm.urdf",
                   {"robot.urdf", "expected an existing file", "no_such_arm.urdf", "does not exist"}},
-        BadConfig{"not-unit-quaternion", "[0.302934347, -0.581931466", "[0.6, -0.581931466",
+        BadConfig{"not-unit-quaternion",
+                  "[0.302934347, -0.581931466",
+                  "[0.6, -0.581931466",
                   {"camera.pose.rotation_wxyz", "expected a unit quaternion"}},
-        BadConfig{"short-list", "translation_m: [-0.90, -0.20, 1.80]", "translation_m: [-0.90, 1.80]",
+        BadConfig{"short-list",
+                  "translation_m: [-0.90, -0.20, 1.80]",
+                  "translation_m: [-0.90, 1.80]",
                   {"camera.pose.translation_m", "expected a list of 3 numbers", "2 entries"}},
         BadConfig{"not-yaml", "robot:\n", "robot: [\n", {"not valid YAML"}},
-        BadConfig{"pan-tilt-offset-without-head", "    faults: []\n",
-                  "    faults: [{kind: pan_tilt_offset, start_s: 1, duration_s: 1, pan_offset_deg: 3, tilt_offset_deg: 0}]\n",
+        BadConfig{"pan-tilt-offset-without-head",
+                  "    faults: []\n",
+                  "    faults: [{kind: pan_tilt_offset, start_s: 1, duration_s: 1, pan_offset_deg: 3, "
+                  "tilt_offset_deg: 0}]\n",
                   {"camera.sim.faults", "only with camera.sim.pan_tilt"}},
-        BadConfig{"estimate-wait-out-of-range", "    wait_ms: 0\n", "    wait_ms: 5000\n",
+        BadConfig{"estimate-wait-out-of-range",
+                  "    wait_ms: 0\n",
+                  "    wait_ms: 5000\n",
                   {"risk.estimate.wait_ms", "expected a number in"}},
-        BadConfig{"plan-step-longer-than-horizon", "step_ms: 20}", "step_ms: 600}",
+        BadConfig{"plan-step-longer-than-horizon",
+                  "step_ms: 20}",
+                  "step_ms: 600}",
                   {"joints_sim.plan.step_ms", "no longer than horizon_ms"}}),
     [](const ::testing::TestParamInfo<BadConfig>& info) {
       std::string name = info.param.name;
-      for (auto& c : name) if (c == '-') c = '_';
+      for (auto& c : name)
+        if (c == '-') c = '_';
       return name;
     });
 

@@ -70,7 +70,8 @@ TEST(ProcessConfig, MissingConfigArgumentIsAUsageError) {
 TEST(ProcessConfig, HelpExitsZero) {
   for (const char* process : kProcesses) {
     std::string out, err;
-    EXPECT_EQ(run_command(std::string("help-") + process, {bin_dir() + "/" + process, "--help"}, &out, &err), 0);
+    EXPECT_EQ(run_command(std::string("help-") + process, {bin_dir() + "/" + process, "--help"}, &out, &err),
+              0);
     EXPECT_NE(out.find(std::string("usage: ") + process), std::string::npos) << out;
   }
 }

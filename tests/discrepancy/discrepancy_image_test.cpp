@@ -1,8 +1,8 @@
 // The discrepancy image on synthetic frames whose every count is known.
 #include <gtest/gtest.h>
 
-#include "tofguard/discrepancy/discrepancy_image.hpp"
 #include "synthetic_frames.hpp"
+#include "tofguard/discrepancy/discrepancy_image.hpp"
 
 namespace tofguard::test {
 namespace {
@@ -210,7 +210,8 @@ TEST(Discrepancy, FramesThatDoNotFitAreUnusableAndSayWhy) {
   const link_labels_t labels = labels_frame(model.label, 4);
 
   const SyntheticImage small = draw({}, 88, 72);
-  auto s = compute_discrepancy(camera, depth_frame(small.depth_mm, 4, 88, 72), labels, sim_parameters()).summary;
+  auto s =
+      compute_discrepancy(camera, depth_frame(small.depth_mm, 4, 88, 72), labels, sim_parameters()).summary;
   EXPECT_FALSE(s.usable);
   EXPECT_EQ(s.unusable_kind, discrepancy_t::UNUSABLE_MISMATCHED);
   EXPECT_EQ(s.unusable_reason, "rendered frame is 88x72, camera frame 176x144");

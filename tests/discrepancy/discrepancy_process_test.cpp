@@ -20,8 +20,8 @@ class DiscrepancyProcess : public ::testing::Test {
         "discrepancy-process", std::vector<std::string>{bin_dir() + "/tofguard-discrepancy", "--config",
                                                         chain_config("discrepancy")});
     // Up when its heartbeat comes.
-    ASSERT_TRUE(wait_until([&] { return !bus_.last_heartbeat("tofguard-discrepancy").process.empty(); }, kDeadline,
-                           [&] { bus_.poll(); }))
+    ASSERT_TRUE(wait_until([&] { return !bus_.last_heartbeat("tofguard-discrepancy").process.empty(); },
+                           kDeadline, [&] { bus_.poll(); }))
         << process_->stderr_text();
   }
   void TearDown() override {
@@ -87,8 +87,8 @@ TEST_F(DiscrepancyProcess, CameraFrameWithoutRenderingIsPublishedUnusableAndCoun
   EXPECT_EQ(d.unusable_reason, "no rendered frame and labels for seq 10: waited 100 ms");
   // Not before the pairing deadline.
   EXPECT_GE(waited_us, 100'000);
-  ASSERT_TRUE(wait_until([&] { return bus_.last_heartbeat("tofguard-discrepancy").frames_dropped >= 1; }, kDeadline,
-                         [&] { bus_.poll(); }));
+  ASSERT_TRUE(wait_until([&] { return bus_.last_heartbeat("tofguard-discrepancy").frames_dropped >= 1; },
+                         kDeadline, [&] { bus_.poll(); }));
 }
 
 TEST_F(DiscrepancyProcess, UnusableLabelsGiveAnUnusableFrameAtOnce) {
@@ -145,7 +145,8 @@ TEST_F(DiscrepancyProcess, MalformedInputOnEveryChannelIsDroppedAndCounted) {
       << "decode " << bus_.last_heartbeat("tofguard-discrepancy").decode_errors << " validation "
       << bus_.last_heartbeat("tofguard-discrepancy").validation_errors;
   EXPECT_TRUE(process_->running());
-  EXPECT_NE(process_->stderr_text().find("TOF_DEPTH: num_pixels"), std::string::npos) << process_->stderr_text();
+  EXPECT_NE(process_->stderr_text().find("TOF_DEPTH: num_pixels"), std::string::npos)
+      << process_->stderr_text();
 }
 
 }  // namespace

@@ -1,8 +1,8 @@
 // Pairing camera, rendered and label frames by seq with a bounded wait.
 #include <gtest/gtest.h>
 
-#include "tofguard/discrepancy/frame_pairer.hpp"
 #include "synthetic_frames.hpp"
+#include "tofguard/discrepancy/frame_pairer.hpp"
 
 namespace tofguard::test {
 namespace {

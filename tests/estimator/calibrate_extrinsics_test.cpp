@@ -12,11 +12,11 @@
 #include <iostream>
 #include <sstream>
 
-#include "tofguard/common/depth_frame.hpp"
 #include "estimator_test_support.hpp"
+#include "tofguard/common/depth_frame.hpp"
+#include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/joint_state_t.hpp"
-#include "tofguard/deployment/process_settings.hpp"
 
 namespace tofguard::estimator {
 namespace {
@@ -39,8 +39,8 @@ void write_event(lcm::LogFile* log, int64_t utime, const std::string& channel, c
 
 // A log of `poses` (one camera frame each, joint states 5 ms before and
 // after it), frames from the simulated camera at the config's true pose.
-std::string write_log(const std::string& name, const deployment::Config& config, const std::vector<robot_model::JointPositions>& poses,
-                      bool with_depth) {
+std::string write_log(const std::string& name, const deployment::Config& config,
+                      const std::vector<robot_model::JointPositions>& poses, bool with_depth) {
   const std::string dir = tofguard::test::output_dir() + "/estimator";
   std::filesystem::create_directories(dir);
   const std::string path = dir + "/" + name;
@@ -63,8 +63,8 @@ std::string write_log(const std::string& name, const deployment::Config& config,
     write_event(&log, state.utime, config.channels.joint_state, state);
     if (with_depth) {
       const std::vector<float> depth_m = frames.capture(poses[k], camera, in, k + 1);
-      const depth_image_t frame =
-          make_depth_image(config.camera.id, config.camera.intrinsics, utime, static_cast<int64_t>(k), true, depth_m);
+      const depth_image_t frame = make_depth_image(config.camera.id, config.camera.intrinsics, utime,
+                                                   static_cast<int64_t>(k), true, depth_m);
       write_event(&log, utime, config.channels.depth, frame);
     }
     state.utime = utime + 5000;
@@ -106,17 +106,20 @@ TEST(CalibrateExtrinsics, ConvergesFromFiveCentimetresAndFiveDegrees) {
   const Eigen::Isometry3d truth = test::pose_of(truth_config.camera.pose);
   Eigen::Isometry3d wrong = truth;
   wrong.translation() += Eigen::Vector3d(0.03, -0.03, 0.0283);  // 5.0 cm
-  wrong.linear() = wrong.linear() * Eigen::AngleAxisd(deg(5), Eigen::Vector3d(1, 1, 0).normalized()).toRotationMatrix();
+  wrong.linear() =
+      wrong.linear() * Eigen::AngleAxisd(deg(5), Eigen::Vector3d(1, 1, 0).normalized()).toRotationMatrix();
   const Eigen::Quaterniond q(wrong.linear());
   const std::string config_path = tofguard::test::sim_config_variant(
       "calibrate-extrinsics",
       {{"translation_m: [-0.90, -0.20, 1.80]",
-        "translation_m: " + yaml_list({wrong.translation().x(), wrong.translation().y(), wrong.translation().z()})},
+        "translation_m: " +
+            yaml_list({wrong.translation().x(), wrong.translation().y(), wrong.translation().z()})},
        {"rotation_wxyz: [0.302934347, -0.581931466, 0.669435574, -0.348486102]",
         "rotation_wxyz: " + yaml_list({q.w(), q.x(), q.y(), q.z()})}});
   const deployment::Config config = deployment::load_config(config_path, nullptr);
 
-  const CalibrationResult result = calibrate_extrinsics(deployment::estimator_process_settings(config), log, CalibrationOptions());
+  const CalibrationResult result =
+      calibrate_extrinsics(deployment::estimator_process_settings(config), log, CalibrationOptions());
   ASSERT_EQ(result.error, "");
   const Eigen::Isometry3d estimated = result.pose.frame_from_optical();
   const Eigen::Isometry3d error = truth.inverse() * estimated;
@@ -133,8 +136,8 @@ TEST(CalibrateExtrinsics, ConvergesFromFiveCentimetresAndFiveDegrees) {
   const std::string out = tofguard::test::output_dir() + "/estimator/pose.yaml";
   std::string stdout_text, stderr_text;
   ASSERT_EQ(tofguard::test::run_command("calibrate-extrinsics",
-                                        {tofguard::test::bin_dir() + "/tofguard-calibrate-extrinsics", "--config",
-                                         config_path, log, "--out", out},
+                                        {tofguard::test::bin_dir() + "/tofguard-calibrate-extrinsics",
+                                         "--config", config_path, log, "--out", out},
                                         &stdout_text, &stderr_text),
             0)
       << stderr_text;
@@ -150,15 +153,21 @@ TEST(CalibrateExtrinsics, OneLineErrors) {
   std::string err;
   // No depth frames in the log.
   const std::string joints_only = write_log("joints-only.lcm", config, arm_poses(), false);
-  EXPECT_EQ(tofguard::test::run_command("calibrate-no-depth", {bin, "--config", config_path, joints_only}, nullptr, &err), 1);
+  EXPECT_EQ(tofguard::test::run_command("calibrate-no-depth", {bin, "--config", config_path, joints_only},
+                                        nullptr, &err),
+            1);
   EXPECT_NE(err.find("no TOF_DEPTH frames of camera 'tof-mast'"), std::string::npos) << err;
   // All frames at one pose.
   const std::vector<robot_model::JointPositions> still(4, test::side_reach_pose());
   const std::string one_pose = write_log("one-pose.lcm", config, still, true);
-  EXPECT_EQ(tofguard::test::run_command("calibrate-one-pose", {bin, "--config", config_path, one_pose}, nullptr, &err), 1);
+  EXPECT_EQ(tofguard::test::run_command("calibrate-one-pose", {bin, "--config", config_path, one_pose},
+                                        nullptr, &err),
+            1);
   EXPECT_NE(err.find("too few frames with distinct arm poses (1"), std::string::npos) << err;
   // Not a log.
-  EXPECT_EQ(tofguard::test::run_command("calibrate-missing", {bin, "--config", config_path, "/nonexistent.lcm"}, nullptr, &err), 1);
+  EXPECT_EQ(tofguard::test::run_command("calibrate-missing",
+                                        {bin, "--config", config_path, "/nonexistent.lcm"}, nullptr, &err),
+            1);
   EXPECT_NE(err.find("/nonexistent.lcm: cannot open as an LCM log"), std::string::npos) << err;
 }
 

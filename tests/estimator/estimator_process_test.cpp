@@ -30,19 +30,22 @@ constexpr double kDeg = M_PI / 180.0;
 // side-reach pose, where every link is in view, and a periodic estimate
 // every 400 ms.
 std::string rig_config() {
-  return sim_config_variant(
-      "estimator-process",
-      {{"a1: {center: -0.30, amplitude: 0.35, period_s: 9.0}", "a1: {center: -0.6, amplitude: 0.02, period_s: 9.0}"},
-       {"a2: {center: 0.70, amplitude: 0.20, period_s: 7.0, phase_rad: 1.0}",
-        "a2: {center: 1.3, amplitude: 0.02, period_s: 7.0, phase_rad: 1.0}"},
-       {"a3: {center: 0.00, amplitude: 0.30, period_s: 11.0}", "a3: {center: -0.4, amplitude: 0.02, period_s: 11.0}"},
-       {"a4: {center: 1.10, amplitude: 0.25, period_s: 6.0, phase_rad: 2.0}",
-        "a4: {center: 1.2, amplitude: 0.02, period_s: 6.0, phase_rad: 2.0}"},
-       {"a5: {center: 0.00, amplitude: 0.40, period_s: 8.0}", "a5: {center: 0.6, amplitude: 0.02, period_s: 8.0}"},
-       {"a6: {center: 0.60, amplitude: 0.25, period_s: 5.0, phase_rad: 0.5}",
-        "a6: {center: 1.0, amplitude: 0.02, period_s: 5.0, phase_rad: 0.5}"},
-       {"a7: {center: 0.00, amplitude: 0.50, period_s: 4.0}", "a7: {center: -0.4, amplitude: 0.02, period_s: 4.0}"},
-       {"periodic_period_ms: 1000", "periodic_period_ms: 400"}});
+  return sim_config_variant("estimator-process",
+                            {{"a1: {center: -0.30, amplitude: 0.35, period_s: 9.0}",
+                              "a1: {center: -0.6, amplitude: 0.02, period_s: 9.0}"},
+                             {"a2: {center: 0.70, amplitude: 0.20, period_s: 7.0, phase_rad: 1.0}",
+                              "a2: {center: 1.3, amplitude: 0.02, period_s: 7.0, phase_rad: 1.0}"},
+                             {"a3: {center: 0.00, amplitude: 0.30, period_s: 11.0}",
+                              "a3: {center: -0.4, amplitude: 0.02, period_s: 11.0}"},
+                             {"a4: {center: 1.10, amplitude: 0.25, period_s: 6.0, phase_rad: 2.0}",
+                              "a4: {center: 1.2, amplitude: 0.02, period_s: 6.0, phase_rad: 2.0}"},
+                             {"a5: {center: 0.00, amplitude: 0.40, period_s: 8.0}",
+                              "a5: {center: 0.6, amplitude: 0.02, period_s: 8.0}"},
+                             {"a6: {center: 0.60, amplitude: 0.25, period_s: 5.0, phase_rad: 0.5}",
+                              "a6: {center: 1.0, amplitude: 0.02, period_s: 5.0, phase_rad: 0.5}"},
+                             {"a7: {center: 0.00, amplitude: 0.50, period_s: 4.0}",
+                              "a7: {center: -0.4, amplitude: 0.02, period_s: 4.0}"},
+                             {"periodic_period_ms: 1000", "periodic_period_ms: 400"}});
 }
 
 struct Rig {
@@ -114,8 +117,8 @@ TEST(EstimatorProcess, NamesAnEncoderOffsetOnRealFrames) {
   EXPECT_EQ(clean->num_frames, rig.config.estimator.frames_per_estimate);
 
   // a4 reads 10 degrees more than it is.
-  ASSERT_EQ(run_command("estimator-fault", {bin_dir() + "/tofguard-sim-fault", "--config", rig.config_path, "--joint",
-                                            "a4", "--offset-deg", "10"}),
+  ASSERT_EQ(run_command("estimator-fault", {bin_dir() + "/tofguard-sim-fault", "--config", rig.config_path,
+                                            "--joint", "a4", "--offset-deg", "10"}),
             0);
   const int64_t fault_utime = wall_utime();
   std::optional<motion_estimate_t> faulty;
@@ -134,9 +137,10 @@ TEST(EstimatorProcess, NamesAnEncoderOffsetOnRealFrames) {
       << stderr_all();
   // The estimate sees a4 10 degrees less than it reads, and a4 is the joint
   // with the largest offset.
-  std::cout << "estimate of frame " << faulty->seq << ": a4 " << offset_deg(*faulty, "a4") << " deg, residual "
-            << faulty->residual_before_mm << " -> " << faulty->residual_after_mm << " mm, " << faulty->compute_us
-            << " us; before the fault a4 " << offset_deg(*clean, "a4") << " deg\n";
+  std::cout << "estimate of frame " << faulty->seq << ": a4 " << offset_deg(*faulty, "a4")
+            << " deg, residual " << faulty->residual_before_mm << " -> " << faulty->residual_after_mm
+            << " mm, " << faulty->compute_us << " us; before the fault a4 " << offset_deg(*clean, "a4")
+            << " deg\n";
   EXPECT_NEAR(offset_deg(*faulty, "a4"), -10.0, 2.5);
   for (const char* other : {"a1", "a2", "a3", "a5", "a6", "a7"}) {
     EXPECT_LT(std::abs(offset_deg(*faulty, other)), std::abs(offset_deg(*faulty, "a4"))) << other;
@@ -144,8 +148,8 @@ TEST(EstimatorProcess, NamesAnEncoderOffsetOnRealFrames) {
   EXPECT_GT(faulty->residual_before_mm, faulty->residual_after_mm);
 
   // A discrepancy past the warning level: that frame is estimated at once.
-  ASSERT_TRUE(wait_until([&] { return rig.newest_frame.has_value(); }, std::chrono::seconds(5),
-                         [&] { rig.pump(); }));
+  ASSERT_TRUE(
+      wait_until([&] { return rig.newest_frame.has_value(); }, std::chrono::seconds(5), [&] { rig.pump(); }));
   discrepancy_t d{};
   d.utime = rig.newest_frame->utime;
   d.seq = rig.newest_frame->seq;
@@ -166,8 +170,8 @@ TEST(EstimatorProcess, NamesAnEncoderOffsetOnRealFrames) {
       std::chrono::seconds(10), [&] { rig.pump(); }))
       << stderr_all();
 
-  ASSERT_TRUE(wait_until([&] { return rig.heartbeat && rig.heartbeat->frames_out >= 3; }, std::chrono::seconds(2),
-                         [&] { rig.pump(); }));
+  ASSERT_TRUE(wait_until([&] { return rig.heartbeat && rig.heartbeat->frames_out >= 3; },
+                         std::chrono::seconds(2), [&] { rig.pump(); }));
   EXPECT_EQ(rig.heartbeat->decode_errors, 0);
 }
 

@@ -2,10 +2,10 @@
 // estimate is made of (estimator.frames_per_estimate, docs/estimator.md).
 #include <gtest/gtest.h>
 
-#include "tofguard/common/depth_frame.hpp"
-#include "tofguard/estimator/estimator_process.hpp"
-#include "tofguard/deployment/process_settings.hpp"
 #include "estimator_test_support.hpp"
+#include "tofguard/common/depth_frame.hpp"
+#include "tofguard/deployment/process_settings.hpp"
+#include "tofguard/estimator/estimator_process.hpp"
 
 namespace tofguard::estimator {
 namespace {
@@ -14,7 +14,9 @@ constexpr int64_t kStartUtime = 1'000'000'000;
 constexpr int64_t kFramePeriodUs = 33'333;
 
 constexpr double kA4RadPerS = 0.5;
-double a4_at(int64_t utime) { return test::side_reach_pose().at("a4") + kA4RadPerS * (utime - kStartUtime) * 1e-6; }
+double a4_at(int64_t utime) {
+  return test::side_reach_pose().at("a4") + kA4RadPerS * (utime - kStartUtime) * 1e-6;
+}
 
 class SchedulerTest : public ::testing::Test {
  protected:
@@ -62,7 +64,8 @@ class SchedulerTest : public ::testing::Test {
     EXPECT_EQ(ready.size(), 1u);
     std::vector<int> seqs;
     if (ready.empty() || !ready[0].job) return seqs;
-    for (const EstimatorFrame& f : ready[0].job->frames) seqs.push_back(static_cast<int>(std::lround(f.depth_m[0] * 1000)) - 1000);
+    for (const EstimatorFrame& f : ready[0].job->frames)
+      seqs.push_back(static_cast<int>(std::lround(f.depth_m[0] * 1000)) - 1000);
     return seqs;
   }
 

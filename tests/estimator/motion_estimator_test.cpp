@@ -6,9 +6,9 @@
 
 #include <iostream>
 
-#include "tofguard/risk/estimate_finding.hpp"
-#include "tofguard/estimator/estimate_message.hpp"
 #include "estimator_test_support.hpp"
+#include "tofguard/estimator/estimate_message.hpp"
+#include "tofguard/risk/estimate_finding.hpp"
 #include "tofguard/risk_t.hpp"
 
 namespace tofguard::estimator {
@@ -21,7 +21,8 @@ using test::to_deg;
 // significant beyond 3 sigma and 2 degrees): the estimate as published,
 // then classify_estimate. The one rule that decides whether an estimate
 // names a joint or the camera; the tests judge the estimator by it.
-risk::FrameFinding risk_finding(const EstimateResult& r, const deployment::Config& config, bool near_arm_evidence = false) {
+risk::FrameFinding risk_finding(const EstimateResult& r, const deployment::Config& config,
+                                bool near_arm_evidence = false) {
   EstimateContext context;
   context.utime = 1;
   context.camera_id = config.camera.id;
@@ -56,9 +57,11 @@ tofguard::test::SimulatedFrames* MotionEstimatorTest::frames_ = nullptr;
 
 // The frames of an estimate with an encoder offset on `joint`
 // (SimulatedFrames::frames_with_offset): the sim camera where configured.
-std::vector<EstimatorFrame> frames_with_offset(tofguard::test::SimulatedFrames* frames, const deployment::Config& config,
-                                               const robot_model::JointPositions& truth, const std::string& joint,
-                                               double offset_rad, int num_frames, uint64_t* index) {
+std::vector<EstimatorFrame> frames_with_offset(tofguard::test::SimulatedFrames* frames,
+                                               const deployment::Config& config,
+                                               const robot_model::JointPositions& truth,
+                                               const std::string& joint, double offset_rad, int num_frames,
+                                               uint64_t* index) {
   return frames->frames_with_offset(truth, test::pose_of(config.camera.pose), config.camera.intrinsics, joint,
                                     offset_rad, num_frames, index);
 }
@@ -80,8 +83,8 @@ TEST_F(MotionEstimatorTest, EncoderOffsets) {
   double largest_error_deg = 0;
   for (const char* joint : {"a1", "a2", "a3", "a4", "a5", "a6", "a7"}) {
     for (double offset_deg : {5.0, 10.0, 20.0}) {
-      const EstimateResult r = estimator.estimate(
-          frames_with_offset(frames_, *config_, test::side_reach_pose(), joint, deg(offset_deg), num_frames, &index));
+      const EstimateResult r = estimator.estimate(frames_with_offset(
+          frames_, *config_, test::side_reach_pose(), joint, deg(offset_deg), num_frames, &index));
       ASSERT_TRUE(r.usable) << r.unusable_reason;
       EXPECT_EQ(r.num_frames, num_frames);
       ++cases;
@@ -94,11 +97,11 @@ TEST_F(MotionEstimatorTest, EncoderOffsets) {
       accurate += is_accurate;
       if (!is_right) std::cout << "  risk: " << finding.detail << " (converged " << r.converged << ")\n";
       largest_error_deg = std::max(largest_error_deg, std::abs(error_deg));
-      std::cout << joint << " +" << offset_deg << " deg: estimated " << to_deg(r.joints[k].offset()) << " (sigma "
-                << to_deg(r.joints[k].sigma) << ")" << (is_right ? ", suspect right" : ", SUSPECT WRONG")
-                << (is_accurate ? "" : ", INACCURATE") << "; iterations " << r.iterations << ", residual "
-                << r.residual_before_m * 1000 << " -> " << r.residual_after_m * 1000 << " mm, "
-                << r.compute_us / 1000 << " ms\n";
+      std::cout << joint << " +" << offset_deg << " deg: estimated " << to_deg(r.joints[k].offset())
+                << " (sigma " << to_deg(r.joints[k].sigma) << ")"
+                << (is_right ? ", suspect right" : ", SUSPECT WRONG") << (is_accurate ? "" : ", INACCURATE")
+                << "; iterations " << r.iterations << ", residual " << r.residual_before_m * 1000 << " -> "
+                << r.residual_after_m * 1000 << " mm, " << r.compute_us / 1000 << " ms\n";
     }
   }
   std::cout << "suspect right " << right << ", offset accurate " << accurate << " of " << cases
@@ -117,8 +120,8 @@ TEST_F(MotionEstimatorTest, EncoderOffsetsFromOneFrame) {
   int right = 0, accurate = 0, cases = 0;
   for (const char* joint : {"a1", "a2", "a3", "a4", "a5", "a6", "a7"}) {
     for (double offset_deg : {5.0, 10.0, 20.0}) {
-      const EstimateResult r = estimator.estimate(
-          frames_with_offset(frames_, *config_, test::side_reach_pose(), joint, deg(offset_deg), 1, &index)[0]);
+      const EstimateResult r = estimator.estimate(frames_with_offset(
+          frames_, *config_, test::side_reach_pose(), joint, deg(offset_deg), 1, &index)[0]);
       ASSERT_TRUE(r.usable) << r.unusable_reason;
       ++cases;
       const int k = joint[1] - '1';
@@ -126,11 +129,12 @@ TEST_F(MotionEstimatorTest, EncoderOffsetsFromOneFrame) {
       const risk::FrameFinding finding = risk_finding(r, *config_);
       right += finding.cause == tofguard::risk_t::CAUSE_JOINT_ERROR && finding.suspect == joint;
       accurate += std::abs(error_deg) <= std::max(1.5, 0.25 * offset_deg);
-      std::cout << joint << " +" << offset_deg << " deg, one frame: estimated " << to_deg(r.joints[k].offset())
-                << " (sigma " << to_deg(r.joints[k].sigma) << ")\n";
+      std::cout << joint << " +" << offset_deg << " deg, one frame: estimated "
+                << to_deg(r.joints[k].offset()) << " (sigma " << to_deg(r.joints[k].sigma) << ")\n";
     }
   }
-  std::cout << "one frame: suspect right " << right << ", offset accurate " << accurate << " of " << cases << "\n";
+  std::cout << "one frame: suspect right " << right << ", offset accurate " << accurate << " of " << cases
+            << "\n";
   EXPECT_GE(right, 18);
   EXPECT_GE(accurate, 18);
 }
@@ -210,8 +214,8 @@ TEST_F(MotionEstimatorTest, ObjectBesideTheArm) {
     const Eigen::Vector3d at = poses.world_from_link[frames_->scene().find_link(link)].translation();
     const Eigen::Vector3d right_in_world = camera.linear() * Eigen::Vector3d::UnitX();
     const Eigen::Vector3d center = at + right_in_world * 0.16;
-    const std::vector<renderer::ExtraObject> box = {
-        renderer::ExtraObject::box(Eigen::Vector3d(0.12, 0.12, 0.12), Eigen::Isometry3d(Eigen::Translation3d(center)))};
+    const std::vector<renderer::ExtraObject> box = {renderer::ExtraObject::box(
+        Eigen::Vector3d(0.12, 0.12, 0.12), Eigen::Isometry3d(Eigen::Translation3d(center)))};
     ++index;
     EstimatorFrame clear;
     clear.intrinsics = in;
@@ -230,7 +234,8 @@ TEST_F(MotionEstimatorTest, ObjectBesideTheArm) {
       std::cout << a.joints[k].name << " " << moved_deg << "  ";
       EXPECT_LT(moved_deg, 1.0) << "box beside " << link << ": joint " << a.joints[k].name;
     }
-    std::cout << " camera moved " << (a.correction.inverse() * b.correction).translation().norm() * 1000 << " mm\n";
+    std::cout << " camera moved " << (a.correction.inverse() * b.correction).translation().norm() * 1000
+              << " mm\n";
     // Issue 7: the cause is UNKNOWN_OBJECT. The estimate names no joint and
     // no camera error; with the discrepancy's evidence of nearer surfaces
     // near the arm (what the object frame's discrepancy_t carries),
@@ -238,7 +243,8 @@ TEST_F(MotionEstimatorTest, ObjectBesideTheArm) {
     const risk::FrameFinding alone = risk_finding(b, *config_);
     EXPECT_NE(alone.cause, tofguard::risk_t::CAUSE_JOINT_ERROR) << link << ": " << alone.detail;
     EXPECT_NE(alone.cause, tofguard::risk_t::CAUSE_CALIBRATION_ERROR) << link << ": " << alone.detail;
-    EXPECT_EQ(risk_finding(b, *config_, /*near_arm_evidence=*/true).cause, tofguard::risk_t::CAUSE_UNKNOWN_OBJECT)
+    EXPECT_EQ(risk_finding(b, *config_, /*near_arm_evidence=*/true).cause,
+              tofguard::risk_t::CAUSE_UNKNOWN_OBJECT)
         << link;
   }
 }

@@ -9,13 +9,13 @@
 
 #include <iostream>
 
-#include "tofguard/risk/estimate_finding.hpp"
+#include "estimator_test_support.hpp"
+#include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/estimator/estimate_message.hpp"
 #include "tofguard/estimator/estimator_process.hpp"
-#include "estimator_test_support.hpp"
-#include "tofguard/sim/sim_camera.hpp"
+#include "tofguard/risk/estimate_finding.hpp"
 #include "tofguard/risk_t.hpp"
-#include "tofguard/deployment/process_settings.hpp"
+#include "tofguard/sim/sim_camera.hpp"
 
 namespace tofguard::estimator {
 namespace {
@@ -49,7 +49,8 @@ struct PanTiltCase {
   double reading_error_deg = 0;  // angle between true and reported pose
 };
 
-PanTiltCase estimate_at(const deployment::Config& config, tofguard::test::SimulatedFrames* frames, int64_t t_us, uint64_t index) {
+PanTiltCase estimate_at(const deployment::Config& config, tofguard::test::SimulatedFrames* frames,
+                        int64_t t_us, uint64_t index) {
   sim::SimulatedCamera head(config.camera, config.camera.sim, nullptr, 0);
   const CameraPose true_pose = head.true_pose(t_us);
   const std::optional<CameraPose> reading = head.reported_pose(t_us);
@@ -63,7 +64,8 @@ PanTiltCase estimate_at(const deployment::Config& config, tofguard::test::Simula
   frame.depth_m = frames->capture(joints, test::pose_of(true_pose), frame.intrinsics, index);
   frame.reported_joints = joints;
   frame.world_from_optical = test::pose_of(*reading);
-  MotionEstimator estimator(frames->scene(), &frames->renderer(), options_from_settings(deployment::estimator_process_settings(config)));
+  MotionEstimator estimator(frames->scene(), &frames->renderer(),
+                            options_from_settings(deployment::estimator_process_settings(config)));
   const EstimateResult result = estimator.estimate(frame);
   EstimateContext context;
   context.utime = t_us;
@@ -83,7 +85,8 @@ double correction_deg(const motion_estimate_t& m) {
 
 // Before the fault the head turns (pan 10 deg at 3 s) and its reading is
 // right: nothing to correct, no finding.
-void expect_no_finding_before_the_fault(const deployment::Config& config, tofguard::test::SimulatedFrames* frames) {
+void expect_no_finding_before_the_fault(const deployment::Config& config,
+                                        tofguard::test::SimulatedFrames* frames) {
   const PanTiltCase good = estimate_at(config, frames, 3 * kSecond, 1);
   EXPECT_NEAR(good.reading_error_deg, 0, 1e-9);
   ASSERT_TRUE(good.message.usable) << good.message.unusable_reason;
@@ -94,7 +97,8 @@ void expect_no_finding_before_the_fault(const deployment::Config& config, tofgua
 
 // After it the head's reading is 3 deg off: the correction finds it (at
 // 8 s and 10 s, the head in other positions).
-void expect_calibration_error_after_the_fault(const deployment::Config& config, tofguard::test::SimulatedFrames* frames) {
+void expect_calibration_error_after_the_fault(const deployment::Config& config,
+                                              tofguard::test::SimulatedFrames* frames) {
   uint64_t index = 2;
   for (int64_t t_us : {8 * kSecond, 10 * kSecond}) {
     const PanTiltCase bad = estimate_at(config, frames, t_us, index++);

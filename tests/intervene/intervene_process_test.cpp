@@ -1,8 +1,8 @@
 // tofguard-intervene as a real process over real LCM (private network
 // namespace), driven through its wire contract and tofguard-reset.
 #include <gtest/gtest.h>
-#include <lcm/lcm-cpp.hpp>
 #include <signal.h>
+#include <lcm/lcm-cpp.hpp>
 
 #include <atomic>
 #include <cmath>
@@ -73,7 +73,8 @@ struct Bench {
     }
     lcm.handleTimeout(5);
   }
-  bool wait_for(const std::function<bool(const safety_status_t&)>& condition, std::chrono::milliseconds deadline) {
+  bool wait_for(const std::function<bool(const safety_status_t&)>& condition,
+                std::chrono::milliseconds deadline) {
     statuses.clear();
     return wait_until(
         [&] {
@@ -106,7 +107,8 @@ TEST(InterveneProcess, LatchedStopResetAndRestart) {
   EXPECT_TRUE(bench.statuses.front().latched);
 
   // A reset while the risk is SAFE is accepted; motion becomes allowed.
-  ASSERT_TRUE(wait_until([&] { return bench.power_messages > 3; }, std::chrono::seconds(5), [&] { bench.pump(); }));
+  ASSERT_TRUE(
+      wait_until([&] { return bench.power_messages > 3; }, std::chrono::seconds(5), [&] { bench.pump(); }));
   std::string out;
   // tofguard-reset blocks; keep the feed going from a thread of its own.
   std::atomic<bool> resetting{true};
@@ -138,14 +140,16 @@ TEST(InterveneProcess, LatchedStopResetAndRestart) {
   });
   EXPECT_EQ(reset("reset-accepted", &out), 0) << out;
   EXPECT_NE(out.find("reset accepted"), std::string::npos) << out;
-  ASSERT_TRUE(bench.wait_for([](const safety_status_t& s) { return s.motion_allowed; }, std::chrono::seconds(2)));
+  ASSERT_TRUE(
+      bench.wait_for([](const safety_status_t& s) { return s.motion_allowed; }, std::chrono::seconds(2)));
 
   // DANGEROUS -> motion withdrawn well within 200 ms of the risk.
   bench.risk_cause = risk_t::CAUSE_JOINT_ERROR;  // (the cause first: the feeder reads both)
   bench.risk_level = risk_t::DANGEROUS;
   bench.last_feed_us = 0;  // send it now
   const int64_t danger_sent_us = monotonic_us();
-  ASSERT_TRUE(bench.wait_for([](const safety_status_t& s) { return !s.motion_allowed; }, std::chrono::seconds(2)));
+  ASSERT_TRUE(
+      bench.wait_for([](const safety_status_t& s) { return !s.motion_allowed; }, std::chrono::seconds(2)));
   EXPECT_LT(monotonic_us() - danger_sent_us, 200000);
   const safety_status_t stopped = bench.statuses.back();
   EXPECT_EQ(stopped.cause, risk_t::CAUSE_JOINT_ERROR);
@@ -155,7 +159,8 @@ TEST(InterveneProcess, LatchedStopResetAndRestart) {
   // A reset while DANGEROUS is refused, with the reason. (Not before the
   // feeder thread's stream says DANGEROUS too: a SAFE it read just before
   // the change could otherwise be tofguard-intervene's newest risk.)
-  ASSERT_TRUE(wait_until([&] { return feeder_dangerous_sent > 0; }, std::chrono::seconds(2), [&] { bench.pump(); }));
+  ASSERT_TRUE(
+      wait_until([&] { return feeder_dangerous_sent > 0; }, std::chrono::seconds(2), [&] { bench.pump(); }));
   EXPECT_EQ(reset("reset-refused", &out), 1) << out;
   EXPECT_NE(out.find("refused: current risk is DANGEROUS: joint error"), std::string::npos) << out;
   resetting = false;
@@ -163,8 +168,9 @@ TEST(InterveneProcess, LatchedStopResetAndRestart) {
 
   // The risk stream dies -> power cut.
   bench.send_risk = false;
-  ASSERT_TRUE(bench.wait_for([](const safety_status_t& s) { return s.stop == safety_status_t::STOP_POWER_CUT; },
-                             std::chrono::seconds(2)));
+  ASSERT_TRUE(
+      bench.wait_for([](const safety_status_t& s) { return s.stop == safety_status_t::STOP_POWER_CUT; },
+                     std::chrono::seconds(2)));
   EXPECT_FALSE(bench.last_power.power_enabled);
   EXPECT_EQ(bench.statuses.back().reason.rfind("SAFETY_RISK stale", 0), 0u) << bench.statuses.back().reason;
   EXPECT_EQ(bench.statuses.back().cause, risk_t::CAUSE_JOINT_ERROR);  // the first cause stays
@@ -231,9 +237,9 @@ TEST(InterveneProcess, MalformedInputIsDroppedCountedAndTheGoodRisksStillJudged)
   bench.lcm.publish("JOINT_STATE", &nan_joint);
   bench.lcm.publish("SAFETY_RESET", truncated, sizeof truncated);
 
-  ASSERT_TRUE(wait_until(
-      [&] { return heartbeat.last.decode_errors >= 3 && heartbeat.last.validation_errors >= 2; },
-      std::chrono::seconds(5), [&] { bench.pump(); }))
+  ASSERT_TRUE(
+      wait_until([&] { return heartbeat.last.decode_errors >= 3 && heartbeat.last.validation_errors >= 2; },
+                 std::chrono::seconds(5), [&] { bench.pump(); }))
       << "decode " << heartbeat.last.decode_errors << " validation " << heartbeat.last.validation_errors;
   EXPECT_EQ(heartbeat.last.decode_errors, 3);
   EXPECT_EQ(heartbeat.last.validation_errors, 2);
@@ -258,7 +264,8 @@ TEST(InterveneProcess, MalformedInputIsDroppedCountedAndTheGoodRisksStillJudged)
   feeder.join();
   bench.risk_level = risk_t::DANGEROUS;
   bench.risk_cause = risk_t::CAUSE_UNKNOWN_OBJECT;
-  EXPECT_TRUE(bench.wait_for([](const safety_status_t& s) { return !s.motion_allowed; }, std::chrono::seconds(2)));
+  EXPECT_TRUE(
+      bench.wait_for([](const safety_status_t& s) { return !s.motion_allowed; }, std::chrono::seconds(2)));
 }
 
 }  // namespace

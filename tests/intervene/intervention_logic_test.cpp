@@ -82,7 +82,8 @@ TEST(InterventionLogic, ResetOnlyWhileTheCurrentRiskIsSafeAndFresh) {
   logic.on_risk(risk(risk_t::DANGEROUS, risk_t::CAUSE_UNKNOWN_OBJECT), 2 * kMs, kUtime0);
   d = logic.on_reset(reset(), 3 * kMs, kUtime0);
   EXPECT_FALSE(d.accepted);
-  EXPECT_NE(d.reason.find("refused: current risk is DANGEROUS: unknown object"), std::string::npos) << d.reason;
+  EXPECT_NE(d.reason.find("refused: current risk is DANGEROUS: unknown object"), std::string::npos)
+      << d.reason;
 
   logic.on_risk(risk(risk_t::WARNING), 4 * kMs, kUtime0);
   EXPECT_FALSE(logic.on_reset(reset(), 5 * kMs, kUtime0).accepted);

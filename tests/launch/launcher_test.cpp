@@ -4,9 +4,9 @@
 #include <filesystem>
 #include <regex>
 
+#include "test_support.hpp"
 #include "tofguard/launch/log_rotation.hpp"
 #include "tofguard/launch/restart_policy.hpp"
-#include "test_support.hpp"
 
 namespace tofguard::test {
 namespace {
@@ -51,8 +51,9 @@ TEST(LogRotation, DeletesTooOldThenOldestUntilTheTotalFitsButNeverTheNewest) {
 std::string launch_section(const std::string& log_dir, const std::string& processes, bool recorder = false) {
   return "\nlaunch:\n  processes:\n" + processes +
          "  restart_backoff_initial_ms: 50\n  restart_backoff_max_ms: 400\n  max_restarts: 3\n"
-         "  restart_window_s: 60\n  log_dir: " + log_dir + "\n  recorder:\n    enabled: " +
-         (recorder ? "true" : "false") + "\n    max_file_mb: 1\n    max_total_mb: 10\n    max_age_h: 1\n";
+         "  restart_window_s: 60\n  log_dir: " +
+         log_dir + "\n  recorder:\n    enabled: " + (recorder ? "true" : "false") +
+         "\n    max_file_mb: 1\n    max_total_mb: 10\n    max_age_h: 1\n";
 }
 
 std::vector<pid_t> pids_in(const std::string& text, const std::string& name) {
@@ -88,7 +89,8 @@ TEST(Launcher, MissingExecutableIsAConfigErrorBeforeAnythingStarts) {
       "launch-missing", {},
       launch_section(log_dir,
                      "    - {name: sleeper, command: [/bin/sleep, '1000'], required: true}\n"
-                     "    - {name: ghost, command: [tofguard-no-such-process, --config, '{config}'], required: true}\n"));
+                     "    - {name: ghost, command: [tofguard-no-such-process, --config, '{config}'], "
+                     "required: true}\n"));
   std::string out, err;
   EXPECT_EQ(run_command("launch-missing", {bin_dir() + "/tofguard-launch", config}, &out, &err), 2);
   EXPECT_NE(err.find("launch.processes[1].command"), std::string::npos) << err;
@@ -109,17 +111,24 @@ TEST(Launcher, RestartsAKilledProcessGivesUpOnACrashLoopAndStopsEverything) {
                      "    - {name: family, command: [/bin/bash, -c, 'sleep 1000 & wait'], required: true}\n"
                      "    - {name: crasher, command: [/bin/false], required: false}\n"));
   Subprocess launch("launch-group", {bin_dir() + "/tofguard-launch", config});
-  ASSERT_TRUE(wait_until([&] { return pids_in(launch.stdout_text(), "sleeper").size() == 1 &&
-                                      pids_in(launch.stdout_text(), "family").size() == 1; },
-                         std::chrono::seconds(5)))
+  ASSERT_TRUE(wait_until(
+      [&] {
+        return pids_in(launch.stdout_text(), "sleeper").size() == 1 &&
+               pids_in(launch.stdout_text(), "family").size() == 1;
+      },
+      std::chrono::seconds(5)))
       << launch.stdout_text() << launch.stderr_text();
   const pid_t sleeper = pids_in(launch.stdout_text(), "sleeper")[0];
   const pid_t family = pids_in(launch.stdout_text(), "family")[0];
 
   // The crash loop: 3 restarts, then left stopped and reported.
-  ASSERT_TRUE(wait_until([&] { return launch.stdout_text().find("crasher: exited with code 1; crashed 3 times "
-                                                                 "recently: left stopped") != std::string::npos; },
-                         std::chrono::seconds(10)))
+  ASSERT_TRUE(wait_until(
+      [&] {
+        return launch.stdout_text().find(
+                   "crasher: exited with code 1; crashed 3 times "
+                   "recently: left stopped") != std::string::npos;
+      },
+      std::chrono::seconds(10)))
       << launch.stdout_text();
 
   // A required process killed: reported and restarted with a new pid.
@@ -127,7 +136,8 @@ TEST(Launcher, RestartsAKilledProcessGivesUpOnACrashLoopAndStopsEverything) {
   ASSERT_TRUE(wait_until([&] { return pids_in(launch.stdout_text(), "sleeper").size() == 2; },
                          std::chrono::seconds(5)))
       << launch.stdout_text();
-  EXPECT_NE(launch.stdout_text().find("sleeper: killed by signal 9"), std::string::npos) << launch.stdout_text();
+  EXPECT_NE(launch.stdout_text().find("sleeper: killed by signal 9"), std::string::npos)
+      << launch.stdout_text();
   const pid_t sleeper2 = pids_in(launch.stdout_text(), "sleeper")[1];
   EXPECT_NE(sleeper2, sleeper);
 
@@ -146,8 +156,10 @@ TEST(Launcher, RecorderWritesEveryChannelToRotatingFiles) {
   std::filesystem::remove_all(log_dir);
   const std::string config = sim_config_variant(
       "launch-recorder", {},
-      launch_section(log_dir, "    - {name: intervene, command: [tofguard-intervene, --config, '{config}'], required: true}\n",
-                     /*recorder=*/true));
+      launch_section(
+          log_dir,
+          "    - {name: intervene, command: [tofguard-intervene, --config, '{config}'], required: true}\n",
+          /*recorder=*/true));
   Subprocess launch("launch-recorder", {bin_dir() + "/tofguard-launch", config});
   // tofguard-intervene publishes SAFETY_STATUS at 50 Hz: the safety recording grows.
   auto recorded_bytes = [&] {
@@ -165,4 +177,3 @@ TEST(Launcher, RecorderWritesEveryChannelToRotatingFiles) {
 
 }  // namespace
 }  // namespace tofguard::test
-

@@ -7,8 +7,8 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
-#include <limits>
 #include <iostream>
+#include <limits>
 #include <sstream>
 
 #include "renderer_test_util.hpp"
@@ -80,8 +80,9 @@ std::string urdf_for(const std::vector<Primitive>& primitives) {
   urdf.precision(17);
   urdf << "<?xml version=\"1.0\"?>\n<robot name=\"analytic\">\n  <link name=\"world\"/>\n";
   for (const Primitive& p : primitives) {
-    urdf << "  <joint name=\"" << p.link << "_joint\" type=\"fixed\"><parent link=\"world\"/><child link=\"" << p.link
-         << "\"/><origin xyz=\"" << p.xyz.transpose() << "\" rpy=\"" << p.rpy.transpose() << "\"/></joint>\n"
+    urdf << "  <joint name=\"" << p.link << "_joint\" type=\"fixed\"><parent link=\"world\"/><child link=\""
+         << p.link << "\"/><origin xyz=\"" << p.xyz.transpose() << "\" rpy=\"" << p.rpy.transpose()
+         << "\"/></joint>\n"
          << "  <link name=\"" << p.link << "\"><visual><geometry>" << p.geometry_xml
          << "</geometry></visual></link>\n";
   }
@@ -97,7 +98,8 @@ struct Expected {
 // Ray-casts pixel centres (u, v) through the OpenCV model; labels from
 // `link_index` (the renderer's link order).
 Expected ray_cast(const std::vector<Primitive>& primitives, const Eigen::Isometry3d& world_from_optical,
-                  const Intrinsics& k, double far_m, const std::function<int(const std::string&)>& link_index) {
+                  const Intrinsics& k, double far_m,
+                  const std::function<int(const std::string&)>& link_index) {
   Expected e;
   e.depth_m.assign(static_cast<size_t>(k.width) * k.height, 0);
   e.labels.assign(e.depth_m.size(), 0);
@@ -142,7 +144,8 @@ Comparison compare(const RenderResult& r, const Expected& e, const Intrinsics& k
     if (c.first_failure.empty()) {
       std::ostringstream s;
       s << what << " at (" << u << ", " << v << "): rendered label " << r.labels[at(u, v)] << " depth "
-        << r.depth_m[at(u, v)] << ", expected label " << e.labels[at(u, v)] << " depth " << e.depth_m[at(u, v)];
+        << r.depth_m[at(u, v)] << ", expected label " << e.labels[at(u, v)] << " depth "
+        << e.depth_m[at(u, v)];
       c.first_failure = s.str();
     }
   };
@@ -215,15 +218,16 @@ class AnalyticRender : public ::testing::Test {
                  Eigen::Vector3d(0.5, -0.3, 0.8), [](const Eigen::Vector3d& o, const Eigen::Vector3d& d) {
                    return ray_box(o, d, Eigen::Vector3d(0.15, 0.075, 0.1));
                  }});
-    p.push_back({"cylinder", "<cylinder radius=\"0.08\" length=\"0.5\"/>", w * Eigen::Vector3d(0.05, 0.25, 1.6),
-                 Eigen::Vector3d(1.2, 0.4, -0.3), [](const Eigen::Vector3d& o, const Eigen::Vector3d& d) {
-                   return ray_cylinder(o, d, 0.08, 0.5);
-                 }});
+    p.push_back(
+        {"cylinder", "<cylinder radius=\"0.08\" length=\"0.5\"/>", w * Eigen::Vector3d(0.05, 0.25, 1.6),
+         Eigen::Vector3d(1.2, 0.4, -0.3),
+         [](const Eigen::Vector3d& o, const Eigen::Vector3d& d) { return ray_cylinder(o, d, 0.08, 0.5); }});
     return p;
   }
 
   static robot_model::SceneModel scene() {
-    return robot_model::load_scene(write_test_file("analytic.urdf", urdf_for(primitives())), {}, robot_model::SceneOptions{});
+    return robot_model::load_scene(write_test_file("analytic.urdf", urdf_for(primitives())), {},
+                                   robot_model::SceneOptions{});
   }
 };
 
@@ -246,7 +250,8 @@ TEST_F(AnalyticRender, MatchesRayCastWithOffCentrePrincipalPointAndUnequalFocalL
   EXPECT_EQ(c.interior_label_failures, 0) << c.first_failure;
   EXPECT_EQ(c.silhouette_failures, 0) << c.first_failure;
   EXPECT_LT(c.worst_depth_error_m, 0.001);
-  std::cout << "interior pixels " << c.interior_pixels << ", worst depth error " << c.worst_depth_error_m * 1000 << " mm\n";
+  std::cout << "interior pixels " << c.interior_pixels << ", worst depth error "
+            << c.worst_depth_error_m * 1000 << " mm\n";
   // Nothing rendered has depth outside what it could have.
   for (size_t i = 0; i < r.labels.size(); ++i) {
     if (r.labels[i] == 0) {
@@ -268,7 +273,8 @@ TEST_F(AnalyticRender, SameSceneAtAnotherSizeAndPrincipalPoint) {
   ASSERT_TRUE(r.usable) << r.unusable_reason;
   const Comparison c = compare(r, ray_cast(primitives(), world_from_optical(), k, 5.0, index_in(r)), k);
   EXPECT_GT(c.interior_pixels, 8000);
-  EXPECT_EQ(c.interior_depth_failures + c.interior_label_failures + c.silhouette_failures, 0) << c.first_failure;
+  EXPECT_EQ(c.interior_depth_failures + c.interior_label_failures + c.silhouette_failures, 0)
+      << c.first_failure;
 }
 
 TEST(AnalyticRenderOrientation, AsymmetricSceneIsNeitherMirroredNorTransposed) {
@@ -285,7 +291,8 @@ TEST(AnalyticRenderOrientation, AsymmetricSceneIsNeitherMirroredNorTransposed) {
          << "\"><visual><geometry><box size=\"0.1 0.1 0.1\"/></geometry></visual></link>";
   }
   urdf << "</robot>";
-  const robot_model::SceneModel scene = robot_model::load_scene(write_test_file("corners.urdf", urdf.str()), {}, robot_model::SceneOptions{});
+  const robot_model::SceneModel scene =
+      robot_model::load_scene(write_test_file("corners.urdf", urdf.str()), {}, robot_model::SceneOptions{});
   DepthRenderer renderer(scene, 0.1, 5.0);
   const Intrinsics k{160, 100, 120.0, 110.0, 70.4, 45.6};
   // The camera's optical frame is the world frame here.

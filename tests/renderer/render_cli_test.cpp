@@ -14,8 +14,10 @@ TEST(RenderCli, WritesDepthInMillimetresAndLabels) {
   // origin looking along world z; an environment floor further back.
   const std::string robot = write_test_file(
       "cli/robot.urdf",
-      "<robot name=\"r\"><link name=\"world\"/><joint name=\"slide\" type=\"prismatic\"><parent link=\"world\"/>"
-      "<child link=\"cube\"/><axis xyz=\"0 0 1\"/><limit lower=\"0\" upper=\"2\" effort=\"1\" velocity=\"1\"/></joint>"
+      "<robot name=\"r\"><link name=\"world\"/><joint name=\"slide\" type=\"prismatic\"><parent "
+      "link=\"world\"/>"
+      "<child link=\"cube\"/><axis xyz=\"0 0 1\"/><limit lower=\"0\" upper=\"2\" effort=\"1\" "
+      "velocity=\"1\"/></joint>"
       "<link name=\"cube\"><visual><geometry><box size=\"0.2 0.2 0.2\"/></geometry></visual></link></robot>");
   const std::string environment = write_test_file(
       "cli/env.urdf",
@@ -26,9 +28,10 @@ TEST(RenderCli, WritesDepthInMillimetresAndLabels) {
   const std::string labels_png = write_test_file("cli/labels.png", "");
   std::string out, err;
   const int rc = tofguard::test::run_command(
-      "render_cli", {tofguard::test::bin_dir() + "/tofguard-renderer", "render", "--urdf", robot, "--env", environment,
-                     "--joint", "slide=1.1", "--camera-pose", "0,0,0,1,0,0,0", "--intrinsics", "64,48,60,58,30.5,22.5",
-                     "--out", depth_png, "--labels", labels_png},
+      "render_cli",
+      {tofguard::test::bin_dir() + "/tofguard-renderer", "render", "--urdf", robot, "--env", environment,
+       "--joint", "slide=1.1", "--camera-pose", "0,0,0,1,0,0,0", "--intrinsics", "64,48,60,58,30.5,22.5",
+       "--out", depth_png, "--labels", labels_png},
       &out, &err);
   ASSERT_EQ(rc, 0) << err;
   EXPECT_NE(out.find("wrote"), std::string::npos) << out;
@@ -50,13 +53,15 @@ TEST(RenderCli, WritesDepthInMillimetresAndLabels) {
 TEST(RenderCli, UsageAndModelErrors) {
   std::string out, err;
   const std::string bin = tofguard::test::bin_dir() + "/tofguard-renderer";
-  EXPECT_EQ(tofguard::test::run_command("render_cli_usage", {bin, "render", "--urdf", "x.urdf"}, &out, &err), 2);
+  EXPECT_EQ(tofguard::test::run_command("render_cli_usage", {bin, "render", "--urdf", "x.urdf"}, &out, &err),
+            2);
   EXPECT_NE(err.find("--camera-pose is required"), std::string::npos) << err;
-  EXPECT_EQ(tofguard::test::run_command("render_cli_missing",
-                                        {bin, "render", "--urdf", "/nonexistent.urdf", "--camera-pose", "0,0,0,1,0,0,0",
-                                         "--intrinsics", "8,8,8,8,4,4", "--out", "/tmp/x.png"},
-                                        &out, &err),
-            1);
+  EXPECT_EQ(
+      tofguard::test::run_command("render_cli_missing",
+                                  {bin, "render", "--urdf", "/nonexistent.urdf", "--camera-pose",
+                                   "0,0,0,1,0,0,0", "--intrinsics", "8,8,8,8,4,4", "--out", "/tmp/x.png"},
+                                  &out, &err),
+      1);
   EXPECT_NE(err.find("/nonexistent.urdf: cannot read the URDF file"), std::string::npos) << err;
 }
 

@@ -10,14 +10,14 @@
 #include <optional>
 #include <regex>
 
-#include "tofguard/renderer/depth_renderer.hpp"
-#include "tofguard/renderer/renderer_process.hpp"
 #include "test_support.hpp"
 #include "tofguard/common/camera_pose_message.hpp"
 #include "tofguard/common/clock.hpp"
 #include "tofguard/common/depth_frame.hpp"
-#include "tofguard/heartbeat_t.hpp"
 #include "tofguard/deployment/process_settings.hpp"
+#include "tofguard/heartbeat_t.hpp"
+#include "tofguard/renderer/depth_renderer.hpp"
+#include "tofguard/renderer/renderer_process.hpp"
 
 namespace tofguard::renderer {
 namespace {
@@ -33,7 +33,8 @@ robot_model::JointPositions arm_at(int64_t utime, int64_t t0) {
 }
 
 struct Bench {
-  deployment::Config config = deployment::load_config(tofguard::test::source_dir() + "/config/sim.yaml", nullptr);
+  deployment::Config config =
+      deployment::load_config(tofguard::test::source_dir() + "/config/sim.yaml", nullptr);
   lcm::LCM safety{config.lcm.url};
   lcm::LCM images{config.lcm.image_url};
   std::map<int64_t, depth_image_t> rendered;  // by seq
@@ -48,8 +49,12 @@ struct Bench {
     images.subscribe(config.channels.labels, &Bench::on_labels, this);
     safety.subscribe(config.channels.heartbeat, &Bench::on_heartbeat, this);
   }
-  void on_rendered(const lcm::ReceiveBuffer*, const std::string&, const depth_image_t* m) { rendered[m->seq] = *m; }
-  void on_labels(const lcm::ReceiveBuffer*, const std::string&, const link_labels_t* m) { labels[m->seq] = *m; }
+  void on_rendered(const lcm::ReceiveBuffer*, const std::string&, const depth_image_t* m) {
+    rendered[m->seq] = *m;
+  }
+  void on_labels(const lcm::ReceiveBuffer*, const std::string&, const link_labels_t* m) {
+    labels[m->seq] = *m;
+  }
   void on_heartbeat(const lcm::ReceiveBuffer*, const std::string&, const heartbeat_t* m) {
     if (m->process == "tofguard-renderer") heartbeat = *m;
   }
@@ -91,9 +96,9 @@ struct Bench {
 };
 
 TEST(RendererProcess, RendersFramesAtInterpolatedJointsAndMarksUnusableOnes) {
-  tofguard::test::Subprocess process(
-      "renderer-process",
-      {tofguard::test::bin_dir() + "/tofguard-renderer", "--config", tofguard::test::source_dir() + "/config/sim.yaml"});
+  tofguard::test::Subprocess process("renderer-process",
+                                     {tofguard::test::bin_dir() + "/tofguard-renderer", "--config",
+                                      tofguard::test::source_dir() + "/config/sim.yaml"});
   Bench bench;
 
   // Until the process is up, keep sending joint states and a frame between
@@ -124,9 +129,11 @@ TEST(RendererProcess, RendersFramesAtInterpolatedJointsAndMarksUnusableOnes) {
 
   // The numbers: the library at the joints interpolated at the frame's utime.
   const deployment::Config& config = bench.config;
-  const robot_model::SceneModel scene = robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths, scene_options(config.renderer, config.robot));
+  const robot_model::SceneModel scene = robot_model::load_scene(
+      config.robot.urdf_path, config.environment.urdf_paths, scene_options(config.renderer, config.robot));
   DepthRenderer renderer(scene, config.renderer.near_m, config.renderer.far_m);
-  const RenderResult expected = renderer.render(arm_at(out.utime, bench.t0), config.camera.pose, config.camera.intrinsics);
+  const RenderResult expected =
+      renderer.render(arm_at(out.utime, bench.t0), config.camera.pose, config.camera.intrinsics);
   ASSERT_TRUE(expected.usable);
   int differing = 0, robot_pixels = 0;
   for (size_t i = 0; i < expected.depth_m.size(); ++i) {
@@ -184,8 +191,8 @@ TEST(RendererProcess, RendersFramesAtInterpolatedJointsAndMarksUnusableOnes) {
     EXPECT_FALSE(bench.labels.at(missing_seq).usable);
     EXPECT_EQ(bench.labels.at(missing_seq).unusable_reason, "joint 'a4' missing from the joint state");
   }
-  std::cout << "late frame " << (bench.labels.count(late_seq) ? "labelled" : "dropped") << ", missing-joint frame "
-            << (bench.labels.count(missing_seq) ? "labelled" : "dropped") << "\n";
+  std::cout << "late frame " << (bench.labels.count(late_seq) ? "labelled" : "dropped")
+            << ", missing-joint frame " << (bench.labels.count(missing_seq) ? "labelled" : "dropped") << "\n";
   EXPECT_EQ(bench.rendered.count(late_seq), 0u);
   EXPECT_EQ(bench.rendered.count(missing_seq), 0u);
   EXPECT_TRUE(bench.labels.at(good_seq).usable) << bench.labels.at(good_seq).unusable_reason;
@@ -215,43 +222,47 @@ int differing_pixels(const depth_image_t& out, const link_labels_t& labels, cons
 }
 
 TEST(RendererProcess, FollowsAMovingCameraAtEachFramesUtime) {
-  tofguard::test::Subprocess process(
-      "renderer-process-moving-camera",
-      {tofguard::test::bin_dir() + "/tofguard-renderer", "--config", tofguard::test::source_dir() + "/config/sim.yaml"});
+  tofguard::test::Subprocess process("renderer-process-moving-camera",
+                                     {tofguard::test::bin_dir() + "/tofguard-renderer", "--config",
+                                      tofguard::test::source_dir() + "/config/sim.yaml"});
   Bench bench;
   const deployment::Config& config = bench.config;
   // The configured pose panned by `deg` about the world's vertical axis.
   auto panned = [&](double deg) {
     CameraPose p = config.camera.pose;
-    p.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(deg * M_PI / 180, Eigen::Vector3d::UnitZ())) * p.rotation;
+    p.rotation =
+        Eigen::Quaterniond(Eigen::AngleAxisd(deg * M_PI / 180, Eigen::Vector3d::UnitZ())) * p.rotation;
     return p;
   };
   // The head pans 6 deg between two readings 66 ms apart (90 deg/s).
   const int64_t t0 = bench.t0;
   const int64_t t1 = t0 + 66'000;
   // Once the process listens (its heartbeat comes after it subscribed).
-  ASSERT_TRUE(wait_until([&] { return bench.heartbeat.utime > 0; }, std::chrono::seconds(20), [&] { bench.pump(); }))
+  ASSERT_TRUE(
+      wait_until([&] { return bench.heartbeat.utime > 0; }, std::chrono::seconds(20), [&] { bench.pump(); }))
       << process.stderr_text();
   // Joint states and both readings, until the process has taken them all
   // in (11 joint states + 2 poses; the first messages after it subscribed
   // can be lost, and repeats are ignored).
   int64_t sent_us = 0;
-  ASSERT_TRUE(wait_until([&] { return bench.heartbeat.frames_in >= 13; }, std::chrono::seconds(10), [&] {
-    if (monotonic_us() - sent_us > 300'000) {
-      sent_us = monotonic_us();
-      bench.next_joint_utime = t0;
-      bench.publish_joints_until(t1 + 40'000);
-      bench.publish_pose(t0, panned(0));
-      bench.publish_pose(t1, panned(6));
-    }
-    bench.pump();
-  })) << bench.heartbeat.frames_in;
+  ASSERT_TRUE(wait_until([&] { return bench.heartbeat.frames_in >= 13; }, std::chrono::seconds(10),
+                         [&] {
+                           if (monotonic_us() - sent_us > 300'000) {
+                             sent_us = monotonic_us();
+                             bench.next_joint_utime = t0;
+                             bench.publish_joints_until(t1 + 40'000);
+                             bench.publish_pose(t0, panned(0));
+                             bench.publish_pose(t1, panned(6));
+                           }
+                           bench.pump();
+                         }))
+      << bench.heartbeat.frames_in;
 
   // A frame between the readings, and one past the newest beyond the 40 ms
   // limit. Until the process is up, and while a frame may overtake its pose
   // (poses travel on the safety URL, frames on the image URL), send them
   // again with new seqs.
-  const int64_t mid_utime = t0 + 22'000;    // a third of the way: pan 2 deg
+  const int64_t mid_utime = t0 + 22'000;  // a third of the way: pan 2 deg
   const int64_t late_utime = t1 + 41'000;
   int64_t mid_seq = -1;
   int64_t late_seq = -1;
@@ -264,7 +275,8 @@ TEST(RendererProcess, FollowsAMovingCameraAtEachFramesUtime) {
       std::chrono::seconds(20),
       [&] {
         // (A frame sent while the process was still subscribing is lost.)
-        const bool unanswered = mid_seq > 0 && !bench.labels.count(mid_seq) && monotonic_us() - mid_sent_us > 300'000;
+        const bool unanswered =
+            mid_seq > 0 && !bench.labels.count(mid_seq) && monotonic_us() - mid_sent_us > 300'000;
         if (mid_seq < 0 || unanswered || (bench.labels.count(mid_seq) && !bench.labels.at(mid_seq).usable)) {
           mid_seq = bench.publish_frame(mid_utime);
           mid_sent_us = monotonic_us();
@@ -274,14 +286,18 @@ TEST(RendererProcess, FollowsAMovingCameraAtEachFramesUtime) {
         }
         bench.pump();
       }))
-      << process.stderr_text() << "heartbeat in " << bench.heartbeat.frames_in << " validation " << bench.heartbeat.validation_errors
-      << " decode " << bench.heartbeat.decode_errors << " status " << bench.heartbeat.status << "; mid seq " << mid_seq << " late seq " << late_seq << ", labels: " << [&] {
+      << process.stderr_text() << "heartbeat in " << bench.heartbeat.frames_in << " validation "
+      << bench.heartbeat.validation_errors << " decode " << bench.heartbeat.decode_errors << " status "
+      << bench.heartbeat.status << "; mid seq " << mid_seq << " late seq " << late_seq
+      << ", labels: " << [&] {
            std::string why;
-           for (const auto& [seq, l] : bench.labels) why += std::to_string(seq) + ": " + (l.usable ? "usable" : l.unusable_reason) + "; ";
+           for (const auto& [seq, l] : bench.labels)
+             why += std::to_string(seq) + ": " + (l.usable ? "usable" : l.unusable_reason) + "; ";
            return why;
          }();
 
-  const robot_model::SceneModel scene = robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths, scene_options(config.renderer, config.robot));
+  const robot_model::SceneModel scene = robot_model::load_scene(
+      config.robot.urdf_path, config.environment.urdf_paths, scene_options(config.renderer, config.robot));
   DepthRenderer renderer(scene, config.renderer.near_m, config.renderer.far_m);
   const RenderResult at_mid = renderer.render(arm_at(mid_utime, t0), panned(2), config.camera.intrinsics);
   const RenderResult unpanned = renderer.render(arm_at(mid_utime, t0), panned(0), config.camera.intrinsics);
@@ -308,12 +324,13 @@ std::pair<int, int> prediction_counts(const heartbeat_t& hb) {
 }
 
 TEST(RendererProcess, APlannedFrameIsRenderedAheadAndIdenticalToTheNormalRendering) {
-  tofguard::test::Subprocess process(
-      "renderer-process-prediction",
-      {tofguard::test::bin_dir() + "/tofguard-renderer", "--config", tofguard::test::source_dir() + "/config/sim.yaml"});
+  tofguard::test::Subprocess process("renderer-process-prediction",
+                                     {tofguard::test::bin_dir() + "/tofguard-renderer", "--config",
+                                      tofguard::test::source_dir() + "/config/sim.yaml"});
   Bench bench;
   const deployment::Config& config = bench.config;
-  ASSERT_TRUE(wait_until([&] { return bench.heartbeat.utime > 0; }, std::chrono::seconds(20), [&] { bench.pump(); }))
+  ASSERT_TRUE(
+      wait_until([&] { return bench.heartbeat.utime > 0; }, std::chrono::seconds(20), [&] { bench.pump(); }))
       << process.stderr_text();
   // The arm holds still where its plan says, for 10 s.
   const robot_model::JointPositions planned = arm_at(bench.t0 + 300'000, bench.t0);
@@ -350,27 +367,28 @@ TEST(RendererProcess, APlannedFrameIsRenderedAheadAndIdenticalToTheNormalRenderi
     return int64_t{-1};
   };
   int64_t utime = bench.t0 + 33'000;
-  ASSERT_TRUE(wait_until(
-      [&] { return prediction_counts(bench.heartbeat).first >= 3; }, std::chrono::seconds(20),
-      [&] {
-        bench.safety.publish(config.channels.planned_trajectory, &plan);
-        send_frame(utime);
-        utime += 33'000;
-        // Give the process its idle time to render ahead, as a camera does.
-        const int64_t until = monotonic_us() + 30'000;
-        while (monotonic_us() < until) bench.pump();
-      }))
+  ASSERT_TRUE(wait_until([&] { return prediction_counts(bench.heartbeat).first >= 3; },
+                         std::chrono::seconds(20),
+                         [&] {
+                           bench.safety.publish(config.channels.planned_trajectory, &plan);
+                           send_frame(utime);
+                           utime += 33'000;
+                           // Give the process its idle time to render ahead, as a camera does.
+                           const int64_t until = monotonic_us() + 30'000;
+                           while (monotonic_us() < until) bench.pump();
+                         }))
       << process.stderr_text() << bench.heartbeat.status;
   // The counts once the heartbeat has caught up with the last frame.
   const int64_t last_utime = utime - 33'000;
-  ASSERT_TRUE(wait_until([&] { return bench.heartbeat.last_frame_utime == last_utime; }, std::chrono::seconds(5),
-                         [&] { bench.pump(); }));
+  ASSERT_TRUE(wait_until([&] { return bench.heartbeat.last_frame_utime == last_utime; },
+                         std::chrono::seconds(5), [&] { bench.pump(); }));
   const auto [hits, misses] = prediction_counts(bench.heartbeat);
   EXPECT_EQ(misses, 0) << bench.heartbeat.status;
 
   // Every rendered frame is the library's rendering at the planned joints:
   // those published from a prediction are identical to the others.
-  const robot_model::SceneModel scene = robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths, scene_options(config.renderer, config.robot));
+  const robot_model::SceneModel scene = robot_model::load_scene(
+      config.robot.urdf_path, config.environment.urdf_paths, scene_options(config.renderer, config.robot));
   DepthRenderer renderer(scene, config.renderer.near_m, config.renderer.far_m);
   const RenderResult expected = renderer.render(planned, config.camera.pose, config.camera.intrinsics);
   ASSERT_TRUE(expected.usable);
@@ -380,7 +398,8 @@ TEST(RendererProcess, APlannedFrameIsRenderedAheadAndIdenticalToTheNormalRenderi
     ++compared;
     const depth_image_t& out = bench.rendered.at(seq);
     for (size_t i = 0; i < expected.depth_m.size(); ++i) {
-      ASSERT_EQ(out.depth_mm[i], static_cast<int16_t>(std::round(expected.depth_m[i] * 1000.0))) << seq << " " << i;
+      ASSERT_EQ(out.depth_mm[i], static_cast<int16_t>(std::round(expected.depth_m[i] * 1000.0)))
+          << seq << " " << i;
       ASSERT_EQ(bench.labels.at(seq).label[i], expected.labels[i]) << seq << " " << i;
     }
   }

@@ -4,16 +4,19 @@
 
 #include <cmath>
 
-#include "tofguard/renderer/renderer_process.hpp"
-#include "tofguard/deployment/process_settings.hpp"
 #include "test_support.hpp"
+#include "tofguard/deployment/process_settings.hpp"
+#include "tofguard/renderer/renderer_process.hpp"
 
 namespace tofguard::renderer {
 namespace {
 
-deployment::Config sim_config() { return deployment::load_config(tofguard::test::source_dir() + "/config/sim.yaml", nullptr); }
+deployment::Config sim_config() {
+  return deployment::load_config(tofguard::test::source_dir() + "/config/sim.yaml", nullptr);
+}
 
-joint_state_t joint_state(int64_t utime, const robot_model::JointPositions& positions, const std::string& robot = "friend-sim") {
+joint_state_t joint_state(int64_t utime, const robot_model::JointPositions& positions,
+                          const std::string& robot = "friend-sim") {
   joint_state_t m;
   m.utime = utime;
   m.robot_id = robot;
@@ -70,7 +73,8 @@ TEST(RendererService, PublishesTheModelAtTheInterpolatedJointsInMillimetres) {
   EXPECT_EQ(out.labels.num_links, static_cast<int>(out.labels.link_name.size()));
 
   // The same as the library at arm(1.25), rounded to millimetres.
-  const robot_model::SceneModel scene = robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths, scene_options(config.renderer, config.robot));
+  const robot_model::SceneModel scene = robot_model::load_scene(
+      config.robot.urdf_path, config.environment.urdf_paths, scene_options(config.renderer, config.robot));
   DepthRenderer renderer(scene, config.renderer.near_m, config.renderer.far_m);
   const RenderResult expected = renderer.render(arm(1.25), config.camera.pose, k);
   ASSERT_TRUE(expected.usable);
@@ -109,7 +113,8 @@ TEST(RendererService, UnusableFramesPublishOnlyLabelsWithTheReason) {
   service.on_joint_state(joint_state(1'020'000, arm(1.0)));
   out = service.render(frame(1'050'000, 3, k));  // 30 ms beyond the newest, limit 20 ms
   EXPECT_FALSE(out.labels.usable);
-  EXPECT_EQ(out.labels.unusable_reason.rfind("newest joint state is 30.000000 ms older than the frame", 0), 0u)
+  EXPECT_EQ(out.labels.unusable_reason.rfind("newest joint state is 30.000000 ms older than the frame", 0),
+            0u)
       << out.labels.unusable_reason;
 
   depth_image_t other_camera = frame(1'015'000, 4, k);
@@ -130,8 +135,8 @@ TEST(RendererService, CameraPoseMessagesReplaceTheStaticPoseOfThatCamera) {
   pose.camera_id = "tof-mast";
   pose.frame_id = "world";
   // 10 cm further back along the optical axis (rotation as in sim.yaml).
-  const Eigen::Vector3d back = config.camera.pose.translation_m -
-                               0.1 * (config.camera.pose.rotation * Eigen::Vector3d::UnitZ());
+  const Eigen::Vector3d back =
+      config.camera.pose.translation_m - 0.1 * (config.camera.pose.rotation * Eigen::Vector3d::UnitZ());
   for (int i = 0; i < 3; ++i) pose.translation[i] = back[i];
   pose.rotation[0] = config.camera.pose.rotation.w();
   pose.rotation[1] = config.camera.pose.rotation.x();
@@ -142,7 +147,8 @@ TEST(RendererService, CameraPoseMessagesReplaceTheStaticPoseOfThatCamera) {
   ASSERT_TRUE(before.depth && after.depth);
   // Moving back along the optical axis adds 100 mm to every Z; the pixel
   // nearest the principal point sees (almost) the same point as before.
-  const size_t centre = static_cast<size_t>(std::lround(k.cy)) * k.width + static_cast<size_t>(std::lround(k.cx));
+  const size_t centre =
+      static_cast<size_t>(std::lround(k.cy)) * k.width + static_cast<size_t>(std::lround(k.cx));
   ASSERT_NE(before.labels.label[centre], 0);
   EXPECT_EQ(before.labels.label[centre], after.labels.label[centre]);
   EXPECT_NEAR(after.depth->depth_mm[centre] - before.depth->depth_mm[centre], 100, 5);

@@ -17,9 +17,9 @@
 // SAFE. The test runs tofguard-reset, as an operator would, once three
 // frames in a row were judged SAFE (in the nominal lead-in before a fault).
 #include <gtest/gtest.h>
-#include <lcm/lcm-cpp.hpp>
 #include <signal.h>
 #include <unistd.h>
+#include <lcm/lcm-cpp.hpp>
 
 #include <cstdlib>
 #include <filesystem>
@@ -32,11 +32,11 @@
 #include <string_view>
 
 #include "test_support.hpp"
+#include "tofguard/common/risk_names.hpp"
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/heartbeat_t.hpp"
-#include "tofguard/common/risk_names.hpp"
 #include "tofguard/risk_t.hpp"
 #include "tofguard/safety_status_t.hpp"
 #include "tofguard/sim_camera_fault_t.hpp"
@@ -90,10 +90,10 @@ const std::string& replay_config_path() {
   static const std::string path = [] {
     const std::string p = output_dir() + "/replay.yaml";
     std::string out, err;
-    const int code = run_command("replay-write-config",
-                                 {"/bin/bash", source_dir() + "/scripts/record-scenario", "--write-config", p,
-                                  "--replay"},
-                                 &out, &err);
+    const int code =
+        run_command("replay-write-config",
+                    {"/bin/bash", source_dir() + "/scripts/record-scenario", "--write-config", p, "--replay"},
+                    &out, &err);
     if (code != 0) throw std::runtime_error("record-scenario --write-config failed: " + out + err);
     return p;
   }();
@@ -108,7 +108,8 @@ struct Frame {
 };
 
 Frame frame_of(const depth_image_t& d, int64_t received_us) {
-  const std::string_view bytes(reinterpret_cast<const char*>(d.depth_mm.data()), d.depth_mm.size() * sizeof(int16_t));
+  const std::string_view bytes(reinterpret_cast<const char*>(d.depth_mm.data()),
+                               d.depth_mm.size() * sizeof(int16_t));
   return {d.seq, d.utime, received_us, std::hash<std::string_view>{}(bytes)};
 }
 
@@ -121,7 +122,8 @@ struct Verdict {
   int64_t received_us = 0;
   // What must be the same on every replay.
   std::string key() const {
-    return std::to_string(seq) + " " + risk_level_name(level) + " " + risk_cause_name(cause) + " '" + suspect + "'";
+    return std::to_string(seq) + " " + risk_level_name(level) + " " + risk_cause_name(cause) + " '" +
+           suspect + "'";
   }
 };
 
@@ -171,12 +173,12 @@ InputLog read_input_log(const std::string& path) {
 
 // What the replay's lcm-logger recorded.
 struct ReplayOutput {
-  std::vector<Frame> frames;        // TOF_DEPTH as replayed
-  std::vector<Verdict> verdicts;    // SAFETY_RISK for camera frames
-  std::vector<Verdict> timeouts;    // SAFETY_RISK with seq -1
-  std::vector<Status> statuses;     // SAFETY_STATUS
-  int64_t first_input_us = 0;       // the first replayed TOF_DEPTH or JOINT_STATE
-  int64_t last_input_us = 0;        // the last one
+  std::vector<Frame> frames;      // TOF_DEPTH as replayed
+  std::vector<Verdict> verdicts;  // SAFETY_RISK for camera frames
+  std::vector<Verdict> timeouts;  // SAFETY_RISK with seq -1
+  std::vector<Status> statuses;   // SAFETY_STATUS
+  int64_t first_input_us = 0;     // the first replayed TOF_DEPTH or JOINT_STATE
+  int64_t last_input_us = 0;      // the last one
   bool reset_accepted = false;
 
   std::map<int64_t, std::vector<const Verdict*>> verdicts_by_seq() const {
@@ -205,7 +207,8 @@ struct ReplayOutput {
     const Verdict* first = nullptr;
     for (const auto* list : {&verdicts, &timeouts}) {
       for (const Verdict& v : *list) {
-        if (v.level == risk_t::DANGEROUS && v.received_us >= us && (!first || v.received_us < first->received_us)) {
+        if (v.level == risk_t::DANGEROUS && v.received_us >= us &&
+            (!first || v.received_us < first->received_us)) {
           first = &v;
         }
       }
@@ -252,12 +255,13 @@ class Replay {
     // The outputs, and the inputs as replayed (for the replay's timeline).
     logger_ = std::make_unique<Subprocess>(
         run_name + "-lcm-logger",
-        std::vector<std::string>{in_path("lcm-logger"), "-q", "-f", "--flush-interval=20",
-                                 "-c", "(SAFETY_.*|TOF_DEPTH|JOINT_STATE|CAMERA_POSE)",
+        std::vector<std::string>{in_path("lcm-logger"), "-q", "-f", "--flush-interval=20", "-c",
+                                 "(SAFETY_.*|TOF_DEPTH|JOINT_STATE|CAMERA_POSE)",
                                  "--lcm-url=" + config_.lcm.url, output_log_});
     for (const std::string& name : kChain) {
       chain_.push_back(std::make_unique<Subprocess>(
-          run_name + "-" + name, std::vector<std::string>{bin_dir() + "/" + name, "--config", replay_config_path()}));
+          run_name + "-" + name,
+          std::vector<std::string>{bin_dir() + "/" + name, "--config", replay_config_path()}));
     }
     // Ready: every process beats, and the logger writes (the heartbeats).
     const bool ready = wait_until(
@@ -284,8 +288,9 @@ class Replay {
     // after the verdict (same URL, so behind it in every receiver's queue)
     // have arrived here, i.e. at least 100 ms later.
     const int beats_at_last_verdict = heartbeats_seen_;
-    wait_until([&] { return heartbeats_seen_ >= beats_at_last_verdict + 3 * static_cast<int>(kChain.size()); },
-               std::chrono::seconds(2), [&] { pump(); });
+    wait_until(
+        [&] { return heartbeats_seen_ >= beats_at_last_verdict + 3 * static_cast<int>(kChain.size()); },
+        std::chrono::seconds(2), [&] { pump(); });
     logger_->signal(SIGINT);
     EXPECT_EQ(logger_->wait(std::chrono::seconds(5)), 0) << logger_->stderr_text();
     for (auto& p : chain_) p->signal(SIGTERM);
@@ -312,9 +317,9 @@ class Replay {
     }
     if (!reset_accepted_ && !reset_ && safe_streak_ >= kSafeFramesBeforeReset) {
       reset_ = std::make_unique<Subprocess>(
-          "replay-reset", std::vector<std::string>{bin_dir() + "/tofguard-reset", "--config", replay_config_path(),
-                                                   "--who", "replay_test", "--why", "start of the replay",
-                                                   "--timeout-ms", "1000"});
+          "replay-reset",
+          std::vector<std::string>{bin_dir() + "/tofguard-reset", "--config", replay_config_path(), "--who",
+                                   "replay_test", "--why", "start of the replay", "--timeout-ms", "1000"});
     }
   }
   void on_heartbeat(const lcm::ReceiveBuffer*, const std::string&, const heartbeat_t* hb) {
@@ -342,7 +347,9 @@ class Replay {
   ReplayOutput output_;
 };
 
-std::string data_log(const std::string& name) { return std::string(TOFGUARD_REPLAY_DATA_DIR) + "/" + name + ".lcmlog"; }
+std::string data_log(const std::string& name) {
+  return std::string(TOFGUARD_REPLAY_DATA_DIR) + "/" + name + ".lcmlog";
+}
 
 // Every judged frame was replayed and got exactly one verdict (one failure
 // each, naming the frames).
@@ -384,7 +391,8 @@ void expect_same_verdicts(const InputLog& input, const ReplayOutput& first, cons
     if (key_a == key_b) continue;
     ++differences;
     ADD_FAILURE() << "two replays judged a frame differently:\n  1st: " << key_a << " | "
-                  << (a[i] ? a[i]->detail : "") << "\n  2nd: " << key_b << " | " << (b[i] ? b[i]->detail : "");
+                  << (a[i] ? a[i]->detail : "") << "\n  2nd: " << key_b << " | "
+                  << (b[i] ? b[i]->detail : "");
   }
   EXPECT_EQ(a.size(), b.size());
   EXPECT_EQ(differences, 0);
@@ -401,7 +409,8 @@ std::string describe(const ReplayOutput& out) {
 // same verdict sequence.
 void replay_twice(const std::string& name, const std::function<void(const InputLog&, const Replay&)>& check) {
   const std::string log = data_log(name);
-  ASSERT_TRUE(std::filesystem::exists(log)) << log << " missing (built from tests/data/" << name << ".lcmlog.xz)";
+  ASSERT_TRUE(std::filesystem::exists(log))
+      << log << " missing (built from tests/data/" << name << ".lcmlog.xz)";
   ASSERT_FALSE(in_path("lcm-logplayer").empty() || in_path("lcm-logger").empty()) << "liblcm-bin missing";
   const InputLog input = read_input_log(log);
   ASSERT_GE(input.judged_seqs().size(), 10u) << log;
@@ -420,7 +429,9 @@ void replay_twice(const std::string& name, const std::function<void(const InputL
   expect_same_verdicts(input, outputs[0], outputs[1]);
 }
 
-int64_t frame_period_us(const deployment::Config& config) { return static_cast<int64_t>(1e6 / config.camera.rate_hz); }
+int64_t frame_period_us(const deployment::Config& config) {
+  return static_cast<int64_t>(1e6 / config.camera.rate_hz);
+}
 
 // A fault log: motion allowed before the fault, then withdrawn with `cause`
 // within `frames_to_dangerous` frame periods + the processing budget of the
@@ -490,19 +501,22 @@ TEST(Replay, NominalLogNeverStopsTheArm) {
 
 TEST(Replay, EncoderOffsetStopsWithJointErrorOnA4) {
   replay_twice("encoder-offset", [](const InputLog& input, const Replay& replay) {
-    expect_fault_stop(input, replay, risk_t::CAUSE_JOINT_ERROR, "a4", replay.config().risk.debounce_frames - 1);
+    expect_fault_stop(input, replay, risk_t::CAUSE_JOINT_ERROR, "a4",
+                      replay.config().risk.debounce_frames - 1);
   });
 }
 
 TEST(Replay, CameraPoseOffsetStopsWithCalibrationError) {
   replay_twice("camera-pose", [](const InputLog& input, const Replay& replay) {
-    expect_fault_stop(input, replay, risk_t::CAUSE_CALIBRATION_ERROR, "", replay.config().risk.debounce_frames - 1);
+    expect_fault_stop(input, replay, risk_t::CAUSE_CALIBRATION_ERROR, "",
+                      replay.config().risk.debounce_frames - 1);
   });
 }
 
 TEST(Replay, IntrudingObjectStopsWithUnknownObject) {
   replay_twice("intruding-object", [](const InputLog& input, const Replay& replay) {
-    expect_fault_stop(input, replay, risk_t::CAUSE_UNKNOWN_OBJECT, "", replay.config().risk.debounce_frames - 1);
+    expect_fault_stop(input, replay, risk_t::CAUSE_UNKNOWN_OBJECT, "",
+                      replay.config().risk.debounce_frames - 1);
   });
 }
 

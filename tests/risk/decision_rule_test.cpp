@@ -109,7 +109,8 @@ TEST(DecisionRule, AnExpiredDeadlineIsDangerousAtOnceAndTheFrameStillCounts) {
 }
 
 TEST(DecisionRule, TheTimeoutVerdictHasNoFrameAndTheLastFramesUtime) {
-  const FrameFinding stale{risk_t::CAUSE_COMPONENT_FAULT, "tofguard-renderer", 300, 250, "tofguard-renderer heartbeat"};
+  const FrameFinding stale{risk_t::CAUSE_COMPONENT_FAULT, "tofguard-renderer", 300, 250,
+                           "tofguard-renderer heartbeat"};
   const risk_t r = risk::timeout_verdict(1'700'000'000'123'456, stale);
   EXPECT_EQ(r.seq, -1);
   EXPECT_EQ(r.utime, 1'700'000'000'123'456);

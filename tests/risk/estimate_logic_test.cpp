@@ -6,17 +6,17 @@
 
 #include <cmath>
 
+#include "synthetic_estimates.hpp"
 #include "synthetic_frames.hpp"
+#include "test_support.hpp"
+#include "tofguard/common/planned_trajectory.hpp"
+#include "tofguard/common/wire_checks.hpp"
+#include "tofguard/deployment/config.hpp"
+#include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/discrepancy/discrepancy_image.hpp"
 #include "tofguard/risk/estimate_finding.hpp"
 #include "tofguard/risk/risk_monitor.hpp"
 #include "tofguard/robot_model/kinematic_tree.hpp"
-#include "synthetic_estimates.hpp"
-#include "test_support.hpp"
-#include "tofguard/deployment/config.hpp"
-#include "tofguard/deployment/process_settings.hpp"
-#include "tofguard/common/planned_trajectory.hpp"
-#include "tofguard/common/wire_checks.hpp"
 
 namespace tofguard::test {
 namespace {
@@ -41,7 +41,8 @@ const deployment::Config& sim_config() {
 }
 
 const robot_model::KinematicTree& friend_arm() {
-  static const robot_model::KinematicTree tree = robot_model::load_kinematic_tree(sim_config().robot.urdf_path);
+  static const robot_model::KinematicTree tree =
+      robot_model::load_kinematic_tree(sim_config().robot.urdf_path);
   return tree;
 }
 
@@ -149,7 +150,7 @@ TEST(ClassifyEstimate, CameraCorrectionIsACalibrationError) {
 
 TEST(ClassifyEstimate, AJointErrorWinsOverASmallCameraCorrection) {
   motion_estimate_t e = synthetic_estimate();
-  e.correction_translation[0] = 0.025;  // ratio 1.25
+  e.correction_translation[0] = 0.025;                   // ratio 1.25
   e.estimated_position[index_of(e, "a6")] -= 10 * kDeg;  // ratio 5
   const FrameFinding f = classify_estimate(e, sim_config().risk);
   EXPECT_EQ(f.cause, risk_t::CAUSE_JOINT_ERROR);
@@ -469,8 +470,8 @@ TEST(PlanDeviation, AQueuedFrameKeepsTheFindingItWasClassifiedWithOnArrival) {
   feed_all(&m, kStart);
   m.on_plan(plan_a1(t0, 0.0, t0 + 500'000, 0.5));
   m.on_joint_state(joints_at(t0 + 200'000, 0.2 - 7.2 * kDeg), kStart);  // 7.2 deg off the plan
-  const discrepancy_t waiting = mismatch_frame(100, 0);                  // waits up to 60 ms
-  discrepancy_t queued = summary_of(default_arm(), 101);                 // nothing the camera sees
+  const discrepancy_t waiting = mismatch_frame(100, 0);                 // waits up to 60 ms
+  discrepancy_t queued = summary_of(default_arm(), 101);                // nothing the camera sees
   queued.utime = t0 + 243'000;
   EXPECT_TRUE(m.on_frame(waiting, kStart).empty());
   EXPECT_TRUE(m.on_frame(queued, kStart + 33 * kMs).empty());
@@ -496,8 +497,8 @@ TEST(PlannedTrajectory, InterpolatesInsideItsSpanAndKeepsTheOldPlanBeforeANewOne
   EXPECT_FALSE(plan.at(999).has_value());
   EXPECT_FALSE(plan.at(2001).has_value());
   plan.add(plan_a1(1500, 5.0, 2500, 6.0));
-  EXPECT_DOUBLE_EQ(plan.at(1250)->at("a1"), 0.25);   // the old plan before 1500
-  EXPECT_DOUBLE_EQ(plan.at(1500)->at("a1"), 5.0);    // the new one from 1500
+  EXPECT_DOUBLE_EQ(plan.at(1250)->at("a1"), 0.25);  // the old plan before 1500
+  EXPECT_DOUBLE_EQ(plan.at(1500)->at("a1"), 5.0);   // the new one from 1500
   EXPECT_DOUBLE_EQ(plan.at(2000)->at("a1"), 5.5);
   EXPECT_EQ(plan.last_utime(), 2500);
 }
@@ -523,7 +524,8 @@ TEST(WireChecks, MotionEstimate) {
   EXPECT_EQ(check_motion_estimate(e).rfind("position_sigma[0] (a1): expected a finite sigma >= 0", 0), 0u);
   e = synthetic_estimate();
   e.usable = false;
-  EXPECT_EQ(check_motion_estimate(e), "unusable_reason: expected a reason for an unusable estimate, got an empty string");
+  EXPECT_EQ(check_motion_estimate(e),
+            "unusable_reason: expected a reason for an unusable estimate, got an empty string");
   e.unusable_reason = "too few model points visible";
   e.correction_rotation[0] = 0;  // not looked at when unusable
   EXPECT_EQ(check_motion_estimate(e), "");

@@ -4,13 +4,13 @@
 #include <gtest/gtest.h>
 
 #include "synthetic_frames.hpp"
+#include "test_support.hpp"
+#include "tofguard/deployment/config.hpp"
+#include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/discrepancy/discrepancy_image.hpp"
 #include "tofguard/risk/frame_classifier.hpp"
 #include "tofguard/risk/risk_monitor.hpp"
 #include "tofguard/robot_model/kinematic_tree.hpp"
-#include "test_support.hpp"
-#include "tofguard/deployment/config.hpp"
-#include "tofguard/deployment/process_settings.hpp"
 
 namespace tofguard::test {
 namespace {
@@ -21,7 +21,8 @@ using risk::FrameFinding;
 using risk::RiskMonitor;
 
 const deployment::Config& sim_config() {
-  static const deployment::Config config = deployment::load_config(source_dir() + "/config/sim.yaml", nullptr);
+  static const deployment::Config config =
+      deployment::load_config(source_dir() + "/config/sim.yaml", nullptr);
   return config;
 }
 
@@ -37,7 +38,8 @@ const deployment::Config& config_depth_100ms() {
 }
 
 const robot_model::KinematicTree& friend_arm() {
-  static const robot_model::KinematicTree tree = robot_model::load_kinematic_tree(sim_config().robot.urdf_path);
+  static const robot_model::KinematicTree tree =
+      robot_model::load_kinematic_tree(sim_config().robot.urdf_path);
   return tree;
 }
 
@@ -63,10 +65,11 @@ FrameFinding classify(const discrepancy_t& d, bool arm_moving = false) {
 TEST(FrameClassifier, RulesAreEvaluatedInTheDocumentedOrder) {
   std::vector<std::string> names;
   for (const risk::FrameRule& rule : risk::frame_rules()) names.push_back(rule.name);
-  EXPECT_EQ(names, (std::vector<std::string>{"unusable frame", "invalid pixels", "uncalibrated camera", "frozen image",
-                                             "calibration error", "joint error: links missing",
-                                             "joint error: links beside unexplained surfaces", "unknown object",
-                                             "unexplained blob"}));
+  EXPECT_EQ(names,
+            (std::vector<std::string>{"unusable frame", "invalid pixels", "uncalibrated camera",
+                                      "frozen image", "calibration error", "joint error: links missing",
+                                      "joint error: links beside unexplained surfaces", "unknown object",
+                                      "unexplained blob"}));
   // An object near the arm that also makes a large blob is an unknown
   // object, not unclassified: the earlier rule wins.
   discrepancy_t d = summary_of(default_arm());
@@ -100,7 +103,8 @@ TEST(FrameClassifier, ShiftedLinkIsAJointErrorOfTheJointAboveIt) {
 
 TEST(FrameClassifier, MismatchOnSeveralLinksBlamesTheJointAboveAllOfThem) {
   // link1 and link2 both displaced: their common ancestor link1 hangs on a1.
-  std::vector<Box> scene = {{40, 100, 60, 140, kArmMm, 1}, {50, 60, 70, 100, kArmMm, 2}, {76, 60, 116, 80, kArmMm, 3}};
+  std::vector<Box> scene = {
+      {40, 100, 60, 140, kArmMm, 1}, {50, 60, 70, 100, kArmMm, 2}, {76, 60, 116, 80, kArmMm, 3}};
   const FrameFinding f = classify(summary_of(scene));
   EXPECT_EQ(f.cause, risk_t::CAUSE_JOINT_ERROR) << f.detail;
   EXPECT_EQ(f.suspect, "a1");
@@ -171,10 +175,11 @@ TEST(FrameClassifier, ShiftOverArmAndEnvironmentIsACalibrationError) {
   for (int i = 0; i < kWidth * kHeight; ++i) {
     if (seen.label[i] == link_labels_t::ENVIRONMENT_FIRST) seen.depth_mm[i] = kFloorMm + 80;
   }
-  const discrepancy_t d = discrepancy::compute_discrepancy(depth_frame(with_noise(seen.depth_mm, 2), 1),
-                                                           depth_frame(model.depth_mm, 1), labels_frame(model.label, 1),
-                                                           discrepancy::parameters_from(sim_config().discrepancy))
-                              .summary;
+  const discrepancy_t d =
+      discrepancy::compute_discrepancy(depth_frame(with_noise(seen.depth_mm, 2), 1),
+                                       depth_frame(model.depth_mm, 1), labels_frame(model.label, 1),
+                                       discrepancy::parameters_from(sim_config().discrepancy))
+          .summary;
   const FrameFinding f = classify(d);
   EXPECT_EQ(f.cause, risk_t::CAUSE_CALIBRATION_ERROR) << f.detail;
   EXPECT_GT(f.score, 0.95);
@@ -293,7 +298,8 @@ TEST(RiskMonitor, EachInputHasItsOwnDeadlineAndCause) {
   judged_at_once(&m, d, now);
   now += 101 * kMs;
   m.on_joint_state(joints(0.5), now);
-  for (const char* p : {"tofguard-camera", "tofguard-renderer", "tofguard-discrepancy"}) m.on_heartbeat(heartbeat(p), now);
+  for (const char* p : {"tofguard-camera", "tofguard-renderer", "tofguard-discrepancy"})
+    m.on_heartbeat(heartbeat(p), now);
   auto r = m.check_deadlines(now);
   ASSERT_TRUE(r);
   EXPECT_EQ(r->suspect, "TOF_DEPTH");
@@ -304,7 +310,8 @@ TEST(RiskMonitor, EachInputHasItsOwnDeadlineAndCause) {
   judged_at_once(&m, d, now);
   now += 101 * kMs;
   m.on_depth(now);
-  for (const char* p : {"tofguard-camera", "tofguard-renderer", "tofguard-discrepancy"}) m.on_heartbeat(heartbeat(p), now);
+  for (const char* p : {"tofguard-camera", "tofguard-renderer", "tofguard-discrepancy"})
+    m.on_heartbeat(heartbeat(p), now);
   judged_at_once(&m, d, now);
   r = m.check_deadlines(now);
   ASSERT_TRUE(r);
@@ -380,7 +387,8 @@ TEST(RiskMonitor, MismatchIsWarningUntilDebouncedThenDangerousAndClearsOnAGoodFr
     levels.push_back(r.level);
   }
   // debounce_frames = 3.
-  EXPECT_EQ(levels, (std::vector<int8_t>{risk_t::WARNING, risk_t::WARNING, risk_t::DANGEROUS, risk_t::DANGEROUS}));
+  EXPECT_EQ(levels,
+            (std::vector<int8_t>{risk_t::WARNING, risk_t::WARNING, risk_t::DANGEROUS, risk_t::DANGEROUS}));
   now += 33 * kMs;
   feed_all(&m, now);
   const risk_t r = judged_at_once(&m, good, now);

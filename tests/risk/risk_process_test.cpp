@@ -7,15 +7,15 @@
 #include <cmath>
 
 #include "chain_bus.hpp"
+#include "synthetic_estimates.hpp"
 #include "synthetic_frames.hpp"
-#include "tofguard/discrepancy/discrepancy_image.hpp"
 #include "tofguard/camera_pose_t.hpp"
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/deployment/process_settings.hpp"
+#include "tofguard/discrepancy/discrepancy_image.hpp"
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/motion_estimate_t.hpp"
 #include "tofguard/planned_trajectory_t.hpp"
-#include "synthetic_estimates.hpp"
 
 namespace tofguard::test {
 namespace {
@@ -26,9 +26,10 @@ constexpr int kFramePeriodMs = 33;
 discrepancy_t summary(int64_t seq, int shift_px) {
   const SyntheticImage model = draw(default_arm());
   const deployment::Config config = deployment::load_config(source_dir() + "/config/sim.yaml", nullptr);
-  return discrepancy::compute_discrepancy(depth_frame(with_noise(draw(default_arm(shift_px)).depth_mm, seq), seq),
-                                          depth_frame(model.depth_mm, seq), labels_frame(model.label, seq),
-                                          discrepancy::parameters_from(config.discrepancy))
+  return discrepancy::compute_discrepancy(
+             depth_frame(with_noise(draw(default_arm(shift_px)).depth_mm, seq), seq),
+             depth_frame(model.depth_mm, seq), labels_frame(model.label, seq),
+             discrepancy::parameters_from(config.discrepancy))
       .summary;
 }
 
@@ -51,7 +52,10 @@ class RiskProcess : public ::testing::Test {
     good_ = summary(1, 0);
     shifted_ = summary(1, 16);
     process_ = std::make_unique<Subprocess>(
-        "risk-process", std::vector<std::string>{bin_dir() + "/tofguard-risk", "--config", chain_config("risk", {{"    wait_ms: 0\n", "    wait_ms: 60\n"}})});  // these tests watch the wait
+        "risk-process", std::vector<std::string>{
+                            bin_dir() + "/tofguard-risk", "--config",
+                            chain_config("risk", {{"    wait_ms: 0\n",
+                                                   "    wait_ms: 60\n"}})});  // these tests watch the wait
     ASSERT_TRUE(wait_until([&] { return !bus_.last_heartbeat("tofguard-risk").process.empty(); }, kDeadline,
                            [&] { bus_.poll(); }))
         << process_->stderr_text();
@@ -93,8 +97,8 @@ class RiskProcess : public ::testing::Test {
 
   // Feeds `frame` every period until the verdict for seq `seq` arrived.
   bool feed_until_judged(const discrepancy_t& frame, int64_t seq) {
-    return run_until(bus_, [&] { return risk_for(seq) != nullptr; }, kDeadline, kFramePeriodMs,
-                     [&] { step(frame); });
+    return run_until(
+        bus_, [&] { return risk_for(seq) != nullptr; }, kDeadline, kFramePeriodMs, [&] { step(frame); });
   }
 
   ChainBus bus_;
@@ -189,7 +193,8 @@ TEST_F(RiskProcess, WithoutAnEstimateTheDiscrepancyRulesJudgeAfterTheWait) {
   ASSERT_TRUE(feed_until_judged(shifted_, unusable_seq));
   const risk_t* r = risk_for(unusable_seq);
   EXPECT_EQ(r->suspect, "a2");
-  EXPECT_NE(r->detail.find("estimate explains nothing: unusable, too few model points visible"), std::string::npos)
+  EXPECT_NE(r->detail.find("estimate explains nothing: unusable, too few model points visible"),
+            std::string::npos)
       << r->detail;
   EXPECT_EQ(r->level, risk_t::DANGEROUS);
 }
@@ -240,8 +245,9 @@ TEST_F(RiskProcess, CameraStallTimesOutByItselfWithinTheDeadline) {
     return -1;
   };
   // Joint state and heartbeats go on; the camera (and so the chain) stops.
-  ASSERT_TRUE(run_until(bus_, [&] { return stall_verdict() >= 0; }, kDeadline, kFramePeriodMs,
-                        [&] { step(good_, /*camera=*/false); }));
+  ASSERT_TRUE(run_until(
+      bus_, [&] { return stall_verdict() >= 0; }, kDeadline, kFramePeriodMs,
+      [&] { step(good_, /*camera=*/false); }));
   const risk_t& r = bus_.risks.messages[stall_verdict()];
   const int64_t after_us = bus_.risks.arrival_us[stall_verdict()] - last_depth_us_;
   EXPECT_EQ(r.level, risk_t::DANGEROUS);
@@ -256,7 +262,11 @@ TEST_F(RiskProcess, CameraStallTimesOutByItselfWithinTheDeadline) {
 TEST_F(RiskProcess, MissingHeartbeatIsAComponentFault) {
   ASSERT_TRUE(feed_until_judged(good_, 3));
   ASSERT_TRUE(run_until(
-      bus_, [&] { return !bus_.risks.messages.empty() && bus_.risks.messages.back().cause == risk_t::CAUSE_COMPONENT_FAULT; },
+      bus_,
+      [&] {
+        return !bus_.risks.messages.empty() &&
+               bus_.risks.messages.back().cause == risk_t::CAUSE_COMPONENT_FAULT;
+      },
       kDeadline, kFramePeriodMs, [&] { step(good_, true, /*renderer_beats=*/false); }));
   EXPECT_EQ(bus_.risks.messages.back().suspect, "tofguard-renderer");
   EXPECT_EQ(bus_.risks.messages.back().level, risk_t::DANGEROUS);
@@ -327,10 +337,12 @@ TEST_F(RiskProcess, MalformedInputOnEveryChannelIsDroppedAndCounted) {
       << bus_.last_heartbeat("tofguard-risk").validation_errors << "\n"
       << process_->stderr_text();
   EXPECT_TRUE(process_->running());
-  EXPECT_NE(process_->stderr_text().find("JOINT_STATE: position[3] (a4): expected a finite number"), std::string::npos)
-      << process_->stderr_text();
-  EXPECT_NE(process_->stderr_text().find("MOTION_ESTIMATE: estimated_position[2] (a3): expected a finite number"),
+  EXPECT_NE(process_->stderr_text().find("JOINT_STATE: position[3] (a4): expected a finite number"),
             std::string::npos)
+      << process_->stderr_text();
+  EXPECT_NE(
+      process_->stderr_text().find("MOTION_ESTIMATE: estimated_position[2] (a3): expected a finite number"),
+      std::string::npos)
       << process_->stderr_text();
 }
 

@@ -19,9 +19,10 @@ class SafetyChain : public ::testing::Test {
   void SetUp() override {
     const std::string config = chain_config("chain");
     discrepancy_ = std::make_unique<Subprocess>(
-        "chain-discrepancy", std::vector<std::string>{bin_dir() + "/tofguard-discrepancy", "--config", config});
-    risk_ = std::make_unique<Subprocess>("chain-risk",
-                                         std::vector<std::string>{bin_dir() + "/tofguard-risk", "--config", config});
+        "chain-discrepancy",
+        std::vector<std::string>{bin_dir() + "/tofguard-discrepancy", "--config", config});
+    risk_ = std::make_unique<Subprocess>(
+        "chain-risk", std::vector<std::string>{bin_dir() + "/tofguard-risk", "--config", config});
     ASSERT_TRUE(wait_until(
         [&] {
           return !bus_.last_heartbeat("tofguard-risk").process.empty() &&
@@ -49,7 +50,8 @@ class SafetyChain : public ::testing::Test {
     bus_.safety.publish("JOINT_STATE", &joints);
     bus_.beat("tofguard-camera");
     ++seq_;
-    const depth_image_t camera = depth_frame(with_noise(draw(scene).depth_mm, static_cast<uint32_t>(seq_)), seq_);
+    const depth_image_t camera =
+        depth_frame(with_noise(draw(scene).depth_mm, static_cast<uint32_t>(seq_)), seq_);
     bus_.images.publish("TOF_DEPTH", &camera);
     if (!renderer_alive) return;
     bus_.beat("tofguard-renderer");
@@ -75,7 +77,8 @@ class SafetyChain : public ::testing::Test {
 
 TEST_F(SafetyChain, NoiseStaysSafeAnObjectIsDangerousADeadRendererIsAComponentFault) {
   // 1 s of nominal frames: every frame judged SAFE.
-  ASSERT_TRUE(run_until(bus_, [&] { return risk_for(30) != nullptr; }, kDeadline, 33, [&] { step(default_arm()); }));
+  ASSERT_TRUE(run_until(
+      bus_, [&] { return risk_for(30) != nullptr; }, kDeadline, 33, [&] { step(default_arm()); }));
   for (int64_t seq = 2; seq <= 30; ++seq) {
     const risk_t* r = risk_for(seq);
     ASSERT_NE(r, nullptr) << seq;
@@ -86,8 +89,9 @@ TEST_F(SafetyChain, NoiseStaysSafeAnObjectIsDangerousADeadRendererIsAComponentFa
   std::vector<Box> with_object = default_arm();
   with_object.push_back({30, 110, 50, 130, 1400, 0});
   const int64_t first_object = seq_ + 1;
-  ASSERT_TRUE(run_until(bus_, [&] { return risk_for(first_object + 2) != nullptr; }, kDeadline, 33,
-                        [&] { step(with_object); }));
+  ASSERT_TRUE(run_until(
+      bus_, [&] { return risk_for(first_object + 2) != nullptr; }, kDeadline, 33,
+      [&] { step(with_object); }));
   EXPECT_EQ(risk_for(first_object)->level, risk_t::WARNING);
   EXPECT_EQ(risk_for(first_object + 2)->level, risk_t::DANGEROUS);
   EXPECT_EQ(risk_for(first_object + 2)->cause, risk_t::CAUSE_UNKNOWN_OBJECT);
@@ -95,7 +99,8 @@ TEST_F(SafetyChain, NoiseStaysSafeAnObjectIsDangerousADeadRendererIsAComponentFa
   // Back to nominal, then the renderer dies: no rendered frames, no
   // heartbeat. The chain reports it by itself.
   const int64_t clear = seq_ + 3;
-  ASSERT_TRUE(run_until(bus_, [&] { return risk_for(clear) != nullptr; }, kDeadline, 33, [&] { step(default_arm()); }));
+  ASSERT_TRUE(run_until(
+      bus_, [&] { return risk_for(clear) != nullptr; }, kDeadline, 33, [&] { step(default_arm()); }));
   EXPECT_EQ(risk_for(clear)->level, risk_t::SAFE);
   const size_t before = bus_.risks.messages.size();
   const int64_t last_rendered = seq_;
@@ -103,14 +108,17 @@ TEST_F(SafetyChain, NoiseStaysSafeAnObjectIsDangerousADeadRendererIsAComponentFa
   auto component_fault = [&]() -> int {
     for (size_t i = before; i < bus_.risks.messages.size(); ++i) {
       const risk_t& r = bus_.risks.messages[i];
-      if (r.level == risk_t::DANGEROUS && r.cause == risk_t::CAUSE_COMPONENT_FAULT) return static_cast<int>(i);
+      if (r.level == risk_t::DANGEROUS && r.cause == risk_t::CAUSE_COMPONENT_FAULT)
+        return static_cast<int>(i);
     }
     return -1;
   };
-  ASSERT_TRUE(run_until(bus_, [&] { return component_fault() >= 0; }, kDeadline, 33, [&] {
-    if (first_unrendered_us == 0) first_unrendered_us = monotonic_us();
-    step(default_arm(), /*renderer_alive=*/false);
-  }));
+  ASSERT_TRUE(run_until(
+      bus_, [&] { return component_fault() >= 0; }, kDeadline, 33,
+      [&] {
+        if (first_unrendered_us == 0) first_unrendered_us = monotonic_us();
+        step(default_arm(), /*renderer_alive=*/false);
+      }));
   const int i = component_fault();
   EXPECT_EQ(bus_.risks.messages[i].suspect, "tofguard-renderer");
   // Within 200 ms of the first camera frame the renderer missed (pairing

@@ -33,7 +33,8 @@ TEST(KinematicTree, FriendArmJointsAndDistalLinks) {
   EXPECT_EQ(tree.lowest_common_ancestor({"link7"}), "link7");
   EXPECT_TRUE(tree.is_descendant_or_self("gripper", "link2"));
   EXPECT_FALSE(tree.is_descendant_or_self("link1", "link2"));
-  EXPECT_EQ(tree.chain_from_root("link2"), (std::vector<std::string>{"world", "base_link", "link1", "link2"}));
+  EXPECT_EQ(tree.chain_from_root("link2"),
+            (std::vector<std::string>{"world", "base_link", "link1", "link2"}));
   EXPECT_EQ(tree.child_link("a3"), "link3");
   EXPECT_EQ(tree.child_link("no_such_joint"), "");
 }
@@ -78,8 +79,8 @@ constexpr const char* kTable = R"(<?xml version="1.0"?>
 )";
 
 TEST(KinematicTree, BranchesMimicsPrismaticJointsAndAnEnvironment) {
-  const KinematicTree tree =
-      load_kinematic_tree(write_test_file("branched.urdf", kBranched), {write_test_file("table.urdf", kTable)});
+  const KinematicTree tree = load_kinematic_tree(write_test_file("branched.urdf", kBranched),
+                                                 {write_test_file("table.urdf", kTable)});
   // Siblings in the order of their names, mimic joints move but are not
   // actuated, environment joints are fixed.
   EXPECT_EQ(tree.movable_joint_names, (std::vector<std::string>{"slide", "left", "right", "spin"}));
@@ -88,8 +89,8 @@ TEST(KinematicTree, BranchesMimicsPrismaticJointsAndAnEnvironment) {
   EXPECT_TRUE(tree.is_prismatic_joint("slide"));
   EXPECT_FALSE(tree.is_prismatic_joint("spin"));
   EXPECT_EQ(tree.num_robot_links, 5);
-  EXPECT_EQ(tree.link_names(),
-            (std::vector<std::string>{"base", "carriage", "finger_left", "finger_right", "wheel", "floor", "top"}));
+  EXPECT_EQ(tree.link_names(), (std::vector<std::string>{"base", "carriage", "finger_left", "finger_right",
+                                                         "wheel", "floor", "top"}));
   EXPECT_TRUE(tree.is_robot_link("wheel"));
   EXPECT_FALSE(tree.is_robot_link("top"));
   EXPECT_FALSE(tree.is_robot_link("nowhere"));
@@ -124,7 +125,8 @@ TEST(KinematicTree, BranchesMimicsPrismaticJointsAndAnEnvironment) {
 }
 
 TEST(KinematicTreeErrors, OneLineNamingTheFileAndJoint) {
-  const std::string malformed = write_test_file("tree_malformed.urdf", "<robot name='x'><link name='a'/><oops/>");
+  const std::string malformed =
+      write_test_file("tree_malformed.urdf", "<robot name='x'><link name='a'/><oops/>");
   try {
     load_kinematic_tree(malformed);
     FAIL() << "expected ModelError";
@@ -141,8 +143,10 @@ TEST(KinematicTreeErrors, OneLineNamingTheFileAndJoint) {
     load_kinematic_tree(floating);
     FAIL() << "expected ModelError";
   } catch (const ModelError& e) {
-    EXPECT_EQ(std::string(e.what()), floating + ": joint 'free': type not supported (fixed, revolute, continuous and "
-                                                "prismatic are)");
+    EXPECT_EQ(std::string(e.what()),
+              floating +
+                  ": joint 'free': type not supported (fixed, revolute, continuous and "
+                  "prismatic are)");
   }
 }
 

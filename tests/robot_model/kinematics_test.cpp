@@ -77,11 +77,13 @@ TEST_F(Kinematics, ChainMatchesHandComputedTransforms) {
   const Eigen::Isometry3d l5 = l4 * pose({0.2, 0, 0.1}, {-0.4, 0, 0.2}) * rotation_about({0, 0.6, 0.8}, q5);
 
   EXPECT_TRUE(pose_of(poses, "base").isApprox(Eigen::Isometry3d::Identity(), 1e-12));
-  EXPECT_TRUE(pose_of(poses, "l1").isApprox(l1, 1e-12)) << pose_of(poses, "l1").matrix() << "\n" << l1.matrix();
+  EXPECT_TRUE(pose_of(poses, "l1").isApprox(l1, 1e-12)) << pose_of(poses, "l1").matrix() << "\n"
+                                                        << l1.matrix();
   EXPECT_TRUE(pose_of(poses, "l2").isApprox(l2, 1e-12));
   EXPECT_TRUE(pose_of(poses, "l3").isApprox(l3, 1e-12));
   EXPECT_TRUE(pose_of(poses, "l4").isApprox(l4, 1e-12));
-  EXPECT_TRUE(pose_of(poses, "l5").isApprox(l5, 1e-12)) << pose_of(poses, "l5").matrix() << "\n" << l5.matrix();
+  EXPECT_TRUE(pose_of(poses, "l5").isApprox(l5, 1e-12)) << pose_of(poses, "l5").matrix() << "\n"
+                                                        << l5.matrix();
   // A number to read: where l5's origin is.
   EXPECT_NEAR((pose_of(poses, "l5").translation() - l5.translation()).norm(), 0, 1e-12);
 }
@@ -93,10 +95,10 @@ TEST_F(Kinematics, WrongRpyOrderOrAxisWouldBeDetected) {
   ASSERT_TRUE(poses.usable);
   Eigen::Isometry3d xyz_order = Eigen::Isometry3d::Identity();
   xyz_order.translation() = Eigen::Vector3d(0.1, 0.2, 0.3);
-  xyz_order.linear() = (Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()) *
-                        Eigen::AngleAxisd(-0.2, Eigen::Vector3d::UnitY()) *
-                        Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()))
-                           .toRotationMatrix();
+  xyz_order.linear() =
+      (Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()) * Eigen::AngleAxisd(-0.2, Eigen::Vector3d::UnitY()) *
+       Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()))
+          .toRotationMatrix();
   const Eigen::Isometry3d wrong_l1 = xyz_order * rotation_about({0, 0, 1}, 0.7);
   EXPECT_GT((pose_of(poses, "l1").linear() - wrong_l1.linear()).norm(), 0.05);
   const Eigen::Isometry3d right_l1 = pose({0.1, 0.2, 0.3}, {0.3, -0.2, 0.5});

@@ -65,11 +65,13 @@ std::string obj(const std::vector<std::array<Eigen::Vector3d, 3>>& triangles) {
   for (const auto& t : triangles) {
     for (const auto& p : t) s << "v " << p.transpose() << "\n";
   }
-  for (size_t i = 0; i < triangles.size(); ++i) s << "f " << 3 * i + 1 << " " << 3 * i + 2 << " " << 3 * i + 3 << "\n";
+  for (size_t i = 0; i < triangles.size(); ++i)
+    s << "f " << 3 * i + 1 << " " << 3 * i + 2 << " " << 3 * i + 3 << "\n";
   return s.str();
 }
 
-std::string one_link_urdf(const std::string& geometry, const std::string& origin = "xyz=\"0.1 -0.05 1.2\" rpy=\"0.4 0.3 0.2\"") {
+std::string one_link_urdf(const std::string& geometry,
+                          const std::string& origin = "xyz=\"0.1 -0.05 1.2\" rpy=\"0.4 0.3 0.2\"") {
   return "<?xml version=\"1.0\"?><robot name=\"one\"><link name=\"world\"/>"
          "<joint name=\"fix\" type=\"fixed\"><parent link=\"world\"/><child link=\"thing\"/><origin " +
          origin + "/></joint><link name=\"thing\"><visual><geometry>" + geometry +
@@ -78,7 +80,8 @@ std::string one_link_urdf(const std::string& geometry, const std::string& origin
 
 const Intrinsics kIntrinsics{160, 120, 150.0, 145.0, 78.6, 61.2};
 
-RenderResult render_world_view(const robot_model::SceneModel& scene, const robot_model::JointPositions& joints = {}) {
+RenderResult render_world_view(const robot_model::SceneModel& scene,
+                               const robot_model::JointPositions& joints = {}) {
   DepthRenderer renderer(scene, 0.1, 5.0);
   return renderer.render(joints, camera_pose_in("world", Eigen::Isometry3d::Identity()), kIntrinsics);
 }
@@ -100,18 +103,21 @@ std::pair<int, double> difference(const RenderResult& a, const RenderResult& b) 
 
 TEST(SceneModel, TessellatedBoxAsStlAndObjRendersLikeThePrimitiveBox) {
   const Eigen::Vector3d size(0.3, 0.2, 0.25);
-  const std::string stl_path = write_test_file("packages/testpkg/meshes/box.stl", ascii_stl(tessellated_box(size / 2, 4)));
+  const std::string stl_path =
+      write_test_file("packages/testpkg/meshes/box.stl", ascii_stl(tessellated_box(size / 2, 4)));
   write_test_file("meshes/unit_box.obj", obj(tessellated_box(Eigen::Vector3d::Constant(0.5), 3)));
   const fs::path packages = fs::path(stl_path).parent_path().parent_path().parent_path();
 
-  const robot_model::SceneModel primitive = robot_model::load_scene(write_test_file("box_primitive.urdf", one_link_urdf("<box size=\"0.3 0.2 0.25\"/>")), {}, {});
+  const robot_model::SceneModel primitive = robot_model::load_scene(
+      write_test_file("box_primitive.urdf", one_link_urdf("<box size=\"0.3 0.2 0.25\"/>")), {}, {});
   robot_model::SceneOptions with_packages;
   with_packages.package_paths = {"/nonexistent", packages.string()};
   const robot_model::SceneModel stl = robot_model::load_scene(
-      write_test_file("box_stl.urdf", one_link_urdf("<mesh filename=\"package://testpkg/meshes/box.stl\"/>")), {},
-      with_packages);
+      write_test_file("box_stl.urdf", one_link_urdf("<mesh filename=\"package://testpkg/meshes/box.stl\"/>")),
+      {}, with_packages);
   const robot_model::SceneModel obj_scaled = robot_model::load_scene(
-      write_test_file("box_obj.urdf", one_link_urdf("<mesh filename=\"meshes/unit_box.obj\" scale=\"0.3 0.2 0.25\"/>")),
+      write_test_file("box_obj.urdf",
+                      one_link_urdf("<mesh filename=\"meshes/unit_box.obj\" scale=\"0.3 0.2 0.25\"/>")),
       {}, {});
   EXPECT_EQ(stl.meshes.back().num_triangles(), 6u * 4 * 4 * 2);
   EXPECT_EQ(obj_scaled.meshes.back().num_triangles(), 6u * 3 * 3 * 2);
@@ -133,10 +139,13 @@ TEST(SceneModel, PaddingInflatesPrimitivesAndMeshes) {
   // Seen head-on (no rotation), 1.2 m ahead: the front face moves 2 cm closer.
   const std::string origin = "xyz=\"0 0 1.2\" rpy=\"0 0 0\"";
   write_test_file("meshes/unit_box.obj", obj(tessellated_box(Eigen::Vector3d::Constant(0.5), 3)));
-  const std::string box = write_test_file("pad_box.urdf", one_link_urdf("<box size=\"0.3 0.2 0.25\"/>", origin));
+  const std::string box =
+      write_test_file("pad_box.urdf", one_link_urdf("<box size=\"0.3 0.2 0.25\"/>", origin));
   const std::string mesh = write_test_file(
-      "pad_mesh.urdf", one_link_urdf("<mesh filename=\"meshes/unit_box.obj\" scale=\"0.3 0.2 0.25\"/>", origin));
-  const std::string bigger = write_test_file("pad_bigger.urdf", one_link_urdf("<box size=\"0.34 0.24 0.29\"/>", origin));
+      "pad_mesh.urdf",
+      one_link_urdf("<mesh filename=\"meshes/unit_box.obj\" scale=\"0.3 0.2 0.25\"/>", origin));
+  const std::string bigger =
+      write_test_file("pad_bigger.urdf", one_link_urdf("<box size=\"0.34 0.24 0.29\"/>", origin));
   robot_model::SceneOptions padded;
   padded.padding_m = 0.02;
   const RenderResult plain = render_world_view(robot_model::load_scene(box, {}, {}));
@@ -155,8 +164,9 @@ TEST(SceneModel, PaddingInflatesPrimitivesAndMeshes) {
 }
 
 TEST(SceneModel, ExtraObjectsGetTheirOwnLabelsAndExactDepth) {
-  const robot_model::SceneModel scene =
-      robot_model::load_scene(write_test_file("extra_base.urdf", one_link_urdf("<box size=\"0.1 0.1 0.1\"/>", "xyz=\"0.3 0 2\"")), {}, {});
+  const robot_model::SceneModel scene = robot_model::load_scene(
+      write_test_file("extra_base.urdf", one_link_urdf("<box size=\"0.1 0.1 0.1\"/>", "xyz=\"0.3 0 2\"")), {},
+      {});
   DepthRenderer renderer(scene, 0.1, 5.0);
   Eigen::Isometry3d at = Eigen::Isometry3d::Identity();
   at.translation() = Eigen::Vector3d(-0.2, 0.1, 1.0);
@@ -164,7 +174,8 @@ TEST(SceneModel, ExtraObjectsGetTheirOwnLabelsAndExactDepth) {
   cylinder_at.translation() = Eigen::Vector3d(0.2, -0.15, 1.5);
   const std::vector<ExtraObject> extras = {ExtraObject::sphere(0.1, at),
                                            ExtraObject::cylinder(0.05, 0.3, cylinder_at)};
-  const RenderResult r = renderer.render({}, camera_pose_in("world", Eigen::Isometry3d::Identity()), kIntrinsics, extras);
+  const RenderResult r =
+      renderer.render({}, camera_pose_in("world", Eigen::Isometry3d::Identity()), kIntrinsics, extras);
   ASSERT_TRUE(r.usable) << r.unusable_reason;
   const int u = static_cast<int>(std::lround(kIntrinsics.fx * -0.2 / 1.0 + kIntrinsics.cx));
   const int v = static_cast<int>(std::lround(kIntrinsics.fy * 0.1 / 1.0 + kIntrinsics.cy));
@@ -177,19 +188,22 @@ TEST(SceneModel, ExtraObjectsGetTheirOwnLabelsAndExactDepth) {
   EXPECT_GT(count_label(r, kLabelExtraObjectFirst + 1), 100);
   EXPECT_GT(count_label(r, kLabelRobotFirst + 1), 30);
   // Without them, only the model remains: nothing was uploaded for them.
-  const RenderResult without = renderer.render({}, camera_pose_in("world", Eigen::Isometry3d::Identity()), kIntrinsics);
+  const RenderResult without =
+      renderer.render({}, camera_pose_in("world", Eigen::Isometry3d::Identity()), kIntrinsics);
   EXPECT_EQ(count_label(without, kLabelExtraObjectFirst), 0);
   EXPECT_EQ(count_label(without, kLabelRobotFirst + 1), count_label(r, kLabelRobotFirst + 1));
 }
 
 TEST(SceneModel, DeviceAndSurfacelessPlatformsRenderTheSameImage) {
-  const robot_model::SceneModel scene = robot_model::load_scene(write_test_file("platform.urdf", one_link_urdf("<sphere radius=\"0.2\"/>")), {}, {});
+  const robot_model::SceneModel scene = robot_model::load_scene(
+      write_test_file("platform.urdf", one_link_urdf("<sphere radius=\"0.2\"/>")), {}, {});
   std::vector<RenderResult> results;
   for (EglPlatform platform : {EglPlatform::kDevice, EglPlatform::kSurfaceless}) {
     try {
       DepthRenderer renderer(scene, 0.1, 5.0, platform);
       std::cout << renderer.description() << "\n";
-      results.push_back(renderer.render({}, camera_pose_in("world", Eigen::Isometry3d::Identity()), kIntrinsics));
+      results.push_back(
+          renderer.render({}, camera_pose_in("world", Eigen::Isometry3d::Identity()), kIntrinsics));
     } catch (const RenderError& e) {
       GTEST_SKIP() << "this machine lacks one of the EGL platforms: " << e.what();
     }
@@ -201,7 +215,8 @@ TEST(SceneModel, DeviceAndSurfacelessPlatformsRenderTheSameImage) {
 }
 
 TEST(SceneModel, OneRendererPerThreadRendersConcurrently) {
-  const robot_model::SceneModel scene = robot_model::load_scene(write_test_file("threads.urdf", one_link_urdf("<cylinder radius=\"0.1\" length=\"0.4\"/>")), {}, {});
+  const robot_model::SceneModel scene = robot_model::load_scene(
+      write_test_file("threads.urdf", one_link_urdf("<cylinder radius=\"0.1\" length=\"0.4\"/>")), {}, {});
   const RenderResult expected = render_world_view(scene);
   std::vector<RenderResult> results(2);
   std::vector<std::thread> threads;
@@ -237,7 +252,8 @@ CameraPose sim_camera_pose() {
 
 TEST(SceneModel, DefaultArmAndEnvironmentLabelRanges) {
   const std::string models = tofguard::test::source_dir() + "/config/models/";
-  const robot_model::SceneModel scene = robot_model::load_scene(models + "friend_arm.urdf", {models + "wheelchair_environment.urdf"}, {});
+  const robot_model::SceneModel scene =
+      robot_model::load_scene(models + "friend_arm.urdf", {models + "wheelchair_environment.urdf"}, {});
   EXPECT_EQ(scene.num_robot_links, 10);  // world, base_link, link1..7, gripper
   EXPECT_EQ(scene.actuated_joint_names.size(), 7u);
   DepthRenderer renderer(scene, 0.1, 8.0);
@@ -270,7 +286,8 @@ TEST(SceneModel, JointMissingFromTheJointStateMakesTheFrameUnusable) {
   DepthRenderer renderer(scene, 0.1, 8.0);
   robot_model::JointPositions joints = friend_arm_joints();
   joints.erase("a4");
-  const RenderResult r = renderer.render(joints, sim_camera_pose(), Intrinsics{176, 144, 221.0, 220.5, 87.3, 71.8});
+  const RenderResult r =
+      renderer.render(joints, sim_camera_pose(), Intrinsics{176, 144, 221.0, 220.5, 87.3, 71.8});
   EXPECT_FALSE(r.usable);
   EXPECT_EQ(r.unusable_reason, "joint 'a4' missing from the joint state");
   EXPECT_TRUE(r.depth_m.empty());
@@ -278,7 +295,8 @@ TEST(SceneModel, JointMissingFromTheJointStateMakesTheFrameUnusable) {
 }
 
 TEST(SceneModel, UnknownCameraFrameAndBadIntrinsicsAreUnusable) {
-  const robot_model::SceneModel scene = robot_model::load_scene(write_test_file("frames.urdf", one_link_urdf("<sphere radius=\"0.2\"/>")), {}, {});
+  const robot_model::SceneModel scene = robot_model::load_scene(
+      write_test_file("frames.urdf", one_link_urdf("<sphere radius=\"0.2\"/>")), {}, {});
   DepthRenderer renderer(scene, 0.1, 5.0);
   CameraPose pose = camera_pose_in("nowhere", Eigen::Isometry3d::Identity());
   RenderResult r = renderer.render({}, pose, kIntrinsics);
@@ -300,7 +318,8 @@ TEST(SceneModel, UnknownCameraFrameAndBadIntrinsicsAreUnusable) {
 class Iiwa14 : public ::testing::Test {
  protected:
   void SetUp() override {
-    if (tofguard::test::shared_dir().empty()) GTEST_SKIP() << "../shared is absent: the iiwa14 model is not available";
+    if (tofguard::test::shared_dir().empty())
+      GTEST_SKIP() << "../shared is absent: the iiwa14 model is not available";
     root = fs::path(tofguard::test::shared_dir()) / "robots" / "iiwa14";
     if (!fs::is_directory(root)) GTEST_SKIP() << root << " is absent";
   }
@@ -327,7 +346,8 @@ class Iiwa14 : public ::testing::Test {
     int checked = 0;
     for (size_t link = 0; link < scene.links.size(); ++link) {
       bool has_geometry = false;
-      for (const robot_model::Shape& shape : scene.shapes) has_geometry = has_geometry || shape.link_index == static_cast<int>(link);
+      for (const robot_model::Shape& shape : scene.shapes)
+        has_geometry = has_geometry || shape.link_index == static_cast<int>(link);
       if (!has_geometry) continue;
       EXPECT_GT(count_label(r, kLabelRobotFirst + static_cast<int>(link)), 20) << scene.links[link].name;
       ++checked;
@@ -345,7 +365,8 @@ class Iiwa14 : public ::testing::Test {
 };
 
 TEST_F(Iiwa14, VisualObjMeshesRenderWithEveryLinkLabelled) {
-  const robot_model::SceneModel scene = robot_model::load_scene((root / "urdf" / "iiwa14_no_collision_relative.urdf").string(), {}, {});
+  const robot_model::SceneModel scene =
+      robot_model::load_scene((root / "urdf" / "iiwa14_no_collision_relative.urdf").string(), {}, {});
   std::cout << "iiwa14 visual: " << scene.num_triangles() << " triangles\n";
   EXPECT_GT(scene.num_triangles(), 50000u);
   expect_every_link_with_geometry_labelled(scene);
@@ -361,10 +382,13 @@ TEST_F(Iiwa14, SphereCollisionsThroughPackageUrisRenderWithEveryLinkLabelled) {
   robot_model::SceneOptions options;
   options.geometry = robot_model::GeometrySource::kCollision;
   options.package_paths = {packages.string()};
-  const robot_model::SceneModel scene = robot_model::load_scene((root / "urdf" / "iiwa14_spheres_collision.urdf").string(), {}, options);
+  const robot_model::SceneModel scene =
+      robot_model::load_scene((root / "urdf" / "iiwa14_spheres_collision.urdf").string(), {}, options);
   expect_every_link_with_geometry_labelled(scene);
   options.geometry = robot_model::GeometrySource::kVisual;
-  EXPECT_GT(robot_model::load_scene((root / "urdf" / "iiwa14_spheres_collision.urdf").string(), {}, options).num_triangles(), 50000u);
+  EXPECT_GT(robot_model::load_scene((root / "urdf" / "iiwa14_spheres_collision.urdf").string(), {}, options)
+                .num_triangles(),
+            50000u);
 }
 
 // --- bad models ---
@@ -380,7 +404,8 @@ std::string model_error(const std::string& robot, const std::vector<std::string>
 }
 
 TEST(SceneModelErrors, MalformedUrdf) {
-  const std::string path = write_test_file("bad/malformed.urdf", "<robot name=\"x\"><link name=\"a\"></robot");
+  const std::string path =
+      write_test_file("bad/malformed.urdf", "<robot name=\"x\"><link name=\"a\"></robot");
   const std::string error = model_error(path);
   EXPECT_EQ(error.rfind(path + ": malformed URDF: ", 0), 0u) << error;
   EXPECT_EQ(error.find('\n'), std::string::npos);
@@ -388,29 +413,35 @@ TEST(SceneModelErrors, MalformedUrdf) {
 }
 
 TEST(SceneModelErrors, MissingMeshNamesLinkAndFile) {
-  const std::string path = write_test_file("bad/missing_mesh.urdf", one_link_urdf("<mesh filename=\"meshes/missing.stl\"/>"));
+  const std::string path =
+      write_test_file("bad/missing_mesh.urdf", one_link_urdf("<mesh filename=\"meshes/missing.stl\"/>"));
   const std::string error = model_error(path);
   EXPECT_EQ(error, path + ": link 'thing': mesh 'meshes/missing.stl' not found (resolved to " +
                        (fs::path(path).parent_path() / "meshes/missing.stl").string() + ")");
-  const std::string package = write_test_file("bad/missing_package.urdf", one_link_urdf("<mesh filename=\"package://nopkg/m.stl\"/>"));
-  EXPECT_EQ(model_error(package), package + ": link 'thing': mesh 'package://nopkg/m.stl' not found "
-                                            "(searched: no package_paths configured)");
+  const std::string package = write_test_file("bad/missing_package.urdf",
+                                              one_link_urdf("<mesh filename=\"package://nopkg/m.stl\"/>"));
+  EXPECT_EQ(model_error(package), package +
+                                      ": link 'thing': mesh 'package://nopkg/m.stl' not found "
+                                      "(searched: no package_paths configured)");
   robot_model::SceneOptions options;
   options.package_paths = {"/tmp/a"};
-  EXPECT_EQ(model_error(package, {}, options),
-            package + ": link 'thing': mesh 'package://nopkg/m.stl' not found (searched: /tmp/a/nopkg/m.stl)");
+  EXPECT_EQ(
+      model_error(package, {}, options),
+      package + ": link 'thing': mesh 'package://nopkg/m.stl' not found (searched: /tmp/a/nopkg/m.stl)");
 }
 
 TEST(SceneModelErrors, UnreadableMeshNamesLinkAndFile) {
   write_test_file("bad/meshes/garbage.stl", "this is not a mesh\n");
-  const std::string path = write_test_file("bad/garbage_mesh.urdf", one_link_urdf("<mesh filename=\"meshes/garbage.stl\"/>"));
+  const std::string path =
+      write_test_file("bad/garbage_mesh.urdf", one_link_urdf("<mesh filename=\"meshes/garbage.stl\"/>"));
   const std::string error = model_error(path);
   EXPECT_EQ(error.rfind(path + ": link 'thing': mesh 'meshes/garbage.stl' (", 0), 0u) << error;
   EXPECT_NE(error.find("could not be read"), std::string::npos) << error;
 }
 
 TEST(SceneModelErrors, UnknownGeometryNamesFileAndLink) {
-  const std::string path = write_test_file("bad/capsule.urdf", one_link_urdf("<capsule radius=\"0.1\" length=\"0.3\"/>"));
+  const std::string path =
+      write_test_file("bad/capsule.urdf", one_link_urdf("<capsule radius=\"0.1\" length=\"0.3\"/>"));
   const std::string error = model_error(path);
   EXPECT_EQ(error.rfind(path + ": malformed URDF: ", 0), 0u) << error;
   EXPECT_NE(error.find("thing"), std::string::npos) << error;
@@ -418,11 +449,13 @@ TEST(SceneModelErrors, UnknownGeometryNamesFileAndLink) {
 
 TEST(SceneModelErrors, MovingJointInTheEnvironment) {
   const std::string robot = write_test_file("bad/robot.urdf", one_link_urdf("<sphere radius=\"0.1\"/>"));
-  const std::string environment = write_test_file(
-      "bad/moving_environment.urdf",
-      "<robot name=\"env\"><link name=\"world\"/><joint name=\"door\" type=\"revolute\"><parent link=\"world\"/>"
-      "<child link=\"door\"/><axis xyz=\"0 0 1\"/><limit lower=\"0\" upper=\"1\" effort=\"1\" velocity=\"1\"/></joint>"
-      "<link name=\"door\"/></robot>");
+  const std::string environment =
+      write_test_file("bad/moving_environment.urdf",
+                      "<robot name=\"env\"><link name=\"world\"/><joint name=\"door\" "
+                      "type=\"revolute\"><parent link=\"world\"/>"
+                      "<child link=\"door\"/><axis xyz=\"0 0 1\"/><limit lower=\"0\" upper=\"1\" "
+                      "effort=\"1\" velocity=\"1\"/></joint>"
+                      "<link name=\"door\"/></robot>");
   EXPECT_EQ(model_error(robot, {environment}),
             environment + ": joint 'door': an environment URDF may only have fixed joints (it is static)");
 }
@@ -432,9 +465,10 @@ TEST(SceneModelErrors, BadSizesAndPadding) {
   EXPECT_EQ(model_error(path), path + ": link 'thing': box size must be three positive lengths");
   robot_model::SceneOptions options;
   options.padding_m = -0.01;
-  EXPECT_NE(model_error(write_test_file("bad/ok.urdf", one_link_urdf("<sphere radius=\"0.1\"/>")), {}, options)
-                .find("padding_m"),
-            std::string::npos);
+  EXPECT_NE(
+      model_error(write_test_file("bad/ok.urdf", one_link_urdf("<sphere radius=\"0.1\"/>")), {}, options)
+          .find("padding_m"),
+      std::string::npos);
 }
 
 }  // namespace

@@ -29,7 +29,8 @@ TEST(JointHistory, ExtrapolatesOnlyUpToTheLimit) {
   EXPECT_NEAR(ahead.joints.at("a1"), 0.25, 1e-12);
   const JointsAtTime too_far = history.at(1'030'001);
   EXPECT_FALSE(too_far.usable);
-  EXPECT_EQ(too_far.unusable_reason, "newest joint state is 20.001000 ms older than the frame (limit 20.000000 ms)");
+  EXPECT_EQ(too_far.unusable_reason,
+            "newest joint state is 20.001000 ms older than the frame (limit 20.000000 ms)");
   EXPECT_TRUE(too_far.joints.empty());
   EXPECT_TRUE(history.at(999'000).usable);  // 1 ms before the oldest: held
   EXPECT_FALSE(history.at(970'000).usable);

@@ -16,7 +16,8 @@ namespace {
 constexpr int64_t kT0 = 1'700'000'000'000'000;
 
 const deployment::Config& sim_config() {
-  static const deployment::Config config = deployment::load_config(test::source_dir() + "/config/sim.yaml", nullptr);
+  static const deployment::Config config =
+      deployment::load_config(test::source_dir() + "/config/sim.yaml", nullptr);
   return config;
 }
 

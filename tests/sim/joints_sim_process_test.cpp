@@ -8,8 +8,8 @@
 
 #include "test_support.hpp"
 #include "tofguard/common/clock.hpp"
-#include "tofguard/joint_state_t.hpp"
 #include "tofguard/common/planned_trajectory.hpp"
+#include "tofguard/joint_state_t.hpp"
 #include "tofguard/planned_trajectory_t.hpp"
 #include "tofguard/safety_status_t.hpp"
 #include "tofguard/sim_joint_fault_t.hpp"
@@ -30,7 +30,9 @@ struct Listener {
     lcm.subscribe("SIM_TRUE_JOINT_STATE", &Listener::on_truth, this);
     lcm.subscribe("PLANNED_TRAJECTORY", &Listener::on_plan, this);
   }
-  void on_plan(const lcm::ReceiveBuffer*, const std::string&, const planned_trajectory_t* m) { plans.push_back(*m); }
+  void on_plan(const lcm::ReceiveBuffer*, const std::string&, const planned_trajectory_t* m) {
+    plans.push_back(*m);
+  }
   void on_reported(const lcm::ReceiveBuffer*, const std::string&, const joint_state_t* m) {
     reported = *m;
     all_reported.push_back(*m);
@@ -56,7 +58,8 @@ struct Listener {
 };
 
 TEST(JointsSimProcess, HaltsWithoutPermissionMovesWithItAndInjectsFaults) {
-  Subprocess sim("joints-sim", {bin_dir() + "/tofguard-joints-sim", "--config", source_dir() + "/config/sim.yaml"});
+  Subprocess sim("joints-sim",
+                 {bin_dir() + "/tofguard-joints-sim", "--config", source_dir() + "/config/sim.yaml"});
   Listener l;
   ASSERT_TRUE(wait_until([&] { return l.reported_count >= 5; }, std::chrono::seconds(5), [&] { l.pump(); }))
       << sim.stderr_text();
@@ -87,13 +90,17 @@ TEST(JointsSimProcess, HaltsWithoutPermissionMovesWithItAndInjectsFaults) {
   fault.offset = 0.1745;
   l.lcm.publish("SIM_JOINT_FAULT", &fault);
   ASSERT_TRUE(wait_until(
-      [&] { return l.reported.utime == l.truth.utime && std::abs(l.reported.position[3] - l.truth.position[3] - 0.1745) < 1e-9; },
+      [&] {
+        return l.reported.utime == l.truth.utime &&
+               std::abs(l.reported.position[3] - l.truth.position[3] - 0.1745) < 1e-9;
+      },
       std::chrono::seconds(2), [&] { l.pump(); }));
   EXPECT_EQ(l.reported.position[2], l.truth.position[2]);
 }
 
 TEST(JointsSimProcess, PublishesThePlanItFollows) {
-  Subprocess sim("joints-sim-plan", {bin_dir() + "/tofguard-joints-sim", "--config", source_dir() + "/config/sim.yaml"});
+  Subprocess sim("joints-sim-plan",
+                 {bin_dir() + "/tofguard-joints-sim", "--config", source_dir() + "/config/sim.yaml"});
   Listener l;
   // Halted: the plan holds the arm where it is.
   ASSERT_TRUE(wait_until([&] { return !l.plans.empty(); }, std::chrono::seconds(5), [&] { l.pump(); }))

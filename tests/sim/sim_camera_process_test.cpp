@@ -8,8 +8,6 @@
 
 #include <algorithm>
 
-#include "tofguard/renderer/depth_renderer.hpp"
-#include "tofguard/renderer/renderer_process.hpp"
 #include "test_support.hpp"
 #include "tofguard/common/camera_pose_message.hpp"
 #include "tofguard/common/clock.hpp"
@@ -19,6 +17,8 @@
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/heartbeat_t.hpp"
 #include "tofguard/joint_state_t.hpp"
+#include "tofguard/renderer/depth_renderer.hpp"
+#include "tofguard/renderer/renderer_process.hpp"
 #include "tofguard/sim_camera_fault_t.hpp"
 
 namespace tofguard::test {
@@ -42,7 +42,9 @@ struct Rig {
   int heartbeats = 0;
   int64_t last_truth_us = 0;
 
-  void on_pose(const lcm::ReceiveBuffer*, const std::string&, const camera_pose_t* m) { poses[m->utime] = *m; }
+  void on_pose(const lcm::ReceiveBuffer*, const std::string&, const camera_pose_t* m) {
+    poses[m->utime] = *m;
+  }
   void on_depth(const lcm::ReceiveBuffer*, const std::string&, const depth_image_t* m) {
     frames.push_back(*m);
   }
@@ -98,8 +100,8 @@ TEST(SimCameraProcess, PublishesFaultsAndRendersIntruders) {
   Rig rig;
   Subprocess camera("sim-camera",
                     {bin_dir() + "/tofguard-camera", "--config", source_dir() + "/config/sim.yaml"});
-  ASSERT_TRUE(wait_until([&] { return rig.frames.size() >= 10; }, std::chrono::seconds(30),
-                         [&] { rig.pump(); }))
+  ASSERT_TRUE(
+      wait_until([&] { return rig.frames.size() >= 10; }, std::chrono::seconds(30), [&] { rig.pump(); }))
       << camera.stderr_text();
   for (size_t i = 1; i < rig.frames.size(); ++i) {
     EXPECT_EQ(rig.frames[i].seq, rig.frames[i - 1].seq + 1) << "a frame slot was missed";
@@ -126,7 +128,8 @@ TEST(SimCameraProcess, PublishesFaultsAndRendersIntruders) {
         return d > 450 && d < 750;
       },
       std::chrono::seconds(10), [&] { rig.pump(); }))
-      << "centre depth " << centre_depth_mm(rig.frames.back()) << " mm\n" << camera.stderr_text();
+      << "centre depth " << centre_depth_mm(rig.frames.back()) << " mm\n"
+      << camera.stderr_text();
 
   // Stall: no frames for 1 s, each lost slot counted as dropped.
   ASSERT_TRUE(wait_until([&] { return rig.heartbeats > 0; }, std::chrono::seconds(5), [&] { rig.pump(); }));
@@ -137,8 +140,8 @@ TEST(SimCameraProcess, PublishesFaultsAndRendersIntruders) {
       << camera.stderr_text();
   const size_t frames_in_stall = rig.frames.size();
   const int64_t seq_before = rig.frames.back().seq;
-  ASSERT_TRUE(wait_until([&] { return rig.frames.size() >= frames_in_stall + 3; },
-                         std::chrono::seconds(5), [&] { rig.pump(); }));
+  ASSERT_TRUE(wait_until([&] { return rig.frames.size() >= frames_in_stall + 3; }, std::chrono::seconds(5),
+                         [&] { rig.pump(); }));
   EXPECT_GE(rig.frames.back().seq - seq_before, 10) << "lost slots leave a gap in seq";
 
   camera.signal(SIGTERM);
@@ -148,7 +151,8 @@ TEST(SimCameraProcess, PublishesFaultsAndRendersIntruders) {
 // Fraction of the robot's modelled pixels (rendered from `pose`) whose
 // camera depth is within 30 mm of the model: about 1 when the camera was
 // where `pose` says.
-double robot_match_fraction(renderer::DepthRenderer* renderer, const depth_image_t& frame, const CameraPose& pose) {
+double robot_match_fraction(renderer::DepthRenderer* renderer, const depth_image_t& frame,
+                            const CameraPose& pose) {
   robot_model::JointPositions joints;
   for (int i = 0; i < 7; ++i) joints["a" + std::to_string(i + 1)] = kArm[i];
   const Intrinsics k = intrinsics_of(frame);
@@ -167,19 +171,20 @@ TEST(SimCameraProcess, PanTiltHeadPublishesThePoseOfEachFrameAndAnOffsetReadingD
   // Pan +-10 deg (3 s), tilt +-3 deg (5 s); from 3 s on the head reads 8 deg
   // more pan than it has.
   const std::string config_path = sim_config_variant(
-      "pan-tilt-camera", {{"    faults: []\n",
-                           "    faults: [{kind: pan_tilt_offset, start_s: 3.0, duration_s: 100, pan_offset_deg: 8, "
-                           "tilt_offset_deg: 0}]\n"
-                           "    pan_tilt: {pan_amplitude_deg: 10, pan_period_s: 3, tilt_amplitude_deg: 3, "
-                           "tilt_period_s: 5}\n"}});
+      "pan-tilt-camera",
+      {{"    faults: []\n",
+        "    faults: [{kind: pan_tilt_offset, start_s: 3.0, duration_s: 100, pan_offset_deg: 8, "
+        "tilt_offset_deg: 0}]\n"
+        "    pan_tilt: {pan_amplitude_deg: 10, pan_period_s: 3, tilt_amplitude_deg: 3, "
+        "tilt_period_s: 5}\n"}});
   Rig rig(config_path);
   Subprocess camera("sim-camera-pan-tilt", {bin_dir() + "/tofguard-camera", "--config", config_path});
   ASSERT_TRUE(wait_until([&] { return !rig.frames.empty(); }, std::chrono::seconds(30), [&] { rig.pump(); }))
       << camera.stderr_text();
   // The camera started before its first frame's capture time.
   const int64_t first_utime = rig.frames.front().utime;
-  ASSERT_TRUE(wait_until([&] { return rig.frames.back().utime > first_utime + 4'000'000; }, std::chrono::seconds(20),
-                         [&] { rig.pump(); }))
+  ASSERT_TRUE(wait_until([&] { return rig.frames.back().utime > first_utime + 4'000'000; },
+                         std::chrono::seconds(20), [&] { rig.pump(); }))
       << camera.stderr_text();
   // Whatever is still in flight.
   const int64_t until = monotonic_us() + 100'000;
@@ -190,7 +195,8 @@ TEST(SimCameraProcess, PanTiltHeadPublishesThePoseOfEachFrameAndAnOffsetReadingD
   const deployment::Config& config = rig.config;
   robot_model::SceneOptions options = renderer::scene_options(config.renderer, config.robot);
   options.padding_m = 0;
-  const robot_model::SceneModel scene = robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths, options);
+  const robot_model::SceneModel scene =
+      robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths, options);
   renderer::DepthRenderer renderer(scene, config.renderer.near_m, config.renderer.far_m);
   int consistent = 0, disagreeing = 0;
   double smallest_pan_deg = 1e9, largest_pan_deg = -1e9;

@@ -27,7 +27,8 @@ struct Listener {
   void on_camera(const lcm::ReceiveBuffer*, const std::string&, const sim_camera_fault_t* m) { camera = *m; }
   // Runs the tool on config/sim.yaml and handles what it published.
   int run(const std::vector<std::string>& args, std::string* err = nullptr) {
-    std::vector<std::string> argv = {bin_dir() + "/tofguard-sim-fault", "--config", source_dir() + "/config/sim.yaml"};
+    std::vector<std::string> argv = {bin_dir() + "/tofguard-sim-fault", "--config",
+                                     source_dir() + "/config/sim.yaml"};
     argv.insert(argv.end(), args.begin(), args.end());
     const int code = run_command("sim-fault", argv, nullptr, err);
     while (lcm.handleTimeout(100) > 0) {
@@ -46,8 +47,8 @@ TEST(SimFaultCli, EncoderFault) {
 
 TEST(SimFaultCli, IntrudingObjectWithItsBox) {
   Listener l;
-  ASSERT_EQ(l.run({"--camera-fault", "intruding_object", "--size-m", "0.1,0.2,0.3", "--position-m", "1,-2,0.5",
-                   "--duration-s", "4.5"}),
+  ASSERT_EQ(l.run({"--camera-fault", "intruding_object", "--size-m", "0.1,0.2,0.3", "--position-m",
+                   "1,-2,0.5", "--duration-s", "4.5"}),
             0);
   ASSERT_TRUE(l.camera);
   EXPECT_EQ(l.camera->kind, sim_camera_fault_t::INTRUDING_OBJECT);

@@ -2,10 +2,10 @@
 
 #include <cmath>
 
-#include "tofguard/sim/simulated_arm.hpp"
 #include "test_support.hpp"
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/deployment/process_settings.hpp"
+#include "tofguard/sim/simulated_arm.hpp"
 
 namespace tofguard::sim {
 namespace {
@@ -64,9 +64,10 @@ TEST(SimulatedArm, MotionMustCoverExactlyTheUrdfJoints) {
     }
     return std::string("(no error)");
   };
-  EXPECT_EQ(message(two_joints(), {"j1", "j2", "j3"}),
-            "cfg.yaml: joints_sim.motion: expected an entry for every movable joint of the URDF (j1, j2, j3), "
-            "missing j3");
+  EXPECT_EQ(
+      message(two_joints(), {"j1", "j2", "j3"}),
+      "cfg.yaml: joints_sim.motion: expected an entry for every movable joint of the URDF (j1, j2, j3), "
+      "missing j3");
   EXPECT_EQ(message(two_joints(), {"j2"}),
             "cfg.yaml: joints_sim.motion.j1: unknown joint, expected one of the URDF's movable joints: j2");
   JointsSimSettings bad_fault = two_joints();

@@ -4,8 +4,8 @@
 
 #include <gtest/gtest.h>
 
-#include "tofguard/sim/deterministic_random.hpp"
 #include "sim_test_config.hpp"
+#include "tofguard/sim/deterministic_random.hpp"
 
 namespace tofguard::sim {
 namespace {

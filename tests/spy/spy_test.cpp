@@ -2,30 +2,27 @@
 // lcm-logplayer (private network namespace), its channel filter, and the
 // status board's content.
 #include <gtest/gtest.h>
-#include <lcm/lcm-cpp.hpp>
 #include <signal.h>
+#include <lcm/lcm-cpp.hpp>
 
 #include <cmath>
 #include <filesystem>
 #include <thread>
 
 #include "sample_messages.hpp"
-#include "tofguard/spy/message_format.hpp"
-#include "tofguard/spy/status_board.hpp"
 #include "test_support.hpp"
 #include "tofguard/motion_estimate_t.hpp"
+#include "tofguard/spy/message_format.hpp"
+#include "tofguard/spy/status_board.hpp"
 
 namespace tofguard::test {
 namespace {
 
 const std::vector<std::pair<std::string, std::vector<uint8_t>>>& log_events() {
   static const std::vector<std::pair<std::string, std::vector<uint8_t>>> events = {
-      {"TOF_DEPTH", encoded(sample_depth_image())},
-      {"JOINT_STATE", encoded(sample_joint_state())},
-      {"SAFETY_RISK", encoded(sample_risk())},
-      {"SAFETY_STATUS", encoded(sample_safety_status())},
-      {"SAFETY_HEARTBEAT", encoded(sample_heartbeat())},
-      {"JUNK", {1, 2, 3}},
+      {"TOF_DEPTH", encoded(sample_depth_image())},      {"JOINT_STATE", encoded(sample_joint_state())},
+      {"SAFETY_RISK", encoded(sample_risk())},           {"SAFETY_STATUS", encoded(sample_safety_status())},
+      {"SAFETY_HEARTBEAT", encoded(sample_heartbeat())}, {"JUNK", {1, 2, 3}},
   };
   return events;
 }
@@ -33,11 +30,14 @@ const std::vector<std::pair<std::string, std::vector<uint8_t>>>& log_events() {
 const std::vector<std::string> kExpectedLines = {
     "TOF_DEPTH depth_image_t utime=1700000000123456 seq=42 camera=tof-test 4x3 valid=91.7% calibrated=true",
     "JOINT_STATE joint_state_t utime=1700000000200000 robot=friend-test a1=0.5000 a2=-1.2500 a3=3.0000",
-    "SAFETY_RISK risk_t utime=1700000000123456 seq=42 DANGEROUS joint error suspect=a4 score=123.5 threshold=50 | "
+    "SAFETY_RISK risk_t utime=1700000000123456 seq=42 DANGEROUS joint error suspect=a4 score=123.5 "
+    "threshold=50 | "
     "joint a4 reads 10.0 deg less than seen",
-    "SAFETY_STATUS safety_status_t seq=7 motion_allowed=false stop=software stop latched=true cause=joint error | "
+    "SAFETY_STATUS safety_status_t seq=7 motion_allowed=false stop=software stop latched=true cause=joint "
+    "error | "
     "DANGEROUS: joint error, suspect a4",
-    "SAFETY_HEARTBEAT heartbeat_t tofguard-renderer pid=4242 seq=99 in=1000 out=998 dropped=2 decode_errors=3 "
+    "SAFETY_HEARTBEAT heartbeat_t tofguard-renderer pid=4242 seq=99 in=1000 out=998 dropped=2 "
+    "decode_errors=3 "
     "validation_errors=4 | running",
     "JUNK ? fingerprint 0x0000000000000000 (3 bytes)",
 };
@@ -75,7 +75,8 @@ std::vector<std::string> lines_of(const std::string& text) {
   std::stringstream s(text);
   for (std::string line; std::getline(s, line);) {
     if (line.rfind("tofguard-spy:", 0) != 0 && line.rfind("SPY_PROBE", 0) != 0 &&
-        line.rfind("LOG_LEAD_IN", 0) != 0) lines.push_back(line);
+        line.rfind("LOG_LEAD_IN", 0) != 0)
+      lines.push_back(line);
   }
   return lines;
 }
@@ -99,8 +100,8 @@ std::vector<std::string> spy_on_replay(const std::string& name, const std::strin
         return spy.stdout_text().find("SPY_PROBE") != std::string::npos;
       },
       std::chrono::seconds(5), [] { std::this_thread::sleep_for(std::chrono::milliseconds(20)); }));
-  Subprocess player(name + "-player", {"/usr/bin/lcm-logplayer", "--lcm-url=udpm://239.255.76.67:7667?ttl=0",
-                                       "-s", "1", log});
+  Subprocess player(name + "-player",
+                    {"/usr/bin/lcm-logplayer", "--lcm-url=udpm://239.255.76.67:7667?ttl=0", "-s", "1", log});
   EXPECT_EQ(player.wait(std::chrono::seconds(10)), 0);
   EXPECT_TRUE(wait_until([&] { return lines_of(spy.stdout_text()).size() >= expected_count; },
                          std::chrono::seconds(5)))
@@ -135,10 +136,11 @@ TEST(Spy, MotionEstimateLineShowsOffsetsInDegreesAndTheCameraCorrection) {
   m.residual_after_mm = 6;
   m.compute_us = 41500;
   const std::vector<uint8_t> bytes = encoded(m);
-  EXPECT_EQ(spy::format_message("MOTION_ESTIMATE", bytes.data(), static_cast<int>(bytes.size())),
-            "MOTION_ESTIMATE motion_estimate_t utime=1700000000123456 seq=42 trigger=1 usable=true converged=true "
-            "iterations=7 frames=3 residual_mm=30.0->6.0 | a4=-10.0±0.5° | camera_mm=12.0,-3.0,0.0 camera_deg=0.0 "
-            "compute_ms=41.5");
+  EXPECT_EQ(
+      spy::format_message("MOTION_ESTIMATE", bytes.data(), static_cast<int>(bytes.size())),
+      "MOTION_ESTIMATE motion_estimate_t utime=1700000000123456 seq=42 trigger=1 usable=true converged=true "
+      "iterations=7 frames=3 residual_mm=30.0->6.0 | a4=-10.0±0.5° | camera_mm=12.0,-3.0,0.0 camera_deg=0.0 "
+      "compute_ms=41.5");
 }
 
 TEST(Spy, PrintsOneDecodedLinePerReplayedMessage) {
@@ -148,7 +150,8 @@ TEST(Spy, PrintsOneDecodedLinePerReplayedMessage) {
 
 TEST(Spy, ChannelFilterKeepsOnlyMatchingChannels) {
   const std::string log = write_log("spy-filter");
-  const auto lines = spy_on_replay("spy-filtered", log, {"--channel", "SAFETY_(RISK|STATUS)", "--channel", "SPY_PROBE"}, 2);
+  const auto lines =
+      spy_on_replay("spy-filtered", log, {"--channel", "SAFETY_(RISK|STATUS)", "--channel", "SPY_PROBE"}, 2);
   EXPECT_EQ(lines, (std::vector<std::string>{kExpectedLines[2], kExpectedLines[3]}));
 }
 
@@ -160,7 +163,8 @@ TEST(Spy, StatusBoardShowsPermissionRiskHeartbeatsRatesAndLatency) {
     board.on_message(channel, bytes.data(), static_cast<int>(bytes.size()), t0_us, utime0 + 25'000);
   }
   const std::string text = board.render(t0_us + 100'000, utime0 + 125'000);
-  EXPECT_NE(text.find("PERMISSION TO MOVE: NO (software stop, latched, cause joint error)"), std::string::npos)
+  EXPECT_NE(text.find("PERMISSION TO MOVE: NO (software stop, latched, cause joint error)"),
+            std::string::npos)
       << text;
   EXPECT_NE(text.find("DANGEROUS: joint error, suspect a4"), std::string::npos) << text;
   EXPECT_NE(text.find("RISK: DANGEROUS joint error, suspect a4  (frame seq 42"), std::string::npos) << text;

@@ -90,8 +90,8 @@ class ChainBus {
 
 // Runs `step` every `period_ms` (monotonic) while waiting for `condition`,
 // polling the bus in between; returns whether the condition came true.
-inline bool run_until(ChainBus& bus, const std::function<bool()>& condition, std::chrono::milliseconds deadline,
-                      int period_ms, const std::function<void()>& step) {
+inline bool run_until(ChainBus& bus, const std::function<bool()>& condition,
+                      std::chrono::milliseconds deadline, int period_ms, const std::function<void()>& step) {
   int64_t next_us = monotonic_us();
   return wait_until(condition, deadline, [&] {
     if (monotonic_us() >= next_us) {

@@ -5,11 +5,11 @@
 #include <cmath>
 #include <memory>
 
-#include "tofguard/estimator/motion_estimator.hpp"
 #include "simulated_frames.hpp"
 #include "test_support.hpp"
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/deployment/process_settings.hpp"
+#include "tofguard/estimator/motion_estimator.hpp"
 
 namespace tofguard::estimator::test {
 

@@ -6,8 +6,8 @@
 
 #include <Eigen/Geometry>
 
-#include "tofguard/renderer/depth_renderer.hpp"
 #include "model_test_util.hpp"
+#include "tofguard/renderer/depth_renderer.hpp"
 
 namespace tofguard::renderer::test {
 

@@ -11,12 +11,12 @@
 #include <Eigen/Geometry>
 
 #include "tofguard/camera/depth_calibration.hpp"
+#include "tofguard/deployment/config.hpp"
+#include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/estimator/motion_estimator.hpp"
 #include "tofguard/renderer/depth_renderer.hpp"
 #include "tofguard/robot_model/scene_model.hpp"
 #include "tofguard/sim/tof_error_model.hpp"
-#include "tofguard/deployment/config.hpp"
-#include "tofguard/deployment/process_settings.hpp"
 
 namespace tofguard::test {
 
@@ -40,9 +40,10 @@ class SimulatedFrames {
   // `offset_rad` added to `joint` (an encoder offset; 0: none) and the
   // camera where it is. Advances *frame_index by num_frames.
   std::vector<estimator::EstimatorFrame> frames_with_offset(const robot_model::JointPositions& true_joints,
-                                                 const Eigen::Isometry3d& world_from_optical,
-                                                 const Intrinsics& intrinsics, const std::string& joint,
-                                                 double offset_rad, int num_frames, uint64_t* frame_index);
+                                                            const Eigen::Isometry3d& world_from_optical,
+                                                            const Intrinsics& intrinsics,
+                                                            const std::string& joint, double offset_rad,
+                                                            int num_frames, uint64_t* frame_index);
 
   const robot_model::SceneModel& scene() const { return scene_; }
   // The renderer, to share with an estimator on the same thread.

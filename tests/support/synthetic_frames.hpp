@@ -58,8 +58,8 @@ inline SyntheticImage draw(const std::vector<Box>& boxes, int width = kWidth, in
   return image;
 }
 
-inline depth_image_t depth_frame(const std::vector<int16_t>& depth_mm, int64_t seq,
-                                 int width = kWidth, int height = kHeight) {
+inline depth_image_t depth_frame(const std::vector<int16_t>& depth_mm, int64_t seq, int width = kWidth,
+                                 int height = kHeight) {
   depth_image_t m;
   m.utime = 1'600'000'000'000'000 + seq * 33'333;  // an old utime, as in a replayed log
   m.seq = seq;

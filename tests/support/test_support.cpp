@@ -96,8 +96,8 @@ int Subprocess::wait(std::chrono::milliseconds deadline) {
 std::string Subprocess::stdout_text() const { return read_file(stdout_path_); }
 std::string Subprocess::stderr_text() const { return read_file(stderr_path_); }
 
-int run_command(const std::string& name, const std::vector<std::string>& argv,
-                std::string* stdout_text, std::string* stderr_text) {
+int run_command(const std::string& name, const std::vector<std::string>& argv, std::string* stdout_text,
+                std::string* stderr_text) {
   Subprocess p(name, argv);
   const int code = p.wait(std::chrono::seconds(60));
   if (stdout_text) *stdout_text = p.stdout_text();
@@ -115,7 +115,8 @@ std::string sim_config_variant(const std::string& name,
     text.replace(at, from.size(), to);
   }
   const std::string models = source_dir() + "/config/models/";
-  for (size_t p = text.find("models/"); p != std::string::npos; p = text.find("models/", p + models.size() + 1)) {
+  for (size_t p = text.find("models/"); p != std::string::npos;
+       p = text.find("models/", p + models.size() + 1)) {
     if (p > 0 && text[p - 1] == '/') continue;
     text.replace(p, 7, models);
   }

@@ -1,19 +1,19 @@
 #pragma once
 // Shared test helpers: real subprocesses, waiting on a condition with a
 // deadline (never a sleep as synchronisation), and the project's paths.
+#include <sys/types.h>
 #include <chrono>
 #include <functional>
 #include <string>
-#include <sys/types.h>
 #include <vector>
 
 namespace tofguard::test {
 
 // Folders, fixed at build time.
-std::string source_dir();   // the repository root
-std::string binary_dir();   // the CMake build folder
-std::string bin_dir();      // where the tofguard-* executables are
-std::string output_dir();   // scratch space for test outputs
+std::string source_dir();  // the repository root
+std::string binary_dir();  // the CMake build folder
+std::string bin_dir();     // where the tofguard-* executables are
+std::string output_dir();  // scratch space for test outputs
 // ../shared beside the repository (public robot models), "" when absent.
 std::string shared_dir();
 

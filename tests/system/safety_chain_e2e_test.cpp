@@ -8,8 +8,8 @@
 // right cause. Times are taken on this test's monotonic clock when the
 // messages arrive here.
 #include <gtest/gtest.h>
-#include <lcm/lcm-cpp.hpp>
 #include <signal.h>
+#include <lcm/lcm-cpp.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -19,18 +19,18 @@
 #include <memory>
 #include <thread>
 
-#include "tofguard/robot_model/kinematics.hpp"
 #include "test_support.hpp"
-#include "tofguard/heartbeat_t.hpp"
-#include "tofguard/joint_state_t.hpp"
 #include "tofguard/camera_pose_t.hpp"
 #include "tofguard/common/clock.hpp"
+#include "tofguard/common/risk_names.hpp"
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/depth_image_t.hpp"
+#include "tofguard/heartbeat_t.hpp"
+#include "tofguard/joint_state_t.hpp"
 #include "tofguard/motion_estimate_t.hpp"
-#include "tofguard/common/risk_names.hpp"
 #include "tofguard/risk_t.hpp"
+#include "tofguard/robot_model/kinematics.hpp"
 #include "tofguard/safety_status_t.hpp"
 #include "tofguard/sim_camera_fault_t.hpp"
 #include "tofguard/sim_joint_fault_t.hpp"
@@ -42,10 +42,11 @@ constexpr int64_t kStopBudgetUs = 200'000;
 
 class Chain {
  public:
-  Chain() : config_path_(sim_config_variant("e2e-chain")),
-            config_(deployment::load_config(config_path_, nullptr)),
-            safety_(config_.lcm.url),
-            images_(config_.lcm.image_url) {
+  Chain()
+      : config_path_(sim_config_variant("e2e-chain")),
+        config_(deployment::load_config(config_path_, nullptr)),
+        safety_(config_.lcm.url),
+        images_(config_.lcm.image_url) {
     safety_.subscribe(config_.channels.status, &Chain::on_status, this);
     safety_.subscribe(config_.channels.risk, &Chain::on_risk, this);
     images_.subscribe(config_.channels.depth, &Chain::on_depth, this);
@@ -54,15 +55,17 @@ class Chain {
     safety_.subscribe(config_.channels.motion_estimate, &Chain::on_estimate, this);
     safety_.getFileno();
     images_.getFileno();
-    for (const char* name : {"tofguard-intervene", "tofguard-risk", "tofguard-discrepancy", "tofguard-renderer",
-                             "tofguard-joints-sim", "tofguard-camera", "tofguard-estimator"}) {
+    for (const char* name :
+         {"tofguard-intervene", "tofguard-risk", "tofguard-discrepancy", "tofguard-renderer",
+          "tofguard-joints-sim", "tofguard-camera", "tofguard-estimator"}) {
       start(name);
     }
   }
 
   void start(const std::string& name) {
     processes_[name] = std::make_unique<Subprocess>(
-        "e2e-" + name + "-" + std::to_string(++starts_), std::vector<std::string>{bin_dir() + "/" + name, "--config", config_path_});
+        "e2e-" + name + "-" + std::to_string(++starts_),
+        std::vector<std::string>{bin_dir() + "/" + name, "--config", config_path_});
   }
   Subprocess& process(const std::string& name) { return *processes_.at(name); }
   std::string stderr_of_all() {
@@ -147,14 +150,15 @@ class Chain {
   void bring_to_motion(const std::string& why) {
     safe_streak_ = 0;
     ASSERT_TRUE(wait([&] { return safe_streak_ >= 15; }, std::chrono::seconds(30)))
-        << "never SAFE: last risk " << describe_last_risk() << "\n" << stderr_of_all();
+        << "never SAFE: last risk " << describe_last_risk() << "\n"
+        << stderr_of_all();
     std::string out;
     int code = -1;
     for (int attempt = 0; attempt < 5 && code != 0; ++attempt) {
       // tofguard-reset blocks; the chain keeps running on its own.
-      code = run_command("e2e-reset", {bin_dir() + "/tofguard-reset", "--config", config_path_, "--who", "e2e",
-                                       "--why", why},
-                         &out);
+      code = run_command(
+          "e2e-reset",
+          {bin_dir() + "/tofguard-reset", "--config", config_path_, "--who", "e2e", "--why", why}, &out);
       pump();
     }
     ASSERT_EQ(code, 0) << out << " last risk " << describe_last_risk();
@@ -276,14 +280,17 @@ class Chain {
   }
   void on_estimate(const lcm::ReceiveBuffer*, const std::string&, const motion_estimate_t* e) {
     std::string line = "  estimate seq " + std::to_string(e->seq) + " trigger " + std::to_string(e->trigger) +
-                       (e->usable ? "" : " unusable: " + e->unusable_reason) + (e->converged ? " converged" : " not converged") +
-                       " it " + std::to_string(e->iterations) + " res " + std::to_string(e->residual_before_mm) + "->" +
-                       std::to_string(e->residual_after_mm) + " mm, offsets deg:";
+                       (e->usable ? "" : " unusable: " + e->unusable_reason) +
+                       (e->converged ? " converged" : " not converged") + " it " +
+                       std::to_string(e->iterations) + " res " + std::to_string(e->residual_before_mm) +
+                       "->" + std::to_string(e->residual_after_mm) + " mm, offsets deg:";
     for (int i = 0; i < e->num_joints; ++i) {
-      line += " " + e->joint_name[i] + "=" + std::to_string((e->estimated_position[i] - e->reported_position[i]) * 180 / M_PI) +
-              "+-" + std::to_string(e->position_sigma[i] * 180 / M_PI);
+      line += " " + e->joint_name[i] + "=" +
+              std::to_string((e->estimated_position[i] - e->reported_position[i]) * 180 / M_PI) + "+-" +
+              std::to_string(e->position_sigma[i] * 180 / M_PI);
     }
-    line += " cam " + std::to_string(e->correction_translation[0]) + "," + std::to_string(e->correction_translation[1]) + "," +
+    line += " cam " + std::to_string(e->correction_translation[0]) + "," +
+            std::to_string(e->correction_translation[1]) + "," +
             std::to_string(e->correction_translation[2]) + " us " + std::to_string(e->compute_us);
     estimate_log_.push_back(line);
   }
@@ -347,27 +354,29 @@ class Chain {
   std::string wait_for_detail(const std::string& text, std::chrono::milliseconds deadline,
                               const std::string& and_text = "") {
     std::string found;
-    wait([&] {
-      for (const std::string& d : risk_details_) {
-        if (d.find(text) != std::string::npos && d.find(and_text) != std::string::npos) {
-          found = d;
-          return true;
-        }
-      }
-      return false;
-    }, deadline);
+    wait(
+        [&] {
+          for (const std::string& d : risk_details_) {
+            if (d.find(text) != std::string::npos && d.find(and_text) != std::string::npos) {
+              found = d;
+              return true;
+            }
+          }
+          return false;
+        },
+        deadline);
     return found;
   }
 };
 
-#define EXPECT_STOP(latency_us, status, expected_cause)                                            \
-  do {                                                                                             \
-    std::cout << "stop " << (latency_us) / 1000.0 << " ms after the first affected frame, cause "  \
-              << risk_cause_name((status).cause) << ": " << (status).reason << std::endl;         \
-    EXPECT_LE(latency_us, kStopBudgetUs) << "stop took " << (latency_us) / 1000 << " ms";         \
+#define EXPECT_STOP(latency_us, status, expected_cause)                                             \
+  do {                                                                                              \
+    std::cout << "stop " << (latency_us) / 1000.0 << " ms after the first affected frame, cause "   \
+              << risk_cause_name((status).cause) << ": " << (status).reason << std::endl;           \
+    EXPECT_LE(latency_us, kStopBudgetUs) << "stop took " << (latency_us) / 1000 << " ms";           \
     EXPECT_EQ(risk_cause_name((status).cause), risk_cause_name(expected_cause)) << (status).reason; \
-    EXPECT_FALSE((status).motion_allowed);                                                         \
-    EXPECT_TRUE((status).latched);                                                                 \
+    EXPECT_FALSE((status).motion_allowed);                                                          \
+    EXPECT_TRUE((status).latched);                                                                  \
   } while (0)
 
 TEST(SafetyChainE2E, NominalMotionThenEveryFaultStopsTheArmWithItsCause) {
@@ -388,13 +397,16 @@ TEST(SafetyChainE2E, NominalMotionThenEveryFaultStopsTheArmWithItsCause) {
     EXPECT_TRUE(chain.motion_allowed());
     EXPECT_GE(chain.malformed_rounds, 50);
     // Every process dropped and counted what it could not use, and lives.
-    for (const char* name : {"tofguard-intervene", "tofguard-risk", "tofguard-discrepancy", "tofguard-renderer",
-                             "tofguard-joints-sim", "tofguard-camera", "tofguard-estimator"}) {
+    for (const char* name :
+         {"tofguard-intervene", "tofguard-risk", "tofguard-discrepancy", "tofguard-renderer",
+          "tofguard-joints-sim", "tofguard-camera", "tofguard-estimator"}) {
       ASSERT_TRUE(chain.heartbeats().count(name)) << name;
       const heartbeat_t& hb = chain.heartbeats().at(name);
-      const int64_t errors = hb.decode_errors + hb.validation_errors -
-                             (before.count(name) ? before[name].decode_errors + before[name].validation_errors : 0);
-      EXPECT_GE(errors, 50) << name << ": decode " << hb.decode_errors << ", validation " << hb.validation_errors;
+      const int64_t errors =
+          hb.decode_errors + hb.validation_errors -
+          (before.count(name) ? before[name].decode_errors + before[name].validation_errors : 0);
+      EXPECT_GE(errors, 50) << name << ": decode " << hb.decode_errors << ", validation "
+                            << hb.validation_errors;
       EXPECT_TRUE(chain.process(name).running()) << name;
     }
   }
@@ -402,7 +414,8 @@ TEST(SafetyChainE2E, NominalMotionThenEveryFaultStopsTheArmWithItsCause) {
   safety_status_t stop;
   {
     SCOPED_TRACE("a 10 degree encoder offset on a4");
-    const int64_t latency = chain.stop_latency_after_frame([&] { chain.joint_fault("a4", 10 * M_PI / 180); }, &stop);
+    const int64_t latency =
+        chain.stop_latency_after_frame([&] { chain.joint_fault("a4", 10 * M_PI / 180); }, &stop);
     EXPECT_STOP(latency, stop, risk_t::CAUSE_JOINT_ERROR);
     EXPECT_NE(stop.reason.find("suspect a4"), std::string::npos) << stop.reason;
     // The motion estimate names the joint and its offset in the verdicts
@@ -423,8 +436,8 @@ TEST(SafetyChainE2E, NominalMotionThenEveryFaultStopsTheArmWithItsCause) {
   }
   {
     SCOPED_TRACE("the camera pose off by 5 cm");
-    const int64_t latency =
-        chain.stop_latency_after_frame([&] { chain.publish_camera_pose(Eigen::Vector3d(0.05, 0, 0)); }, &stop);
+    const int64_t latency = chain.stop_latency_after_frame(
+        [&] { chain.publish_camera_pose(Eigen::Vector3d(0.05, 0, 0)); }, &stop);
     EXPECT_STOP(latency, stop, risk_t::CAUSE_CALIBRATION_ERROR);
     const std::string named = chain.wait_for_detail("camera pose off by", std::chrono::seconds(3));
     std::cout << "estimate-named verdict: " << named << std::endl;
@@ -435,8 +448,8 @@ TEST(SafetyChainE2E, NominalMotionThenEveryFaultStopsTheArmWithItsCause) {
   }
   {
     SCOPED_TRACE("an object within 0.2 m of the arm");
-    const int64_t latency =
-        chain.stop_latency_after_frame([&] { chain.camera_fault(sim_camera_fault_t::INTRUDING_OBJECT); }, &stop);
+    const int64_t latency = chain.stop_latency_after_frame(
+        [&] { chain.camera_fault(sim_camera_fault_t::INTRUDING_OBJECT); }, &stop);
     EXPECT_STOP(latency, stop, risk_t::CAUSE_UNKNOWN_OBJECT);
     chain.camera_fault(sim_camera_fault_t::CLEAR);
     chain.bring_to_motion("object gone");
@@ -456,7 +469,8 @@ TEST(SafetyChainE2E, NominalMotionThenEveryFaultStopsTheArmWithItsCause) {
     SCOPED_TRACE("a camera stall");
     chain.camera_fault(sim_camera_fault_t::STALL);
     // The deadline runs from the last frame that arrived.
-    chain.wait([&] { return monotonic_us() - chain.last_depth_arrival_us() > 50'000; }, std::chrono::seconds(2));
+    chain.wait([&] { return monotonic_us() - chain.last_depth_arrival_us() > 50'000; },
+               std::chrono::seconds(2));
     const int64_t latency = chain.stop_latency_since(chain.last_depth_arrival_us(), &stop);
     std::cout << "camera stall: stop " << latency / 1000.0 << " ms after the last frame" << std::endl;
     EXPECT_LE(latency, depth_deadline_us + kStopBudgetUs);

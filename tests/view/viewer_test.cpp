@@ -115,9 +115,11 @@ TEST(Viewer, ExportsOnePngPerCameraFrameWithNearerRedAndFartherBlue) {
       << stderr_text;
   EXPECT_NE(stdout_text.find("3 camera frames"), std::string::npos) << stdout_text;
   std::vector<std::string> files;
-  for (const auto& e : std::filesystem::directory_iterator(out)) files.push_back(e.path().filename().string());
+  for (const auto& e : std::filesystem::directory_iterator(out))
+    files.push_back(e.path().filename().string());
   std::sort(files.begin(), files.end());
-  ASSERT_EQ(files, (std::vector<std::string>{"frame_00000010.png", "frame_00000011.png", "frame_00000012.png"}));
+  ASSERT_EQ(files,
+            (std::vector<std::string>{"frame_00000010.png", "frame_00000011.png", "frame_00000012.png"}));
 
   const cv::Mat3b view = cv::imread(out + "/frame_00000010.png", cv::IMREAD_COLOR);
   const int scale = view::panel_scale(kW);

@@ -3,8 +3,8 @@
 // field compared. The log is kept in the test-output folder for
 // DecodeLog.java (the Java side of the same check).
 #include <gtest/gtest.h>
-#include <lcm/lcm-cpp.hpp>
 #include <signal.h>
+#include <lcm/lcm-cpp.hpp>
 
 #include <filesystem>
 #include <map>
@@ -63,8 +63,7 @@ struct Collector {
 template <class T>
 T decode_as(const std::vector<uint8_t>& bytes) {
   T message;
-  EXPECT_EQ(message.decode(bytes.data(), 0, static_cast<int>(bytes.size())),
-            static_cast<int>(bytes.size()));
+  EXPECT_EQ(message.decode(bytes.data(), 0, static_cast<int>(bytes.size())), static_cast<int>(bytes.size()));
   return message;
 }
 
@@ -184,8 +183,7 @@ TEST(LogRoundTrip, EveryFieldSurvivesLoggerAndPlayer) {
   EXPECT_EQ(status.since_utime, status_sent.since_utime);
 
   // Our own types: the received bytes are exactly the sent encoding.
-  for (const char* channel :
-       {"TOF_LABELS", "SAFETY_HEARTBEAT", "SAFETY_RESET", "SAFETY_RESET_REPLY"}) {
+  for (const char* channel : {"TOF_LABELS", "SAFETY_HEARTBEAT", "SAFETY_RESET", "SAFETY_RESET_REPLY"}) {
     EXPECT_EQ(collector.received[channel], payloads.at(channel)) << channel;
   }
 }

@@ -32,8 +32,8 @@ cv::Mat3b depth_panel(const depth_image_t& image, double max_depth_mm, int scale
 
 cv::Mat3b blank_panel(int width, int height, int scale, const std::string& text) {
   cv::Mat3b panel(height * scale, width * scale, cv::Vec3b(40, 40, 40));
-  cv::putText(panel, text, cv::Point(8, panel.rows / 2), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 1,
-              cv::LINE_AA);
+  cv::putText(panel, text, cv::Point(8, panel.rows / 2), cv::FONT_HERSHEY_SIMPLEX, 0.5,
+              cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
   return panel;
 }
 
@@ -62,7 +62,8 @@ cv::Mat3b compose_view(const FrameSet& frames, const discrepancy::Parameters& pa
                                        : blank_panel(w, h, scale, "no rendered frame");
   cv::Mat3b dis = blank_panel(w, h, scale, "no comparison");
   if (frames.rendered && frames.labels) {
-    const auto frame = discrepancy::compute_discrepancy(frames.camera, *frames.rendered, *frames.labels, parameters);
+    const auto frame =
+        discrepancy::compute_discrepancy(frames.camera, *frames.rendered, *frames.labels, parameters);
     if (frame.summary.usable) {
       const discrepancy_image_t colour = discrepancy::colour_image(frame, full_scale_mm);
       // RGB on the wire, BGR in OpenCV.
@@ -83,8 +84,8 @@ cv::Mat3b compose_view(const FrameSet& frames, const discrepancy::Parameters& pa
   if (frames.risk && frames.risk->level == risk_t::DANGEROUS) colour = cv::Scalar(60, 60, 255);
   if (frames.risk && frames.risk->level == risk_t::WARNING) colour = cv::Scalar(0, 200, 255);
   if (frames.risk && frames.risk->level == risk_t::SAFE) colour = cv::Scalar(80, 220, 80);
-  cv::putText(view, verdict_text(frames).substr(0, 110), cv::Point(6, 19), cv::FONT_HERSHEY_SIMPLEX, 0.5, colour, 1,
-              cv::LINE_AA);
+  cv::putText(view, verdict_text(frames).substr(0, 110), cv::Point(6, 19), cv::FONT_HERSHEY_SIMPLEX, 0.5,
+              colour, 1, cv::LINE_AA);
   return view;
 }
 

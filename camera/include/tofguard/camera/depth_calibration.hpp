@@ -25,8 +25,7 @@ double evaluate_polynomial(const std::vector<double>& coefficients, double x);
 // Least-squares polynomial of `degree` through (x[i], y[i]), coefficients in
 // ascending powers. Needs at least degree + 1 points with distinct x; throws
 // std::invalid_argument otherwise.
-std::vector<double> fit_polynomial(const std::vector<double>& x, const std::vector<double>& y,
-                                   int degree);
+std::vector<double> fit_polynomial(const std::vector<double>& x, const std::vector<double>& y, int degree);
 
 class DepthCalibration {
  public:

@@ -28,8 +28,7 @@ const char* fourcc(RawDepthFormat format);
 
 // Converts `pixel_count` little-endian counts at `bytes` to distances in
 // metres (0 stays 0 = invalid). `bytes` must hold 2 * pixel_count bytes.
-std::vector<float> raw16_to_distance_m(const uint8_t* bytes, size_t pixel_count,
-                                       double depth_unit_mm);
+std::vector<float> raw16_to_distance_m(const uint8_t* bytes, size_t pixel_count, double depth_unit_mm);
 
 // Converts radial distances to Z in place, for an image of the intrinsics'
 // size. The per-pixel factors are computed once.

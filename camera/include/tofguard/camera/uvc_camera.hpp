@@ -19,8 +19,8 @@
 #include <string>
 #include <vector>
 
-#include "tofguard/camera/depth_conversion.hpp"
 #include "tofguard/camera/depth_camera_settings.hpp"
+#include "tofguard/camera/depth_conversion.hpp"
 
 struct uvc_context;
 struct uvc_device;
@@ -43,8 +43,7 @@ class UvcCamera {
   // A frame: Z in metres (0 = invalid, not yet calibrated), capture time,
   // and its number among all frames libuvc delivered since construction
   // (malformed ones included, so a dropped frame leaves a gap).
-  using FrameHandler =
-      std::function<void(std::vector<float> depth_m, int64_t utime, int64_t frame_number)>;
+  using FrameHandler = std::function<void(std::vector<float> depth_m, int64_t utime, int64_t frame_number)>;
 
   // `on_frame` is called on libuvc's thread.
   UvcCamera(const CameraSettings& camera, const UvcSettings& uvc, FrameHandler on_frame);

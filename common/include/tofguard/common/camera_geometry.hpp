@@ -90,9 +90,10 @@ class UnitQuaternion {
 
   // `field` names the quaternion in the error ("rotation", "rotation_wxyz");
   // a non-finite component is reported as field[i], i in w, x, y, z order.
-  static std::optional<Violation> check(const Eigen::Quaterniond& q, double tolerance, const std::string& field);
-  static std::optional<UnitQuaternion> make(const Eigen::Quaterniond& q, double tolerance, const std::string& field,
-                                            std::string* why);
+  static std::optional<Violation> check(const Eigen::Quaterniond& q, double tolerance,
+                                        const std::string& field);
+  static std::optional<UnitQuaternion> make(const Eigen::Quaterniond& q, double tolerance,
+                                            const std::string& field, std::string* why);
 
   const Eigen::Quaterniond& quaternion() const { return q_; }
   operator const Eigen::Quaterniond&() const { return q_; }  // NOLINT: a unit quaternion is a quaternion

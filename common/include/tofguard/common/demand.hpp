@@ -18,8 +18,8 @@
 // SAFETY_STATUS is positive logic (motion_allowed must keep arriving) the
 // robot controller stops the arm even if tofguard-intervene itself is the
 // process that died; the stop latches until an accepted reset. The line is in
-// the process's log (tofguard-launch keeps every process's output). Carrying on with a broken invariant could instead publish a
-// plausible but wrong "motion allowed".
+// the process's log (tofguard-launch keeps every process's output). Carrying on with a broken invariant could
+// instead publish a plausible but wrong "motion allowed".
 //
 // `message` is any expression convertible to std::string; it is evaluated
 // only when the condition fails, so it may build a string with numbers.
@@ -41,9 +41,9 @@ namespace tofguard::internal {
 
 }  // namespace tofguard::internal
 
-#define TOFGUARD_DEMAND(condition, message)                                             \
-  do {                                                                                  \
-    if (!(condition)) {                                                                 \
-      ::tofguard::internal::demand_failed(#condition, __FILE__, __LINE__, (message));  \
-    }                                                                                   \
+#define TOFGUARD_DEMAND(condition, message)                                           \
+  do {                                                                                \
+    if (!(condition)) {                                                               \
+      ::tofguard::internal::demand_failed(#condition, __FILE__, __LINE__, (message)); \
+    }                                                                                 \
   } while (0)

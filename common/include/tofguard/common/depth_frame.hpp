@@ -82,7 +82,8 @@ constexpr int16_t label_of_link(int link, int num_robot_links) {
 // are (num_robot_links robot links, num_links - num_robot_links environment
 // links). Called per pixel: inline.
 constexpr int link_of_label(int label, int num_robot_links, int num_links) {
-  if (label >= kLabelRobotFirst && label < kLabelRobotFirst + num_robot_links) return label - kLabelRobotFirst;
+  if (label >= kLabelRobotFirst && label < kLabelRobotFirst + num_robot_links)
+    return label - kLabelRobotFirst;
   if (label >= kLabelEnvironmentFirst && label < kLabelEnvironmentFirst + (num_links - num_robot_links)) {
     return num_robot_links + (label - kLabelEnvironmentFirst);
   }
@@ -91,7 +92,9 @@ constexpr int link_of_label(int label, int num_robot_links, int num_links) {
 
 // A robot link's label / an environment link's label (whatever the number
 // of links).
-constexpr bool is_robot_label(int label) { return label >= kLabelRobotFirst && label < kLabelEnvironmentFirst; }
+constexpr bool is_robot_label(int label) {
+  return label >= kLabelRobotFirst && label < kLabelEnvironmentFirst;
+}
 constexpr bool is_environment_label(int label) {
   return label >= kLabelEnvironmentFirst && label < kLabelExtraObjectFirst;
 }
@@ -102,8 +105,8 @@ constexpr bool is_environment_label(int label) {
 // usable, with one label per pixel. Throws std::invalid_argument when
 // `labels` does not hold width*height values or num_robot_links is not in
 // 0..link_names.size().
-link_labels_t make_link_labels(const depth_image_t& frame, int num_robot_links, std::vector<std::string> link_names,
-                               std::vector<int16_t> labels);
+link_labels_t make_link_labels(const depth_image_t& frame, int num_robot_links,
+                               std::vector<std::string> link_names, std::vector<int16_t> labels);
 // The same, unusable: no pixels, and why (one line; check_link_labels
 // drops an unusable frame without a reason).
 link_labels_t make_unusable_link_labels(const depth_image_t& frame, int num_robot_links,

@@ -20,8 +20,7 @@ struct MessageCounters {
 
 class HeartbeatPublisher {
  public:
-  HeartbeatPublisher(lcm::LCM* lcm, std::string channel, std::string process_name,
-                     double rate_hz);
+  HeartbeatPublisher(lcm::LCM* lcm, std::string channel, std::string process_name, double rate_hz);
 
   MessageCounters& counters() { return counters_; }
   void set_status(const std::string& status) { status_ = status; }

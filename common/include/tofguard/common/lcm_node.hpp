@@ -17,10 +17,10 @@
 #include <string>
 #include <vector>
 
-#include "tofguard/common/lcm_settings.hpp"
 #include "tofguard/common/decode.hpp"
 #include "tofguard/common/error_log.hpp"
 #include "tofguard/common/heartbeat.hpp"
+#include "tofguard/common/lcm_settings.hpp"
 
 namespace tofguard {
 
@@ -50,8 +50,7 @@ class LcmNode {
   // `check` returns "" for a valid message, else "field: expected ..., got
   // ..." (see wire_checks.hpp). Every valid message counts as frames_in.
   template <class T>
-  void subscribe(lcm::LCM& lcm, const std::string& channel,
-                 std::function<void(const T&)> on_message,
+  void subscribe(lcm::LCM& lcm, const std::string& channel, std::function<void(const T&)> on_message,
                  std::function<std::string(const T&)> check = nullptr);
 
   // Calls `tick` every `period_us` microseconds of the monotonic clock
@@ -114,8 +113,7 @@ struct LcmNode::CheckedSubscription : LcmNode::SubscriptionBase {
 };
 
 template <class T>
-void LcmNode::subscribe(lcm::LCM& lcm, const std::string& channel,
-                        std::function<void(const T&)> on_message,
+void LcmNode::subscribe(lcm::LCM& lcm, const std::string& channel, std::function<void(const T&)> on_message,
                         std::function<std::string(const T&)> check) {
   auto subscription = std::make_unique<CheckedSubscription<T>>();
   subscription->node = this;

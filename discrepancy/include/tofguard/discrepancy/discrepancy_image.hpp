@@ -14,8 +14,8 @@
 #include <opencv2/core.hpp>
 
 #include "tofguard/common/depth_frame.hpp"
-#include "tofguard/discrepancy/discrepancy_settings.hpp"
 #include "tofguard/depth_image_t.hpp"
+#include "tofguard/discrepancy/discrepancy_settings.hpp"
 #include "tofguard/discrepancy_image_t.hpp"
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/link_labels_t.hpp"

@@ -14,6 +14,7 @@ ProcessInfo calibrate_extrinsics_info();
 
 // `arguments`: LOG [--out FILE] [--frames N]. Exit code 0 done, 1 no
 // calibration, 2 usage error.
-int run_calibrate_extrinsics(const EstimatorProcessSettings& settings, const std::vector<std::string>& arguments);
+int run_calibrate_extrinsics(const EstimatorProcessSettings& settings,
+                             const std::vector<std::string>& arguments);
 
 }  // namespace tofguard::estimator

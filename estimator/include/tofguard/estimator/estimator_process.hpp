@@ -33,18 +33,18 @@
 #include <string>
 #include <thread>
 
-#include "tofguard/estimator/estimate_message.hpp"
-#include "tofguard/estimator/motion_estimator.hpp"
-#include "tofguard/robot_model/scene_model.hpp"
-#include "tofguard/robot_state/state_history.hpp"
 #include "tofguard/camera_pose_t.hpp"
-#include "tofguard/estimator/estimator_settings.hpp"
+#include "tofguard/common/process.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/discrepancy_t.hpp"
+#include "tofguard/estimator/estimate_message.hpp"
+#include "tofguard/estimator/estimator_settings.hpp"
+#include "tofguard/estimator/motion_estimator.hpp"
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/motion_estimate_t.hpp"
-#include "tofguard/common/process.hpp"
 #include "tofguard/risk_t.hpp"
+#include "tofguard/robot_model/scene_model.hpp"
+#include "tofguard/robot_state/state_history.hpp"
 
 namespace tofguard::estimator {
 
@@ -117,7 +117,7 @@ class EstimatorScheduler {
   const robot_model::SceneModel& scene_;
   robot_state::StateHistory state_;
   std::map<int64_t, depth_image_t> frames_;  // by seq
-  std::map<int64_t, int8_t> wanted_;          // seq -> trigger
+  std::map<int64_t, int8_t> wanted_;         // seq -> trigger
   std::set<int64_t> estimated_;
   std::set<int64_t> warning_seqs_;  // kept frames that passed the warning level (discrepancy or risk)
   int64_t last_warning_utime_ = 0;  // utime of the last warning-triggered frame

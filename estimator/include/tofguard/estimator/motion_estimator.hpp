@@ -34,10 +34,10 @@
 
 #include <Eigen/Geometry>
 
+#include "tofguard/common/camera_settings.hpp"
 #include "tofguard/renderer/depth_renderer.hpp"
 #include "tofguard/robot_model/kinematics.hpp"
 #include "tofguard/robot_model/scene_model.hpp"
-#include "tofguard/common/camera_settings.hpp"
 
 namespace tofguard::estimator {
 
@@ -100,7 +100,7 @@ struct EstimatorOptions {
   // joint's distal points more than the current estimate, and at least
   // min_joint_points.
   double joint_search_range_rad = 0.52;  // 30 degrees
-  double joint_search_step_rad = 0.07;  // 4 degrees
+  double joint_search_step_rad = 0.07;   // 4 degrees
   int joint_search_rounds = 2;
   double min_search_gain_fraction = 0.08;
   // A joint is observable (and estimated) when at least this many model
@@ -256,8 +256,8 @@ class MotionEstimator {
   std::string check_frame(const EstimatorFrame& frame) const;
   // Renders `frame` at `state` and adds its residuals to `lin`. Returns ""
   // or why the frame cannot be rendered.
-  std::string linearize(const EstimatorFrame& frame, const State& state, double scale, int stride, PointSet points,
-                        bool joints_free, Linearization* lin, std::vector<Sample>* samples);
+  std::string linearize(const EstimatorFrame& frame, const State& state, double scale, int stride,
+                        PointSet points, bool joints_free, Linearization* lin, std::vector<Sample>* samples);
   // linearize's stages, per rendered pixel of a link (`chain`: its movable
   // joints up to the root): the contour term (distance in pixels from a
   // rendered occluding contour to the nearest measured one) and the depth

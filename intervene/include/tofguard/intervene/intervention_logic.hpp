@@ -32,9 +32,9 @@ namespace tofguard::intervene {
 // What safety_status_t carries (less utime and seq), plus the power.
 struct Status {
   bool motion_allowed = false;
-  int8_t stop = 0;     // safety_status_t::STOP_*
+  int8_t stop = 0;  // safety_status_t::STOP_*
   bool latched = false;
-  int8_t cause = 0;    // risk_t::CAUSE_*
+  int8_t cause = 0;  // risk_t::CAUSE_*
   std::string reason;
   int64_t since_utime = 0;
   // False once a power cut is ordered.

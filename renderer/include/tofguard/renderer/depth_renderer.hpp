@@ -25,11 +25,11 @@
 
 #include <Eigen/Geometry>
 
+#include "tofguard/common/camera_geometry.hpp"
+#include "tofguard/common/depth_frame.hpp"
 #include "tofguard/renderer/egl_context.hpp"
 #include "tofguard/robot_model/kinematics.hpp"
 #include "tofguard/robot_model/scene_model.hpp"
-#include "tofguard/common/camera_geometry.hpp"
-#include "tofguard/common/depth_frame.hpp"
 
 namespace tofguard::renderer {
 
@@ -91,13 +91,14 @@ class DepthRenderer {
   // `camera_pose` is the optical frame's pose in link camera_pose.frame_id
   // (resolved through forward kinematics, so a camera on the arm moves with
   // it). Never throws for bad input: the result is then unusable.
-  RenderResult render(const robot_model::JointPositions& joints, const CameraPose& camera_pose, const Intrinsics& intrinsics,
-                      const std::vector<ExtraObject>& extra_objects = {});
+  RenderResult render(const robot_model::JointPositions& joints, const CameraPose& camera_pose,
+                      const Intrinsics& intrinsics, const std::vector<ExtraObject>& extra_objects = {});
 
   // Same, with the camera pose already in the world frame and the links'
   // poses already known (e.g. a motion estimator trying many candidates).
-  RenderResult render_at(const robot_model::LinkPoses& link_poses, const Eigen::Isometry3d& world_from_optical,
-                         const Intrinsics& intrinsics, const std::vector<ExtraObject>& extra_objects = {});
+  RenderResult render_at(const robot_model::LinkPoses& link_poses,
+                         const Eigen::Isometry3d& world_from_optical, const Intrinsics& intrinsics,
+                         const std::vector<ExtraObject>& extra_objects = {});
 
   // Which EGL platform and GL renderer is in use, for logs.
   const std::string& description() const;

@@ -38,16 +38,16 @@
 #include <set>
 #include <string>
 
-#include "tofguard/renderer/depth_renderer.hpp"
-#include "tofguard/renderer/renderer_settings.hpp"
-#include "tofguard/robot_state/state_history.hpp"
 #include "tofguard/camera_pose_t.hpp"
+#include "tofguard/common/planned_trajectory.hpp"
+#include "tofguard/common/process.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/link_labels_t.hpp"
-#include "tofguard/common/planned_trajectory.hpp"
 #include "tofguard/planned_trajectory_t.hpp"
-#include "tofguard/common/process.hpp"
+#include "tofguard/renderer/depth_renderer.hpp"
+#include "tofguard/renderer/renderer_settings.hpp"
+#include "tofguard/robot_state/state_history.hpp"
 
 namespace tofguard::renderer {
 
@@ -128,7 +128,8 @@ class RendererService {
   void learn_period(const depth_image_t& frame);
   void plan_prediction(const depth_image_t& frame);
   // True when `prediction_` may stand for `frame` rendered at `joints` and `pose`.
-  bool prediction_matches(const depth_image_t& frame, const robot_model::JointPositions& joints, const CameraPose& pose) const;
+  bool prediction_matches(const depth_image_t& frame, const robot_model::JointPositions& joints,
+                          const CameraPose& pose) const;
 
   RendererProcessSettings settings_;
   robot_model::SceneModel scene_;

@@ -8,9 +8,9 @@
 #include <cstdint>
 #include <optional>
 
-#include "tofguard/risk/risk_settings.hpp"
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/risk/frame_classifier.hpp"
+#include "tofguard/risk/risk_settings.hpp"
 #include "tofguard/risk_t.hpp"
 
 namespace tofguard::risk {
@@ -23,7 +23,8 @@ class DecisionRule {
   // (rules, estimate and plan applied), judged in frame order: every call
   // counts one frame for the debounce, also while `expired_input` (the first
   // expired deadline) overrides the verdict.
-  risk_t decide(const discrepancy_t& frame, FrameFinding finding, const std::optional<FrameFinding>& expired_input);
+  risk_t decide(const discrepancy_t& frame, FrameFinding finding,
+                const std::optional<FrameFinding>& expired_input);
 
   // Consecutive frames with a finding so far.
   int consecutive_findings() const { return consecutive_; }

@@ -9,9 +9,9 @@
 #include <set>
 #include <string>
 
+#include "tofguard/motion_estimate_t.hpp"
 #include "tofguard/risk/frame_classifier.hpp"
 #include "tofguard/risk/risk_settings.hpp"
-#include "tofguard/motion_estimate_t.hpp"
 
 namespace tofguard::risk {
 

@@ -9,10 +9,10 @@
 #include <string>
 #include <vector>
 
-#include "tofguard/robot_model/kinematic_tree.hpp"
 #include "tofguard/common/risk_names.hpp"
-#include "tofguard/risk/risk_settings.hpp"
 #include "tofguard/discrepancy_t.hpp"
+#include "tofguard/risk/risk_settings.hpp"
+#include "tofguard/robot_model/kinematic_tree.hpp"
 
 namespace tofguard::risk {
 
@@ -50,8 +50,8 @@ struct LinkView {
 // and the context, with the per-link views every mismatch rule shares.
 class FrameEvidence {
  public:
-  FrameEvidence(const discrepancy_t& frame, const robot_model::KinematicTree& robot, const RiskSettings& config,
-                const ClassifierContext& context)
+  FrameEvidence(const discrepancy_t& frame, const robot_model::KinematicTree& robot,
+                const RiskSettings& config, const ClassifierContext& context)
       : frame(frame), robot(robot), config(config), context(context) {}
 
   const discrepancy_t& frame;
@@ -88,8 +88,8 @@ struct FrameRule {
 const std::vector<FrameRule>& frame_rules();
 
 // The first finding of frame_rules(), or none.
-FrameFinding classify_frame(const discrepancy_t& frame, const robot_model::KinematicTree& robot, const RiskSettings& config,
-                            const ClassifierContext& context);
+FrameFinding classify_frame(const discrepancy_t& frame, const robot_model::KinematicTree& robot,
+                            const RiskSettings& config, const ClassifierContext& context);
 
 // `value` with `decimals` digits after the point, for detail lines.
 std::string fixed(double value, int decimals);

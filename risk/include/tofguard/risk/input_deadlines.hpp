@@ -41,8 +41,8 @@ class InputDeadlines {
 
  private:
   struct Deadline {
-    std::string what;   // channel or process name
-    int8_t cause = 0;   // risk_t::CAUSE_*
+    std::string what;  // channel or process name
+    int8_t cause = 0;  // risk_t::CAUSE_*
     int64_t limit_us = 0;
     int64_t last_us = 0;  // last arrival (or the start), monotonic
     bool ever = false;    // anything arrived yet

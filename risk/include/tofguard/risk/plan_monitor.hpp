@@ -9,11 +9,11 @@
 #include <set>
 #include <string>
 
-#include "tofguard/risk/risk_settings.hpp"
 #include "tofguard/common/planned_trajectory.hpp"
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/planned_trajectory_t.hpp"
 #include "tofguard/risk/frame_classifier.hpp"
+#include "tofguard/risk/risk_settings.hpp"
 
 namespace tofguard::risk {
 

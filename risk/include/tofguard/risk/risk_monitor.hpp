@@ -24,7 +24,6 @@
 #include <vector>
 
 #include "tofguard/common/lcm_settings.hpp"
-#include "tofguard/risk/risk_settings.hpp"
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/heartbeat_t.hpp"
 #include "tofguard/joint_state_t.hpp"
@@ -36,6 +35,7 @@
 #include "tofguard/risk/input_deadlines.hpp"
 #include "tofguard/risk/joint_states_by_utime.hpp"
 #include "tofguard/risk/plan_monitor.hpp"
+#include "tofguard/risk/risk_settings.hpp"
 #include "tofguard/risk_t.hpp"
 #include "tofguard/robot_model/kinematic_tree.hpp"
 
@@ -77,7 +77,8 @@ class RiskMonitor {
 
   // "" or the first of `names` (field `field`) that is not a moving joint
   // of the robot's URDF.
-  std::string check_joint_names(const std::vector<std::string>& names, const std::string& field = "name") const;
+  std::string check_joint_names(const std::vector<std::string>& names,
+                                const std::string& field = "name") const;
   std::string check_joint_names(const joint_state_t& state) const { return check_joint_names(state.name); }
 
  private:

@@ -4,8 +4,8 @@
 // camera (TOF_DEPTH on the image URL), JOINT_STATE, CAMERA_POSE (when
 // required), the discrepancy stream, and the heartbeats of the required
 // processes.
-#include "tofguard/risk/risk_settings.hpp"
 #include "tofguard/common/process.hpp"
+#include "tofguard/risk/risk_settings.hpp"
 
 namespace tofguard::risk {
 

@@ -15,10 +15,10 @@
 
 #include <Eigen/Geometry>
 
-#include "tofguard/robot_state/joint_history.hpp"
-#include "tofguard/sim/tof_error_model.hpp"
 #include "tofguard/common/camera_settings.hpp"
+#include "tofguard/robot_state/joint_history.hpp"
 #include "tofguard/sim/sim_settings.hpp"
+#include "tofguard/sim/tof_error_model.hpp"
 
 namespace tofguard::sim {
 
@@ -71,10 +71,10 @@ class SimulatedCamera {
 
   struct Frame {
     enum class Outcome {
-      kImage,        // image is valid
-      kStalled,      // stall fault: no frame
-      kNoJointState, // no true joint state near the capture time
-      kRenderFailed, // the renderer said the image is unusable
+      kImage,         // image is valid
+      kStalled,       // stall fault: no frame
+      kNoJointState,  // no true joint state near the capture time
+      kRenderFailed,  // the renderer said the image is unusable
     };
     Outcome outcome = Outcome::kImage;
     std::string why;  // one line unless kImage

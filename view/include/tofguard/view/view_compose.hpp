@@ -11,8 +11,8 @@
 #include <opencv2/core.hpp>
 
 #include "tofguard/common/lcm_settings.hpp"
-#include "tofguard/discrepancy/discrepancy_image.hpp"
 #include "tofguard/depth_image_t.hpp"
+#include "tofguard/discrepancy/discrepancy_image.hpp"
 #include "tofguard/link_labels_t.hpp"
 #include "tofguard/risk_t.hpp"
 
@@ -30,8 +30,8 @@ int panel_scale(int width);
 
 // The three panels and the verdict line; `parameters` decide what is a
 // match (the deployment's discrepancy tolerance).
-cv::Mat3b compose_view(const FrameSet& frames, const discrepancy::Parameters& parameters,
-                       double max_depth_mm, double full_scale_mm);
+cv::Mat3b compose_view(const FrameSet& frames, const discrepancy::Parameters& parameters, double max_depth_mm,
+                       double full_scale_mm);
 
 // The verdict line: e.g. "seq 42  DANGEROUS joint error, suspect a4 | ...",
 // or "seq 42  no verdict".
