@@ -114,8 +114,19 @@ TEST(RendererProcess, RendersFramesAtInterpolatedJointsAndMarksUnusableOnes) {
         bench.pump();
       }))
       << process.stderr_text();
-  // Whichever frame came through first: its utime is what it was sent with.
-  const depth_image_t& out = bench.rendered.begin()->second;
+  // The renderer is up now. A frame sent while it was still joining its
+  // multicast groups may have reached it without the joint state before it
+  // (the safety and image sockets join one after the other), and was then
+  // rendered at the nearest joint state, not interpolated: compare a frame
+  // sent now. The joint states travel on the safety URL and the frame on the
+  // image URL, so the frame can overtake the last of them: it lies between
+  // two states that have three more behind them.
+  bench.publish_joints_until(bench.next_joint_utime + 40'000);
+  const int64_t compared_seq = bench.publish_frame(bench.next_joint_utime - 40'000 - 3'700);
+  ASSERT_TRUE(wait_until([&] { return bench.rendered.count(compared_seq) > 0; }, std::chrono::seconds(5),
+                         [&] { bench.pump(); }))
+      << process.stderr_text();
+  const depth_image_t& out = bench.rendered.at(compared_seq);
   ASSERT_EQ(bench.labels.count(out.seq), 1u);
   const link_labels_t& labels = bench.labels.at(out.seq);
   EXPECT_TRUE(labels.usable) << labels.unusable_reason;
@@ -148,11 +159,22 @@ TEST(RendererProcess, RendersFramesAtInterpolatedJointsAndMarksUnusableOnes) {
   // (200 ms beyond: still beyond every joint state sent below, whichever
   // arrives first.)
   const int64_t late_seq = bench.publish_frame(bench.next_joint_utime - 10'000 + 200'000);
-  // A frame whose joint state lacks a4.
+  // A frame whose joint state lacks a4. The frame can overtake that state
+  // (other URL) and be extrapolated from the complete one before it: send
+  // the same capture again (new seq) until one is judged after the state
+  // without a4 arrived.
   robot_model::JointPositions without_a4 = arm_at(bench.next_joint_utime, bench.t0);
   without_a4.erase("a4");
   bench.publish_joints(bench.next_joint_utime, without_a4);
-  const int64_t missing_seq = bench.publish_frame(bench.next_joint_utime);
+  int64_t missing_seq = -1;
+  for (int attempt = 0; attempt < 20 && missing_seq < 0; ++attempt) {
+    const int64_t seq = bench.publish_frame(bench.next_joint_utime);
+    ASSERT_TRUE(wait_until([&] { return bench.labels.count(seq) > 0; }, std::chrono::seconds(10),
+                           [&] { bench.pump(); }))
+        << process.stderr_text();
+    if (!bench.labels.at(seq).usable) missing_seq = seq;
+  }
+  ASSERT_GE(missing_seq, 0) << "no frame judged after the joint state without a4 arrived";
   bench.next_joint_utime += 10'000;
   // Then a good one, bracketed by complete joint states. The joint states
   // travel on the safety URL and the frame on the image URL, so under load
