@@ -110,6 +110,58 @@ TEST(FrameClassifier, MismatchOnSeveralLinksBlamesTheJointAboveAllOfThem) {
   EXPECT_EQ(f.suspect, "a1");
 }
 
+// Nothing in the joint rules is tuned to the default arm: the same
+// summaries, their links renamed to three consecutive links of the iiwa14
+// and the Kinova Gen3 (../shared/robots), blame those arms' own joints.
+TEST(FrameClassifier, JointErrorsOnTheIiwa14AndTheKinovaGen3BlameTheirOwnJoints) {
+  if (shared_dir().empty())
+    GTEST_SKIP() << "../shared is absent: the iiwa14 and Kinova Gen3 models are not available";
+  struct Arm {
+    std::string urdf;
+    std::vector<std::string> links;  // replaces base_link, link1, link2
+    std::string joint_above_link2;   // the one-link shift's suspect
+    std::string joint_above_both;    // the two-link shift's suspect
+  };
+  const std::string robots = shared_dir() + "/robots";
+  const std::vector<Arm> arms = {
+      {robots + "/iiwa14/urdf/iiwa14_no_collision.urdf",
+       {"iiwa_link_0", "iiwa_link_1", "iiwa_link_2"},
+       "iiwa_joint_2",
+       "iiwa_joint_1"},
+      {robots + "/iiwa14/urdf/iiwa14_no_collision.urdf",
+       {"iiwa_link_4", "iiwa_link_5", "iiwa_link_6"},
+       "iiwa_joint_6",
+       "iiwa_joint_5"},
+      {robots +
+           "/kinova_gen3/kortex_description/arms/gen3/7dof/urdf/GEN3-7DOF-NOVISION_FOR_URDF_ARM_V12.urdf",
+       {"base_link", "shoulder_link", "half_arm_1_link"},
+       "joint_2",
+       "joint_1"},
+      {robots +
+           "/kinova_gen3/kortex_description/arms/gen3/7dof/urdf/GEN3-7DOF-NOVISION_FOR_URDF_ARM_V12.urdf",
+       {"forearm_link", "spherical_wrist_1_link", "spherical_wrist_2_link"},
+       "joint_6",
+       "joint_5"},
+  };
+  const std::vector<Box> both_shifted = {
+      {40, 100, 60, 140, kArmMm, 1}, {50, 60, 70, 100, kArmMm, 2}, {76, 60, 116, 80, kArmMm, 3}};
+  for (const Arm& arm : arms) {
+    SCOPED_TRACE(arm.links[0]);
+    const robot_model::KinematicTree tree = robot_model::load_kinematic_tree(arm.urdf);
+    auto renamed = [&](discrepancy_t d) {
+      for (size_t i = 0; i < arm.links.size(); ++i) d.link_name[i] = arm.links[i];
+      return d;
+    };
+    const FrameFinding one =
+        classify_frame(renamed(summary_of(default_arm(16))), tree, sim_config().risk, {});
+    EXPECT_EQ(one.cause, risk_t::CAUSE_JOINT_ERROR) << one.detail;
+    EXPECT_EQ(one.suspect, arm.joint_above_link2) << one.detail;
+    const FrameFinding two = classify_frame(renamed(summary_of(both_shifted)), tree, sim_config().risk, {});
+    EXPECT_EQ(two.cause, risk_t::CAUSE_JOINT_ERROR) << two.detail;
+    EXPECT_EQ(two.suspect, arm.joint_above_both) << two.detail;
+  }
+}
+
 TEST(FrameClassifier, WholeArmShiftedWithTheFixedBaseIsACalibrationError) {
   // The camera a few centimetres off: the near arm (base_link included,
   // which no joint can move) shifts 8 px, the distant floor stays within
