@@ -1,0 +1,374 @@
+#include "judge_campaign.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+#include "simulated_frames.hpp"
+#include "tofguard/common/depth_frame.hpp"
+#include "tofguard/common/risk_names.hpp"
+#include "tofguard/discrepancy/discrepancy_image.hpp"
+#include "tofguard/renderer/rendered_kinematics.hpp"
+#include "tofguard/risk/risk_monitor.hpp"
+#include "tofguard/risk_t.hpp"
+#include "tofguard/robot_model/kinematic_tree.hpp"
+#include "tofguard/robot_model/kinematics.hpp"
+
+namespace tofguard::test {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kPi = 3.141592653589793;
+constexpr double kDegToRad = kPi / 180;
+
+// A floor (top at z = 0) and a wall 0.8 m behind the robot's root: static
+// structure at several depths and slopes, as a room gives a real camera.
+std::string write_generic_scene(const std::string& dir) {
+  fs::create_directories(dir);
+  const std::string path = dir + "/floor_and_wall.urdf";
+  std::ofstream out(path);
+  out << R"(<?xml version="1.0"?>
+<robot name="floor_and_wall">
+  <link name="room"/>
+  <link name="floor"><visual><origin xyz="0 0 -0.01"/><geometry><box size="4 4 0.02"/></geometry></visual></link>
+  <link name="wall"><visual><origin xyz="-0.8 0 1.0"/><geometry><box size="0.02 4 2"/></geometry></visual></link>
+  <joint name="room_floor" type="fixed"><parent link="room"/><child link="floor"/></joint>
+  <joint name="room_wall" type="fixed"><parent link="room"/><child link="wall"/></joint>
+</robot>
+)";
+  if (!out) throw std::runtime_error(path + ": cannot write the campaign's scene");
+  return path;
+}
+
+// Optical frame (x right, y down, z forward) at `eye` looking at `target`,
+// world z up.
+Eigen::Isometry3d look_at(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
+  const Eigen::Vector3d z = (target - eye).normalized();
+  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
+  const Eigen::Vector3d y = z.cross(x);
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear().col(0) = x;
+  pose.linear().col(1) = y;
+  pose.linear().col(2) = z;
+  pose.translation() = eye;
+  return pose;
+}
+
+deployment::Config embedded_config() {
+  return deployment::load_config(std::string(TOFGUARD_SOURCE_DIR) + "/config/sim.yaml", nullptr);
+}
+
+// The campaign judges frames only: no deadlines to feed, no estimate, no
+// plan (each has its own tests).
+void judge_frames_only(deployment::Config* config) {
+  config->risk.required_heartbeats.clear();
+  config->risk.estimate_enabled = false;
+  config->risk.plan_enabled = false;
+  config->risk.camera_pose_required = false;
+}
+
+double joint_position(const sim::JointMotion& m, double t_s) {
+  return m.center + m.amplitude * std::sin(2 * kPi * t_s / m.period_s + m.phase_rad);
+}
+double joint_velocity(const sim::JointMotion& m, double t_s) {
+  return m.amplitude * 2 * kPi / m.period_s * std::cos(2 * kPi * t_s / m.period_s + m.phase_rad);
+}
+
+}  // namespace
+
+CampaignArm default_campaign_arm() {
+  CampaignArm arm{"default arm (config/sim.yaml)", embedded_config()};
+  judge_frames_only(&arm.config);
+  return arm;
+}
+
+CampaignArm generic_campaign_arm(const std::string& name, const std::string& urdf,
+                                 const std::vector<std::string>& package_paths, const std::string& scene_dir,
+                                 const Eigen::Vector3d& eye_m, const Eigen::Vector3d& target_m) {
+  CampaignArm arm{name, embedded_config()};
+  deployment::Config& c = arm.config;
+  c.robot.urdf_path = urdf;
+  c.robot.package_paths = package_paths;
+  c.environment.urdf_paths = {write_generic_scene(scene_dir)};
+  const Eigen::Isometry3d pose = look_at(eye_m, target_m);
+  c.camera.pose = CameraPose("world", pose.translation(), UnitQuaternion(Eigen::Quaterniond(pose.linear())));
+  // Every actuated joint about a bent pose (inside its limits), each with
+  // its own period so that the poses do not repeat.
+  const robot_model::KinematicTree tree = robot_model::load_kinematic_tree(urdf);
+  c.joints_sim.motion.clear();
+  for (size_t i = 0; i < tree.actuated_joint_names.size(); ++i) {
+    const std::string& name_i = tree.actuated_joint_names[i];
+    sim::JointMotion m;
+    m.joint = name_i;
+    const bool prismatic = tree.is_prismatic_joint(name_i);
+    const double sign = (i / 2) % 2 == 0 ? 1.0 : -1.0;
+    m.center = prismatic ? 0 : (i % 2 == 1 ? 0.7 * sign : 0.3 * sign);
+    m.amplitude = prismatic ? 0.01 : 0.3;
+    m.period_s = 5.0 + 1.3 * static_cast<double>(i);
+    m.phase_rad = static_cast<double>(i);
+    for (const robot_model::Joint& j : tree.joints) {
+      if (j.name != name_i || !j.limits.has_position_limits) continue;
+      const double margin = 0.1 * (j.limits.upper - j.limits.lower);
+      m.center = std::clamp(m.center, j.limits.lower + margin + m.amplitude,
+                            j.limits.upper - margin - m.amplitude);
+    }
+    c.joints_sim.motion.push_back(m);
+  }
+  judge_frames_only(&c);
+  return arm;
+}
+
+std::optional<CampaignArm> iiwa14_campaign_arm(const std::string& shared_dir, const std::string& scene_dir) {
+  const std::string urdf = shared_dir + "/robots/iiwa14/urdf/iiwa14_no_collision_relative.urdf";
+  if (shared_dir.empty() || !fs::exists(urdf)) return std::nullopt;
+  return generic_campaign_arm("iiwa14", urdf, {}, scene_dir + "/iiwa14", {1.5, 0.5, 1.3}, {0, 0, 0.6});
+}
+
+std::optional<CampaignArm> kinova_gen3_campaign_arm(const std::string& shared_dir,
+                                                    const std::string& scene_dir) {
+  const std::string root = shared_dir + "/robots/kinova_gen3";
+  const std::string urdf =
+      root + "/kortex_description/arms/gen3/7dof/urdf/GEN3-7DOF-NOVISION_FOR_URDF_ARM_V12.urdf";
+  if (shared_dir.empty() || !fs::exists(urdf)) return std::nullopt;
+  return generic_campaign_arm("Kinova Gen3", urdf, {root}, scene_dir + "/kinova_gen3", {1.3, 0.45, 1.1},
+                              {0, 0, 0.5});
+}
+
+std::vector<CampaignRun> standard_fault_runs(const CampaignArm& arm,
+                                             const std::vector<double>& joint_offsets_deg) {
+  std::vector<CampaignRun> runs;
+  uint64_t seed = 1000;
+  auto add = [&](CampaignFault fault) {
+    CampaignRun run;
+    run.fault = std::move(fault);
+    run.start_s = 0.77 * static_cast<double>(runs.size());
+    run.noise_seed = seed++;
+    runs.push_back(run);
+  };
+  int n = 0;
+  for (const sim::JointMotion& m : arm.config.joints_sim.motion) {
+    for (double deg : joint_offsets_deg) {
+      CampaignFault f;
+      f.kind = CampaignFault::Kind::kJointOffset;
+      f.joint = m.joint;
+      const double sign = (n++ % 2 == 0) ? 1.0 : -1.0;
+      f.offset = sign * deg * kDegToRad;
+      std::ostringstream label;
+      label << m.joint << " " << (sign > 0 ? "+" : "-") << deg << " deg";
+      f.label = label.str();
+      add(f);
+    }
+  }
+  struct CameraCase {
+    const char* label;
+    Eigen::Vector3d translation_m;
+    Eigen::Vector3d rotation_axis;
+    double rotation_deg;
+  };
+  const CameraCase cases[] = {
+      {"camera 2 cm along x", {0.02, 0, 0}, Eigen::Vector3d::UnitX(), 0},
+      {"camera 2 cm along y", {0, -0.02, 0}, Eigen::Vector3d::UnitX(), 0},
+      {"camera 2 cm along z (optical axis)", {0, 0, 0.02}, Eigen::Vector3d::UnitX(), 0},
+      {"camera 3 cm along z (optical axis)", {0, 0, -0.03}, Eigen::Vector3d::UnitX(), 0},
+      {"camera turned 1 deg about x", {0, 0, 0}, Eigen::Vector3d::UnitX(), 1},
+      {"camera turned 1 deg about y", {0, 0, 0}, Eigen::Vector3d::UnitY(), -1},
+      {"camera turned 1 deg about z", {0, 0, 0}, Eigen::Vector3d::UnitZ(), 1},
+  };
+  for (const CameraCase& c : cases) {
+    CampaignFault f;
+    f.kind = CampaignFault::Kind::kCameraPose;
+    f.camera_error = Eigen::Isometry3d::Identity();
+    f.camera_error.translation() = c.translation_m;
+    f.camera_error.linear() = Eigen::AngleAxisd(c.rotation_deg * kDegToRad, c.rotation_axis).toRotationMatrix();
+    f.label = c.label;
+    add(f);
+  }
+  return runs;
+}
+
+std::vector<CampaignRun> nominal_runs(double seconds, double run_s, uint64_t seed) {
+  std::vector<CampaignRun> runs;
+  const int frames_per_run = static_cast<int>(std::lround(run_s * 30));
+  for (double t = 0; t < seconds; t += run_s) {
+    CampaignRun run;
+    run.fault.label = "nominal";
+    run.onset_frame = frames_per_run;  // never reached: every frame is before the onset
+    run.frames_after_onset = 0;
+    run.start_s = t;
+    run.noise_seed = seed++;
+    runs.push_back(run);
+  }
+  return runs;
+}
+
+std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vector<CampaignRun>& runs) {
+  const deployment::Config& config = arm.config;
+  SimulatedFrames truth(config);
+  // The model as tofguard-renderer loads it (the config's geometry and
+  // padding), and the tree tofguard-risk loads.
+  robot_model::SceneOptions options;
+  options.geometry = config.renderer.geometry;
+  options.padding_m = config.renderer.padding_m;
+  options.package_paths = config.robot.package_paths;
+  const robot_model::SceneModel model_scene =
+      robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths, options);
+  renderer::DepthRenderer model(model_scene, config.renderer.near_m, config.renderer.far_m);
+  const robot_model::KinematicTree robot_tree = robot_model::load_kinematic_tree(config.robot.urdf_path);
+  const discrepancy::Parameters parameters = discrepancy::parameters_from(config.discrepancy);
+  const Intrinsics intrinsics = config.camera.intrinsics;
+  const double period_s = 1.0 / config.camera.rate_hz;
+  const auto period_us = static_cast<int64_t>(std::llround(period_s * 1e6));
+  const Eigen::Isometry3d reported_pose = config.camera.pose.frame_from_optical();
+
+  std::vector<CampaignResult> results;
+  for (const CampaignRun& run : runs) {
+    risk::RiskMonitor monitor(config.risk, config.channels, robot_tree, 0);
+    CampaignResult result;
+    result.label = run.fault.label;
+    const int num_frames = run.onset_frame + run.frames_after_onset;
+    for (int k = 0; k < num_frames; ++k) {
+      const double t_s = run.start_s + k * period_s;
+      const int64_t now_us = (k + 1) * period_us;
+      const bool faulty = run.fault.kind != CampaignFault::Kind::kNone && k >= run.onset_frame;
+      robot_model::JointPositions true_joints;
+      joint_state_t state{};
+      state.utime = 1'700'000'000'000'000 + k * period_us;
+      state.robot_id = config.robot.id;
+      for (const sim::JointMotion& m : config.joints_sim.motion) {
+        const double q = joint_position(m, t_s);
+        true_joints[m.joint] = q;
+        state.name.push_back(m.joint);
+        state.position.push_back(q + (faulty && run.fault.kind == CampaignFault::Kind::kJointOffset &&
+                                              m.joint == run.fault.joint
+                                          ? run.fault.offset
+                                          : 0.0));
+        state.velocity.push_back(joint_velocity(m, t_s));
+        state.effort.push_back(0);
+      }
+      state.num_joints = static_cast<int32_t>(state.name.size());
+      robot_model::JointPositions reported_joints;
+      for (int i = 0; i < state.num_joints; ++i) reported_joints[state.name[i]] = state.position[i];
+      const Eigen::Isometry3d true_pose =
+          faulty && run.fault.kind == CampaignFault::Kind::kCameraPose ? reported_pose * run.fault.camera_error
+                                                                         : reported_pose;
+
+      const std::vector<float> depth_m =
+          truth.capture(true_joints, true_pose, intrinsics, run.noise_seed * 100000 + static_cast<uint64_t>(k));
+      const depth_image_t camera =
+          make_depth_image(config.camera.id, intrinsics, state.utime, k, /*calibrated=*/true, depth_m);
+
+      const robot_model::LinkPoses poses = robot_model::forward_kinematics(model_scene, reported_joints);
+      if (!poses.usable) throw std::runtime_error(poses.unusable_reason);
+      renderer::RenderResult rendered_result = model.render_at(poses, reported_pose, intrinsics);
+      if (!rendered_result.usable) throw std::runtime_error(rendered_result.unusable_reason);
+      const depth_image_t rendered = make_depth_image(config.camera.id, intrinsics, state.utime, k,
+                                                      /*calibrated=*/true, rendered_result.depth_m);
+      link_labels_t labels = make_link_labels(camera, model_scene.num_robot_links, model_scene.link_names(),
+                                              std::move(rendered_result.labels));
+      renderer::set_rendered_kinematics(renderer::rendered_kinematics(model_scene, poses, reported_pose), &labels);
+
+      const discrepancy::DiscrepancyFrame frame =
+          discrepancy::compute_discrepancy(camera, rendered, labels, parameters);
+      monitor.on_depth(now_us);
+      monitor.on_joint_state(state, now_us);
+      for (const risk_t& verdict : monitor.on_frame(frame.summary, now_us)) {
+        ++result.frames_judged;
+        const bool after_onset = verdict.seq >= run.onset_frame && run.fault.kind != CampaignFault::Kind::kNone;
+        if (verdict.level == risk_t::DANGEROUS && !after_onset && !result.false_stop) {
+          result.false_stop = true;
+          result.false_stop_detail = "seq " + std::to_string(verdict.seq) + ": " + verdict.detail;
+        }
+        if (!after_onset) continue;
+        if (!result.stopped) {
+          if (verdict.level != risk_t::DANGEROUS) continue;
+          result.stopped = true;
+          result.stop_frames = static_cast<int>(verdict.seq) - run.onset_frame + 1;
+          result.cause = verdict.cause;
+          result.suspect = verdict.suspect;
+          result.detail = verdict.detail;
+          continue;
+        }
+        if (verdict.level == risk_t::SAFE) ++result.safe_after_stop;
+        if (verdict.suspect != result.suspect || verdict.cause != result.cause) ++result.suspect_changes;
+      }
+    }
+    if (run.fault.kind == CampaignFault::Kind::kJointOffset) {
+      result.right_cause = result.stopped && result.cause == risk_t::CAUSE_JOINT_ERROR;
+      result.right_suspect = result.right_cause && result.suspect == run.fault.joint;
+    } else if (run.fault.kind == CampaignFault::Kind::kCameraPose) {
+      result.right_cause = result.stopped && result.cause == risk_t::CAUSE_CALIBRATION_ERROR;
+      result.right_suspect = result.right_cause;
+    }
+    results.push_back(result);
+  }
+  return results;
+}
+
+std::string campaign_report(const std::string& arm, const std::vector<CampaignResult>& results,
+                            double frame_period_s) {
+  struct Tally {
+    int runs = 0, detected = 0, right_cause = 0, right_suspect = 0, false_stops = 0, safe_after = 0,
+        switches = 0, frames = 0;
+    std::vector<int> latency;
+  };
+  std::map<std::string, Tally> by_kind;
+  std::ostringstream misses;
+  for (const CampaignResult& r : results) {
+    const std::string kind = r.label == "nominal"                        ? "nominal"
+                             : r.label.rfind("camera", 0) == 0           ? "camera pose"
+                             : r.label.find(" 3 deg") != std::string::npos ? "joint offset 3 deg"
+                             : r.label.find(" 5 deg") != std::string::npos ? "joint offset 5 deg"
+                                                                           : "joint offset >= 10 deg";
+    Tally& t = by_kind[kind];
+    ++t.runs;
+    t.frames += r.frames_judged;
+    t.false_stops += r.false_stop ? 1 : 0;
+    if (r.false_stop) misses << "- " << arm << ", " << r.label << ": false stop, " << r.false_stop_detail << "\n";
+    if (kind == "nominal") continue;
+    t.detected += r.stopped ? 1 : 0;
+    t.right_cause += r.right_cause ? 1 : 0;
+    t.right_suspect += r.right_suspect ? 1 : 0;
+    t.safe_after += r.safe_after_stop;
+    t.switches += r.suspect_changes;
+    if (r.stopped) t.latency.push_back(r.stop_frames);
+    if (!r.stopped) {
+      misses << "- " << arm << ", " << r.label << ": not detected\n";
+    } else if (!r.right_suspect) {
+      misses << "- " << arm << ", " << r.label << ": stopped as " << risk_cause_name(r.cause)
+             << (r.suspect.empty() ? "" : " " + r.suspect) << " (" << r.detail << ")\n";
+    }
+    if (r.safe_after_stop > 0 || r.suspect_changes > 0) {
+      misses << "- " << arm << ", " << r.label << ": after the stop " << r.safe_after_stop << " SAFE, "
+             << r.suspect_changes << " other cause/suspect\n";
+    }
+  }
+  std::ostringstream out;
+  out << "| " << arm
+      << " | runs | frames | detected | right cause | right suspect at stop | median / max frames to stop "
+         "(ms) | SAFE after stop | suspect changes | false stops |\n"
+      << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+  for (auto& [kind, t] : by_kind) {
+    std::string latency = "-";
+    if (!t.latency.empty()) {
+      std::sort(t.latency.begin(), t.latency.end());
+      const int median = t.latency[t.latency.size() / 2];
+      const int max = t.latency.back();
+      std::ostringstream l;
+      l << median << " / " << max << " (" << std::lround(median * frame_period_s * 1000) << " / "
+        << std::lround(max * frame_period_s * 1000) << ")";
+      latency = l.str();
+    }
+    out << "| " << kind << " | " << t.runs << " | " << t.frames << " | " << t.detected << " | " << t.right_cause
+        << " | " << t.right_suspect << " | " << latency << " | " << t.safe_after << " | " << t.switches << " | "
+        << t.false_stops << " |\n";
+  }
+  const std::string m = misses.str();
+  if (!m.empty()) out << "\n" << m;
+  return out.str();
+}
+
+}  // namespace tofguard::test
