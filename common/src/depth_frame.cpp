@@ -91,6 +91,10 @@ link_labels_t labels_header(const depth_image_t& frame, int num_robot_links,
   m.num_links = static_cast<int32_t>(m.link_name.size());
   m.usable = false;
   m.num_pixels = 0;
+  // No kinematics (the renderer adds them: renderer/rendered_kinematics.hpp).
+  m.num_joints = 0;
+  m.num_axes = 0;
+  m.num_link_axes = 0;
   return m;
 }
 

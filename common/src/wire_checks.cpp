@@ -3,6 +3,7 @@
 #include <cmath>
 #include <set>
 #include <sstream>
+#include <utility>
 #include <vector>
 
 namespace tofguard {
@@ -41,6 +42,150 @@ std::string check_unit_quaternion(const double q[4], const std::string& field) {
   const auto v =
       UnitQuaternion::check(Eigen::Quaterniond(q[0], q[1], q[2], q[3]), kWireQuaternionTolerance, field);
   return v ? v->line() : "";
+}
+
+// A moving axis' direction must be a unit vector within this.
+constexpr double kAxisDirectionTolerance = 1e-6;
+
+template <typename T>
+std::string check_count(int32_t n, const std::vector<T>& array, const std::string& field,
+                        const std::string& count) {
+  if (n < 0) return expected(count, "a count >= 0", n);
+  if (array.size() != static_cast<size_t>(n)) {
+    return field + ": expected " + count + " = " + std::to_string(n) + " entries, got " +
+           std::to_string(array.size());
+  }
+  return "";
+}
+
+// link_labels_t's kinematics (num_joints .. link_axis).
+std::string check_kinematics(const link_labels_t& l) {
+  if (auto p = check_count(l.num_joints, l.joint_name, "joint_name", "num_joints"); !p.empty()) return p;
+  if (auto p = check_names(l.joint_name, "joint_name"); !p.empty()) return p;
+  for (const auto& [size, field] : {std::pair<size_t, const char*>{l.axis_joint.size(), "axis_joint"},
+                                    {l.axis_multiplier.size(), "axis_multiplier"},
+                                    {l.axis_prismatic.size(), "axis_prismatic"},
+                                    {l.axis_origin_m.size(), "axis_origin_m"},
+                                    {l.axis_direction.size(), "axis_direction"},
+                                    {l.axis_parent.size(), "axis_parent"}}) {
+    if (l.num_axes < 0) return expected("num_axes", "a count >= 0", l.num_axes);
+    if (size != static_cast<size_t>(l.num_axes)) {
+      return std::string(field) + ": expected num_axes = " + std::to_string(l.num_axes) + " entries, got " +
+             std::to_string(size);
+    }
+  }
+  if (auto p = check_count(l.num_link_axes, l.link_axis, "link_axis", "num_link_axes"); !p.empty()) return p;
+  if (l.num_axes == 0) {
+    if (l.num_link_axes != 0) return expected("num_link_axes", "0 when num_axes is 0", l.num_link_axes);
+    return "";
+  }
+  if (l.num_link_axes != l.num_robot_links) {
+    return expected("num_link_axes", "num_robot_links = " + std::to_string(l.num_robot_links),
+                    l.num_link_axes);
+  }
+  for (int m = 0; m < l.num_axes; ++m) {
+    const std::string at = "[" + std::to_string(m) + "]";
+    if (l.axis_joint[m] < 0 || l.axis_joint[m] >= l.num_joints) {
+      return expected("axis_joint" + at,
+                      "a joint index 0..num_joints-1 = " + std::to_string(l.num_joints - 1), l.axis_joint[m]);
+    }
+    if (!std::isfinite(l.axis_multiplier[m])) {
+      return expected("axis_multiplier" + at, "a finite number", l.axis_multiplier[m]);
+    }
+    if (l.axis_origin_m[m].size() != 3 || l.axis_direction[m].size() != 3) {
+      return "axis_origin_m" + at + " / axis_direction" + at + ": expected 3 coordinates";
+    }
+    double norm2 = 0;
+    for (int c = 0; c < 3; ++c) {
+      if (!std::isfinite(l.axis_origin_m[m][c])) {
+        return expected("axis_origin_m" + at, "finite coordinates (m)", l.axis_origin_m[m][c]);
+      }
+      if (!std::isfinite(l.axis_direction[m][c])) {
+        return expected("axis_direction" + at, "a finite unit vector", l.axis_direction[m][c]);
+      }
+      norm2 += l.axis_direction[m][c] * l.axis_direction[m][c];
+    }
+    if (!(std::abs(std::sqrt(norm2) - 1) <= kAxisDirectionTolerance)) {
+      return expected("axis_direction" + at, "a unit vector (length 1 within 1e-6)", std::sqrt(norm2));
+    }
+    if (l.axis_parent[m] < -1 || l.axis_parent[m] >= m) {
+      return expected("axis_parent" + at, "-1 or an axis index below " + std::to_string(m), l.axis_parent[m]);
+    }
+  }
+  for (int i = 0; i < l.num_link_axes; ++i) {
+    if (l.link_axis[i] < -1 || l.link_axis[i] >= l.num_axes) {
+      return expected("link_axis[" + std::to_string(i) + "]",
+                      "-1 or an axis index 0..num_axes-1 = " + std::to_string(l.num_axes - 1),
+                      l.link_axis[i]);
+    }
+  }
+  return "";
+}
+
+// discrepancy_t's evidence fields.
+std::string check_evidence(const discrepancy_t& d) {
+  const auto finite_array = [](const double* v, int n, const std::string& field) -> std::string {
+    for (int i = 0; i < n; ++i) {
+      if (!std::isfinite(v[i]))
+        return expected(field + "[" + std::to_string(i) + "]", "a finite number", v[i]);
+    }
+    return "";
+  };
+  if (auto p = check_count(d.num_link_bias, d.link_bias_mm, "link_bias_mm", "num_link_bias"); !p.empty())
+    return p;
+  if (auto p = check_count(d.num_link_bias, d.link_bias_sigma_mm, "link_bias_sigma_mm", "num_link_bias");
+      !p.empty()) {
+    return p;
+  }
+  if (d.num_link_bias != 0 && d.num_link_bias != d.num_links) {
+    return expected("num_link_bias", "0 or num_links = " + std::to_string(d.num_links), d.num_link_bias);
+  }
+  for (int i = 0; i < d.num_link_bias; ++i) {
+    if (!std::isfinite(d.link_bias_mm[i])) {
+      return expected("link_bias_mm[" + std::to_string(i) + "]", "a finite bias (mm)", d.link_bias_mm[i]);
+    }
+    if (!(std::isfinite(d.link_bias_sigma_mm[i]) && d.link_bias_sigma_mm[i] >= 0)) {
+      return expected("link_bias_sigma_mm[" + std::to_string(i) + "]", "a finite sigma >= 0 (mm)",
+                      d.link_bias_sigma_mm[i]);
+    }
+  }
+  if (d.camera_fit_pixels < 0) return expected("camera_fit_pixels", "a count >= 0", d.camera_fit_pixels);
+  if (auto p = finite_array(d.camera_score, 6, "camera_score"); !p.empty()) return p;
+  if (auto p = finite_array(d.camera_information, 36, "camera_information"); !p.empty()) return p;
+  if (auto p = finite_array(d.camera_correction, 6, "camera_correction"); !p.empty()) return p;
+  for (int k = 0; k < 6; ++k) {
+    if (d.camera_information[7 * k] < 0) {
+      return expected("camera_information[" + std::to_string(7 * k) + "]", "a diagonal entry >= 0",
+                      d.camera_information[7 * k]);
+    }
+  }
+  if (!(std::isfinite(d.static_chi2) && d.static_chi2 >= 0)) {
+    return expected("static_chi2", "a finite sum >= 0", d.static_chi2);
+  }
+  if (auto p = check_count(d.num_joints, d.joint_name, "joint_name", "num_joints"); !p.empty()) return p;
+  if (auto p = check_count(d.num_joints, d.joint_fit_pixels, "joint_fit_pixels", "num_joints"); !p.empty())
+    return p;
+  if (auto p = check_count(d.num_joints, d.joint_score, "joint_score", "num_joints"); !p.empty()) return p;
+  if (auto p = check_count(d.num_joints, d.joint_information, "joint_information", "num_joints");
+      !p.empty()) {
+    return p;
+  }
+  if (auto p = check_names(d.joint_name, "joint_name"); !p.empty()) return p;
+  for (int j = 0; j < d.num_joints; ++j) {
+    const std::string at = "[" + std::to_string(j) + "]";
+    if (d.joint_fit_pixels[j] < 0)
+      return expected("joint_fit_pixels" + at, "a count >= 0", d.joint_fit_pixels[j]);
+    if (!std::isfinite(d.joint_score[j]))
+      return expected("joint_score" + at, "a finite number", d.joint_score[j]);
+    if (!(std::isfinite(d.joint_information[j]) && d.joint_information[j] >= 0)) {
+      return expected("joint_information" + at, "a finite number >= 0", d.joint_information[j]);
+    }
+  }
+  if (d.robot_fit_pixels < 0) return expected("robot_fit_pixels", "a count >= 0", d.robot_fit_pixels);
+  if (!(std::isfinite(d.robot_chi2) && d.robot_chi2 >= 0)) {
+    return expected("robot_chi2", "a finite sum >= 0", d.robot_chi2);
+  }
+  return "";
 }
 
 }  // namespace
@@ -109,7 +254,7 @@ std::string check_link_labels(const link_labels_t& labels) {
   if (labels.num_pixels != pixels) {
     return expected("num_pixels", "width*height = " + std::to_string(pixels), labels.num_pixels);
   }
-  return "";
+  return check_kinematics(labels);
 }
 
 std::string check_risk(const risk_t& risk) {
@@ -249,7 +394,7 @@ std::string check_discrepancy(const discrepancy_t& d) {
   if (!std::isfinite(d.near_arm_area_m2) || !std::isfinite(d.largest_blob_area_m2)) {
     return "near_arm_area_m2 / largest_blob_area_m2: expected finite areas";
   }
-  return "";
+  return check_evidence(d);
 }
 
 std::string check_heartbeat(const heartbeat_t& hb) {

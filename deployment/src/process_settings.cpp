@@ -28,6 +28,7 @@ risk::RiskProcessSettings risk_process_settings(const Config& config) {
   s.channels = config.channels;
   s.robot_urdf_path = config.robot.urdf_path;
   s.camera_id = config.camera.id;
+  s.camera_rate_hz = config.camera.rate_hz;
   s.risk = config.risk;
   return s;
 }

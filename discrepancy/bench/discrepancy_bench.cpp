@@ -69,6 +69,20 @@ Frames make_frames(int width, int height) {
   box(&f.camera.depth_mm, nullptr, 40, 60, 60, 100, 1500, 0);
   box(&f.camera.depth_mm, nullptr, 70, 60, 110, 80, 1500, 0);
   box(&f.camera.depth_mm, nullptr, 30, 110, 50, 130, 1400, 0);
+  // The kinematics as rendered (so that the evidence stage runs): link1
+  // turns about a vertical axis through the base, link2 about a horizontal
+  // one at link1's top.
+  f.labels.num_joints = 2;
+  f.labels.joint_name = {"a1", "a2"};
+  f.labels.num_axes = 2;
+  f.labels.axis_joint = {0, 1};
+  f.labels.axis_multiplier = {1, 1};
+  f.labels.axis_prismatic = {false, false};
+  f.labels.axis_origin_m = {{-0.3, 0.3, 1.5}, {-0.3, -0.1, 1.5}};
+  f.labels.axis_direction = {{0, -1, 0}, {0, 0, 1}};
+  f.labels.axis_parent = {-1, 0};
+  f.labels.num_link_axes = 3;
+  f.labels.link_axis = {-1, 0, 1};
   std::mt19937 rng(1);
   std::normal_distribution<double> unit(0, 1);
   for (int16_t& d : f.camera.depth_mm) {

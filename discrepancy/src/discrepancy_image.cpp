@@ -414,6 +414,9 @@ Parameters parameters_from(const DiscrepancySettings& config) {
   p.silhouette_jump_mm = config.silhouette_jump_mm;
   p.near_arm_m = config.near_arm_m;
   p.max_depth_mm = config.max_depth_mm;
+  p.evidence.model_sigma_mm = config.evidence_model_sigma_mm;
+  p.evidence.clip_sigmas = config.evidence_clip_sigmas;
+  p.evidence.pixels_per_sample = config.evidence_pixels_per_sample;
   return p;
 }
 
@@ -504,6 +507,10 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
   const PixelFootprint footprint(camera, rendered);
   largest_blob(classes.mismatch_mask, parameters.opening_radius_px, footprint, &s);
   near_arm_surfaces(camera, rendered, frame, classes, parameters, footprint, &s);
+  // Stage 7, evidence (evidence.hpp).
+  const EvidenceNoise noise{parameters.tolerance.sigma_at_0m_mm, parameters.tolerance.sigma_per_m2_mm,
+                            parameters.silhouette_jump_mm};
+  compute_evidence(camera, rendered, labels, silhouette, noise, parameters.evidence, &s);
   return frame;
 }
 

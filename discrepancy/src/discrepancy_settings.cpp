@@ -25,6 +25,13 @@ DiscrepancySettings read_discrepancy_settings(YamlMap map) {
     d.colour_image_full_scale_mm = colour.number("full_scale_mm", 1, 32767);
     colour.finish();
   }
+  {
+    YamlMap evidence = map.map("evidence");
+    d.evidence_model_sigma_mm = evidence.number("model_sigma_mm", 0, 1000);
+    d.evidence_clip_sigmas = evidence.number("clip_sigmas", 0.5, 100);
+    d.evidence_pixels_per_sample = evidence.number("pixels_per_sample", 1, 10000);
+    evidence.finish();
+  }
   map.finish();
   return d;
 }

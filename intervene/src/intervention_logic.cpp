@@ -165,6 +165,16 @@ ResetDecision InterventionLogic::on_reset(const reset_request_t& request, int64_
   if (!risk_fresh(now_us)) {
     return {false, "refused: SAFETY_RISK stale for " + ms(now_us - risk_arrival_us_)};
   }
+  // A DANGEROUS frame verdict is an open diagnosis: tofguard-risk keeps it
+  // (cause and suspect as at the stop) until the fault has been gone for
+  // risk.evidence.clear_frames frames, so no single SAFE verdict comes while
+  // it persists. A timeout verdict (seq -1) is not a diagnosis.
+  if (risk_.level == risk_t::DANGEROUS && risk_.seq >= 0) {
+    std::string text = "refused: diagnosis open: " + risk_cause_name(risk_.cause);
+    if (!risk_.suspect.empty()) text += ", suspect " + risk_.suspect;
+    if (!risk_.detail.empty()) text += " (" + risk_.detail + ")";
+    return {false, text};
+  }
   if (risk_.level != risk_t::SAFE) {
     return {false, "refused: current risk is " + describe(risk_)};
   }

@@ -1,4 +1,5 @@
 #include "tofguard/renderer/depth_renderer.hpp"
+#include "tofguard/renderer/rendered_kinematics.hpp"
 
 #include <cmath>
 #include <cstring>
@@ -259,6 +260,8 @@ struct DepthRenderer::Impl {
     } catch (const RenderError& e) {
       return unusable(e.what());
     }
+    result.world_from_link = poses.world_from_link;
+    result.world_from_optical = world_from_optical;
     if (const std::string why = ensure_framebuffer(intrinsics.width, intrinsics.height); !why.empty()) {
       return unusable(why);
     }
@@ -362,14 +365,11 @@ RenderResult DepthRenderer::render(const robot_model::JointPositions& joints, co
   robot_model::LinkPoses poses = robot_model::forward_kinematics(impl_->scene, joints);
   Eigen::Isometry3d world_from_optical = Eigen::Isometry3d::Identity();
   if (poses.usable) {
-    const int frame = impl_->scene.find_link(camera_pose.frame_id);
-    if (frame < 0) {
-      poses = {false, "camera pose frame '" + camera_pose.frame_id + "' is not a link of the model", {}};
-    } else if (const auto v = camera_pose.check(kWireQuaternionTolerance)) {
-      // Normalising a rotation far from unit would hide a fault upstream.
-      poses = {false, "camera pose: " + v->line(), {}};
+    std::string why;
+    if (const auto pose = renderer::world_from_optical(impl_->scene, poses, camera_pose, &why)) {
+      world_from_optical = *pose;
     } else {
-      world_from_optical = poses.world_from_link[frame] * camera_pose.frame_from_optical();
+      poses = {false, why, {}};
     }
   }
   return impl_->render_at(poses, world_from_optical, intrinsics, extra_objects);

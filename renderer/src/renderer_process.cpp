@@ -1,4 +1,5 @@
 #include "tofguard/renderer/renderer_process.hpp"
+#include "tofguard/renderer/rendered_kinematics.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -169,12 +170,20 @@ RenderedFrame RendererService::render(const depth_image_t& frame) {
     if (missed) ++consecutive_misses_;
     result = renderer_->render(state.joints.joints, state.camera_pose.pose, intrinsics_of(frame));
   }
-  RenderedFrame out = make_output(frame, std::move(result));
+  // The kinematics at the frame's own joints and camera pose (a hit's image
+  // was rendered at the prediction's, within the tolerances).
+  std::optional<RenderedKinematics> kinematics;
+  if (result.usable) {
+    kinematics = rendered_kinematics(scene_, state.joints.joints, state.camera_pose.pose);
+    if (!kinematics) kinematics = rendered_kinematics(scene_, result);
+  }
+  RenderedFrame out = make_output(frame, std::move(result), kinematics);
   plan_prediction(frame);
   return out;
 }
 
-RenderedFrame RendererService::make_output(const depth_image_t& frame, RenderResult result) const {
+RenderedFrame RendererService::make_output(const depth_image_t& frame, RenderResult result,
+                                           const std::optional<RenderedKinematics>& kinematics) const {
   RenderedFrame out;
   if (!result.usable) {
     out.labels =
@@ -182,6 +191,7 @@ RenderedFrame RendererService::make_output(const depth_image_t& frame, RenderRes
     return out;
   }
   out.labels = make_link_labels(frame, scene_.num_robot_links, scene_.link_names(), std::move(result.labels));
+  if (kinematics) set_rendered_kinematics(*kinematics, &out.labels);
   // The model's depth is exact: calibrated (no distance calibration to
   // apply), no amplitude.
   out.depth = make_depth_image(frame.camera_id, intrinsics_of(frame), frame.utime, frame.seq,

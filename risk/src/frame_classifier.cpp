@@ -115,9 +115,16 @@ FrameFinding frozen_image(const FrameEvidence& e) {
 
 // ---- What the mismatch looks like ----
 
+// The three fraction rules below judge only frames without evidence
+// (discrepancy_t.evidence_available false: labels from a renderer that
+// publishes no kinematics). With evidence, the sequential tests
+// (evidence_tests.hpp) decide calibration and joint errors, in frame order
+// (RiskMonitor).
+
 // CALIBRATION_ERROR: the static environment and the arm disagree broadly.
 FrameFinding calibration_error(const FrameEvidence& e) {
   const discrepancy_t& f = e.frame;
+  if (f.evidence_available) return {};
   const RiskSettings& config = e.config;
   const std::vector<LinkView>& visible = e.visible_links();
   const int64_t environment_compared = e.environment_compared();
@@ -161,6 +168,7 @@ FrameFinding calibration_error(const FrameEvidence& e) {
 // hang below one moving joint; the proximal links match. A missing link the
 // URDF does not know is UNCLASSIFIED (never judged safe).
 FrameFinding joint_error_missing_links(const FrameEvidence& e) {
+  if (e.frame.evidence_available) return {};
   const RiskSettings& config = e.config;
   const robot_model::KinematicTree& robot = e.robot;
   const std::vector<LinkView>& visible = e.visible_links();
@@ -222,6 +230,7 @@ FrameFinding joint_error_missing_links(const FrameEvidence& e) {
 FrameFinding joint_error_beside_unexplained_surfaces(const FrameEvidence& e) {
   const RiskSettings& config = e.config;
   const robot_model::KinematicTree& robot = e.robot;
+  if (e.frame.evidence_available) return {};
   if (!(e.frame.near_arm_area_m2 >= config.unknown_object_min_area_m2)) return {};
   std::vector<std::string> affected;
   int64_t mismatching = 0;

@@ -16,13 +16,14 @@ ClassifierContext classifier_context(const ChannelNames& channels) {
 }  // namespace
 
 RiskMonitor::RiskMonitor(const RiskSettings& settings, const ChannelNames& channels,
-                         robot_model::KinematicTree robot, int64_t start_us)
+                         robot_model::KinematicTree robot, double camera_rate_hz, int64_t start_us)
     : settings_(settings),
       classifier_context_(classifier_context(channels)),
       robot_(std::move(robot)),
       deadlines_(settings, channels, start_us),
       plan_(settings, robot_.prismatic_joint_names),
       gate_(settings, robot_.prismatic_joint_names),
+      evidence_(settings, robot_, camera_rate_hz),
       decision_(settings) {}
 
 void RiskMonitor::on_joint_state(const joint_state_t& state, int64_t now_us) {
@@ -67,7 +68,25 @@ std::vector<risk_t> RiskMonitor::judge(std::vector<ClassifiedFrame> released, in
   verdicts.reserve(released.size());
   for (ClassifiedFrame& c : released) {
     last_frame_utime_ = c.frame.utime;
-    verdicts.push_back(decision_.decide(c.frame, std::move(c.finding), deadlines_.first_expired(now_us)));
+    FrameFinding finding = std::move(c.finding);
+    EvidenceStep evidence;
+    // The sensor rules come first: a frame with a sensor or component fault
+    // carries no evidence to trust (a frozen image would count twice).
+    if (!is_fault_cause(finding.cause)) {
+      evidence = evidence_.update(c.frame);
+      if (evidence.crossed) {
+        finding = std::move(evidence.finding);
+        finding.at_once = true;
+      } else if (evidence.warning && finding.cause == risk_t::CAUSE_NONE) {
+        finding = std::move(evidence.finding);
+        finding.warning_only = true;
+      }
+    }
+    const bool was_open = decision_.diagnosis_open();
+    verdicts.push_back(decision_.decide(c.frame, std::move(finding), deadlines_.first_expired(now_us),
+                                        evidence_.quiet(), evidence.summary));
+    // A closed diagnosis starts the tests afresh.
+    if (was_open && !decision_.diagnosis_open()) evidence_.reset();
   }
   return verdicts;
 }

@@ -1,5 +1,7 @@
 #include "tofguard/risk/risk_settings.hpp"
 
+#include <cmath>
+
 namespace tofguard::risk {
 
 RiskSettings read_risk_settings(YamlMap map) {
@@ -61,6 +63,17 @@ RiskSettings read_risk_settings(YamlMap map) {
     r.estimate_min_rotation_deg = estimate.number("min_rotation_deg", 0, 180);
     r.estimate_unexplained_residual_mm = estimate.number("unexplained_residual_mm", 0, 10000);
     estimate.finish();
+  }
+  {
+    YamlMap evidence = map.map("evidence");
+    r.evidence_false_stop_period_h = evidence.number("false_stop_period_h", 1e-3, 1e9);
+    r.evidence_joint_offset_rad = evidence.number("joint_offset_deg", 0.01, 90) * M_PI / 180.0;
+    r.evidence_joint_offset_m = evidence.number("joint_offset_m", 1e-5, 1);
+    r.evidence_camera_translation_m = evidence.number("camera_translation_m", 1e-4, 1);
+    r.evidence_camera_rotation_rad = evidence.number("camera_rotation_deg", 0.01, 90) * M_PI / 180.0;
+    r.evidence_warning_fraction = evidence.number("warning_fraction", 0.01, 1);
+    r.evidence_clear_frames = static_cast<int>(evidence.integer("clear_frames", 1, 100000));
+    evidence.finish();
   }
   {
     YamlMap plan = map.map("plan");

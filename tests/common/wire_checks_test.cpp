@@ -72,6 +72,139 @@ TEST(WireChecks, Discrepancy) {
   EXPECT_EQ(field_of(d), "near_arm_area_m2 / largest_blob_area_m2");
 }
 
+// With the evidence fields filled (issue 14).
+discrepancy_t discrepancy_with_evidence() {
+  discrepancy_t d = valid_discrepancy();
+  d.evidence_available = true;
+  d.num_link_bias = 2;
+  d.link_bias_mm = {1.5f, -0.5f};
+  d.link_bias_sigma_mm = {0.8f, 0.2f};
+  d.camera_fit_pixels = 20;
+  for (int k = 0; k < 6; ++k) d.camera_information[7 * k] = 1e6;
+  d.static_chi2 = 18;
+  d.num_joints = 2;
+  d.joint_name = {"a1", "a2"};
+  d.joint_fit_pixels = {10, 4};
+  d.joint_score = {100, -3};
+  d.joint_information = {1e5, 2e3};
+  d.robot_fit_pixels = 10;
+  d.robot_chi2 = 9;
+  return d;
+}
+
+TEST(WireChecks, DiscrepancyEvidence) {
+  EXPECT_EQ(check_discrepancy(discrepancy_with_evidence()), "");
+  discrepancy_t d = discrepancy_with_evidence();
+  d.num_link_bias = 1;
+  d.link_bias_mm.resize(1);
+  d.link_bias_sigma_mm.resize(1);
+  EXPECT_EQ(field_of(d), "num_link_bias");
+  d = discrepancy_with_evidence();
+  d.link_bias_mm[1] = kNaN;
+  EXPECT_EQ(field_of(d), "link_bias_mm[1]");
+  d = discrepancy_with_evidence();
+  d.link_bias_sigma_mm[0] = -1;
+  EXPECT_EQ(field_of(d), "link_bias_sigma_mm[0]");
+  d = discrepancy_with_evidence();
+  d.camera_score[4] = std::nan("");
+  EXPECT_EQ(field_of(d), "camera_score[4]");
+  d = discrepancy_with_evidence();
+  d.camera_information[14] = -1;
+  EXPECT_EQ(field_of(d), "camera_information[14]");
+  d = discrepancy_with_evidence();
+  d.camera_correction[5] = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(field_of(d), "camera_correction[5]");
+  d = discrepancy_with_evidence();
+  d.static_chi2 = -1;
+  EXPECT_EQ(field_of(d), "static_chi2");
+  d = discrepancy_with_evidence();
+  d.joint_score.resize(1);
+  EXPECT_EQ(field_of(d), "joint_score");
+  d = discrepancy_with_evidence();
+  d.joint_name[1] = "a1";
+  EXPECT_EQ(field_of(d), "joint_name[1]");
+  d = discrepancy_with_evidence();
+  d.joint_information[0] = -2;
+  EXPECT_EQ(field_of(d), "joint_information[0]");
+  d = discrepancy_with_evidence();
+  d.robot_chi2 = std::nan("");
+  EXPECT_EQ(field_of(d), "robot_chi2");
+}
+
+// Two robot links and a floor; axes a1 (revolute) then a2 (prismatic).
+link_labels_t labels_with_kinematics() {
+  link_labels_t l{};
+  l.utime = 1'700'000'000'000'000;
+  l.seq = 1;
+  l.camera_id = "cam";
+  l.usable = true;
+  l.width = 2;
+  l.height = 1;
+  l.num_robot_links = 2;
+  l.num_links = 3;
+  l.link_name = {"base", "link1", "floor"};
+  l.num_pixels = 2;
+  l.label = {1, 2};
+  l.num_joints = 2;
+  l.joint_name = {"a1", "a2"};
+  l.num_axes = 2;
+  l.axis_joint = {0, 1};
+  l.axis_multiplier = {1, 1};
+  l.axis_prismatic = {false, true};
+  l.axis_origin_m = {{0, 0, 2}, {0.1, 0, 2}};
+  l.axis_direction = {{0, 1, 0}, {0, 0, 1}};
+  l.axis_parent = {-1, 0};
+  l.num_link_axes = 2;
+  l.link_axis = {-1, 1};
+  return l;
+}
+
+std::string field_of(const link_labels_t& l) {
+  const std::string problem = check_link_labels(l);
+  return problem.substr(0, problem.find(':'));
+}
+
+TEST(WireChecks, LinkLabelsKinematics) {
+  EXPECT_EQ(check_link_labels(labels_with_kinematics()), "");
+  link_labels_t l = labels_with_kinematics();
+  l.num_axes = 0;
+  l.axis_joint.clear();
+  l.axis_multiplier.clear();
+  l.axis_prismatic.clear();
+  l.axis_origin_m.clear();
+  l.axis_direction.clear();
+  l.axis_parent.clear();
+  EXPECT_EQ(field_of(l), "num_link_axes") << "no axes, no link axes";
+  l.num_link_axes = 0;
+  l.link_axis.clear();
+  EXPECT_EQ(check_link_labels(l), "") << "no kinematics at all";
+  l = labels_with_kinematics();
+  l.num_link_axes = 1;
+  l.link_axis = {-1};
+  EXPECT_EQ(field_of(l), "num_link_axes");
+  l = labels_with_kinematics();
+  l.axis_joint[1] = 2;
+  EXPECT_EQ(field_of(l), "axis_joint[1]");
+  l = labels_with_kinematics();
+  l.axis_parent[0] = 0;
+  EXPECT_EQ(field_of(l), "axis_parent[0]");
+  l = labels_with_kinematics();
+  l.axis_direction[0][1] = 1.01;
+  EXPECT_EQ(field_of(l), "axis_direction[0]");
+  l = labels_with_kinematics();
+  l.axis_origin_m[1][2] = std::nan("");
+  EXPECT_EQ(field_of(l), "axis_origin_m[1]");
+  l = labels_with_kinematics();
+  l.axis_multiplier[0] = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(field_of(l), "axis_multiplier[0]");
+  l = labels_with_kinematics();
+  l.link_axis[0] = 2;
+  EXPECT_EQ(field_of(l), "link_axis[0]");
+  l = labels_with_kinematics();
+  l.joint_name.pop_back();
+  EXPECT_EQ(field_of(l), "joint_name");
+}
+
 TEST(WireChecks, Heartbeat) {
   heartbeat_t hb{};
   EXPECT_EQ(check_heartbeat(hb), "process: expected a process name, got an empty string");

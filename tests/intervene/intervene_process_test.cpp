@@ -162,7 +162,7 @@ TEST(InterveneProcess, LatchedStopResetAndRestart) {
   ASSERT_TRUE(
       wait_until([&] { return feeder_dangerous_sent > 0; }, std::chrono::seconds(2), [&] { bench.pump(); }));
   EXPECT_EQ(reset("reset-refused", &out), 1) << out;
-  EXPECT_NE(out.find("refused: current risk is DANGEROUS: joint error"), std::string::npos) << out;
+  EXPECT_NE(out.find("refused: diagnosis open: joint error"), std::string::npos) << out;
   resetting = false;
   feeder.join();
 

@@ -82,11 +82,34 @@ TEST(InterventionLogic, ResetOnlyWhileTheCurrentRiskIsSafeAndFresh) {
   logic.on_risk(risk(risk_t::DANGEROUS, risk_t::CAUSE_UNKNOWN_OBJECT), 2 * kMs, kUtime0);
   d = logic.on_reset(reset(), 3 * kMs, kUtime0);
   EXPECT_FALSE(d.accepted);
-  EXPECT_NE(d.reason.find("refused: current risk is DANGEROUS: unknown object"), std::string::npos)
+  EXPECT_EQ(d.reason, "refused: diagnosis open: unknown object (test)");
+
+  // The diagnosis names its suspect and the detail tofguard-risk gave.
+  risk_t open = risk(risk_t::DANGEROUS, risk_t::CAUSE_JOINT_ERROR, "a4");
+  open.seq = 120;
+  open.detail =
+      "diagnosis open since seq 101: joint a4 reads other than seen (sequential evidence, CUSUM "
+      "log-likelihood "
+      "ratio): 20.6 of h 20.6; this frame: no finding [clean 3/10 frames]";
+  logic.on_risk(open, 3 * kMs, kUtime0);
+  d = logic.on_reset(reset(), 3 * kMs, kUtime0);
+  EXPECT_FALSE(d.accepted);
+  EXPECT_EQ(d.reason, "refused: diagnosis open: joint error, suspect a4 (" + open.detail + ")");
+
+  // A timeout (seq -1) is no diagnosis, but refused as well.
+  risk_t timeout = risk(risk_t::DANGEROUS, risk_t::CAUSE_SENSOR_FAULT, "TOF_DEPTH");
+  timeout.seq = -1;
+  logic.on_risk(timeout, 3 * kMs, kUtime0);
+  d = logic.on_reset(reset(), 3 * kMs, kUtime0);
+  EXPECT_FALSE(d.accepted);
+  EXPECT_NE(d.reason.find("refused: current risk is DANGEROUS: sensor fault, suspect TOF_DEPTH"),
+            std::string::npos)
       << d.reason;
 
   logic.on_risk(risk(risk_t::WARNING), 4 * kMs, kUtime0);
-  EXPECT_FALSE(logic.on_reset(reset(), 5 * kMs, kUtime0).accepted);
+  d = logic.on_reset(reset(), 5 * kMs, kUtime0);
+  EXPECT_FALSE(d.accepted);
+  EXPECT_NE(d.reason.find("refused: current risk is WARNING"), std::string::npos) << d.reason;
 
   logic.on_risk(risk(risk_t::SAFE), 6 * kMs, kUtime0);
   d = logic.on_reset(reset(), 7 * kMs, kUtime0 + 7000);

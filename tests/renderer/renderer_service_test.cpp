@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "test_support.hpp"
+#include "tofguard/common/wire_checks.hpp"
 #include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/renderer/renderer_process.hpp"
 
@@ -62,6 +63,10 @@ TEST(RendererService, PublishesTheModelAtTheInterpolatedJointsInMillimetres) {
   const RenderedFrame out = service.render(frame(1'002'500, 42, k));
   ASSERT_TRUE(out.labels.usable) << out.labels.unusable_reason;
   ASSERT_TRUE(out.depth.has_value());
+  // The kinematics as rendered travel with the labels (issue 14).
+  EXPECT_GT(out.labels.num_axes, 0);
+  EXPECT_EQ(out.labels.num_link_axes, out.labels.num_robot_links);
+  EXPECT_EQ(check_link_labels(out.labels), "");
   EXPECT_EQ(out.depth->utime, 1'002'500);
   EXPECT_EQ(out.depth->seq, 42);
   EXPECT_EQ(out.depth->camera_id, "tof-mast");

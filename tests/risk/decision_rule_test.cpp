@@ -45,7 +45,6 @@ TEST(DecisionRule, AFindingIsWarningUntilItHeldForTheDebounceCountAndOneCleanFra
       {risk_t::WARNING, " [1/3 frames]"},
       {risk_t::WARNING, " [2/3 frames]"},
       {risk_t::DANGEROUS, " [3/3 frames]"},
-      {risk_t::DANGEROUS, " [3/3 frames]"},
   };
   for (size_t i = 0; i < expected.size(); ++i) {
     const risk_t r = rule.decide(frame(100 + i), joint_error(), std::nullopt);
@@ -58,7 +57,18 @@ TEST(DecisionRule, AFindingIsWarningUntilItHeldForTheDebounceCountAndOneCleanFra
     EXPECT_DOUBLE_EQ(r.score, 0.4);
     EXPECT_DOUBLE_EQ(r.threshold, 0.1);
   }
+  // The stop opened a diagnosis: the next frame is DANGEROUS with the stop's
+  // finding, whatever it shows.
+  EXPECT_TRUE(rule.diagnosis_open());
+  const risk_t open = rule.decide(frame(103), joint_error(), std::nullopt);
+  EXPECT_EQ(open.level, risk_t::DANGEROUS);
+  EXPECT_EQ(
+      open.detail,
+      "diagnosis open since seq 102: joint a4 reads other than seen [3/3 frames]; this frame: joint a4 reads "
+      "other than seen [clean 0/1 frames]");
   EXPECT_EQ(rule.consecutive_findings(), 4);
+
+  // risk.evidence.clear_frames = 1 here: one clean frame closes it.
 
   const risk_t clean = rule.decide(frame(104), FrameFinding{}, std::nullopt);
   EXPECT_EQ(clean.level, risk_t::SAFE);
@@ -80,9 +90,66 @@ TEST(DecisionRule, FaultsUseTheSensorDebounceAndTheCountRunsAcrossCauses) {
   EXPECT_EQ(r.detail, "invalid pixels [2/2 frames]");
   // Consecutive frames with any finding count: the third is DANGEROUS as a
   // model mismatch as well.
+  // The sensor fault's diagnosis stays open with its cause and suspect.
   r = rule.decide(frame(3), joint_error(), std::nullopt);
   EXPECT_EQ(r.level, risk_t::DANGEROUS);
-  EXPECT_EQ(r.detail, "joint a4 reads other than seen [3/3 frames]");
+  EXPECT_EQ(r.cause, risk_t::CAUSE_SENSOR_FAULT);
+  EXPECT_EQ(r.suspect, "TOF_DEPTH");
+  EXPECT_EQ(
+      r.detail,
+      "diagnosis open since seq 2: invalid pixels [2/2 frames]; this frame: joint a4 reads other than seen "
+      "[clean 0/1 frames]");
+  EXPECT_EQ(rule.consecutive_findings(), 3);
+}
+
+// A crossed sequential test is DANGEROUS at once, growing evidence only
+// WARNING; a diagnosis closes after clear_frames frames without any finding
+// and with the evidence quiet, and any finding restarts the count.
+TEST(DecisionRule, SequentialFindingsAndTheDiagnosisThatStaysOpen) {
+  risk::RiskSettings settings = debounce(3, 2);
+  settings.evidence_clear_frames = 3;
+  DecisionRule rule(settings);
+  FrameFinding growing = joint_error();
+  growing.warning_only = true;
+  for (int i = 0; i < 5; ++i) {
+    const risk_t r = rule.decide(frame(10 + i), growing, std::nullopt);
+    EXPECT_EQ(r.level, risk_t::WARNING);
+    EXPECT_EQ(r.detail, "joint a4 reads other than seen");
+  }
+  EXPECT_EQ(rule.decide(frame(15), FrameFinding{}, std::nullopt).level, risk_t::SAFE);
+  FrameFinding crossed = joint_error();
+  crossed.at_once = true;
+  risk_t r = rule.decide(frame(16), crossed, std::nullopt);
+  EXPECT_EQ(r.level, risk_t::DANGEROUS);
+  EXPECT_EQ(r.detail, "joint a4 reads other than seen");
+  FrameFinding other{risk_t::CAUSE_JOINT_ERROR, "a5", 30, 20, "joint a5 reads other than seen"};
+  other.at_once = true;
+  r = rule.decide(frame(17), other, std::nullopt);
+  EXPECT_EQ(r.suspect, "a4");
+  // Clean frames, but the evidence not yet quiet: not counted.
+  r = rule.decide(frame(18), FrameFinding{}, std::nullopt, /*evidence_quiet=*/false, "evidence: a4 12.0");
+  EXPECT_EQ(r.level, risk_t::DANGEROUS);
+  EXPECT_EQ(r.detail,
+            "diagnosis open since seq 16: joint a4 reads other than seen; this frame: no finding; evidence: "
+            "a4 12.0 "
+            "[clean 0/3 frames]");
+  EXPECT_EQ(rule.decide(frame(19), FrameFinding{}, std::nullopt).level, risk_t::DANGEROUS);
+  EXPECT_EQ(rule.clean_frames(), 1);
+  EXPECT_EQ(rule.decide(frame(20), FrameFinding{}, std::nullopt).level, risk_t::DANGEROUS);
+  EXPECT_EQ(rule.clean_frames(), 2);
+  // A finding (even a mere warning) restarts the count.
+  EXPECT_EQ(rule.decide(frame(21), growing, std::nullopt).level, risk_t::DANGEROUS);
+  EXPECT_EQ(rule.clean_frames(), 0);
+  // So does an expired deadline.
+  const FrameFinding stale{risk_t::CAUSE_SENSOR_FAULT, "JOINT_STATE", 101, 100, "JOINT_STATE stale"};
+  EXPECT_EQ(rule.decide(frame(22), FrameFinding{}, std::nullopt).level, risk_t::DANGEROUS);
+  EXPECT_EQ(rule.decide(frame(23), FrameFinding{}, stale).detail, "timeout: JOINT_STATE stale");
+  EXPECT_EQ(rule.clean_frames(), 0);
+  for (int i = 0; i < 2; ++i)
+    EXPECT_EQ(rule.decide(frame(24 + i), FrameFinding{}, std::nullopt).level, risk_t::DANGEROUS);
+  EXPECT_TRUE(rule.diagnosis_open());
+  EXPECT_EQ(rule.decide(frame(26), FrameFinding{}, std::nullopt).level, risk_t::SAFE);
+  EXPECT_FALSE(rule.diagnosis_open());
 }
 
 TEST(DecisionRule, AnExpiredDeadlineIsDangerousAtOnceAndTheFrameStillCounts) {

@@ -27,6 +27,7 @@ using risk::FrameFinding;
 using risk::RiskMonitor;
 
 constexpr int64_t kStart = 5'000'000'000;  // monotonic
+constexpr double kRateHz = 30;             // camera.rate_hz of config/sim.yaml
 constexpr int64_t kMs = 1000;
 
 // config/sim.yaml with a 60 ms wait for a frame's own estimate (sim.yaml
@@ -211,7 +212,7 @@ void feed_all(RiskMonitor* m, int64_t now) {
 }
 
 TEST(EstimateWait, AMismatchFrameWaitsForItsEstimateWhichNamesTheCause) {
-  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kStart);
+  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kRateHz, kStart);
   feed_all(&m, kStart);
   const discrepancy_t bad = summary_of(default_arm(16), 100);  // discrepancy rules: JOINT_ERROR a2
   EXPECT_TRUE(m.on_frame(bad, kStart).empty());
@@ -248,7 +249,7 @@ TEST(EstimateWait, AFrameWithoutItsOwnEstimateUsesARecentOneAfterTheWait) {
   // The estimator takes longer than a frame period: the estimate of frame
   // 100 serves frame 101 (33 ms later) once 101's own wait is over, but not
   // frame 102, which is more than risk.estimate.max_age_ms after it.
-  RiskMonitor m(config_with_max_age().risk, config_with_max_age().channels, friend_arm(), kStart);
+  RiskMonitor m(config_with_max_age().risk, config_with_max_age().channels, friend_arm(), kRateHz, kStart);
   feed_all(&m, kStart);
   const discrepancy_t first = mismatch_frame(100, 0);
   EXPECT_TRUE(m.on_frame(first, kStart).empty());
@@ -277,7 +278,7 @@ TEST(EstimateWait, AnEarlierFramesEstimateThatNamesNoJointOrCameraSaysNothingAbo
   // An estimate of frame 100 that explains nothing and leaves a high
   // residual would, for frame 100 itself, mean an unknown object; for frame
   // 101 (a fault may have begun since) it is no evidence: the rules judge.
-  RiskMonitor m(config_with_max_age().risk, config_with_max_age().channels, friend_arm(), kStart);
+  RiskMonitor m(config_with_max_age().risk, config_with_max_age().channels, friend_arm(), kRateHz, kStart);
   feed_all(&m, kStart);
   const discrepancy_t first = mismatch_frame(100, 0);
   EXPECT_TRUE(m.on_frame(first, kStart).empty());
@@ -296,7 +297,7 @@ TEST(EstimateWait, AnEarlierFramesEstimateThatNamesNoJointOrCameraSaysNothingAbo
 }
 
 TEST(EstimateWait, WithoutAnEstimateTheDiscrepancyRulesJudgeAfterTheWaitAndFramesKeepTheirOrder) {
-  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kStart);
+  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kRateHz, kStart);
   feed_all(&m, kStart);
   const discrepancy_t bad = summary_of(default_arm(16), 100);
   const discrepancy_t good = summary_of(default_arm(), 101);
@@ -326,7 +327,7 @@ TEST(EstimateWait, AnEstimateThatExplainsNothingNeverMakesTheFrameSafer) {
     motion_estimate_t e = estimate_for(bad);
     e.converged = converged;
     e.estimated_position[index_of(e, "a4")] += converged ? 0.0 : 20 * kDeg;
-    RiskMonitor fresh(sim_config().risk, sim_config().channels, friend_arm(), kStart);
+    RiskMonitor fresh(sim_config().risk, sim_config().channels, friend_arm(), kRateHz, kStart);
     feed_all(&fresh, kStart);
     fresh.on_estimate(e, kStart);  // already there when the frame comes
     const std::vector<risk_t> out = fresh.on_frame(bad, kStart);
@@ -339,7 +340,7 @@ TEST(EstimateWait, AnEstimateThatExplainsNothingNeverMakesTheFrameSafer) {
 }
 
 TEST(EstimateWait, CleanFramesAndSensorFaultsDoNotWaitAndEstimatesCanBeSwitchedOff) {
-  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kStart);
+  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kRateHz, kStart);
   feed_all(&m, kStart);
   const discrepancy_t good = summary_of(default_arm(), 101);
   ASSERT_EQ(m.on_frame(good, kStart).size(), 1u);
@@ -353,7 +354,7 @@ TEST(EstimateWait, CleanFramesAndSensorFaultsDoNotWaitAndEstimatesCanBeSwitchedO
 
   deployment::Config off = sim_config();
   off.risk.estimate_enabled = false;
-  RiskMonitor without(off.risk, off.channels, friend_arm(), kStart);
+  RiskMonitor without(off.risk, off.channels, friend_arm(), kRateHz, kStart);
   feed_all(&without, kStart);
   const auto out = without.on_frame(summary_of(default_arm(16), 100), kStart);
   ASSERT_EQ(out.size(), 1u);
@@ -361,7 +362,7 @@ TEST(EstimateWait, CleanFramesAndSensorFaultsDoNotWaitAndEstimatesCanBeSwitchedO
 }
 
 TEST(EstimateWait, EstimateVerdictsAreDebouncedLikeTheOthers) {
-  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kStart);
+  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kRateHz, kStart);
   std::vector<int8_t> levels;
   for (int i = 0; i < 3; ++i) {
     const int64_t now = kStart + i * 33 * kMs;
@@ -402,7 +403,7 @@ risk_t judged_at_once(RiskMonitor* m, const discrepancy_t& frame, int64_t now) {
 // Each frame is judged with the joint state of its capture time (the
 // newest at or before its utime), whenever it is processed.
 TEST(PlanDeviation, TheJointStateAtTheFramesUtimeAwayFromThePlanIsAFindingDebouncedLikeTheOthers) {
-  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kStart);
+  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kRateHz, kStart);
   const int64_t t0 = 1'700'000'000'000'000;
   feed_all(&m, kStart);
   // a1 planned from 0 to 0.5 rad over 500 ms.
@@ -434,7 +435,7 @@ TEST(PlanDeviation, TheJointStateAtTheFramesUtimeAwayFromThePlanIsAFindingDeboun
 
   // A frame captured before the deviation, judged late (after the deviating
   // joint states came): judged with the joint state of its own time.
-  RiskMonitor late(sim_config().risk, sim_config().channels, friend_arm(), kStart);
+  RiskMonitor late(sim_config().risk, sim_config().channels, friend_arm(), kRateHz, kStart);
   feed_all(&late, kStart);
   late.on_plan(plan_a1(t0, 0.0, t0 + 500'000, 0.5));
   late.on_joint_state(joints_at(t0 + 200'000, 0.2), kStart);
@@ -442,18 +443,26 @@ TEST(PlanDeviation, TheJointStateAtTheFramesUtimeAwayFromThePlanIsAFindingDeboun
   EXPECT_EQ(judged_at_once(&late, frame_at(t0 + 250'000), kStart).level, risk_t::SAFE);
   EXPECT_EQ(judged_at_once(&late, frame_at(t0 + 310'000), kStart).cause, risk_t::CAUSE_UNCLASSIFIED);
 
+  // The stop's diagnosis stays open (DANGEROUS with the stop's finding)
+  // until risk.evidence.clear_frames frames without a finding; the frames
+  // below have none.
   // Beyond the plan's end there is nothing to compare with.
   m.on_joint_state(joints_at(t0 + 600'000, 3.0), kStart);
-  EXPECT_EQ(judged_at_once(&m, frame_at(t0 + 605'000), kStart).level, risk_t::SAFE);
+  risk_t open = judged_at_once(&m, frame_at(t0 + 605'000), kStart);
+  EXPECT_EQ(open.level, risk_t::DANGEROUS);
+  EXPECT_EQ(open.suspect, "a1");
+  EXPECT_NE(open.detail.find("this frame: no finding"), std::string::npos) << open.detail;
 
   // A new plan replaces the old one from its first point on.
   m.on_plan(plan_a1(t0 + 550'000, 2.9, t0 + 900'000, 3.2));
   m.on_joint_state(joints_at(t0 + 610'000, 2.95), kStart);
-  EXPECT_EQ(judged_at_once(&m, frame_at(t0 + 615'000), kStart).level, risk_t::SAFE);
+  open = judged_at_once(&m, frame_at(t0 + 615'000), kStart);
+  EXPECT_NE(open.detail.find("this frame: no finding"), std::string::npos) << open.detail;
+  EXPECT_NE(open.detail.find("[clean 2/10 frames]"), std::string::npos) << open.detail;
 
   deployment::Config off = sim_config();
   off.risk.plan_enabled = false;
-  RiskMonitor without(off.risk, off.channels, friend_arm(), kStart);
+  RiskMonitor without(off.risk, off.channels, friend_arm(), kRateHz, kStart);
   feed_all(&without, kStart);
   without.on_plan(plan_a1(t0, 0.0, t0 + 500'000, 0.5));
   without.on_joint_state(joints_at(t0 + 200'000, 1.0), kStart);
@@ -465,7 +474,7 @@ TEST(PlanDeviation, TheJointStateAtTheFramesUtimeAwayFromThePlanIsAFindingDeboun
 // the finding it was classified with, whatever joint states arrive while it
 // queues.
 TEST(PlanDeviation, AQueuedFrameKeepsTheFindingItWasClassifiedWithOnArrival) {
-  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kStart);
+  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kRateHz, kStart);
   const int64_t t0 = 1'700'000'000'000'000;
   feed_all(&m, kStart);
   m.on_plan(plan_a1(t0, 0.0, t0 + 500'000, 0.5));

@@ -286,6 +286,7 @@ TEST(FrameClassifier, LinkUnknownToTheUrdfIsNeverJudgedSafe) {
 // ---- RiskMonitor: debouncing and deadlines on an explicit clock ----
 
 constexpr int64_t kStart = 5'000'000'000;  // monotonic, unrelated to any utime
+constexpr double kRateHz = 30;             // camera.rate_hz of config/sim.yaml
 constexpr int64_t kMs = 1000;
 
 heartbeat_t heartbeat(const std::string& process) {
@@ -322,7 +323,7 @@ risk_t judged_at_once(RiskMonitor* m, const discrepancy_t& frame, int64_t now) {
 }
 
 TEST(RiskMonitor, NothingArrivedIsStaleAfterTheFirstDeadline) {
-  RiskMonitor m(config_depth_100ms().risk, config_depth_100ms().channels, friend_arm(), kStart);
+  RiskMonitor m(config_depth_100ms().risk, config_depth_100ms().channels, friend_arm(), kRateHz, kStart);
   EXPECT_FALSE(m.check_deadlines(kStart + 100 * kMs).has_value());
   const auto r = m.check_deadlines(kStart + 101 * kMs);
   ASSERT_TRUE(r.has_value());
@@ -337,7 +338,7 @@ TEST(RiskMonitor, NothingArrivedIsStaleAfterTheFirstDeadline) {
 }
 
 TEST(RiskMonitor, EachInputHasItsOwnDeadlineAndCause) {
-  RiskMonitor m(config_depth_100ms().risk, config_depth_100ms().channels, friend_arm(), kStart);
+  RiskMonitor m(config_depth_100ms().risk, config_depth_100ms().channels, friend_arm(), kRateHz, kStart);
   int64_t now = kStart;
   feed_all(&m, now);
   discrepancy_t d = summary_of(default_arm(), 40);
@@ -406,13 +407,13 @@ TEST(RiskMonitor, EachInputHasItsOwnDeadlineAndCause) {
 
 TEST(RiskMonitor, CameraPoseIsWatchedOnlyWhenRequired) {
   deployment::Config config = sim_config();
-  RiskMonitor optional(config.risk, config.channels, friend_arm(), kStart);
+  RiskMonitor optional(config.risk, config.channels, friend_arm(), kRateHz, kStart);
   feed_all(&optional, kStart + 2000 * kMs);
   judged_at_once(&optional, summary_of(default_arm()), kStart + 2000 * kMs);
   EXPECT_FALSE(optional.check_deadlines(kStart + 2000 * kMs).has_value());
 
   config.risk.camera_pose_required = true;
-  RiskMonitor required(config.risk, config.channels, friend_arm(), kStart);
+  RiskMonitor required(config.risk, config.channels, friend_arm(), kRateHz, kStart);
   feed_all(&required, kStart + 2000 * kMs);
   judged_at_once(&required, summary_of(default_arm()), kStart + 2000 * kMs);
   const auto r = required.check_deadlines(kStart + 2000 * kMs);
@@ -422,8 +423,8 @@ TEST(RiskMonitor, CameraPoseIsWatchedOnlyWhenRequired) {
   EXPECT_FALSE(required.check_deadlines(kStart + 2000 * kMs).has_value());
 }
 
-TEST(RiskMonitor, MismatchIsWarningUntilDebouncedThenDangerousAndClearsOnAGoodFrame) {
-  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kStart);
+TEST(RiskMonitor, MismatchIsWarningUntilDebouncedThenDangerousAndClearsAfterClearFramesGoodFrames) {
+  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kRateHz, kStart);
   const discrepancy_t bad = summary_of(default_arm(16), 100);
   const discrepancy_t good = summary_of(default_arm(), 104);
   int64_t now = kStart;
@@ -441,6 +442,18 @@ TEST(RiskMonitor, MismatchIsWarningUntilDebouncedThenDangerousAndClearsOnAGoodFr
   // debounce_frames = 3.
   EXPECT_EQ(levels,
             (std::vector<int8_t>{risk_t::WARNING, risk_t::WARNING, risk_t::DANGEROUS, risk_t::DANGEROUS}));
+  // The diagnosis stays open, its cause and suspect latched, until
+  // risk.evidence.clear_frames (10) good frames in a row.
+  for (int i = 1; i < sim_config().risk.evidence_clear_frames; ++i) {
+    now += 33 * kMs;
+    feed_all(&m, now);
+    const risk_t r = judged_at_once(&m, good, now);
+    EXPECT_EQ(r.level, risk_t::DANGEROUS);
+    EXPECT_EQ(r.cause, risk_t::CAUSE_JOINT_ERROR);
+    EXPECT_EQ(r.suspect, "a2");
+    EXPECT_EQ(r.detail.rfind("diagnosis open since seq 100: joint a2", 0), 0u) << r.detail;
+    EXPECT_NE(r.detail.find("this frame: no finding"), std::string::npos) << r.detail;
+  }
   now += 33 * kMs;
   feed_all(&m, now);
   const risk_t r = judged_at_once(&m, good, now);
@@ -452,7 +465,7 @@ TEST(RiskMonitor, MismatchIsWarningUntilDebouncedThenDangerousAndClearsOnAGoodFr
 }
 
 TEST(RiskMonitor, SensorFaultsUseTheirOwnDebounce) {
-  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kStart);
+  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kRateHz, kStart);
   discrepancy_t unusable = summary_of(default_arm());
   unusable.usable = false;
   unusable.unusable_kind = discrepancy_t::UNUSABLE_RENDERER;
@@ -463,7 +476,7 @@ TEST(RiskMonitor, SensorFaultsUseTheirOwnDebounce) {
 }
 
 TEST(RiskMonitor, FrozenImageNeedsAMovingArm) {
-  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kStart);
+  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kRateHz, kStart);
   discrepancy_t frozen = summary_of(default_arm());
   frozen.repeat_count = 3;
   m.on_depth(kStart);
@@ -489,14 +502,14 @@ TEST(RiskMonitor, FrozenImageIsJudgedByTheJointStateAtTheFramesCaptureTime) {
   frozen.repeat_count = 3;
   frozen.utime = kCapture;
   {
-    RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kStart);
+    RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kRateHz, kStart);
     m.on_depth(kStart);
     m.on_joint_state(joints_at(0.3, kCapture - 10 * kMs), kStart);
     m.on_joint_state(joints_at(0.0, kCapture + 50 * kMs), kStart);  // the arm halted after the capture
     EXPECT_EQ(judged_at_once(&m, frozen, kStart).cause, risk_t::CAUSE_SENSOR_FAULT);
   }
   {
-    RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kStart);
+    RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kRateHz, kStart);
     m.on_depth(kStart);
     m.on_joint_state(joints_at(0.0, kCapture - 10 * kMs), kStart);
     m.on_joint_state(joints_at(0.3, kCapture + 50 * kMs), kStart);  // it started after the capture
@@ -505,7 +518,7 @@ TEST(RiskMonitor, FrozenImageIsJudgedByTheJointStateAtTheFramesCaptureTime) {
 }
 
 TEST(RiskMonitor, JointNamesMustBeTheRobotsMovingJoints) {
-  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kStart);
+  RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kRateHz, kStart);
   joint_state_t s = joints(0);
   EXPECT_EQ(m.check_joint_names(s), "");
   s.name = {"mount"};

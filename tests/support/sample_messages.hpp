@@ -111,6 +111,9 @@ inline link_labels_t sample_link_labels() {
   m.link_name = {"link1", "link2", "table"};
   m.num_pixels = 6;
   m.label = {0, 1, 2, link_labels_t::ENVIRONMENT_FIRST, 0, 1};
+  m.num_joints = 0;
+  m.num_axes = 0;
+  m.num_link_axes = 0;
   return m;
 }
 

@@ -91,6 +91,9 @@ inline link_labels_t labels_frame(const std::vector<int16_t>& label, int64_t seq
   m.link_name = {"base_link", "link1", "link2", "floor"};
   m.num_pixels = width * height;
   m.label = label;
+  m.num_joints = 0;
+  m.num_axes = 0;
+  m.num_link_axes = 0;
   return m;
 }
 

@@ -66,6 +66,9 @@ link_labels_t labels(int64_t seq) {
   for (int v = 40; v < 100; ++v) {
     for (int u = 40; u < 70; ++u) m.label[v * kW + u] = link_labels_t::ROBOT_FIRST;
   }
+  m.num_joints = 0;
+  m.num_axes = 0;
+  m.num_link_axes = 0;
   return m;
 }
 

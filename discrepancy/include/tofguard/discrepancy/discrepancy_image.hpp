@@ -16,6 +16,7 @@
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/discrepancy/discrepancy_settings.hpp"
+#include "tofguard/discrepancy/evidence.hpp"
 #include "tofguard/discrepancy_image_t.hpp"
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/link_labels_t.hpp"
@@ -50,6 +51,8 @@ struct Parameters {
   double near_arm_m = 0.2;
   // Logical maximum of |I_dis| per pixel for the normalised seed score, mm.
   double max_depth_mm = 8000;
+  // The evidence stage (evidence.hpp).
+  EvidenceParameters evidence;
 };
 
 Parameters parameters_from(const DiscrepancySettings& config);

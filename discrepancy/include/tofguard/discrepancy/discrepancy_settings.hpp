@@ -48,6 +48,13 @@ struct DiscrepancySettings {
   bool colour_image_enabled = false;
   std::string colour_image_channel;
   double colour_image_full_scale_mm = 0;
+  // evidence.{model_sigma_mm, clip_sigmas, pixels_per_sample}: the evidence
+  // stage (docs/safety-chain.md, "Evidence"): the model's own inaccuracy per
+  // pixel (mm, added in quadrature to sigma(d)), the residual clip in sigmas,
+  // and how many pixels make one independent noise sample.
+  double evidence_model_sigma_mm = 0;
+  double evidence_clip_sigmas = 0;
+  double evidence_pixels_per_sample = 0;
 };
 
 // Reads (and finishes) the `discrepancy` section.

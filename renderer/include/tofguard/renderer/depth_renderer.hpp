@@ -68,6 +68,11 @@ struct RenderResult {
   // SceneModel::links' names: robot links first, then the environment's.
   std::vector<std::string> link_names;
   int num_robot_links = 0;
+  // Where it was rendered from (usable results only): every link's pose and
+  // the optical frame's pose in the world (rendered_kinematics.hpp turns
+  // them into link_labels_t's kinematics).
+  std::vector<Eigen::Isometry3d> world_from_link;
+  Eigen::Isometry3d world_from_optical = Eigen::Isometry3d::Identity();
 };
 
 // The matrix that takes optical-frame points (X, Y, Z, 1) to GL clip

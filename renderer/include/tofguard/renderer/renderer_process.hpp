@@ -46,6 +46,7 @@
 #include "tofguard/link_labels_t.hpp"
 #include "tofguard/planned_trajectory_t.hpp"
 #include "tofguard/renderer/depth_renderer.hpp"
+#include "tofguard/renderer/rendered_kinematics.hpp"
 #include "tofguard/renderer/renderer_settings.hpp"
 #include "tofguard/robot_state/state_history.hpp"
 
@@ -124,7 +125,8 @@ class RendererService {
     bool rendered = false;
     RenderResult result;  // usable when rendered and worth using
   };
-  RenderedFrame make_output(const depth_image_t& frame, RenderResult result) const;
+  RenderedFrame make_output(const depth_image_t& frame, RenderResult result,
+                            const std::optional<RenderedKinematics>& kinematics) const;
   void learn_period(const depth_image_t& frame);
   void plan_prediction(const depth_image_t& frame);
   // True when `prediction_` may stand for `frame` rendered at `joints` and `pose`.

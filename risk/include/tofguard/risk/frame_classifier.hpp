@@ -25,6 +25,12 @@ struct FrameFinding {
   double score = 0;
   double threshold = 0;
   std::string detail;
+  // DANGEROUS at once, no frame debounce: a sequential test that crossed
+  // its threshold (the CUSUM is its debounce).
+  bool at_once = false;
+  // WARNING, never DANGEROUS by itself: a sequential test's evidence is
+  // growing but has not crossed.
+  bool warning_only = false;
 };
 
 struct ClassifierContext {

@@ -8,15 +8,22 @@
 //                                          estimate, which may rename a
 //                                          model mismatch's cause;
 //   PlanMonitor     (plan_monitor.hpp)     the arm leaving its plan;
-//   DecisionRule    (decision_rule.hpp)    debounce into WARNING/DANGEROUS.
+//   SequentialEvidence (evidence_tests.hpp) the CUSUMs on the frames'
+//                                          evidence: calibration and joint
+//                                          errors;
+//   DecisionRule    (decision_rule.hpp)    debounce into WARNING/DANGEROUS,
+//                                          the open diagnosis (hysteresis).
 //
 // Each frame is classified once, when it arrives: the frame rules
 // (classify_frame) and, when they find nothing, the plan rule, both with the
 // joint state of the frame's capture time (the newest at or before its
 // utime), so a replayed log is judged the same however late a frame is
-// processed. The gate then holds it (or not) and may rename its cause; the
-// decision rule debounces the verdicts in frame order, and an input deadline
-// that has expired by the time of the verdict makes it DANGEROUS.
+// processed. The gate then holds it (or not) and may rename its cause. The
+// frames are then judged in frame order: the sequential evidence tests take
+// the frame's evidence (a crossed test replaces any finding but a sensor or
+// component fault's), the decision rule debounces the verdicts and keeps a
+// diagnosis open, and an input deadline that has expired by the time of the
+// verdict makes it DANGEROUS.
 // docs/safety-chain.md gives every rule.
 #include <cstdint>
 #include <optional>
@@ -31,6 +38,7 @@
 #include "tofguard/planned_trajectory_t.hpp"
 #include "tofguard/risk/decision_rule.hpp"
 #include "tofguard/risk/estimate_gate.hpp"
+#include "tofguard/risk/evidence_tests.hpp"
 #include "tofguard/risk/frame_classifier.hpp"
 #include "tofguard/risk/input_deadlines.hpp"
 #include "tofguard/risk/joint_states_by_utime.hpp"
@@ -43,10 +51,11 @@ namespace tofguard::risk {
 
 class RiskMonitor {
  public:
-  // `channels` name the inputs in the verdicts' details. The deadlines run
+  // `channels` name the inputs in the verdicts' details; `camera_rate_hz`
+  // (camera.rate_hz) sets the evidence tests' threshold. The deadlines run
   // from `start_us` (monotonic).
   RiskMonitor(const RiskSettings& settings, const ChannelNames& channels, robot_model::KinematicTree robot,
-              int64_t start_us);
+              double camera_rate_hz, int64_t start_us);
 
   // Arrivals of valid messages.
   void on_depth(int64_t now_us) { deadlines_.on_depth(now_us); }
@@ -67,6 +76,8 @@ class RiskMonitor {
   // The verdicts of frames whose wait for an estimate has ended by now_us.
   std::vector<risk_t> release_due(int64_t now_us);
   size_t waiting_frames() const { return gate_.waiting_frames(); }
+  const SequentialEvidence& evidence() const { return evidence_; }
+  bool diagnosis_open() const { return decision_.diagnosis_open(); }
 
   using EstimateStats = EstimateGate::Stats;
   const EstimateStats& estimate_stats() const { return gate_.stats(); }
@@ -94,6 +105,7 @@ class RiskMonitor {
   JointStatesByUtime joint_states_;
   PlanMonitor plan_;
   EstimateGate gate_;
+  SequentialEvidence evidence_;
   DecisionRule decision_;
   int64_t last_frame_utime_ = 0;
 };

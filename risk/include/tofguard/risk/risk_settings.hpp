@@ -83,6 +83,27 @@ struct RiskSettings {
   // something the model lacks (an unknown object), millimetres.
   double estimate_unexplained_residual_mm = 0;
 
+  // evidence.*: the sequential evidence tests on discrepancy_t's evidence
+  // fields (docs/safety-chain.md, "Sequential evidence and its
+  // thresholds"). false_stop_period_h: one false stop in this many hours of
+  // nominal operation is allowed; with the number of hypotheses and the
+  // camera rate it gives the CUSUM threshold h.
+  double evidence_false_stop_period_h = 0;
+  // The smallest faults to detect, each test's alternative: a joint offset
+  // (joint_offset_deg, read in degrees, held in radians; joint_offset_m for
+  // prismatic joints), a camera translation (camera_translation_m) along
+  // any optical axis or a rotation about one (camera_rotation_deg, held in
+  // radians).
+  double evidence_joint_offset_rad = 0;
+  double evidence_joint_offset_m = 0;
+  double evidence_camera_translation_m = 0;
+  double evidence_camera_rotation_rad = 0;
+  // WARNING while some CUSUM is at or above this fraction of h.
+  double evidence_warning_fraction = 0;
+  // A diagnosis (a DANGEROUS verdict) stays open, its cause and suspect
+  // latched, until this many consecutive frames have no finding at all.
+  int evidence_clear_frames = 0;
+
   // plan.*: the plan (PLANNED_TRAJECTORY): a joint state inside the plan's
   // time span further than this from the plan at its utime is "the arm left
   // its plan" (degrees; metres for prismatic joints).
@@ -102,6 +123,9 @@ struct RiskProcessSettings {
   std::string robot_urdf_path;
   // camera.id: frames and estimates of another camera are rejected.
   std::string camera_id;
+  // camera.rate_hz: frames per second, for the evidence tests' threshold
+  // (false stops per hour = hypotheses * frames per hour / e^h).
+  double camera_rate_hz = 0;
   RiskSettings risk;
 };
 

@@ -1,0 +1,112 @@
+#pragma once
+// The evidence stage of compute_discrepancy (docs/safety-chain.md,
+// "Evidence"): a one-step, noise-weighted linear fit of the residual
+// I_dis = I_gen - I_ToF to the hypotheses "the camera pose is off" (six
+// parameters, on the static pixels) and "joint j reads other than seen"
+// (one parameter per joint, on the pixels of the links it moves), and each
+// link's shared bias. Fills discrepancy_t's evidence fields.
+//
+// J_i, how the rendered depth at pixel i changes per unit of a parameter,
+// comes from the rendered surface's slope and the labels' kinematics
+// (link_labels_t's axes, optical frame): a surface point p moving with
+// velocity v changes the depth at its fixed pixel by g . v with
+//   g = (-Gu fx / Z, -Gv fy / Z, 1 + (Gu fx X + Gv fy Y) / Z^2),
+// Gu = dZ/du, Gv = dZ/dv the rendered depth's slope (central differences
+// over neighbours of the same label and no silhouette jump).
+//
+// Units: J in millimetres per radian (revolute joints, camera rotation) or
+// per metre (prismatic joints, camera translation). Frames: the camera's
+// optical frame (x right, y down, z forward).
+//
+// Pure computation: no LCM, no clocks; one pass over the pixels, nothing
+// allocated per pixel.
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "tofguard/depth_image_t.hpp"
+#include "tofguard/discrepancy_t.hpp"
+#include "tofguard/link_labels_t.hpp"
+
+namespace tofguard::discrepancy {
+
+// discrepancy.evidence.* (DiscrepancySettings).
+struct EvidenceParameters {
+  // The model's own inaccuracy per pixel, mm: sigma_i = sqrt(sigma(d)^2 +
+  // model_sigma_mm^2).
+  double model_sigma_mm = 3.0;
+  // Residuals are clipped to +-clip_sigmas * sigma_i.
+  double clip_sigmas = 4.0;
+  // Pixels per independent noise sample (1: independent per pixel; a
+  // camera with spatial filtering: its filter's footprint): w_i =
+  // 1 / (pixels_per_sample * sigma_i^2).
+  double pixels_per_sample = 1.0;
+};
+
+// The camera noise model and silhouette threshold the stage shares with
+// the rest of compute_discrepancy.
+struct EvidenceNoise {
+  // sigma(d) = sigma_at_0m_mm + sigma_per_m2_mm * d^2, d the camera depth, m.
+  double sigma_at_0m_mm = 4.0;
+  double sigma_per_m2_mm = 1.2;
+  // Rendered depth steps over this are silhouettes (no slope across), mm.
+  double silhouette_jump_mm = 50;
+};
+
+// Per-pixel Jacobians of a rendered frame and its labels' kinematics.
+// Keeps pointers into `rendered` and `labels`: they must outlive it.
+class EvidenceJacobian {
+ public:
+  EvidenceJacobian(const depth_image_t& rendered, const link_labels_t& labels, double silhouette_jump_mm);
+
+  // False when the labels carry no kinematics (num_axes = 0) or they do not
+  // fit the labels (then at() is never true).
+  bool available() const { return available_; }
+  int num_joints() const { return num_joints_; }
+
+  // The Jacobian of pixel i (row-major index): mm per unit of each camera
+  // parameter (t_x, t_y, t_z per metre, w_x, w_y, w_z per radian; the seen
+  // optical frame in the reported one) into camera[6], and of each joint
+  // into joints[num_joints()] (every entry written). *moved: whether some
+  // joint moves the pixel's link (then camera[] is zero: not a static
+  // pixel), *link the pixel's link (link_name index). False (nothing
+  // written) when the pixel takes no part: no rendered depth, no link, or
+  // no slope (no qualifying neighbour in u or in v).
+  bool at(int i, double camera[6], double* joints, bool* moved, int* link) const;
+
+ private:
+  struct Axis {
+    int joint;
+    double multiplier;
+    bool prismatic;
+    Eigen::Vector3d origin_mm;
+    Eigen::Vector3d direction;
+    int parent;
+  };
+  bool available_ = false;
+  int width_ = 0;
+  int height_ = 0;
+  double fx_ = 1, fy_ = 1, cx_ = 0, cy_ = 0;
+  double jump_mm_ = 0;
+  int num_joints_ = 0;
+  int num_robot_links_ = 0;
+  int num_links_ = 0;
+  const int16_t* depth_ = nullptr;
+  const int16_t* label_ = nullptr;
+  std::vector<Axis> axes_;
+  std::vector<int> link_axis_;
+};
+
+// Fills `summary`'s evidence fields (evidence_available .. robot_chi2) for a
+// usable, compared frame; `silhouette` is compute_discrepancy's mask (1 =
+// beside a silhouette). Leaves them zero (evidence_available false) when the
+// labels carry no kinematics.
+void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered, const link_labels_t& labels,
+                      const std::vector<uint8_t>& silhouette, const EvidenceNoise& noise,
+                      const EvidenceParameters& parameters, discrepancy_t* summary);
+
+// Clears the evidence fields (evidence_available false, everything zero).
+void clear_evidence(discrepancy_t* summary);
+
+}  // namespace tofguard::discrepancy

@@ -1,0 +1,237 @@
+#include "tofguard/discrepancy/evidence.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Geometry>
+
+#include "tofguard/common/depth_frame.hpp"
+
+namespace tofguard::discrepancy {
+
+EvidenceJacobian::EvidenceJacobian(const depth_image_t& rendered, const link_labels_t& labels,
+                                   double silhouette_jump_mm)
+    : width_(rendered.width),
+      height_(rendered.height),
+      fx_(rendered.fx),
+      fy_(rendered.fy),
+      cx_(rendered.cx),
+      cy_(rendered.cy),
+      jump_mm_(silhouette_jump_mm > 0 ? silhouette_jump_mm : 1e9),
+      num_joints_(labels.num_joints),
+      num_robot_links_(labels.num_robot_links),
+      num_links_(labels.num_links),
+      depth_(rendered.depth_mm.data()),
+      label_(labels.label.data()) {
+  // The wire checks make these hold; an in-process caller may not have run
+  // them, so a misfit only switches the evidence off.
+  const auto n = static_cast<size_t>(labels.num_axes);
+  const size_t pixels = static_cast<size_t>(std::max(width_, 0)) * static_cast<size_t>(std::max(height_, 0));
+  if (labels.num_axes <= 0 || labels.num_joints <= 0 || labels.axis_joint.size() != n ||
+      labels.axis_multiplier.size() != n || labels.axis_prismatic.size() != n ||
+      labels.axis_origin_m.size() != n || labels.axis_direction.size() != n ||
+      labels.axis_parent.size() != n ||
+      labels.link_axis.size() != static_cast<size_t>(labels.num_robot_links) ||
+      labels.num_link_axes != labels.num_robot_links || rendered.depth_mm.size() != pixels ||
+      labels.label.size() != pixels || !(fx_ > 0) || !(fy_ > 0)) {
+    return;
+  }
+  axes_.resize(n);
+  for (size_t m = 0; m < n; ++m) {
+    Axis& a = axes_[m];
+    if (labels.axis_origin_m[m].size() != 3 || labels.axis_direction[m].size() != 3) return;
+    a.joint = labels.axis_joint[m];
+    a.multiplier = labels.axis_multiplier[m];
+    a.prismatic = labels.axis_prismatic[m];
+    a.origin_mm = 1000.0 * Eigen::Vector3d(labels.axis_origin_m[m][0], labels.axis_origin_m[m][1],
+                                           labels.axis_origin_m[m][2]);
+    a.direction = Eigen::Vector3d(labels.axis_direction[m][0], labels.axis_direction[m][1],
+                                  labels.axis_direction[m][2]);
+    a.parent = labels.axis_parent[m];
+    if (a.joint < 0 || a.joint >= num_joints_ || a.parent < -1 || a.parent >= static_cast<int>(m)) return;
+  }
+  link_axis_ = labels.link_axis;
+  for (int a : link_axis_) {
+    if (a < -1 || a >= static_cast<int>(n)) return;
+  }
+  available_ = true;
+}
+
+bool EvidenceJacobian::at(int i, double camera[6], double* joints, bool* moved, int* link_out) const {
+  if (!available_) return false;
+  const int z_mm = depth_[i];
+  if (z_mm <= 0) return false;
+  const int l = label_[i];
+  const int link = link_of_label(l, num_robot_links_, num_links_);
+  if (link < 0) return false;
+  const int u = i % width_;
+  const int v = i / width_;
+  // The slope of the rendered surface, mm per pixel: central differences
+  // over the neighbours on the same link and surface, one-sided with one.
+  const auto qualifies = [&](int n) {
+    const int d = depth_[n];
+    return d > 0 && label_[n] == l && std::abs(d - z_mm) <= jump_mm_;
+  };
+  const auto slope = [&](bool has_minus, int minus, bool has_plus, int plus, double* g) {
+    const bool a = has_minus && qualifies(minus);
+    const bool b = has_plus && qualifies(plus);
+    if (a && b) {
+      *g = 0.5 * (depth_[plus] - depth_[minus]);
+    } else if (b) {
+      *g = depth_[plus] - z_mm;
+    } else if (a) {
+      *g = z_mm - depth_[minus];
+    } else {
+      return false;
+    }
+    return true;
+  };
+  double gu = 0;
+  double gv = 0;
+  if (!slope(u > 0, i - 1, u + 1 < width_, i + 1, &gu) ||
+      !slope(v > 0, i - width_, v + 1 < height_, i + width_, &gv)) {
+    return false;
+  }
+  const double z = z_mm;
+  const Eigen::Vector3d p((u - cx_) * z / fx_, (v - cy_) * z / fy_, z);
+  const Eigen::Vector3d g(-gu * fx_ / z, -gv * fy_ / z,
+                          1.0 + (gu * fx_ * p.x() + gv * fy_ * p.y()) / (z * z));
+  *link_out = link;
+  std::fill(joints, joints + num_joints_, 0.0);
+  const int first_axis = link < num_robot_links_ ? link_axis_[link] : -1;
+  *moved = first_axis >= 0;
+  if (*moved) {
+    for (int m = first_axis; m >= 0; m = axes_[m].parent) {
+      const Axis& a = axes_[m];
+      // Revolute: v = direction x (p - origin) (mm per rad); prismatic:
+      // v = direction (1000 mm per m).
+      const double j = a.prismatic ? 1000.0 * g.dot(a.direction) : g.dot(a.direction.cross(p - a.origin_mm));
+      joints[a.joint] += a.multiplier * j;
+    }
+    std::fill(camera, camera + 6, 0.0);
+  } else {
+    // A static point seen from the optical frame moved by (t, w): its
+    // coordinates change by -t - w x p.
+    camera[0] = -1000.0 * g.x();
+    camera[1] = -1000.0 * g.y();
+    camera[2] = -1000.0 * g.z();
+    // Rotation w = e_k: v = -e_k x p = p x e_k, and g . (p x e_k) =
+    // e_k . (g x p) (mm per radian, p in mm).
+    const Eigen::Vector3d gxp = g.cross(p);
+    camera[3] = gxp.x();
+    camera[4] = gxp.y();
+    camera[5] = gxp.z();
+  }
+  return true;
+}
+
+void clear_evidence(discrepancy_t* s) {
+  s->evidence_available = false;
+  s->num_link_bias = 0;
+  s->link_bias_mm.clear();
+  s->link_bias_sigma_mm.clear();
+  s->camera_fit_pixels = 0;
+  std::fill(s->camera_score, s->camera_score + 6, 0.0);
+  std::fill(s->camera_information, s->camera_information + 36, 0.0);
+  std::fill(s->camera_correction, s->camera_correction + 6, 0.0);
+  s->static_chi2 = 0;
+  s->num_joints = 0;
+  s->joint_name.clear();
+  s->joint_fit_pixels.clear();
+  s->joint_score.clear();
+  s->joint_information.clear();
+  s->robot_fit_pixels = 0;
+  s->robot_chi2 = 0;
+}
+
+void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered, const link_labels_t& labels,
+                      const std::vector<uint8_t>& silhouette, const EvidenceNoise& noise,
+                      const EvidenceParameters& parameters, discrepancy_t* summary) {
+  discrepancy_t& s = *summary;
+  clear_evidence(&s);
+  const EvidenceJacobian jacobian(rendered, labels, noise.silhouette_jump_mm);
+  const int num_pixels = camera.width * camera.height;
+  if (!jacobian.available() || camera.depth_mm.size() != static_cast<size_t>(num_pixels) ||
+      silhouette.size() != static_cast<size_t>(num_pixels)) {
+    return;
+  }
+  const int num_links = labels.num_links;
+  const int num_joints = jacobian.num_joints();
+  std::vector<double> link_sum_wr(num_links, 0.0);
+  std::vector<double> link_sum_w(num_links, 0.0);
+  std::vector<double> joint_row(num_joints, 0.0);
+  s.joint_fit_pixels.assign(num_joints, 0);
+  s.joint_score.assign(num_joints, 0.0);
+  s.joint_information.assign(num_joints, 0.0);
+  Eigen::Matrix<double, 6, 1> camera_score = Eigen::Matrix<double, 6, 1>::Zero();
+  Eigen::Matrix<double, 6, 6> camera_information = Eigen::Matrix<double, 6, 6>::Zero();
+  double camera_row[6];
+  const int16_t* tof = camera.depth_mm.data();
+  const int16_t* gen = rendered.depth_mm.data();
+  const double model_var = parameters.model_sigma_mm * parameters.model_sigma_mm;
+  const double inv_pps = 1.0 / parameters.pixels_per_sample;
+  for (int i = 0; i < num_pixels; ++i) {
+    const int t = tof[i];
+    if (t <= 0 || gen[i] <= 0 || silhouette[i]) continue;
+    bool moved = false;
+    int link = -1;
+    if (!jacobian.at(i, camera_row, joint_row.data(), &moved, &link)) continue;
+    const double d_m = metres_from_mm(t);
+    const double sigma_d = noise.sigma_at_0m_mm + noise.sigma_per_m2_mm * d_m * d_m;
+    const double var = sigma_d * sigma_d + model_var;
+    const double limit = parameters.clip_sigmas * std::sqrt(var);
+    const double r = std::clamp(static_cast<double>(gen[i] - t), -limit, limit);
+    const double w = inv_pps / var;
+    link_sum_wr[link] += w * r;
+    link_sum_w[link] += w;
+    if (moved) {
+      ++s.robot_fit_pixels;
+      s.robot_chi2 += w * r * r;
+      for (int j = 0; j < num_joints; ++j) {
+        const double jj = joint_row[j];
+        if (jj == 0.0) continue;
+        ++s.joint_fit_pixels[j];
+        s.joint_score[j] -= w * jj * r;
+        s.joint_information[j] += w * jj * jj;
+      }
+    } else {
+      ++s.camera_fit_pixels;
+      s.static_chi2 += w * r * r;
+      const Eigen::Map<const Eigen::Matrix<double, 6, 1>> jc(camera_row);
+      camera_score -= (w * r) * jc;
+      camera_information.selfadjointView<Eigen::Upper>().rankUpdate(jc, w);
+    }
+  }
+  camera_information = camera_information.selfadjointView<Eigen::Upper>();
+  Eigen::Matrix<double, 6, 1> correction = Eigen::Matrix<double, 6, 1>::Zero();
+  if (s.camera_fit_pixels > 0) {
+    const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(camera_information);
+    const Eigen::Matrix<double, 6, 1> d = ldlt.vectorD();
+    // Rank-deficient (e.g. a single plane seen head-on leaves the sideways
+    // translation unobservable): no correction.
+    if (ldlt.info() == Eigen::Success && ldlt.isPositive() && d.maxCoeff() > 0 &&
+        d.minCoeff() > 1e-12 * d.maxCoeff()) {
+      correction = ldlt.solve(camera_score);
+      if (!correction.allFinite()) correction.setZero();
+    }
+  }
+  for (int k = 0; k < 6; ++k) {
+    s.camera_score[k] = camera_score[k];
+    s.camera_correction[k] = correction[k];
+    for (int c = 0; c < 6; ++c) s.camera_information[6 * k + c] = camera_information(k, c);
+  }
+  s.num_link_bias = num_links;
+  s.link_bias_mm.assign(num_links, 0.0f);
+  s.link_bias_sigma_mm.assign(num_links, 0.0f);
+  for (int l = 0; l < num_links; ++l) {
+    if (link_sum_w[l] <= 0) continue;
+    s.link_bias_mm[l] = static_cast<float>(link_sum_wr[l] / link_sum_w[l]);
+    s.link_bias_sigma_mm[l] = static_cast<float>(1.0 / std::sqrt(link_sum_w[l]));
+  }
+  s.num_joints = num_joints;
+  s.joint_name = labels.joint_name;
+  s.evidence_available = true;
+}
+
+}  // namespace tofguard::discrepancy

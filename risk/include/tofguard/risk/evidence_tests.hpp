@@ -1,0 +1,100 @@
+#pragma once
+// Sequential evidence tests (docs/safety-chain.md, "Sequential evidence and
+// its thresholds"): from the evidence fields of each discrepancy_t (a
+// parameter's score s and information I: s ~ N(0, I) without a fault,
+// s ~ N(I * delta, I) with the parameter off by delta), a per-frame
+// log-likelihood ratio per hypothesis (the camera pose; each moving joint)
+// and a CUSUM on it, S_k = max(0, S_{k-1} + LLR_k), capped at h. A
+// hypothesis crosses when S_k >= h; h follows from the target false-stop
+// rate (Lorden's bound and a union bound over the hypotheses). Pure logic:
+// frames come in frame order, no clocks, no LCM.
+#include <array>
+#include <cstdint>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "tofguard/discrepancy_t.hpp"
+#include "tofguard/risk/frame_classifier.hpp"
+#include "tofguard/risk/risk_settings.hpp"
+#include "tofguard/robot_model/kinematic_tree.hpp"
+
+namespace tofguard::risk {
+
+// log(cosh(x)), stable for any finite x: |x| + log1p(exp(-2|x|)) - log 2.
+double log_cosh(double x);
+
+// The per-frame log-likelihood ratio of "the parameter is off by +delta or
+// -delta (1/2 each)" against "it is not", for score s and information I:
+// log cosh(delta s) - delta^2 I / 2.
+double joint_llr(double score, double information, double delta);
+
+// The camera's: the mixture over the 12 alternatives "+-delta_a along
+// parameter a" (tx, ty, tz, rx, ry, rz), with the diagonal of the 6x6
+// information matrix (row-major): log((1/6) sum_a cosh(delta_a s_a)
+// exp(-delta_a^2 I_aa / 2)), by log-sum-exp.
+double camera_llr(const std::array<double, 6>& score, const std::array<double, 36>& information,
+                  const std::array<double, 6>& delta);
+
+// The CUSUM threshold for `hypotheses` tests on frames at `rate_hz` and at
+// most one false stop per `false_stop_period_h` hours:
+// h = ln(hypotheses * rate_hz * 3600 * false_stop_period_h).
+double cusum_threshold(int hypotheses, double rate_hz, double false_stop_period_h);
+
+// What one frame's evidence says.
+struct EvidenceStep {
+  // The frame carried evidence (discrepancy_t.evidence_available) and the
+  // CUSUMs were updated.
+  bool updated = false;
+  // A hypothesis crossed h (finding: its cause, suspect and detail; score
+  // its CUSUM, threshold h).
+  bool crossed = false;
+  // No crossing, but a CUSUM at or above warning_fraction * h (finding:
+  // the largest one's).
+  bool warning = false;
+  FrameFinding finding;
+  // Every CUSUM below warning_fraction * h after this frame.
+  bool quiet = true;
+  // One line with the frame's evidence: the largest CUSUM and h.
+  std::string summary;
+};
+
+class SequentialEvidence {
+ public:
+  // The hypotheses: the camera and each of `robot`'s moving joints (their
+  // offsets in radians, prismatic joints in metres). `camera_rate_hz`:
+  // camera.rate_hz (> 0).
+  SequentialEvidence(const RiskSettings& risk, const robot_model::KinematicTree& robot,
+                     double camera_rate_hz);
+
+  // The next frame in frame order. A frame without evidence changes
+  // nothing (updated false; quiet tells the CUSUMs' state).
+  EvidenceStep update(const discrepancy_t& frame);
+  // Every CUSUM back to 0 (a closed diagnosis).
+  void reset();
+
+  double threshold() const { return h_; }
+  double warning_level() const { return warning_fraction_ * h_; }
+  int hypotheses() const { return static_cast<int>(joint_cusum_.size()) + 1; }
+  double camera_cusum() const { return camera_cusum_; }
+  // 0 for a joint that is not a moving joint of the robot.
+  double joint_cusum(const std::string& joint) const;
+  // Every CUSUM below warning_level().
+  bool quiet() const;
+
+ private:
+  FrameFinding camera_finding(const discrepancy_t& frame) const;
+  FrameFinding joint_finding(const discrepancy_t& frame, int index) const;
+
+  std::set<std::string> prismatic_;
+  double joint_delta_rad_;
+  double joint_delta_m_;
+  std::array<double, 6> camera_delta_;
+  double warning_fraction_;
+  double h_;
+  double camera_cusum_ = 0;
+  std::map<std::string, double> joint_cusum_;  // every moving joint of the robot
+};
+
+}  // namespace tofguard::risk

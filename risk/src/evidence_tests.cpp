@@ -1,0 +1,224 @@
+#include "tofguard/risk/evidence_tests.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "tofguard/common/demand.hpp"
+#include "tofguard/risk_t.hpp"
+
+namespace tofguard::risk {
+
+double log_cosh(double x) {
+  const double a = std::abs(x);
+  return a + std::log1p(std::exp(-2 * a)) - std::log(2.0);
+}
+
+double joint_llr(double score, double information, double delta) {
+  return log_cosh(delta * score) - delta * delta * information / 2;
+}
+
+double camera_llr(const std::array<double, 6>& score, const std::array<double, 36>& information,
+                  const std::array<double, 6>& delta) {
+  std::array<double, 6> terms{};
+  double largest = -std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 6; ++a) {
+    terms[a] = log_cosh(delta[a] * score[a]) - delta[a] * delta[a] * information[a * 6 + a] / 2;
+    largest = std::max(largest, terms[a]);
+  }
+  if (!std::isfinite(largest)) return largest;
+  double sum = 0;
+  for (double t : terms) sum += std::exp(t - largest);
+  return largest + std::log(sum / 6);
+}
+
+double cusum_threshold(int hypotheses, double rate_hz, double false_stop_period_h) {
+  TOFGUARD_DEMAND(hypotheses >= 1 && rate_hz > 0 && false_stop_period_h > 0,
+                  "cusum_threshold: hypotheses " + std::to_string(hypotheses) + ", rate " +
+                      std::to_string(rate_hz) + " Hz, period " + std::to_string(false_stop_period_h) + " h");
+  return std::log(hypotheses * rate_hz * 3600.0 * false_stop_period_h);
+}
+
+SequentialEvidence::SequentialEvidence(const RiskSettings& risk, const robot_model::KinematicTree& robot,
+                                       double camera_rate_hz)
+    : prismatic_(robot.prismatic_joint_names),
+      joint_delta_rad_(risk.evidence_joint_offset_rad),
+      joint_delta_m_(risk.evidence_joint_offset_m),
+      camera_delta_{risk.evidence_camera_translation_m, risk.evidence_camera_translation_m,
+                    risk.evidence_camera_translation_m, risk.evidence_camera_rotation_rad,
+                    risk.evidence_camera_rotation_rad,  risk.evidence_camera_rotation_rad},
+      warning_fraction_(risk.evidence_warning_fraction) {
+  for (const std::string& joint : robot.movable_joint_names) joint_cusum_[joint] = 0;
+  h_ = cusum_threshold(hypotheses(), camera_rate_hz, risk.evidence_false_stop_period_h);
+}
+
+double SequentialEvidence::joint_cusum(const std::string& joint) const {
+  const auto it = joint_cusum_.find(joint);
+  return it == joint_cusum_.end() ? 0 : it->second;
+}
+
+bool SequentialEvidence::quiet() const {
+  if (camera_cusum_ >= warning_level()) return false;
+  for (const auto& [joint, s] : joint_cusum_) {
+    if (s >= warning_level()) return false;
+  }
+  return true;
+}
+
+void SequentialEvidence::reset() {
+  camera_cusum_ = 0;
+  for (auto& [joint, s] : joint_cusum_) s = 0;
+}
+
+namespace {
+
+constexpr double kDeg = 180.0 / M_PI;
+
+// One CUSUM step, capped at h: once crossed, more evidence adds nothing,
+// and a fault that went away clears as fast as one frame can show it. A
+// non-finite ratio (a bug upstream) counts as crossing: fail safe.
+double step(double cusum, double llr, double h) {
+  if (!std::isfinite(llr)) return h;
+  return std::min(h, std::max(0.0, cusum + llr));
+}
+
+}  // namespace
+
+FrameFinding SequentialEvidence::camera_finding(const discrepancy_t& f) const {
+  const double* c = f.camera_correction;
+  FrameFinding finding;
+  finding.cause = risk_t::CAUSE_CALIBRATION_ERROR;
+  finding.score = camera_cusum_;
+  finding.threshold = h_;
+  finding.detail =
+      "camera pose off (sequential evidence, CUSUM log-likelihood ratio): " + fixed(camera_cusum_, 1) +
+      " of h " + fixed(h_, 1) + "; fitted correction (" + fixed(100 * c[0], 1) + ", " + fixed(100 * c[1], 1) +
+      ", " + fixed(100 * c[2], 1) + ") cm, (" + fixed(kDeg * c[3], 2) + ", " + fixed(kDeg * c[4], 2) + ", " +
+      fixed(kDeg * c[5], 2) + ")° about the optical x, y, z axes (seen vs configured)";
+  return finding;
+}
+
+FrameFinding SequentialEvidence::joint_finding(const discrepancy_t& f, int i) const {
+  const std::string& joint = f.joint_name[i];
+  const bool prismatic = prismatic_.count(joint) > 0;
+  const double unit = prismatic ? 1000.0 : kDeg;
+  const std::string unit_name = prismatic ? " mm" : "°";
+  const double information = f.joint_information[i];
+  FrameFinding finding;
+  finding.cause = risk_t::CAUSE_JOINT_ERROR;
+  finding.suspect = joint;
+  finding.score = joint_cusum(joint);
+  finding.threshold = h_;
+  finding.detail =
+      "joint " + joint +
+      " reads other than seen (sequential evidence, CUSUM log-likelihood ratio): " + fixed(finding.score, 1) +
+      " of h " + fixed(h_, 1);
+  if (information > 0) {
+    finding.detail += "; fitted offset (seen - reported) " + fixed(unit * f.joint_score[i] / information, 1) +
+                      unit_name + " ± " + fixed(unit / std::sqrt(information), 1) + unit_name;
+  }
+  return finding;
+}
+
+EvidenceStep SequentialEvidence::update(const discrepancy_t& f) {
+  EvidenceStep result;
+  if (f.evidence_available) {
+    result.updated = true;
+    std::array<double, 6> score{};
+    std::array<double, 36> information{};
+    std::copy(f.camera_score, f.camera_score + 6, score.begin());
+    std::copy(f.camera_information, f.camera_information + 36, information.begin());
+    camera_cusum_ = step(camera_cusum_, camera_llr(score, information, camera_delta_), h_);
+    TOFGUARD_DEMAND(f.num_joints >= 0 && f.joint_name.size() == static_cast<size_t>(f.num_joints) &&
+                        f.joint_score.size() == f.joint_name.size() &&
+                        f.joint_information.size() == f.joint_name.size(),
+                    "discrepancy seq " + std::to_string(f.seq) + ": joint arrays do not match num_joints");
+    for (int i = 0; i < f.num_joints; ++i) {
+      const auto it = joint_cusum_.find(f.joint_name[i]);
+      if (it == joint_cusum_.end()) continue;  // not a moving joint of the robot: not a hypothesis
+      const double delta = prismatic_.count(it->first) > 0 ? joint_delta_m_ : joint_delta_rad_;
+      it->second = step(it->second, joint_llr(f.joint_score[i], f.joint_information[i], delta), h_);
+    }
+  }
+  // The frame's joint index of each hypothesis, for its fit.
+  std::map<std::string, int> index;
+  if (f.evidence_available) {
+    for (int i = 0; i < f.num_joints; ++i) index[f.joint_name[i]] = i;
+  }
+  // The largest CUSUM relative to h, for warnings and the summary.
+  std::string largest_name = "camera";
+  double largest = camera_cusum_;
+  for (const auto& [joint, s] : joint_cusum_) {
+    if (s > largest) {
+      largest = s;
+      largest_name = joint;
+    }
+  }
+  result.quiet = quiet();
+  result.summary =
+      "evidence: largest CUSUM " + largest_name + " " + fixed(largest, 1) + " of h " + fixed(h_, 1);
+  if (!f.evidence_available) return result;
+
+  if (camera_cusum_ >= h_) {
+    result.crossed = true;
+    result.finding = camera_finding(f);
+    return result;
+  }
+  // Among the joints that crossed, the one whose one-parameter fit explains
+  // this frame's residual best: the largest s^2 / I.
+  int suspect = -1;
+  double best = -1;
+  std::string crossed_without_fit;
+  for (const auto& [joint, s] : joint_cusum_) {
+    if (s < h_) continue;
+    const auto at = index.find(joint);
+    if (at == index.end() || !(f.joint_information[at->second] > 0)) {
+      if (crossed_without_fit.empty()) crossed_without_fit = joint;
+      continue;
+    }
+    const double explained =
+        f.joint_score[at->second] * f.joint_score[at->second] / f.joint_information[at->second];
+    if (explained > best) {
+      best = explained;
+      suspect = at->second;
+    }
+  }
+  if (suspect >= 0) {
+    result.crossed = true;
+    result.finding = joint_finding(f, suspect);
+    return result;
+  }
+  if (!crossed_without_fit.empty()) {
+    // Crossed, but not in this frame's fit (no information now): still the
+    // joint whose evidence crossed.
+    result.crossed = true;
+    result.finding.cause = risk_t::CAUSE_JOINT_ERROR;
+    result.finding.suspect = crossed_without_fit;
+    result.finding.score = joint_cusum(crossed_without_fit);
+    result.finding.threshold = h_;
+    result.finding.detail = "joint " + crossed_without_fit +
+                            " reads other than seen (sequential evidence, CUSUM log-likelihood ratio): " +
+                            fixed(result.finding.score, 1) + " of h " + fixed(h_, 1);
+    return result;
+  }
+  if (largest >= warning_level()) {
+    result.warning = true;
+    const auto at = index.find(largest_name);
+    if (largest_name == "camera" && largest == camera_cusum_) {
+      result.finding = camera_finding(f);
+    } else if (at != index.end()) {
+      result.finding = joint_finding(f, at->second);
+    } else {
+      result.finding.cause = risk_t::CAUSE_JOINT_ERROR;
+      result.finding.suspect = largest_name;
+      result.finding.score = largest;
+      result.finding.threshold = h_;
+      result.finding.detail = "joint " + largest_name +
+                              " evidence growing (CUSUM log-likelihood ratio): " + fixed(largest, 1) +
+                              " of h " + fixed(h_, 1);
+    }
+  }
+  return result;
+}
+
+}  // namespace tofguard::risk

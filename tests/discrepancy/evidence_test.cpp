@@ -1,0 +1,353 @@
+// The evidence stage (discrepancy/evidence.hpp, docs/safety-chain.md
+// "Evidence") with the real renderer: its Jacobians against finite
+// differences of renders on three arms, and its fits on simulated camera
+// frames with an encoder offset, a moved camera and nothing wrong.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "estimator_test_support.hpp"
+#include "simulated_frames.hpp"
+#include "test_support.hpp"
+#include "tofguard/common/depth_frame.hpp"
+#include "tofguard/common/wire_checks.hpp"
+#include "tofguard/discrepancy/discrepancy_image.hpp"
+#include "tofguard/discrepancy/evidence.hpp"
+#include "tofguard/renderer/depth_renderer.hpp"
+#include "tofguard/renderer/rendered_kinematics.hpp"
+#include "tofguard/robot_model/scene_model.hpp"
+
+namespace tofguard::discrepancy {
+namespace {
+
+namespace fs = std::filesystem;
+using robot_model::JointPositions;
+
+constexpr double kDeg = M_PI / 180.0;
+
+struct Frame {
+  renderer::RenderResult result;
+  depth_image_t depth;
+  link_labels_t labels;
+};
+
+Frame render_frame(renderer::DepthRenderer* r, const robot_model::KinematicTree& tree,
+                   const JointPositions& q, const Eigen::Isometry3d& world_from_optical,
+                   const Intrinsics& in) {
+  Frame f;
+  const robot_model::LinkPoses poses = robot_model::forward_kinematics(tree, q);
+  f.result = r->render_at(poses, world_from_optical, in);
+  EXPECT_TRUE(f.result.usable) << f.result.unusable_reason;
+  f.depth = make_depth_image("cam", in, 1, 1, true, f.result.depth_m);
+  f.labels = renderer::make_rendered_link_labels(f.depth, f.result, tree);
+  return f;
+}
+
+// Pixels whose 3x3 neighbourhood shows one link in both renders.
+bool interior(const Frame& a, const Frame& b, int i) {
+  const int w = a.depth.width;
+  const int u = i % w;
+  const int v = i / w;
+  if (u < 1 || v < 1 || u + 1 >= w || v + 1 >= a.depth.height) return false;
+  const int16_t l = a.result.labels[i];
+  if (l == 0) return false;
+  for (int dv = -1; dv <= 1; ++dv) {
+    for (int du = -1; du <= 1; ++du) {
+      const int n = i + dv * w + du;
+      if (a.result.labels[n] != l || b.result.labels[n] != l || a.result.depth_m[n] <= 0) return false;
+    }
+  }
+  return true;
+}
+
+struct Agreement {
+  int pixels = 0;
+  double correlation = 0;
+  double slope = 0;  // least squares actual = slope * predicted
+  double rms_actual_mm = 0;
+};
+
+Agreement agree(const std::vector<double>& predicted, const std::vector<double>& actual) {
+  Agreement a;
+  a.pixels = static_cast<int>(predicted.size());
+  if (a.pixels < 2) return a;
+  double sp = 0, sa = 0, spp = 0, saa = 0, spa = 0;
+  for (size_t k = 0; k < predicted.size(); ++k) {
+    sp += predicted[k];
+    sa += actual[k];
+    spp += predicted[k] * predicted[k];
+    saa += actual[k] * actual[k];
+    spa += predicted[k] * actual[k];
+  }
+  const double n = a.pixels;
+  const double cov = spa / n - sp * sa / (n * n);
+  const double vp = spp / n - sp * sp / (n * n);
+  const double va = saa / n - sa * sa / (n * n);
+  a.correlation = cov / std::sqrt(vp * va);
+  a.slope = spa / spp;
+  a.rms_actual_mm = std::sqrt(saa / n);
+  return a;
+}
+
+// Predicted (J * delta) and actual depth change (mm) on interior pixels of
+// `base` for the render `moved`; `column` picks the parameter: 0..5 camera,
+// 6 + j joint j.
+Agreement compare(const Frame& base, const Frame& moved, int column, double delta) {
+  const EvidenceJacobian jacobian(base.depth, base.labels, 50);
+  EXPECT_TRUE(jacobian.available());
+  std::vector<double> joints(jacobian.num_joints());
+  double camera[6];
+  std::vector<double> predicted;
+  std::vector<double> actual;
+  const int n = base.depth.width * base.depth.height;
+  for (int i = 0; i < n; ++i) {
+    if (!interior(base, moved, i)) continue;
+    bool is_moved = false;
+    int link = -1;
+    if (!jacobian.at(i, camera, joints.data(), &is_moved, &link)) continue;
+    const double j = column < 6 ? camera[column] : joints[column - 6];
+    if (column < 6 && is_moved) continue;
+    if (column >= 6 && !is_moved) continue;
+    const double change_mm = 1000.0 * (moved.result.depth_m[i] - base.result.depth_m[i]);
+    if (std::abs(change_mm) > 30) continue;  // an edge swept past
+    predicted.push_back(j * delta);
+    actual.push_back(change_mm);
+  }
+  return agree(predicted, actual);
+}
+
+// Every joint of `tree` moved by 0.3 degrees (1 mm for a prismatic one):
+// the analytic prediction matches the rendered change.
+void expect_joint_jacobians_match(const robot_model::SceneModel& scene, const JointPositions& q,
+                                  const Eigen::Isometry3d& world_from_optical, const Intrinsics& in,
+                                  const std::string& arm) {
+  renderer::DepthRenderer r(scene, 0.1, 8.0);
+  const Frame base = render_frame(&r, scene, q, world_from_optical, in);
+  ASSERT_GT(base.labels.num_axes, 0);
+  int checked = 0;
+  for (size_t j = 0; j < scene.actuated_joint_names.size(); ++j) {
+    const std::string& name = scene.actuated_joint_names[j];
+    const double delta = scene.is_prismatic_joint(name) ? 0.001 : 0.3 * kDeg;
+    JointPositions moved_q = q;
+    moved_q[name] += delta;
+    const Frame moved = render_frame(&r, scene, moved_q, world_from_optical, in);
+    const Agreement a = compare(base, moved, 6 + static_cast<int>(j), delta);
+    std::cout << arm << " " << name << ": " << a.pixels << " px, correlation " << a.correlation << ", slope "
+              << a.slope << ", rms change " << a.rms_actual_mm << " mm\n";
+    // The slope comes from whole-millimetre rendered depths: changes under
+    // 0.5 mm rms are mostly quantisation. Measured (176x144): slopes
+    // 0.84..1.2, correlations 0.65..0.99 (lowest where the change is ~1 mm).
+    if (a.pixels < 100 || a.rms_actual_mm < 0.5) continue;
+    EXPECT_GT(a.correlation, 0.6) << arm << " " << name;
+    EXPECT_NEAR(a.slope, 1.0, 0.25) << arm << " " << name;
+    ++checked;
+  }
+  EXPECT_GE(checked, 3) << arm;
+}
+
+class EvidenceTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    config_ = new deployment::Config(estimator::test::sim_config());
+    frames_ = new test::SimulatedFrames(*config_);
+  }
+  static void TearDownTestSuite() {
+    delete frames_;
+    delete config_;
+  }
+  static Eigen::Isometry3d camera() { return estimator::test::pose_of(config_->camera.pose); }
+  static deployment::Config* config_;
+  static test::SimulatedFrames* frames_;
+};
+deployment::Config* EvidenceTest::config_ = nullptr;
+test::SimulatedFrames* EvidenceTest::frames_ = nullptr;
+
+TEST_F(EvidenceTest, JointJacobiansMatchRenderedChangesOnTheDefaultArm) {
+  expect_joint_jacobians_match(frames_->scene(), estimator::test::side_reach_pose(), camera(),
+                               config_->camera.intrinsics, "default arm");
+}
+
+TEST_F(EvidenceTest, CameraJacobiansMatchRenderedChanges) {
+  renderer::DepthRenderer& r = frames_->renderer();
+  const Intrinsics& in = config_->camera.intrinsics;
+  const JointPositions q = estimator::test::reach_pose();
+  const Frame base = render_frame(&r, frames_->scene(), q, camera(), in);
+  struct Case {
+    const char* name;
+    int column;
+    double delta;
+  };
+  // The seen optical frame in the reported one: 5 mm along each axis,
+  // 0.2 degrees about each.
+  for (const Case c : {Case{"t_x", 0, 0.005}, Case{"t_y", 1, 0.005}, Case{"t_z", 2, 0.005},
+                       Case{"w_x", 3, 0.2 * kDeg}, Case{"w_y", 4, 0.2 * kDeg}, Case{"w_z", 5, 0.2 * kDeg}}) {
+    Eigen::Isometry3d seen = Eigen::Isometry3d::Identity();
+    if (c.column < 3) {
+      seen.translation()[c.column] = c.delta;
+    } else {
+      seen.linear() = Eigen::AngleAxisd(c.delta, Eigen::Vector3d::Unit(c.column - 3)).toRotationMatrix();
+    }
+    const Frame moved = render_frame(&r, frames_->scene(), q, camera() * seen, in);
+    const Agreement a = compare(base, moved, c.column, c.delta);
+    std::cout << "camera " << c.name << ": " << a.pixels << " px, correlation " << a.correlation << ", slope "
+              << a.slope << ", rms change " << a.rms_actual_mm << " mm\n";
+    EXPECT_GT(a.pixels, 1000) << c.name;
+    if (a.rms_actual_mm < 0.5) continue;  // e.g. t_x on a floor seen from above
+    EXPECT_GT(a.correlation, 0.85) << c.name;
+    EXPECT_NEAR(a.slope, 1.0, 0.15) << c.name;
+  }
+}
+
+// A camera 2 m in front of an arm standing at the origin (+x), looking
+// back along -x, optical y down.
+Eigen::Isometry3d front_view(double height_m) {
+  Eigen::Isometry3d world_from_optical = Eigen::Isometry3d::Identity();
+  world_from_optical.translation() = Eigen::Vector3d(1.8, 0.4, height_m);
+  Eigen::Matrix3d r;
+  r.col(2) = Eigen::Vector3d(-1.8, -0.4, 0).normalized();
+  r.col(0) = Eigen::Vector3d(0, 0, 1).cross(r.col(2)).normalized();
+  r.col(1) = r.col(2).cross(r.col(0));
+  world_from_optical.linear() = r;
+  return world_from_optical;
+}
+
+JointPositions bent(const robot_model::KinematicTree& tree) {
+  const double values[7] = {0.3, 0.5, -0.4, -1.0, 0.6, 0.8, 0.3};
+  JointPositions q;
+  for (size_t j = 0; j < tree.actuated_joint_names.size(); ++j)
+    q[tree.actuated_joint_names[j]] = values[j % 7];
+  return q;
+}
+
+TEST(EvidenceOtherArms, JointJacobiansMatchRenderedChangesOnTheIiwa14AndTheKinovaGen3) {
+  if (test::shared_dir().empty())
+    GTEST_SKIP() << "../shared is absent: the iiwa14 and Kinova Gen3 models are not available";
+  const fs::path robots = fs::path(test::shared_dir()) / "robots";
+  const Intrinsics in{176, 144, 150, 150, 87.5, 71.5};
+  {
+    const fs::path urdf = robots / "iiwa14" / "urdf" / "iiwa14_no_collision_relative.urdf";
+    if (!fs::exists(urdf)) GTEST_SKIP() << urdf << " is absent";
+    const robot_model::SceneModel scene = robot_model::load_scene(urdf.string(), {}, {});
+    expect_joint_jacobians_match(scene, bent(scene), front_view(0.7), in, "iiwa14");
+  }
+  {
+    const fs::path urdf = robots / "kinova_gen3" / "kortex_description" / "arms" / "gen3" / "7dof" / "urdf" /
+                          "GEN3-7DOF-NOVISION_FOR_URDF_ARM_V12.urdf";
+    if (!fs::exists(urdf)) GTEST_SKIP() << urdf << " is absent";
+    robot_model::SceneOptions options;
+    options.package_paths = {(robots / "kinova_gen3").string()};
+    const robot_model::SceneModel scene = robot_model::load_scene(urdf.string(), {}, options);
+    expect_joint_jacobians_match(scene, bent(scene), front_view(0.6), in, "Kinova Gen3");
+  }
+}
+
+// ---- The fits on simulated camera frames ----
+
+Parameters parameters(const deployment::Config& config) { return parameters_from(config.discrepancy); }
+
+discrepancy_t evidence_of(test::SimulatedFrames* frames, const deployment::Config& config,
+                          const JointPositions& true_q, const Eigen::Isometry3d& true_camera,
+                          const JointPositions& reported_q, const Eigen::Isometry3d& reported_camera,
+                          uint64_t index) {
+  const Intrinsics& in = config.camera.intrinsics;
+  const std::vector<float> seen = frames->capture(true_q, true_camera, in, index);
+  const depth_image_t camera = make_depth_image("cam", in, 1, 1, true, seen);
+  const Frame model = render_frame(&frames->renderer(), frames->scene(), reported_q, reported_camera, in);
+  const DiscrepancyFrame f = compute_discrepancy(camera, model.depth, model.labels, parameters(config));
+  EXPECT_TRUE(f.summary.usable) << f.summary.unusable_reason;
+  EXPECT_EQ(check_discrepancy(f.summary), "");
+  return f.summary;
+}
+
+TEST_F(EvidenceTest, AnEncoderOffsetIsBestExplainedByItsOwnJoint) {
+  const JointPositions truth = estimator::test::side_reach_pose();
+  uint64_t index = 10;
+  for (const std::string& joint : frames_->scene().actuated_joint_names) {
+    JointPositions reported = truth;
+    reported[joint] += 3 * kDeg;  // the encoder reads 3 degrees more than the arm is
+    const discrepancy_t s = evidence_of(frames_, *config_, truth, camera(), reported, camera(), ++index);
+    ASSERT_TRUE(s.evidence_available);
+    int best = -1;
+    double best_chi2 = -1;
+    int own = -1;
+    for (int j = 0; j < s.num_joints; ++j) {
+      const double chi2 =
+          s.joint_information[j] > 0 ? s.joint_score[j] * s.joint_score[j] / s.joint_information[j] : 0;
+      if (chi2 > best_chi2) {
+        best_chi2 = chi2;
+        best = j;
+      }
+      if (s.joint_name[j] == joint) own = j;
+    }
+    ASSERT_GE(own, 0);
+    const double fit_deg = s.joint_score[own] / s.joint_information[own] / kDeg;
+    const double sigma_deg = 1 / std::sqrt(s.joint_information[own]) / kDeg;
+    std::cout << joint << " +3 deg: best " << s.joint_name[best] << " (chi2 " << best_chi2 << "), own fit "
+              << fit_deg << " +- " << sigma_deg << " deg over " << s.joint_fit_pixels[own] << " px\n";
+    // Known failure (issue 14, open): a5 turns a cylinder about its own
+    // axis; its 3 degrees are best explained by a3 (chi2 37 vs its own).
+    if (joint != "a5") {
+      EXPECT_EQ(s.joint_name[best], joint);
+    }
+    // Seen minus reported: -3 degrees, roughly (a one-step linear fit).
+    EXPECT_LT(fit_deg, -1.0) << joint;
+    EXPECT_GT(fit_deg, -6.0) << joint;
+  }
+}
+
+TEST_F(EvidenceTest, ACameraMovedAlongItsOpticalAxisIsFitted) {
+  const JointPositions q = estimator::test::reach_pose();
+  for (const double dz : {0.02, -0.02}) {
+    Eigen::Isometry3d moved = Eigen::Isometry3d::Identity();
+    moved.translation().z() = dz;
+    // The camera is really 2 cm further forward (back) than reported.
+    const discrepancy_t s = evidence_of(frames_, *config_, q, camera() * moved, q, camera(), 50);
+    ASSERT_TRUE(s.evidence_available);
+    std::cout << "camera moved " << dz << " m: correction";
+    for (double c : s.camera_correction) std::cout << " " << c;
+    std::cout << " over " << s.camera_fit_pixels << " px, static chi2 " << s.static_chi2 << "\n";
+    EXPECT_NEAR(s.camera_correction[2], dz, 0.006);
+    EXPECT_GT(s.camera_fit_pixels, 5000);
+  }
+}
+
+TEST_F(EvidenceTest, NominalFramesFitNothing) {
+  const JointPositions q = estimator::test::side_reach_pose();
+  const discrepancy_t s = evidence_of(frames_, *config_, q, camera(), q, camera(), 77);
+  ASSERT_TRUE(s.evidence_available);
+  const Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>> info(s.camera_information);
+  const Eigen::Map<const Eigen::Matrix<double, 6, 1>> score(s.camera_score);
+  const double camera_chi2 = score.dot(info.ldlt().solve(score));
+  std::cout << "nominal: camera chi2 (6 dof) " << camera_chi2 << ", correction t_z " << s.camera_correction[2]
+            << " m; static chi2 " << s.static_chi2 << " over " << s.camera_fit_pixels << " px; robot chi2 "
+            << s.robot_chi2 << " over " << s.robot_fit_pixels << " px\n";
+  for (int j = 0; j < s.num_joints; ++j) {
+    const double z = s.joint_score[j] / std::sqrt(s.joint_information[j]);
+    std::cout << "  " << s.joint_name[j] << ": fit " << s.joint_score[j] / s.joint_information[j] / kDeg
+              << " deg, " << z << " sigma\n";
+    EXPECT_LT(std::abs(z), 5.0) << s.joint_name[j];
+  }
+  EXPECT_LT(std::abs(s.camera_correction[2]), 0.005);
+  // Per-pixel residuals as noisy as the noise model says: chi2 per pixel near 1.
+  EXPECT_LT(s.static_chi2 / s.camera_fit_pixels, 2.0);
+  EXPECT_GT(s.static_chi2 / s.camera_fit_pixels, 0.3);
+}
+
+TEST(Evidence, LabelsWithoutKinematicsGiveNoEvidence) {
+  depth_image_t d =
+      make_depth_image("cam", Intrinsics{4, 3, 10, 10, 2, 1}, 1, 1, true, std::vector<float>(12, 1.0f));
+  link_labels_t labels = make_link_labels(d, 1, {"a", "floor"}, std::vector<int16_t>(12, kLabelRobotFirst));
+  const DiscrepancyFrame f = compute_discrepancy(d, d, labels, Parameters{});
+  EXPECT_TRUE(f.summary.usable);
+  EXPECT_FALSE(f.summary.evidence_available);
+  EXPECT_EQ(f.summary.num_joints, 0);
+  EXPECT_EQ(f.summary.num_link_bias, 0);
+  EXPECT_EQ(check_discrepancy(f.summary), "");
+}
+
+}  // namespace
+}  // namespace tofguard::discrepancy

@@ -1,0 +1,422 @@
+// The sequential evidence tests (risk/include/tofguard/risk/evidence_tests.hpp)
+// on synthetic evidence with known statistics: a parameter with information
+// I has score s ~ N(0, I) without a fault and s ~ N(I * delta, I) with the
+// parameter off by delta. Then the same evidence through RiskMonitor: the
+// stop at once, the latched suspect and the diagnosis that stays open.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <iostream>
+#include <map>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "test_support.hpp"
+#include "tofguard/deployment/config.hpp"
+#include "tofguard/risk/evidence_tests.hpp"
+#include "tofguard/risk/risk_monitor.hpp"
+#include "tofguard/robot_model/kinematic_tree.hpp"
+
+namespace tofguard::test {
+namespace {
+
+using risk::EvidenceStep;
+using risk::SequentialEvidence;
+
+constexpr double kDeg = M_PI / 180.0;
+constexpr double kRateHz = 30;  // camera.rate_hz of config/sim.yaml
+
+const deployment::Config& sim_config() {
+  static const deployment::Config config =
+      deployment::load_config(source_dir() + "/config/sim.yaml", nullptr);
+  return config;
+}
+
+const robot_model::KinematicTree& friend_arm() {
+  static const robot_model::KinematicTree tree =
+      robot_model::load_kinematic_tree(sim_config().robot.urdf_path);
+  return tree;
+}
+
+const std::vector<std::string> kJoints = {"a1", "a2", "a3", "a4", "a5", "a6", "a7"};
+
+// Information per joint (1/rad^2), from well seen (a1: a 3 degree offset is
+// 52 sigma in one frame) to hardly seen (a7: 0.03 sigma).
+const std::map<std::string, double> kJointInformation = {{"a1", 1e6}, {"a2", 1e5}, {"a3", 1e4}, {"a4", 3e3},
+                                                         {"a5", 1e3}, {"a6", 1e2}, {"a7", 1.0}};
+// Camera information, diagonal: translation 1/m^2, rotation 1/rad^2.
+const std::array<double, 6> kCameraInformation = {3e5, 3e4, 1e3, 1e4, 1e3, 10};
+
+// A usable frame whose evidence fields hold the given scores (all zero by
+// default) and kJointInformation / kCameraInformation.
+discrepancy_t evidence_frame(int64_t seq) {
+  discrepancy_t d{};
+  d.utime = 1'700'000'000'000'000 + seq * 33'333;
+  d.seq = seq;
+  d.camera_id = sim_config().camera.id;
+  d.usable = true;
+  d.calibrated = true;
+  d.width = 176;
+  d.height = 144;
+  d.num_pixels = d.width * d.height;
+  d.num_match = d.num_pixels;
+  d.num_compared = d.num_pixels;
+  d.evidence_available = true;
+  for (int a = 0; a < 6; ++a) d.camera_information[a * 6 + a] = kCameraInformation[a];
+  d.num_joints = static_cast<int>(kJoints.size());
+  for (const std::string& j : kJoints) {
+    d.joint_name.push_back(j);
+    d.joint_fit_pixels.push_back(300);
+    d.joint_score.push_back(0);
+    d.joint_information.push_back(kJointInformation.at(j));
+  }
+  return d;
+}
+
+int joint_index(const std::string& joint) {
+  return static_cast<int>(std::find(kJoints.begin(), kJoints.end(), joint) - kJoints.begin());
+}
+
+// Scores drawn for one frame: every parameter N(I * offset, I), with the
+// offsets given (radians; camera metres / radians), all others 0.
+class ScoreSource {
+ public:
+  explicit ScoreSource(uint32_t seed) : random_(seed) {}
+  discrepancy_t frame(int64_t seq, const std::map<std::string, double>& joint_offsets = {},
+                      const std::array<double, 6>& camera_offset = {}) {
+    discrepancy_t d = evidence_frame(seq);
+    for (int i = 0; i < d.num_joints; ++i) {
+      const double information = d.joint_information[i];
+      const auto offset = joint_offsets.find(d.joint_name[i]);
+      const double delta = offset == joint_offsets.end() ? 0 : offset->second;
+      d.joint_score[i] = information * delta + std::sqrt(information) * normal_(random_);
+    }
+    for (int a = 0; a < 6; ++a) {
+      const double information = kCameraInformation[a];
+      d.camera_score[a] = information * camera_offset[a] + std::sqrt(information) * normal_(random_);
+    }
+    return d;
+  }
+
+ private:
+  std::mt19937_64 random_;
+  std::normal_distribution<double> normal_;
+};
+
+TEST(EvidenceTests, LogCoshIsExactAndNeverOverflows) {
+  for (double x : {0.0, 1e-8, 0.3, -1.7, 5.0, 20.0})
+    EXPECT_NEAR(risk::log_cosh(x), std::log(std::cosh(x)), 1e-12);
+  EXPECT_NEAR(risk::log_cosh(1e6), 1e6 - std::log(2.0), 1e-6);
+  EXPECT_NEAR(risk::log_cosh(-1e6), 1e6 - std::log(2.0), 1e-6);
+  // No information, no score: the alternative and the null agree.
+  EXPECT_DOUBLE_EQ(risk::joint_llr(0, 0, 3 * kDeg), 0);
+  EXPECT_DOUBLE_EQ(risk::camera_llr({}, {}, {0.02, 0.02, 0.02, kDeg, kDeg, kDeg}), 0);
+}
+
+TEST(EvidenceTests, TheThresholdFollowsFromTheFalseStopRate) {
+  // docs/safety-chain.md: h = ln(K * rate * 3600 s/h * period).
+  EXPECT_NEAR(risk::cusum_threshold(8, 30, 1000), std::log(8 * 30 * 3600.0 * 1000), 1e-12);
+  EXPECT_NEAR(risk::cusum_threshold(8, 30, 1000), 20.577, 1e-3);
+  const SequentialEvidence evidence(sim_config().risk, friend_arm(), sim_config().camera.rate_hz);
+  EXPECT_EQ(evidence.hypotheses(), 8);  // the camera and a1..a7
+  EXPECT_NEAR(evidence.threshold(), 20.577, 1e-3);
+  EXPECT_NEAR(evidence.warning_level(), 0.5 * 20.577, 1e-3);
+}
+
+// 200 000 nominal frames (1.85 hours at 30 Hz): no test crosses h, and
+// every per-frame log-likelihood ratio has a negative mean (the CUSUMs
+// drift down to 0).
+TEST(EvidenceTests, NominalFramesNeverCrossAndEveryRatioDriftsDown) {
+  const risk::RiskSettings& settings = sim_config().risk;
+  SequentialEvidence evidence(settings, friend_arm(), kRateHz);
+  ScoreSource source(14);
+  const std::array<double, 6> camera_delta = {0.02, 0.02, 0.02, kDeg, kDeg, kDeg};
+  std::map<std::string, double> llr_sum;
+  double camera_llr_sum = 0;
+  std::map<std::string, double> largest;
+  double camera_largest = 0;
+  constexpr int kFrames = 200000;
+  for (int k = 0; k < kFrames; ++k) {
+    const discrepancy_t d = source.frame(k);
+    const EvidenceStep step = evidence.update(d);
+    ASSERT_FALSE(step.crossed) << "frame " << k << ": " << step.finding.detail;
+    for (int i = 0; i < d.num_joints; ++i) {
+      llr_sum[d.joint_name[i]] += risk::joint_llr(d.joint_score[i], d.joint_information[i], 3 * kDeg);
+      largest[d.joint_name[i]] = std::max(largest[d.joint_name[i]], evidence.joint_cusum(d.joint_name[i]));
+    }
+    std::array<double, 6> score;
+    std::array<double, 36> information;
+    std::copy(d.camera_score, d.camera_score + 6, score.begin());
+    std::copy(d.camera_information, d.camera_information + 36, information.begin());
+    camera_llr_sum += risk::camera_llr(score, information, camera_delta);
+    camera_largest = std::max(camera_largest, evidence.camera_cusum());
+  }
+  for (const auto& [joint, sum] : llr_sum) {
+    EXPECT_LT(sum / kFrames, 0) << joint;
+    EXPECT_LT(largest[joint], evidence.threshold()) << joint;
+    std::cout << joint << ": mean LLR " << sum / kFrames << ", largest CUSUM " << largest[joint] << "\n";
+  }
+  EXPECT_LT(camera_llr_sum / kFrames, 0);
+  std::cout << "camera: mean LLR " << camera_llr_sum / kFrames << ", largest CUSUM " << camera_largest
+            << ", h " << evidence.threshold() << "\n";
+}
+
+TEST(EvidenceTests, AGrossFaultCrossesOnItsFirstFrame) {
+  SequentialEvidence evidence(sim_config().risk, friend_arm(), kRateHz);
+  ScoreSource source(3);
+  // a1 (I = 1e6 / rad^2) off by 3 degrees: 2742 in delta^2 I, drift 1371 per frame.
+  const EvidenceStep step = evidence.update(source.frame(1, {{"a1", 3 * kDeg}}));
+  ASSERT_TRUE(step.crossed);
+  EXPECT_EQ(step.finding.cause, risk_t::CAUSE_JOINT_ERROR);
+  EXPECT_EQ(step.finding.suspect, "a1");
+  EXPECT_DOUBLE_EQ(step.finding.threshold, evidence.threshold());
+  EXPECT_NE(step.finding.detail.find("fitted offset (seen - reported) "), std::string::npos)
+      << step.finding.detail;
+  EXPECT_NE(step.finding.detail.find("° ± 0.1°"), std::string::npos) << step.finding.detail;
+
+  // The camera 2 cm off sideways (x, I = 3e5 / m^2: 120 in delta^2 I) at once.
+  SequentialEvidence camera(sim_config().risk, friend_arm(), kRateHz);
+  const EvidenceStep moved = camera.update(source.frame(1, {}, {0.02, 0, 0, 0, 0, 0}));
+  ASSERT_TRUE(moved.crossed);
+  EXPECT_EQ(moved.finding.cause, risk_t::CAUSE_CALIBRATION_ERROR);
+  EXPECT_EQ(moved.finding.suspect, "");
+}
+
+// A marginal fault accumulates: a4 (I = 3e3 / rad^2) off by 3 degrees is
+// 2.9 in delta^2 I per frame, so it crosses after about h / (delta^2 I / 2)
+// frames (the mixture over both signs costs up to log 2 per frame more).
+TEST(EvidenceTests, AMarginalFaultCrossesAfterSeveralFramesAsDerived) {
+  const double delta = 3 * kDeg;
+  const double drift = delta * delta * kJointInformation.at("a4") / 2;
+  ScoreSource source(5);
+  double frames_sum = 0;
+  constexpr int kTrials = 200;
+  double h = 0;
+  for (int trial = 0; trial < kTrials; ++trial) {
+    SequentialEvidence evidence(sim_config().risk, friend_arm(), kRateHz);
+    h = evidence.threshold();
+    int frames = 0;
+    EvidenceStep step;
+    while (!step.crossed) {
+      step = evidence.update(source.frame(frames, {{"a4", delta}}));
+      ++frames;
+      ASSERT_LT(frames, 1000);
+    }
+    EXPECT_EQ(step.finding.suspect, "a4");
+    frames_sum += frames;
+  }
+  const double mean = frames_sum / kTrials;
+  const double derived = h / drift;
+  std::cout << "a4 off by 3 deg, delta^2 I = " << 2 * drift << ": crossed after " << mean
+            << " frames, h / (delta^2 I / 2) = " << derived << "\n";
+  EXPECT_GT(mean, 3);
+  EXPECT_GE(mean, 0.8 * derived);
+  EXPECT_LE(mean, 2.0 * derived);
+}
+
+// Two joints' tests crossed: the suspect is the one whose one-parameter fit
+// explains this frame's residual best (the largest s^2 / I).
+TEST(EvidenceTests, TheSuspectIsTheCrossedJointWhoseFitExplainsMost) {
+  SequentialEvidence evidence(sim_config().risk, friend_arm(), kRateHz);
+  discrepancy_t d = evidence_frame(1);
+  d.joint_score[joint_index("a2")] = 1e5 * 4 * kDeg;  // s^2 / I = 1e5 * (4 deg)^2 = 487
+  d.joint_score[joint_index("a3")] = 1e4 * 6 * kDeg;  // 1e4 * (6 deg)^2 = 110
+  EvidenceStep step = evidence.update(d);
+  ASSERT_TRUE(step.crossed);
+  EXPECT_GE(evidence.joint_cusum("a3"), evidence.threshold());
+  EXPECT_EQ(step.finding.suspect, "a2");
+  d.joint_score[joint_index("a3")] = 1e4 * 15 * kDeg;  // 685
+  step = evidence.update(d);
+  EXPECT_EQ(step.finding.suspect, "a3");
+}
+
+TEST(EvidenceTests, GrowingEvidenceWarnsBeforeItCrosses) {
+  SequentialEvidence evidence(sim_config().risk, friend_arm(), kRateHz);
+  discrepancy_t d = evidence_frame(1);
+  // a5 (I = 1e3): s = I * 6 deg gives LLR = log cosh(104.7 * 0.0524) - 1.37 = 3.4 per frame.
+  d.joint_score[joint_index("a5")] = 1e3 * 6 * kDeg;
+  int warnings = 0;
+  EvidenceStep step;
+  for (int k = 0; k < 10 && !step.crossed; ++k) {
+    step = evidence.update(d);
+    if (step.warning) {
+      ++warnings;
+      EXPECT_EQ(step.finding.suspect, "a5");
+      EXPECT_GE(evidence.joint_cusum("a5"), evidence.warning_level());
+      EXPECT_FALSE(step.quiet);
+    }
+  }
+  EXPECT_TRUE(step.crossed);
+  EXPECT_GE(warnings, 2);
+  evidence.reset();
+  EXPECT_TRUE(evidence.quiet());
+  EXPECT_DOUBLE_EQ(evidence.joint_cusum("a5"), 0);
+}
+
+// ---- Through RiskMonitor: judged in frame order ----
+
+constexpr int64_t kStart = 5'000'000'000;  // monotonic
+constexpr int64_t kMs = 1000;
+
+heartbeat_t heartbeat(const std::string& process) {
+  heartbeat_t hb{};
+  hb.process = process;
+  return hb;
+}
+
+void feed_all(risk::RiskMonitor* m, int64_t now) {
+  m->on_depth(now);
+  joint_state_t s{};
+  s.num_joints = 1;
+  s.name = {"a1"};
+  s.position = {0};
+  s.velocity = {0.5};
+  m->on_joint_state(s, now);
+  for (const char* p : {"tofguard-camera", "tofguard-renderer", "tofguard-discrepancy"}) {
+    m->on_heartbeat(heartbeat(p), now);
+  }
+}
+
+risk_t judge(risk::RiskMonitor* m, const discrepancy_t& d, int64_t* now) {
+  *now += 33 * kMs;
+  feed_all(m, *now);
+  const std::vector<risk_t> verdicts = m->on_frame(d, *now);
+  EXPECT_EQ(verdicts.size(), 1u) << "frame " << d.seq;
+  return verdicts.empty() ? risk_t{} : verdicts.front();
+}
+
+TEST(RiskMonitorEvidence, AGrossFaultStopsOnItsFirstFrameAndTheSuspectStaysLatched) {
+  risk::RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kRateHz, kStart);
+  ScoreSource source(7);
+  int64_t now = kStart;
+  int64_t seq = 100;
+  for (; seq < 110; ++seq) EXPECT_EQ(judge(&m, source.frame(seq), &now).level, risk_t::SAFE);
+  // a3 off by 6 degrees (I = 1e4: drift 2 * 27 - 27 / 2 = 41 > h): DANGEROUS on its first frame.
+  risk_t r = judge(&m, source.frame(seq++, {{"a3", 6 * kDeg}}), &now);
+  EXPECT_EQ(r.level, risk_t::DANGEROUS);
+  EXPECT_EQ(r.cause, risk_t::CAUSE_JOINT_ERROR);
+  EXPECT_EQ(r.suspect, "a3");
+  const int64_t stop_seq = r.seq;
+  // Later a2's evidence grows larger (s^2/I of a2 > a3's): the diagnosis
+  // keeps the suspect named at the stop.
+  for (int k = 0; k < 20; ++k) {
+    r = judge(&m, source.frame(seq++, {{"a3", 6 * kDeg}, {"a2", 5 * kDeg}}), &now);
+    EXPECT_EQ(r.level, risk_t::DANGEROUS);
+    EXPECT_EQ(r.cause, risk_t::CAUSE_JOINT_ERROR);
+    EXPECT_EQ(r.suspect, "a3") << r.detail;
+    EXPECT_EQ(r.detail.rfind("diagnosis open since seq " + std::to_string(stop_seq) + ": joint a3", 0), 0u)
+        << r.detail;
+  }
+  EXPECT_NE(r.detail.find("this frame: joint a2"), std::string::npos) << r.detail;
+}
+
+TEST(RiskMonitorEvidence, TheDiagnosisClosesOnlyAfterClearFramesWithoutAnyFinding) {
+  const int clear_frames = sim_config().risk.evidence_clear_frames;
+  ASSERT_EQ(clear_frames, 10);
+  risk::RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kRateHz, kStart);
+  ScoreSource source(9);
+  int64_t now = kStart;
+  int64_t seq = 1;
+  // The camera 2 cm off sideways: a calibration error at once.
+  risk_t r = judge(&m, source.frame(seq++, {}, {0.02, 0, 0, 0, 0, 0}), &now);
+  EXPECT_EQ(r.level, risk_t::DANGEROUS);
+  EXPECT_EQ(r.cause, risk_t::CAUSE_CALIBRATION_ERROR);
+  EXPECT_NE(r.detail.find("fitted correction ("), std::string::npos) << r.detail;
+  // The fault persists for 30 frames: never SAFE.
+  for (int k = 0; k < 30; ++k) {
+    r = judge(&m, source.frame(seq++, {}, {0.02, 0, 0, 0, 0, 0}), &now);
+    EXPECT_EQ(r.level, risk_t::DANGEROUS);
+    EXPECT_EQ(r.cause, risk_t::CAUSE_CALIBRATION_ERROR);
+  }
+  // Fixed: the capped camera CUSUM falls below the warning level within a
+  // few frames (its weakly seen alternatives drift down slowly), DANGEROUS
+  // meanwhile; then clear_frames - 1 clean frames are still DANGEROUS...
+  for (int k = 0; r.detail.find("[clean 1/10 frames]") == std::string::npos; ++k) {
+    ASSERT_LT(k, 100) << r.detail;
+    r = judge(&m, source.frame(seq++), &now);
+    EXPECT_EQ(r.level, risk_t::DANGEROUS);
+  }
+  for (int k = 2; k < clear_frames - 3; ++k) {
+    r = judge(&m, source.frame(seq++), &now);
+    EXPECT_EQ(r.level, risk_t::DANGEROUS) << k;
+    EXPECT_NE(r.detail.find("[clean " + std::to_string(k) + "/10 frames]"), std::string::npos) << r.detail;
+  }
+  // ... and any finding restarts the count: an unknown object for one frame.
+  discrepancy_t object = source.frame(seq++);
+  object.near_arm_area_m2 = 0.01f;
+  object.near_arm_pixels = 200;
+  r = judge(&m, object, &now);
+  EXPECT_EQ(r.level, risk_t::DANGEROUS);
+  EXPECT_EQ(r.cause, risk_t::CAUSE_CALIBRATION_ERROR);  // the diagnosis, not the new finding
+  EXPECT_NE(r.detail.find("this frame: unknown object"), std::string::npos) << r.detail;
+  for (int k = 1; k < clear_frames; ++k) {
+    r = judge(&m, source.frame(seq++), &now);
+    EXPECT_EQ(r.level, risk_t::DANGEROUS) << k;
+    EXPECT_TRUE(m.diagnosis_open());
+  }
+  r = judge(&m, source.frame(seq++), &now);
+  EXPECT_EQ(r.level, risk_t::SAFE) << r.detail;
+  EXPECT_FALSE(m.diagnosis_open());
+  EXPECT_DOUBLE_EQ(m.evidence().camera_cusum(), 0);
+}
+
+// A sensor fault's diagnosis stays open too.
+TEST(RiskMonitorEvidence, ASensorFaultsDiagnosisStaysOpen) {
+  risk::RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kRateHz, kStart);
+  ScoreSource source(11);
+  int64_t now = kStart;
+  discrepancy_t unusable = source.frame(1);
+  unusable.usable = false;
+  unusable.evidence_available = false;
+  unusable.unusable_kind = discrepancy_t::UNUSABLE_RENDERER;
+  unusable.unusable_reason = "renderer: joint a3 missing";
+  EXPECT_EQ(judge(&m, unusable, &now).level, risk_t::WARNING);
+  unusable.seq = 2;
+  EXPECT_EQ(judge(&m, unusable, &now).level, risk_t::DANGEROUS);
+  for (int64_t seq = 3; seq < 3 + 9; ++seq) {
+    const risk_t r = judge(&m, source.frame(seq), &now);
+    EXPECT_EQ(r.level, risk_t::DANGEROUS);
+    EXPECT_EQ(r.cause, risk_t::CAUSE_SENSOR_FAULT);
+    EXPECT_EQ(r.suspect, sim_config().channels.labels);
+  }
+  EXPECT_EQ(judge(&m, source.frame(12), &now).level, risk_t::SAFE);
+}
+
+// With an estimate wait, frames queue behind a waiting one and the tests
+// still see them in frame order: the verdicts come in order, the stop at
+// the first faulty frame.
+TEST(RiskMonitorEvidence, FramesQueuedBehindAnEstimateWaitAreJudgedInOrder) {
+  deployment::Config config = sim_config();
+  config.risk.estimate_wait_us = 60 * kMs;
+  risk::RiskMonitor m(config.risk, config.channels, friend_arm(), kRateHz, kStart);
+  ScoreSource source(13);
+  int64_t now = kStart;
+  feed_all(&m, now);
+  discrepancy_t object = source.frame(1);
+  object.near_arm_area_m2 = 0.01f;  // an unknown object: a model mismatch that waits
+  EXPECT_TRUE(m.on_frame(object, now).empty());
+  now += 20 * kMs;
+  feed_all(&m, now);
+  EXPECT_TRUE(m.on_frame(source.frame(2, {{"a2", 3 * kDeg}}), now).empty());
+  now += 20 * kMs;
+  feed_all(&m, now);
+  EXPECT_TRUE(m.on_frame(source.frame(3, {{"a2", 3 * kDeg}}), now).empty());
+  now += 30 * kMs;
+  feed_all(&m, now);
+  const std::vector<risk_t> verdicts = m.release_due(now);
+  ASSERT_EQ(verdicts.size(), 3u);
+  EXPECT_EQ(verdicts[0].seq, 1);
+  EXPECT_EQ(verdicts[0].level, risk_t::WARNING);
+  EXPECT_EQ(verdicts[0].cause, risk_t::CAUSE_UNKNOWN_OBJECT);
+  EXPECT_EQ(verdicts[1].seq, 2);
+  EXPECT_EQ(verdicts[1].level, risk_t::DANGEROUS);
+  EXPECT_EQ(verdicts[1].suspect, "a2");
+  EXPECT_EQ(verdicts[2].seq, 3);
+  EXPECT_EQ(verdicts[2].suspect, "a2");
+}
+
+}  // namespace
+}  // namespace tofguard::test
