@@ -181,6 +181,16 @@ std::string check_evidence(const discrepancy_t& d) {
       return expected("joint_information" + at, "a finite number >= 0", d.joint_information[j]);
     }
   }
+  if (d.num_joint_information_matrix != d.num_joints * d.num_joints ||
+      d.joint_information_matrix.size() != static_cast<size_t>(d.num_joint_information_matrix)) {
+    return expected("num_joint_information_matrix", "num_joints^2 = " + std::to_string(d.num_joints * d.num_joints),
+                    d.num_joint_information_matrix);
+  }
+  if (auto p = finite_array(d.joint_information_matrix.data(), d.num_joint_information_matrix,
+                            "joint_information_matrix");
+      !p.empty()) {
+    return p;
+  }
   if (d.robot_fit_pixels < 0) return expected("robot_fit_pixels", "a count >= 0", d.robot_fit_pixels);
   if (!(std::isfinite(d.robot_chi2) && d.robot_chi2 >= 0)) {
     return expected("robot_chi2", "a finite sum >= 0", d.robot_chi2);

@@ -141,6 +141,8 @@ void clear_evidence(discrepancy_t* s) {
   s->joint_fit_pixels.clear();
   s->joint_score.clear();
   s->joint_information.clear();
+  s->num_joint_information_matrix = 0;
+  s->joint_information_matrix.clear();
   s->robot_fit_pixels = 0;
   s->robot_chi2 = 0;
 }
@@ -164,6 +166,8 @@ void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered
   s.joint_fit_pixels.assign(num_joints, 0);
   s.joint_score.assign(num_joints, 0.0);
   s.joint_information.assign(num_joints, 0.0);
+  // Upper triangle accumulated per pixel, mirrored at the end.
+  std::vector<double> joint_matrix(static_cast<size_t>(num_joints) * num_joints, 0.0);
   Eigen::Matrix<double, 6, 1> camera_score = Eigen::Matrix<double, 6, 1>::Zero();
   Eigen::Matrix<double, 6, 6> camera_information = Eigen::Matrix<double, 6, 6>::Zero();
   double camera_row[6];
@@ -194,6 +198,8 @@ void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered
         ++s.joint_fit_pixels[j];
         s.joint_score[j] -= w * jj * r;
         s.joint_information[j] += w * jj * jj;
+        double* row = &joint_matrix[static_cast<size_t>(j) * num_joints];
+        for (int k = j; k < num_joints; ++k) row[k] += w * jj * joint_row[k];
       }
     } else {
       ++s.camera_fit_pixels;
@@ -229,6 +235,11 @@ void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered
     s.link_bias_mm[l] = static_cast<float>(link_sum_wr[l] / link_sum_w[l]);
     s.link_bias_sigma_mm[l] = static_cast<float>(1.0 / std::sqrt(link_sum_w[l]));
   }
+  for (int j = 0; j < num_joints; ++j)
+    for (int k = 0; k < j; ++k)
+      joint_matrix[static_cast<size_t>(j) * num_joints + k] = joint_matrix[static_cast<size_t>(k) * num_joints + j];
+  s.num_joint_information_matrix = num_joints * num_joints;
+  s.joint_information_matrix = std::move(joint_matrix);
   s.num_joints = num_joints;
   s.joint_name = labels.joint_name;
   s.evidence_available = true;

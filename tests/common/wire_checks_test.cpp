@@ -87,6 +87,8 @@ discrepancy_t discrepancy_with_evidence() {
   d.joint_fit_pixels = {10, 4};
   d.joint_score = {100, -3};
   d.joint_information = {1e5, 2e3};
+  d.num_joint_information_matrix = 4;
+  d.joint_information_matrix = {1e5, 10, 10, 2e3};
   d.robot_fit_pixels = 10;
   d.robot_chi2 = 9;
   return d;
@@ -126,6 +128,13 @@ TEST(WireChecks, DiscrepancyEvidence) {
   d = discrepancy_with_evidence();
   d.joint_information[0] = -2;
   EXPECT_EQ(field_of(d), "joint_information[0]");
+  d = discrepancy_with_evidence();
+  d.num_joint_information_matrix = 2;
+  d.joint_information_matrix.resize(2);
+  EXPECT_EQ(field_of(d), "num_joint_information_matrix");
+  d = discrepancy_with_evidence();
+  d.joint_information_matrix[2] = kNaN;
+  EXPECT_EQ(field_of(d), "joint_information_matrix[2]");
   d = discrepancy_with_evidence();
   d.robot_chi2 = std::nan("");
   EXPECT_EQ(field_of(d), "robot_chi2");

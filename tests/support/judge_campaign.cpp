@@ -1,6 +1,7 @@
 #include "judge_campaign.hpp"
 
 #include <algorithm>
+#include <cstdlib>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -76,6 +77,39 @@ double joint_position(const sim::JointMotion& m, double t_s) {
 }
 double joint_velocity(const sim::JointMotion& m, double t_s) {
   return m.amplitude * 2 * kPi / m.period_s * std::cos(2 * kPi * t_s / m.period_s + m.phase_rad);
+}
+
+// Pixels whose noise-free depth differs by more than 3 sigma(d) between the
+// model at the true joints and pose and `reported_depth_m` (or that one
+// has a surface and the other none).
+int changed_pixels(renderer::DepthRenderer& model, const robot_model::SceneModel& scene,
+                   const robot_model::JointPositions& true_joints, const Eigen::Isometry3d& true_pose,
+                   const std::vector<float>& reported_depth_m, const Intrinsics& intrinsics,
+                   const discrepancy::DiscrepancySettings& noise) {
+  const robot_model::LinkPoses poses = robot_model::forward_kinematics(scene, true_joints);
+  const renderer::RenderResult truth = model.render_at(poses, true_pose, intrinsics);
+  if (!truth.usable) throw std::runtime_error(truth.unusable_reason);
+  int changed = 0;
+  for (size_t i = 0; i < truth.depth_m.size(); ++i) {
+    const double a = truth.depth_m[i];
+    const double b = reported_depth_m[i];
+    if ((a > 0) != (b > 0)) {
+      ++changed;
+      continue;
+    }
+    const double d = std::max(a, b);
+    const double sigma_m = (noise.noise_sigma_at_0m_mm + noise.noise_sigma_per_m2_mm * d * d) / 1000;
+    if (std::abs(a - b) > 3 * sigma_m) ++changed;
+  }
+  return changed;
+}
+
+std::string fixed_text(double value, int decimals) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(decimals);
+  s << value;
+  return s.str();
 }
 
 }  // namespace
@@ -211,7 +245,7 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
   // The model as tofguard-renderer loads it (the config's geometry and
   // padding), and the tree tofguard-risk loads.
   robot_model::SceneOptions options;
-  options.geometry = config.renderer.geometry;
+  options.geometry = robot_model::parse_geometry_source(config.renderer.geometry);
   options.padding_m = config.renderer.padding_m;
   options.package_paths = config.robot.package_paths;
   const robot_model::SceneModel model_scene =
@@ -226,10 +260,11 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
 
   std::vector<CampaignResult> results;
   for (const CampaignRun& run : runs) {
-    risk::RiskMonitor monitor(config.risk, config.channels, robot_tree, 0);
+    risk::RiskMonitor monitor(config.risk, config.channels, robot_tree, config.camera.rate_hz, 0);
     CampaignResult result;
     result.label = run.fault.label;
     const int num_frames = run.onset_frame + run.frames_after_onset;
+    std::map<std::string, double> previous_t;
     for (int k = 0; k < num_frames; ++k) {
       const double t_s = run.start_s + k * period_s;
       const int64_t now_us = (k + 1) * period_us;
@@ -247,7 +282,6 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
                                           ? run.fault.offset
                                           : 0.0));
         state.velocity.push_back(joint_velocity(m, t_s));
-        state.effort.push_back(0);
       }
       state.num_joints = static_cast<int32_t>(state.name.size());
       robot_model::JointPositions reported_joints;
@@ -265,14 +299,44 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
       if (!poses.usable) throw std::runtime_error(poses.unusable_reason);
       renderer::RenderResult rendered_result = model.render_at(poses, reported_pose, intrinsics);
       if (!rendered_result.usable) throw std::runtime_error(rendered_result.unusable_reason);
+      const std::vector<float> rendered_result_depth = rendered_result.depth_m;
       const depth_image_t rendered = make_depth_image(config.camera.id, intrinsics, state.utime, k,
                                                       /*calibrated=*/true, rendered_result.depth_m);
       link_labels_t labels = make_link_labels(camera, model_scene.num_robot_links, model_scene.link_names(),
                                               std::move(rendered_result.labels));
       renderer::set_rendered_kinematics(renderer::rendered_kinematics(model_scene, poses, reported_pose), &labels);
 
+      if (k == run.onset_frame && run.fault.kind != CampaignFault::Kind::kNone) {
+        result.changed_pixels = changed_pixels(model, model_scene, true_joints, true_pose, rendered_result_depth,
+                                               intrinsics, config.discrepancy);
+      }
       const discrepancy::DiscrepancyFrame frame =
           discrepancy::compute_discrepancy(camera, rendered, labels, parameters);
+      if (k < run.onset_frame || run.fault.kind == CampaignFault::Kind::kNone) {
+        const discrepancy_t& d = frame.summary;
+        auto add_score = [&](double score, double information) {
+          if (!(information > 0)) return;
+          const double t = score / std::sqrt(information);
+          ++result.nominal_scores;
+          result.nominal_score_sum_sq += t * t;
+          result.nominal_scores_beyond_4 += std::abs(t) > 4 ? 1 : 0;
+          result.nominal_score_max_abs = std::max(result.nominal_score_max_abs, std::abs(t));
+        };
+        for (int j = 0; j < d.num_joints; ++j) {
+          add_score(d.joint_score[j], d.joint_information[j]);
+          if (!(d.joint_information[j] > 0)) continue;
+          const double t = d.joint_score[j] / std::sqrt(d.joint_information[j]);
+          const auto previous = previous_t.find(d.joint_name[j]);
+          if (previous != previous_t.end()) {
+            ++result.nominal_differences;
+            result.nominal_difference_sum_sq += (t - previous->second) * (t - previous->second) / 2;
+          }
+          previous_t[d.joint_name[j]] = t;
+        }
+        if (std::getenv("TOFGUARD_CAMPAIGN_CAMERA_SCORES") != nullptr)
+          for (int a = 0; a < 6 && d.evidence_available; ++a)
+            add_score(d.camera_score[a], d.camera_information[7 * a]);
+      }
       monitor.on_depth(now_us);
       monitor.on_joint_state(state, now_us);
       for (const risk_t& verdict : monitor.on_frame(frame.summary, now_us)) {
@@ -314,16 +378,29 @@ std::string campaign_report(const std::string& arm, const std::vector<CampaignRe
     int runs = 0, detected = 0, right_cause = 0, right_suspect = 0, false_stops = 0, safe_after = 0,
         switches = 0, frames = 0;
     std::vector<int> latency;
+    int64_t scores = 0, scores_beyond_4 = 0;
+    double score_sum_sq = 0, score_max_abs = 0;
+    int64_t differences = 0;
+    double difference_sum_sq = 0;
   };
   std::map<std::string, Tally> by_kind;
   std::ostringstream misses;
   for (const CampaignResult& r : results) {
-    const std::string kind = r.label == "nominal"                        ? "nominal"
-                             : r.label.rfind("camera", 0) == 0           ? "camera pose"
-                             : r.label.find(" 3 deg") != std::string::npos ? "joint offset 3 deg"
-                             : r.label.find(" 5 deg") != std::string::npos ? "joint offset 5 deg"
-                                                                           : "joint offset >= 10 deg";
+    std::string kind = r.label;
+    if (r.label.rfind("camera", 0) == 0) {
+      kind = "camera pose";
+    } else if (r.label != "nominal") {
+      // "<joint> +<deg> deg"
+      const size_t sign = r.label.find_last_of("+-");
+      kind = "joint offset " + r.label.substr(sign + 1);
+    }
     Tally& t = by_kind[kind];
+    t.scores += r.nominal_scores;
+    t.score_sum_sq += r.nominal_score_sum_sq;
+    t.scores_beyond_4 += r.nominal_scores_beyond_4;
+    t.score_max_abs = std::max(t.score_max_abs, r.nominal_score_max_abs);
+    t.differences += r.nominal_differences;
+    t.difference_sum_sq += r.nominal_difference_sum_sq;
     ++t.runs;
     t.frames += r.frames_judged;
     t.false_stops += r.false_stop ? 1 : 0;
@@ -335,8 +412,13 @@ std::string campaign_report(const std::string& arm, const std::vector<CampaignRe
     t.safe_after += r.safe_after_stop;
     t.switches += r.suspect_changes;
     if (r.stopped) t.latency.push_back(r.stop_frames);
+    if (std::getenv("TOFGUARD_CAMPAIGN_VERBOSE") != nullptr) {
+      misses << "  " << r.label << ": " << (r.stopped ? std::to_string(r.stop_frames) + " frames, " : "no stop, ")
+             << risk_cause_name(r.cause) << " " << r.suspect << ": " << r.detail << "\n";
+    }
     if (!r.stopped) {
-      misses << "- " << arm << ", " << r.label << ": not detected\n";
+      misses << "- " << arm << ", " << r.label << ": not detected (the fault changes " << r.changed_pixels
+             << " pixels by more than 3 sigma)\n";
     } else if (!r.right_suspect) {
       misses << "- " << arm << ", " << r.label << ": stopped as " << risk_cause_name(r.cause)
              << (r.suspect.empty() ? "" : " " + r.suspect) << " (" << r.detail << ")\n";
@@ -365,6 +447,24 @@ std::string campaign_report(const std::string& arm, const std::vector<CampaignRe
     out << "| " << kind << " | " << t.runs << " | " << t.frames << " | " << t.detected << " | " << t.right_cause
         << " | " << t.right_suspect << " | " << latency << " | " << t.safe_after << " | " << t.switches << " | "
         << t.false_stops << " |\n";
+  }
+  int64_t scores = 0, beyond = 0, differences = 0;
+  double sum_sq = 0, max_abs = 0, difference_sum_sq = 0;
+  for (const auto& [kind, t] : by_kind) {
+    differences += t.differences;
+    difference_sum_sq += t.difference_sum_sq;
+    scores += t.scores;
+    beyond += t.scores_beyond_4;
+    sum_sq += t.score_sum_sq;
+    max_abs = std::max(max_abs, t.score_max_abs);
+  }
+  if (scores > 0) {
+    out << "\nFault-free frames: " << scores << " standardised scores s/sqrt(I) (joints, camera axes): variance "
+        << fixed_text(sum_sq / static_cast<double>(scores), 2) << " (N(0,1): 1), beyond 4: " << beyond << " ("
+        << fixed_text(1e6 * static_cast<double>(beyond) / static_cast<double>(scores), 0)
+        << " per million; N(0,1): 63), largest |t| " << fixed_text(max_abs, 1)
+        << "; from frame to frame (noise alone): variance "
+        << fixed_text(differences > 0 ? difference_sum_sq / static_cast<double>(differences) : 0, 2) << "\n";
   }
   const std::string m = misses.str();
   if (!m.empty()) out << "\n" << m;

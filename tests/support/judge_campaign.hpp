@@ -90,6 +90,25 @@ struct CampaignResult {
   int safe_after_stop = 0;
   int suspect_changes = 0;
   int frames_judged = 0;
+  // At the onset, without camera noise: pixels whose depth the fault
+  // changes by more than 3 sigma of the camera's noise (the model rendered
+  // at the true and at the reported joints and pose). A fault that changes
+  // no pixel cannot be seen by any camera rule.
+  int changed_pixels = 0;
+  // Before the onset (nominal frames): the standardised scores
+  // t = s / sqrt(I) of every joint and camera parameter with information,
+  // which the sequential tests take to be N(0, 1) without a fault
+  // (docs/safety-chain.md): how many, their sum of squares, how many beyond
+  // 4 (N(0,1): 6.3e-5) and the largest |t|.
+  int64_t nominal_scores = 0;
+  double nominal_score_sum_sq = 0;
+  int64_t nominal_scores_beyond_4 = 0;
+  double nominal_score_max_abs = 0;
+  // Half the mean square of frame-to-frame differences of each joint's t:
+  // the noise's share of the variance (a bias that changes slowly with the
+  // pose cancels in the difference).
+  int64_t nominal_differences = 0;
+  double nominal_difference_sum_sq = 0;
 };
 
 // Runs `runs` on `arm`, each from a fresh chain (new CUSUMs, new latch).
