@@ -80,7 +80,7 @@ link_labels_t labels_header(const depth_image_t& frame, int num_robot_links,
     throw std::invalid_argument("make_link_labels: num_robot_links " + std::to_string(num_robot_links) +
                                 ", expected 0.." + std::to_string(link_names.size()));
   }
-  link_labels_t m;
+  link_labels_t m{};
   m.utime = frame.utime;
   m.seq = frame.seq;
   m.camera_id = frame.camera_id;

@@ -96,12 +96,26 @@ TEST_F(SafetyChain, NoiseStaysSafeAnObjectIsDangerousADeadRendererIsAComponentFa
   EXPECT_EQ(risk_for(first_object + 2)->level, risk_t::DANGEROUS);
   EXPECT_EQ(risk_for(first_object + 2)->cause, risk_t::CAUSE_UNKNOWN_OBJECT);
 
-  // Back to nominal, then the renderer dies: no rendered frames, no
-  // heartbeat. The chain reports it by itself.
-  const int64_t clear = seq_ + 3;
+  // Back to nominal: the stop's diagnosis stays open (DANGEROUS, the same
+  // cause) until risk.evidence.clear_frames (10 in config/sim.yaml) nominal
+  // frames in a row; the 10th is SAFE. Then the renderer dies: no rendered
+  // frames, no heartbeat. The chain reports it by itself.
+  const int64_t first_nominal = seq_ + 1;
+  auto first_safe = [&]() -> int64_t {
+    for (const risk_t& r : bus_.risks.messages) {
+      if (r.seq >= first_nominal && r.level == risk_t::SAFE) return r.seq;
+    }
+    return -1;
+  };
   ASSERT_TRUE(run_until(
-      bus_, [&] { return risk_for(clear) != nullptr; }, kDeadline, 33, [&] { step(default_arm()); }));
-  EXPECT_EQ(risk_for(clear)->level, risk_t::SAFE);
+      bus_, [&] { return first_safe() >= 0; }, kDeadline, 33, [&] { step(default_arm()); }));
+  EXPECT_GE(first_safe(), first_nominal + 9);
+  for (int64_t seq = first_nominal; seq < first_safe(); ++seq) {
+    if (const risk_t* open = risk_for(seq)) {
+      EXPECT_EQ(open->level, risk_t::DANGEROUS) << seq;
+      EXPECT_EQ(open->cause, risk_t::CAUSE_UNKNOWN_OBJECT) << seq;
+    }
+  }
   const size_t before = bus_.risks.messages.size();
   const int64_t last_rendered = seq_;
   int64_t first_unrendered_us = 0;

@@ -98,7 +98,7 @@ inline safety_status_t sample_safety_status() {
 }
 
 inline link_labels_t sample_link_labels() {
-  link_labels_t m;
+  link_labels_t m{};
   m.utime = 1700000000123456;
   m.seq = 42;
   m.camera_id = "tof-test";

@@ -79,7 +79,7 @@ inline depth_image_t depth_frame(const std::vector<int16_t>& depth_mm, int64_t s
 
 inline link_labels_t labels_frame(const std::vector<int16_t>& label, int64_t seq, int width = kWidth,
                                   int height = kHeight) {
-  link_labels_t m;
+  link_labels_t m{};
   m.utime = 1'600'000'000'000'000 + seq * 33'333;
   m.seq = seq;
   m.camera_id = "tof-mast";

@@ -51,7 +51,7 @@ depth_image_t frame(int64_t seq, bool camera) {
 }
 
 link_labels_t labels(int64_t seq) {
-  link_labels_t m;
+  link_labels_t m{};
   m.utime = 1700000000000000 + seq * 33333;
   m.seq = seq;
   m.camera_id = "tof-mast";
