@@ -181,15 +181,21 @@ std::string check_evidence(const discrepancy_t& d) {
       return expected("joint_information" + at, "a finite number >= 0", d.joint_information[j]);
     }
   }
-  if (d.num_joint_information_matrix != d.num_joints * d.num_joints ||
-      d.joint_information_matrix.size() != static_cast<size_t>(d.num_joint_information_matrix)) {
-    return expected("num_joint_information_matrix", "num_joints^2 = " + std::to_string(d.num_joints * d.num_joints),
-                    d.num_joint_information_matrix);
-  }
-  if (auto p = finite_array(d.joint_information_matrix.data(), d.num_joint_information_matrix,
-                            "joint_information_matrix");
+  if (auto p = check_count(d.num_joints, d.joint_naming_score, "joint_naming_score", "num_joints");
+      !p.empty())
+    return p;
+  if (auto p =
+          check_count(d.num_joints, d.joint_naming_information, "joint_naming_information", "num_joints");
       !p.empty()) {
     return p;
+  }
+  for (int j = 0; j < d.num_joints; ++j) {
+    const std::string at = "[" + std::to_string(j) + "]";
+    if (!std::isfinite(d.joint_naming_score[j]))
+      return expected("joint_naming_score" + at, "a finite number", d.joint_naming_score[j]);
+    if (!(std::isfinite(d.joint_naming_information[j]) && d.joint_naming_information[j] >= 0)) {
+      return expected("joint_naming_information" + at, "a finite number >= 0", d.joint_naming_information[j]);
+    }
   }
   if (d.robot_fit_pixels < 0) return expected("robot_fit_pixels", "a count >= 0", d.robot_fit_pixels);
   if (!(std::isfinite(d.robot_chi2) && d.robot_chi2 >= 0)) {

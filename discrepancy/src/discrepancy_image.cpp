@@ -416,6 +416,7 @@ Parameters parameters_from(const DiscrepancySettings& config) {
   p.max_depth_mm = config.max_depth_mm;
   p.evidence.model_sigma_mm = config.evidence_model_sigma_mm;
   p.evidence.clip_sigmas = config.evidence_clip_sigmas;
+  p.evidence.naming_gate_sigmas = config.evidence_naming_gate_sigmas;
   p.evidence.pixels_per_sample = config.evidence_pixels_per_sample;
   return p;
 }

@@ -30,6 +30,7 @@ DiscrepancySettings read_discrepancy_settings(YamlMap map) {
     d.evidence_model_sigma_mm = evidence.number("model_sigma_mm", 0, 1000);
     d.evidence_clip_sigmas = evidence.number("clip_sigmas", 0.5, 100);
     d.evidence_pixels_per_sample = evidence.number("pixels_per_sample", 1, 10000);
+    d.evidence_naming_gate_sigmas = evidence.number("naming_gate_sigmas", 1, 100);
     evidence.finish();
   }
   map.finish();

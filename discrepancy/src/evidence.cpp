@@ -141,8 +141,8 @@ void clear_evidence(discrepancy_t* s) {
   s->joint_fit_pixels.clear();
   s->joint_score.clear();
   s->joint_information.clear();
-  s->num_joint_information_matrix = 0;
-  s->joint_information_matrix.clear();
+  s->joint_naming_score.clear();
+  s->joint_naming_information.clear();
   s->robot_fit_pixels = 0;
   s->robot_chi2 = 0;
 }
@@ -166,8 +166,8 @@ void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered
   s.joint_fit_pixels.assign(num_joints, 0);
   s.joint_score.assign(num_joints, 0.0);
   s.joint_information.assign(num_joints, 0.0);
-  // Upper triangle accumulated per pixel, mirrored at the end.
-  std::vector<double> joint_matrix(static_cast<size_t>(num_joints) * num_joints, 0.0);
+  s.joint_naming_score.assign(num_joints, 0.0);
+  s.joint_naming_information.assign(num_joints, 0.0);
   Eigen::Matrix<double, 6, 1> camera_score = Eigen::Matrix<double, 6, 1>::Zero();
   Eigen::Matrix<double, 6, 6> camera_information = Eigen::Matrix<double, 6, 6>::Zero();
   double camera_row[6];
@@ -185,7 +185,9 @@ void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered
     const double sigma_d = noise.sigma_at_0m_mm + noise.sigma_per_m2_mm * d_m * d_m;
     const double var = sigma_d * sigma_d + model_var;
     const double limit = parameters.clip_sigmas * std::sqrt(var);
-    const double r = std::clamp(static_cast<double>(gen[i] - t), -limit, limit);
+    const double raw_r = static_cast<double>(gen[i] - t);
+    const double r = std::clamp(raw_r, -limit, limit);
+    const bool in_naming_fit = std::abs(raw_r) <= parameters.naming_gate_sigmas * std::sqrt(var);
     const double w = inv_pps / var;
     link_sum_wr[link] += w * r;
     link_sum_w[link] += w;
@@ -198,8 +200,9 @@ void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered
         ++s.joint_fit_pixels[j];
         s.joint_score[j] -= w * jj * r;
         s.joint_information[j] += w * jj * jj;
-        double* row = &joint_matrix[static_cast<size_t>(j) * num_joints];
-        for (int k = j; k < num_joints; ++k) row[k] += w * jj * joint_row[k];
+        if (!in_naming_fit) continue;
+        s.joint_naming_score[j] -= w * jj * r;
+        s.joint_naming_information[j] += w * jj * jj;
       }
     } else {
       ++s.camera_fit_pixels;
@@ -235,11 +238,6 @@ void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered
     s.link_bias_mm[l] = static_cast<float>(link_sum_wr[l] / link_sum_w[l]);
     s.link_bias_sigma_mm[l] = static_cast<float>(1.0 / std::sqrt(link_sum_w[l]));
   }
-  for (int j = 0; j < num_joints; ++j)
-    for (int k = 0; k < j; ++k)
-      joint_matrix[static_cast<size_t>(j) * num_joints + k] = joint_matrix[static_cast<size_t>(k) * num_joints + j];
-  s.num_joint_information_matrix = num_joints * num_joints;
-  s.joint_information_matrix = std::move(joint_matrix);
   s.num_joints = num_joints;
   s.joint_name = labels.joint_name;
   s.evidence_available = true;

@@ -117,6 +117,13 @@ FrameFinding SequentialEvidence::joint_finding(const discrepancy_t& f, int i) co
     finding.detail += "; fitted offset (seen - reported) " + fixed(unit * f.joint_score[i] / information, 1) +
                       unit_name + " ± " + fixed(unit / std::sqrt(information), 1) + unit_name;
   }
+  const double naming = f.joint_naming_information[i];
+  if (naming > 0) {
+    finding.detail +=
+        ", named by the fit within the linear range: " + fixed(unit * f.joint_naming_score[i] / naming, 1) +
+        unit_name + ", explains chi^2 " +
+        fixed(f.joint_naming_score[i] * f.joint_naming_score[i] / naming, 0);
+  }
   return finding;
 }
 
@@ -131,7 +138,9 @@ EvidenceStep SequentialEvidence::update(const discrepancy_t& f) {
     camera_cusum_ = step(camera_cusum_, camera_llr(score, information, camera_delta_), h_);
     TOFGUARD_DEMAND(f.num_joints >= 0 && f.joint_name.size() == static_cast<size_t>(f.num_joints) &&
                         f.joint_score.size() == f.joint_name.size() &&
-                        f.joint_information.size() == f.joint_name.size(),
+                        f.joint_information.size() == f.joint_name.size() &&
+                        f.joint_naming_score.size() == f.joint_name.size() &&
+                        f.joint_naming_information.size() == f.joint_name.size(),
                     "discrepancy seq " + std::to_string(f.seq) + ": joint arrays do not match num_joints");
     for (int i = 0; i < f.num_joints; ++i) {
       const auto it = joint_cusum_.find(f.joint_name[i]);
@@ -164,24 +173,46 @@ EvidenceStep SequentialEvidence::update(const discrepancy_t& f) {
     result.finding = camera_finding(f);
     return result;
   }
-  // Among the joints that crossed, the one whose one-parameter fit explains
-  // this frame's residual best: the largest s^2 / I.
+  // Once a joint's CUSUM crossed, a joint reads other than seen; which one
+  // is the joint whose one-parameter naming fit (over the pixels in J's
+  // linear range, discrepancy_t.joint_naming_*) explains this frame's
+  // residual best: the largest s^2 / I, among every joint of the robot (the
+  // first CUSUM to cross may be a distal joint's, whose links the true
+  // joint's offset moves furthest), a joint that has not crossed only on
+  // strong evidence of this frame. Measured on three arms:
+  // docs/safety-chain.md, "Measured".
   int suspect = -1;
   double best = -1;
   std::string crossed_without_fit;
+  bool any_crossed = false;
   for (const auto& [joint, s] : joint_cusum_) {
     if (s < h_) continue;
+    any_crossed = true;
     const auto at = index.find(joint);
-    if (at == index.end() || !(f.joint_information[at->second] > 0)) {
-      if (crossed_without_fit.empty()) crossed_without_fit = joint;
-      continue;
+    if ((at == index.end() || !(f.joint_information[at->second] > 0)) && crossed_without_fit.empty())
+      crossed_without_fit = joint;
+  }
+  if (any_crossed) {
+    // A joint whose own CUSUM has not crossed is named only on strong
+    // evidence of this frame alone: chi^2 >= 2h, what would cross h in one
+    // frame (so that a weak fault's neighbours' noise does not name them).
+    int best_crossed = -1;
+    double best_crossed_explained = -1;
+    for (int i = 0; i < f.num_joints; ++i) {
+      if (joint_cusum_.count(f.joint_name[i]) == 0 || !(f.joint_naming_information[i] > 0)) continue;
+      const double explained =
+          f.joint_naming_score[i] * f.joint_naming_score[i] / f.joint_naming_information[i];
+      if (explained > best) {
+        best = explained;
+        suspect = i;
+      }
+      if (joint_cusum(f.joint_name[i]) >= h_ && explained > best_crossed_explained) {
+        best_crossed_explained = explained;
+        best_crossed = i;
+      }
     }
-    const double explained =
-        f.joint_score[at->second] * f.joint_score[at->second] / f.joint_information[at->second];
-    if (explained > best) {
-      best = explained;
-      suspect = at->second;
-    }
+    if (suspect >= 0 && joint_cusum(f.joint_name[suspect]) < h_ && best < 2 * h_ && best_crossed >= 0)
+      suspect = best_crossed;
   }
   if (suspect >= 0) {
     result.crossed = true;

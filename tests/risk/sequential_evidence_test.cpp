@@ -72,6 +72,8 @@ discrepancy_t evidence_frame(int64_t seq) {
     d.joint_fit_pixels.push_back(300);
     d.joint_score.push_back(0);
     d.joint_information.push_back(kJointInformation.at(j));
+    d.joint_naming_score.push_back(0);
+    d.joint_naming_information.push_back(kJointInformation.at(j));
   }
   return d;
 }
@@ -94,6 +96,7 @@ class ScoreSource {
       const double delta = offset == joint_offsets.end() ? 0 : offset->second;
       d.joint_score[i] = information * delta + std::sqrt(information) * normal_(random_);
     }
+    d.joint_naming_score = d.joint_score;
     for (int a = 0; a < 6; ++a) {
       const double information = kCameraInformation[a];
       d.camera_score[a] = information * camera_offset[a] + std::sqrt(information) * normal_(random_);
@@ -217,19 +220,33 @@ TEST(EvidenceTests, AMarginalFaultCrossesAfterSeveralFramesAsDerived) {
   EXPECT_LE(mean, 2.0 * derived);
 }
 
-// Two joints' tests crossed: the suspect is the one whose one-parameter fit
-// explains this frame's residual best (the largest s^2 / I).
-TEST(EvidenceTests, TheSuspectIsTheCrossedJointWhoseFitExplainsMost) {
+// Two joints' tests crossed: the suspect is the one whose one-parameter
+// naming fit explains this frame's residual best (the largest s^2 / I).
+TEST(EvidenceTests, TheSuspectIsTheJointWhoseNamingFitExplainsMost) {
   SequentialEvidence evidence(sim_config().risk, friend_arm(), kRateHz);
   discrepancy_t d = evidence_frame(1);
   d.joint_score[joint_index("a2")] = 1e5 * 4 * kDeg;  // s^2 / I = 1e5 * (4 deg)^2 = 487
   d.joint_score[joint_index("a3")] = 1e4 * 6 * kDeg;  // 1e4 * (6 deg)^2 = 110
+  d.joint_naming_score = d.joint_score;
   EvidenceStep step = evidence.update(d);
   ASSERT_TRUE(step.crossed);
   EXPECT_GE(evidence.joint_cusum("a3"), evidence.threshold());
   EXPECT_EQ(step.finding.suspect, "a2");
   d.joint_score[joint_index("a3")] = 1e4 * 15 * kDeg;  // 685
+  d.joint_naming_score = d.joint_score;
   step = evidence.update(d);
+  EXPECT_EQ(step.finding.suspect, "a3");
+  // Only a4's CUSUM crossed, but a3's naming fit explains the frame best
+  // (a joint's offset moves the distal links most, where J is least
+  // linear): a3 is named.
+  SequentialEvidence other(sim_config().risk, friend_arm(), kRateHz);
+  d = evidence_frame(1);
+  d.joint_score[joint_index("a4")] = 1e5 * 6 * kDeg;
+  d.joint_naming_score[joint_index("a4")] = 3e3 * 1 * kDeg;  // s^2 / I = 3e3 * (1 deg)^2 = 0.9
+  d.joint_naming_score[joint_index("a3")] = 1e4 * 4 * kDeg;  // 49
+  step = other.update(d);
+  ASSERT_TRUE(step.crossed);
+  EXPECT_LT(other.joint_cusum("a3"), other.threshold());
   EXPECT_EQ(step.finding.suspect, "a3");
 }
 

@@ -1,8 +1,8 @@
 #include "judge_campaign.hpp"
 
 #include <algorithm>
-#include <cstdlib>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -147,8 +147,8 @@ CampaignArm generic_campaign_arm(const std::string& name, const std::string& urd
     for (const robot_model::Joint& j : tree.joints) {
       if (j.name != name_i || !j.limits.has_position_limits) continue;
       const double margin = 0.1 * (j.limits.upper - j.limits.lower);
-      m.center = std::clamp(m.center, j.limits.lower + margin + m.amplitude,
-                            j.limits.upper - margin - m.amplitude);
+      m.center =
+          std::clamp(m.center, j.limits.lower + margin + m.amplitude, j.limits.upper - margin - m.amplitude);
     }
     c.joints_sim.motion.push_back(m);
   }
@@ -217,7 +217,8 @@ std::vector<CampaignRun> standard_fault_runs(const CampaignArm& arm,
     f.kind = CampaignFault::Kind::kCameraPose;
     f.camera_error = Eigen::Isometry3d::Identity();
     f.camera_error.translation() = c.translation_m;
-    f.camera_error.linear() = Eigen::AngleAxisd(c.rotation_deg * kDegToRad, c.rotation_axis).toRotationMatrix();
+    f.camera_error.linear() =
+        Eigen::AngleAxisd(c.rotation_deg * kDegToRad, c.rotation_axis).toRotationMatrix();
     f.label = c.label;
     add(f);
   }
@@ -277,21 +278,21 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
         const double q = joint_position(m, t_s);
         true_joints[m.joint] = q;
         state.name.push_back(m.joint);
-        state.position.push_back(q + (faulty && run.fault.kind == CampaignFault::Kind::kJointOffset &&
-                                              m.joint == run.fault.joint
-                                          ? run.fault.offset
-                                          : 0.0));
+        state.position.push_back(
+            q + (faulty && run.fault.kind == CampaignFault::Kind::kJointOffset && m.joint == run.fault.joint
+                     ? run.fault.offset
+                     : 0.0));
         state.velocity.push_back(joint_velocity(m, t_s));
       }
       state.num_joints = static_cast<int32_t>(state.name.size());
       robot_model::JointPositions reported_joints;
       for (int i = 0; i < state.num_joints; ++i) reported_joints[state.name[i]] = state.position[i];
-      const Eigen::Isometry3d true_pose =
-          faulty && run.fault.kind == CampaignFault::Kind::kCameraPose ? reported_pose * run.fault.camera_error
-                                                                         : reported_pose;
+      const Eigen::Isometry3d true_pose = faulty && run.fault.kind == CampaignFault::Kind::kCameraPose
+                                              ? reported_pose * run.fault.camera_error
+                                              : reported_pose;
 
-      const std::vector<float> depth_m =
-          truth.capture(true_joints, true_pose, intrinsics, run.noise_seed * 100000 + static_cast<uint64_t>(k));
+      const std::vector<float> depth_m = truth.capture(true_joints, true_pose, intrinsics,
+                                                       run.noise_seed * 100000 + static_cast<uint64_t>(k));
       const depth_image_t camera =
           make_depth_image(config.camera.id, intrinsics, state.utime, k, /*calibrated=*/true, depth_m);
 
@@ -304,11 +305,12 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
                                                       /*calibrated=*/true, rendered_result.depth_m);
       link_labels_t labels = make_link_labels(camera, model_scene.num_robot_links, model_scene.link_names(),
                                               std::move(rendered_result.labels));
-      renderer::set_rendered_kinematics(renderer::rendered_kinematics(model_scene, poses, reported_pose), &labels);
+      renderer::set_rendered_kinematics(renderer::rendered_kinematics(model_scene, poses, reported_pose),
+                                        &labels);
 
       if (k == run.onset_frame && run.fault.kind != CampaignFault::Kind::kNone) {
-        result.changed_pixels = changed_pixels(model, model_scene, true_joints, true_pose, rendered_result_depth,
-                                               intrinsics, config.discrepancy);
+        result.changed_pixels = changed_pixels(model, model_scene, true_joints, true_pose,
+                                               rendered_result_depth, intrinsics, config.discrepancy);
       }
       const discrepancy::DiscrepancyFrame frame =
           discrepancy::compute_discrepancy(camera, rendered, labels, parameters);
@@ -341,7 +343,8 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
       monitor.on_joint_state(state, now_us);
       for (const risk_t& verdict : monitor.on_frame(frame.summary, now_us)) {
         ++result.frames_judged;
-        const bool after_onset = verdict.seq >= run.onset_frame && run.fault.kind != CampaignFault::Kind::kNone;
+        const bool after_onset =
+            verdict.seq >= run.onset_frame && run.fault.kind != CampaignFault::Kind::kNone;
         if (verdict.level == risk_t::DANGEROUS && !after_onset && !result.false_stop) {
           result.false_stop = true;
           result.false_stop_detail = "seq " + std::to_string(verdict.seq) + ": " + verdict.detail;
@@ -404,7 +407,8 @@ std::string campaign_report(const std::string& arm, const std::vector<CampaignRe
     ++t.runs;
     t.frames += r.frames_judged;
     t.false_stops += r.false_stop ? 1 : 0;
-    if (r.false_stop) misses << "- " << arm << ", " << r.label << ": false stop, " << r.false_stop_detail << "\n";
+    if (r.false_stop)
+      misses << "- " << arm << ", " << r.label << ": false stop, " << r.false_stop_detail << "\n";
     if (kind == "nominal") continue;
     t.detected += r.stopped ? 1 : 0;
     t.right_cause += r.right_cause ? 1 : 0;
@@ -413,7 +417,8 @@ std::string campaign_report(const std::string& arm, const std::vector<CampaignRe
     t.switches += r.suspect_changes;
     if (r.stopped) t.latency.push_back(r.stop_frames);
     if (std::getenv("TOFGUARD_CAMPAIGN_VERBOSE") != nullptr) {
-      misses << "  " << r.label << ": " << (r.stopped ? std::to_string(r.stop_frames) + " frames, " : "no stop, ")
+      misses << "  " << r.label << ": "
+             << (r.stopped ? std::to_string(r.stop_frames) + " frames, " : "no stop, ")
              << risk_cause_name(r.cause) << " " << r.suspect << ": " << r.detail << "\n";
     }
     if (!r.stopped) {
@@ -444,9 +449,9 @@ std::string campaign_report(const std::string& arm, const std::vector<CampaignRe
         << std::lround(max * frame_period_s * 1000) << ")";
       latency = l.str();
     }
-    out << "| " << kind << " | " << t.runs << " | " << t.frames << " | " << t.detected << " | " << t.right_cause
-        << " | " << t.right_suspect << " | " << latency << " | " << t.safe_after << " | " << t.switches << " | "
-        << t.false_stops << " |\n";
+    out << "| " << kind << " | " << t.runs << " | " << t.frames << " | " << t.detected << " | "
+        << t.right_cause << " | " << t.right_suspect << " | " << latency << " | " << t.safe_after << " | "
+        << t.switches << " | " << t.false_stops << " |\n";
   }
   int64_t scores = 0, beyond = 0, differences = 0;
   double sum_sq = 0, max_abs = 0, difference_sum_sq = 0;
@@ -459,7 +464,8 @@ std::string campaign_report(const std::string& arm, const std::vector<CampaignRe
     max_abs = std::max(max_abs, t.score_max_abs);
   }
   if (scores > 0) {
-    out << "\nFault-free frames: " << scores << " standardised scores s/sqrt(I) (joints, camera axes): variance "
+    out << "\nFault-free frames: " << scores
+        << " standardised scores s/sqrt(I) (joints, camera axes): variance "
         << fixed_text(sum_sq / static_cast<double>(scores), 2) << " (N(0,1): 1), beyond 4: " << beyond << " ("
         << fixed_text(1e6 * static_cast<double>(beyond) / static_cast<double>(scores), 0)
         << " per million; N(0,1): 63), largest |t| " << fixed_text(max_abs, 1)

@@ -118,7 +118,8 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
 // The fault set of issue 14's targets on `arm`: every actuated joint at
 // each of `joint_offsets_deg` (signs alternating), the camera moved by 2 cm
 // along x, y, z and 3 cm along z, and turned 1 degree about x, y, z.
-std::vector<CampaignRun> standard_fault_runs(const CampaignArm& arm, const std::vector<double>& joint_offsets_deg);
+std::vector<CampaignRun> standard_fault_runs(const CampaignArm& arm,
+                                             const std::vector<double>& joint_offsets_deg);
 
 // Nominal: `seconds` of frames without a fault, split into runs of `run_s`.
 std::vector<CampaignRun> nominal_runs(double seconds, double run_s, uint64_t seed);

@@ -91,7 +91,8 @@ int main(int argc, char** argv) {
         runs.insert(runs.end(), nominal.begin(), nominal.end());
       }
       const std::vector<CampaignResult> results = run_campaign(*arm, runs);
-      std::cout << campaign_report(arm->name, results, 1.0 / arm->config.camera.rate_hz) << "\n" << std::flush;
+      std::cout << campaign_report(arm->name, results, 1.0 / arm->config.camera.rate_hz) << "\n"
+                << std::flush;
     }
   } catch (const std::exception& e) {
     std::cerr << "tofguard-judge-campaign: " << e.what() << "\n";

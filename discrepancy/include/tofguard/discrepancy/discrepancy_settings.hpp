@@ -55,6 +55,9 @@ struct DiscrepancySettings {
   double evidence_model_sigma_mm = 0;
   double evidence_clip_sigmas = 0;
   double evidence_pixels_per_sample = 0;
+  // evidence.naming_gate_sigmas: the naming fit's gate in sigmas (the
+  // suspect joint is named from the pixels within it).
+  double evidence_naming_gate_sigmas = 0;
 };
 
 // Reads (and finishes) the `discrepancy` section.

@@ -42,6 +42,9 @@ struct EvidenceParameters {
   // camera with spatial filtering: its filter's footprint): w_i =
   // 1 / (pixels_per_sample * sigma_i^2).
   double pixels_per_sample = 1.0;
+  // The naming fit (discrepancy_t.joint_naming_*) takes the robot's pixels
+  // whose residual is within naming_gate_sigmas * sigma_i.
+  double naming_gate_sigmas = 6.0;
 };
 
 // The camera noise model and silhouette threshold the stage shares with
