@@ -129,7 +129,11 @@ FrameFinding SequentialEvidence::joint_finding(const discrepancy_t& f, int i) co
 
 EvidenceStep SequentialEvidence::update(const discrepancy_t& f) {
   EvidenceStep result;
-  if (f.evidence_available) {
+  // A repeated image (repeat_count > 0: the same depth bytes as the frame
+  // before) is not new evidence: counted again it would double its weight,
+  // and while the arm moves it shows the arm where it was (the frozen-image
+  // rule names that fault).
+  if (f.evidence_available && f.repeat_count == 0) {
     result.updated = true;
     std::array<double, 6> score{};
     std::array<double, 36> information{};
