@@ -417,8 +417,8 @@ std::string campaign_report(const std::string& arm, const std::vector<CampaignRe
     t.switches += r.suspect_changes;
     if (r.stopped) t.latency.push_back(r.stop_frames);
     if (std::getenv("TOFGUARD_CAMPAIGN_VERBOSE") != nullptr) {
-      misses << "  " << r.label << ": "
-             << (r.stopped ? std::to_string(r.stop_frames) + " frames, " : "no stop, ")
+      misses << "  " << r.label << " (" << r.changed_pixels
+             << " px changed): " << (r.stopped ? std::to_string(r.stop_frames) + " frames, " : "no stop, ")
              << risk_cause_name(r.cause) << " " << r.suspect << ": " << r.detail << "\n";
     }
     if (!r.stopped) {
