@@ -221,6 +221,21 @@ EvidenceStep SequentialEvidence::update(const discrepancy_t& f) {
   if (suspect >= 0) {
     result.crossed = true;
     result.finding = joint_finding(f, suspect);
+    if (joint_cusum(f.joint_name[suspect]) < h_) {
+      // Named by the naming fit; the evidence that crossed is another
+      // joint's test.
+      std::string crossed;
+      double largest_crossed = 0;
+      for (const auto& [joint, s] : joint_cusum_) {
+        if (s >= h_ && s > largest_crossed) {
+          largest_crossed = s;
+          crossed = joint;
+        }
+      }
+      result.finding.score = largest_crossed;
+      result.finding.detail += " (the test that crossed: " + crossed + "'s, " + fixed(largest_crossed, 1) +
+                               " of h " + fixed(h_, 1) + ")";
+    }
     return result;
   }
   if (!crossed_without_fit.empty()) {
