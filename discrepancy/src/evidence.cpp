@@ -207,9 +207,13 @@ void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered
     } else {
       ++s.camera_fit_pixels;
       s.static_chi2 += w * r * r;
-      const Eigen::Map<const Eigen::Matrix<double, 6, 1>> jc(camera_row);
-      camera_score -= (w * r) * jc;
-      camera_information.selfadjointView<Eigen::Upper>().rankUpdate(jc, w);
+      // The upper triangle by hand: Eigen's rankUpdate on a 6x6
+      // selfadjoint view costs more than the rest of the pixel.
+      for (int a = 0; a < 6; ++a) {
+        const double wj = w * camera_row[a];
+        camera_score[a] -= wj * r;
+        for (int b = a; b < 6; ++b) camera_information(a, b) += wj * camera_row[b];
+      }
     }
   }
   camera_information = camera_information.selfadjointView<Eigen::Upper>();
