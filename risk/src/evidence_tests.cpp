@@ -129,6 +129,14 @@ FrameFinding SequentialEvidence::joint_finding(const discrepancy_t& f, int i) co
 
 EvidenceStep SequentialEvidence::update(const discrepancy_t& f) {
   EvidenceStep result;
+  if (f.evidence_available) {
+    TOFGUARD_DEMAND(f.num_joints >= 0 && f.joint_name.size() == static_cast<size_t>(f.num_joints) &&
+                        f.joint_score.size() == f.joint_name.size() &&
+                        f.joint_information.size() == f.joint_name.size() &&
+                        f.joint_naming_score.size() == f.joint_name.size() &&
+                        f.joint_naming_information.size() == f.joint_name.size(),
+                    "discrepancy seq " + std::to_string(f.seq) + ": joint arrays do not match num_joints");
+  }
   // A repeated image (repeat_count > 0: the same depth bytes as the frame
   // before) is not new evidence: counted again it would double its weight,
   // and while the arm moves it shows the arm where it was (the frozen-image
@@ -140,23 +148,12 @@ EvidenceStep SequentialEvidence::update(const discrepancy_t& f) {
     std::copy(f.camera_score, f.camera_score + 6, score.begin());
     std::copy(f.camera_information, f.camera_information + 36, information.begin());
     camera_cusum_ = step(camera_cusum_, camera_llr(score, information, camera_delta_), h_);
-    TOFGUARD_DEMAND(f.num_joints >= 0 && f.joint_name.size() == static_cast<size_t>(f.num_joints) &&
-                        f.joint_score.size() == f.joint_name.size() &&
-                        f.joint_information.size() == f.joint_name.size() &&
-                        f.joint_naming_score.size() == f.joint_name.size() &&
-                        f.joint_naming_information.size() == f.joint_name.size(),
-                    "discrepancy seq " + std::to_string(f.seq) + ": joint arrays do not match num_joints");
     for (int i = 0; i < f.num_joints; ++i) {
       const auto it = joint_cusum_.find(f.joint_name[i]);
       if (it == joint_cusum_.end()) continue;  // not a moving joint of the robot: not a hypothesis
       const double delta = prismatic_.count(it->first) > 0 ? joint_delta_m_ : joint_delta_rad_;
       it->second = step(it->second, joint_llr(f.joint_score[i], f.joint_information[i], delta), h_);
     }
-  }
-  // The frame's joint index of each hypothesis, for its fit.
-  std::map<std::string, int> index;
-  if (f.evidence_available) {
-    for (int i = 0; i < f.num_joints; ++i) index[f.joint_name[i]] = i;
   }
   // The largest CUSUM relative to h, for warnings and the summary.
   std::string largest_name = "camera";
@@ -177,87 +174,76 @@ EvidenceStep SequentialEvidence::update(const discrepancy_t& f) {
     result.finding = camera_finding(f);
     return result;
   }
-  // Once a joint's CUSUM crossed, a joint reads other than seen; which one
-  // is the joint whose one-parameter naming fit (over the pixels in J's
-  // linear range, discrepancy_t.joint_naming_*) explains this frame's
-  // residual best: the largest s^2 / I, among every joint of the robot (the
-  // first CUSUM to cross may be a distal joint's, whose links the true
-  // joint's offset moves furthest), a joint that has not crossed only on
-  // strong evidence of this frame. Measured on three arms:
-  // docs/safety-chain.md, "Measured".
-  int suspect = -1;
-  double best = -1;
-  std::string crossed_without_fit;
-  bool any_crossed = false;
+  // The joint test that crossed with the largest CUSUM, if any: a joint
+  // reads other than seen.
+  std::string crossed;
+  double crossed_cusum = 0;
   for (const auto& [joint, s] : joint_cusum_) {
-    if (s < h_) continue;
-    any_crossed = true;
-    const auto at = index.find(joint);
-    if ((at == index.end() || !(f.joint_information[at->second] > 0)) && crossed_without_fit.empty())
-      crossed_without_fit = joint;
+    if (s >= h_ && s > crossed_cusum) {
+      crossed_cusum = s;
+      crossed = joint;
+    }
   }
-  if (any_crossed) {
-    // A joint whose own CUSUM has not crossed is named only on strong
-    // evidence of this frame alone: chi^2 >= 2h, what would cross h in one
-    // frame (so that a weak fault's neighbours' noise does not name them).
+  if (!crossed.empty()) {
+    result.crossed = true;
+    // Which one: the joint whose one-parameter naming fit (over the pixels
+    // in J's linear range, discrepancy_t.joint_naming_*) explains this
+    // frame's residual best, the largest s^2 / I, among every joint of the
+    // robot (the first test to cross may be a distal joint's, whose links
+    // the true joint's offset moves furthest); a joint whose own test has
+    // not crossed only on strong evidence of this frame alone, s^2 / I >= 2h
+    // (what would cross h in one frame), so that a weak fault's neighbours'
+    // noise does not name them. Measured on three arms: docs/safety-chain.md,
+    // "Measured".
+    int best = -1;
     int best_crossed = -1;
+    double best_explained = -1;
     double best_crossed_explained = -1;
     for (int i = 0; i < f.num_joints; ++i) {
       if (joint_cusum_.count(f.joint_name[i]) == 0 || !(f.joint_naming_information[i] > 0)) continue;
       const double explained =
           f.joint_naming_score[i] * f.joint_naming_score[i] / f.joint_naming_information[i];
-      if (explained > best) {
-        best = explained;
-        suspect = i;
+      if (explained > best_explained) {
+        best_explained = explained;
+        best = i;
       }
       if (joint_cusum(f.joint_name[i]) >= h_ && explained > best_crossed_explained) {
         best_crossed_explained = explained;
         best_crossed = i;
       }
     }
-    if (suspect >= 0 && joint_cusum(f.joint_name[suspect]) < h_ && best < 2 * h_ && best_crossed >= 0)
-      suspect = best_crossed;
-  }
-  if (suspect >= 0) {
-    result.crossed = true;
+    const bool best_is_weak =
+        best >= 0 && joint_cusum(f.joint_name[best]) < h_ && best_explained < 2 * h_ && best_crossed >= 0;
+    const int suspect = best_is_weak ? best_crossed : best;
+    if (suspect < 0) {
+      // No joint in this frame's naming fit (every robot pixel beyond the
+      // gate, or none seen): the joint whose test crossed. Still a stop.
+      result.finding.cause = risk_t::CAUSE_JOINT_ERROR;
+      result.finding.suspect = crossed;
+      result.finding.score = crossed_cusum;
+      result.finding.threshold = h_;
+      result.finding.detail = "joint " + crossed +
+                              " reads other than seen (sequential evidence, CUSUM log-likelihood ratio): " +
+                              fixed(crossed_cusum, 1) + " of h " + fixed(h_, 1);
+      return result;
+    }
     result.finding = joint_finding(f, suspect);
     if (joint_cusum(f.joint_name[suspect]) < h_) {
       // Named by the naming fit; the evidence that crossed is another
       // joint's test.
-      std::string crossed;
-      double largest_crossed = 0;
-      for (const auto& [joint, s] : joint_cusum_) {
-        if (s >= h_ && s > largest_crossed) {
-          largest_crossed = s;
-          crossed = joint;
-        }
-      }
-      result.finding.score = largest_crossed;
-      result.finding.detail += " (the test that crossed: " + crossed + "'s, " + fixed(largest_crossed, 1) +
+      result.finding.score = crossed_cusum;
+      result.finding.detail += " (the test that crossed: " + crossed + "'s, " + fixed(crossed_cusum, 1) +
                                " of h " + fixed(h_, 1) + ")";
     }
     return result;
   }
-  if (!crossed_without_fit.empty()) {
-    // Crossed, but not in this frame's fit (no information now): still the
-    // joint whose evidence crossed.
-    result.crossed = true;
-    result.finding.cause = risk_t::CAUSE_JOINT_ERROR;
-    result.finding.suspect = crossed_without_fit;
-    result.finding.score = joint_cusum(crossed_without_fit);
-    result.finding.threshold = h_;
-    result.finding.detail = "joint " + crossed_without_fit +
-                            " reads other than seen (sequential evidence, CUSUM log-likelihood ratio): " +
-                            fixed(result.finding.score, 1) + " of h " + fixed(h_, 1);
-    return result;
-  }
   if (largest >= warning_level()) {
     result.warning = true;
-    const auto at = index.find(largest_name);
+    const auto at = std::find(f.joint_name.begin(), f.joint_name.end(), largest_name);
     if (largest_name == "camera" && largest == camera_cusum_) {
       result.finding = camera_finding(f);
-    } else if (at != index.end()) {
-      result.finding = joint_finding(f, at->second);
+    } else if (at != f.joint_name.end()) {
+      result.finding = joint_finding(f, static_cast<int>(at - f.joint_name.begin()));
     } else {
       result.finding.cause = risk_t::CAUSE_JOINT_ERROR;
       result.finding.suspect = largest_name;

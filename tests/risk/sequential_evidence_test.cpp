@@ -250,6 +250,21 @@ TEST(EvidenceTests, TheSuspectIsTheJointWhoseNamingFitExplainsMost) {
   EXPECT_EQ(step.finding.suspect, "a3");
 }
 
+// A joint's test crossed but no joint is in this frame's naming fit (every
+// robot pixel beyond the gate: a gross offset): still a stop, blaming the
+// joint whose test crossed.
+TEST(EvidenceTests, ACrossedTestStopsWhenNoJointIsInTheNamingFit) {
+  SequentialEvidence evidence(sim_config().risk, friend_arm(), kRateHz);
+  discrepancy_t d = evidence_frame(1);
+  d.joint_score[joint_index("a2")] = 1e5 * 20 * kDeg;
+  d.joint_naming_information.assign(d.num_joints, 0.0);
+  const EvidenceStep step = evidence.update(d);
+  ASSERT_TRUE(step.crossed);
+  EXPECT_EQ(step.finding.cause, risk_t::CAUSE_JOINT_ERROR);
+  EXPECT_EQ(step.finding.suspect, "a2");
+  EXPECT_GE(step.finding.score, evidence.threshold());
+}
+
 TEST(EvidenceTests, GrowingEvidenceWarnsBeforeItCrosses) {
   SequentialEvidence evidence(sim_config().risk, friend_arm(), kRateHz);
   discrepancy_t d = evidence_frame(1);
