@@ -406,8 +406,8 @@ void near_arm_surfaces(const depth_image_t& camera, const depth_image_t& rendere
 
 Parameters parameters_from(const DiscrepancySettings& config) {
   Parameters p;
-  p.tolerance.sigma_at_0m_mm = config.noise_sigma_at_0m_mm;
-  p.tolerance.sigma_per_m2_mm = config.noise_sigma_per_m2_mm;
+  p.tolerance.noise.sigma_at_0m_mm = config.noise_sigma_at_0m_mm;
+  p.tolerance.noise.sigma_per_m2_mm = config.noise_sigma_per_m2_mm;
   p.tolerance.sigmas = config.tolerance_sigmas;
   p.tolerance.model_mm = config.model_tolerance_mm;
   p.opening_radius_px = config.opening_radius_px;
@@ -509,9 +509,8 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
   largest_blob(classes.mismatch_mask, parameters.opening_radius_px, footprint, &s);
   near_arm_surfaces(camera, rendered, frame, classes, parameters, footprint, &s);
   // Stage 7, evidence (evidence.hpp).
-  const EvidenceNoise noise{parameters.tolerance.sigma_at_0m_mm, parameters.tolerance.sigma_per_m2_mm,
-                            parameters.silhouette_jump_mm};
-  compute_evidence(camera, rendered, labels, silhouette, noise, parameters.evidence, &s);
+  compute_evidence(camera, rendered, labels, silhouette, parameters.silhouette_jump_mm,
+                   parameters.tolerance.noise, parameters.evidence, &s);
   return frame;
 }
 

@@ -148,11 +148,11 @@ void clear_evidence(discrepancy_t* s) {
 }
 
 void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered, const link_labels_t& labels,
-                      const std::vector<uint8_t>& silhouette, const EvidenceNoise& noise,
-                      const EvidenceParameters& parameters, discrepancy_t* summary) {
+                      const std::vector<uint8_t>& silhouette, double silhouette_jump_mm,
+                      const DepthNoise& noise, const EvidenceParameters& parameters, discrepancy_t* summary) {
   discrepancy_t& s = *summary;
   clear_evidence(&s);
-  const EvidenceJacobian jacobian(rendered, labels, noise.silhouette_jump_mm);
+  const EvidenceJacobian jacobian(rendered, labels, silhouette_jump_mm);
   const int num_pixels = camera.width * camera.height;
   if (!jacobian.available() || camera.depth_mm.size() != static_cast<size_t>(num_pixels) ||
       silhouette.size() != static_cast<size_t>(num_pixels)) {
@@ -181,8 +181,7 @@ void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered
     bool moved = false;
     int link = -1;
     if (!jacobian.at(i, camera_row, joint_row.data(), &moved, &link)) continue;
-    const double d_m = metres_from_mm(t);
-    const double sigma_d = noise.sigma_at_0m_mm + noise.sigma_per_m2_mm * d_m * d_m;
+    const double sigma_d = noise.sigma_mm(t);
     const double var = sigma_d * sigma_d + model_var;
     const double limit = parameters.clip_sigmas * std::sqrt(var);
     const double raw_r = static_cast<double>(gen[i] - t);

@@ -85,7 +85,7 @@ double joint_velocity(const sim::JointMotion& m, double t_s) {
 int changed_pixels(renderer::DepthRenderer& model, const robot_model::SceneModel& scene,
                    const robot_model::JointPositions& true_joints, const Eigen::Isometry3d& true_pose,
                    const std::vector<float>& reported_depth_m, const Intrinsics& intrinsics,
-                   const discrepancy::DiscrepancySettings& noise) {
+                   const discrepancy::DepthNoise& noise) {
   const robot_model::LinkPoses poses = robot_model::forward_kinematics(scene, true_joints);
   const renderer::RenderResult truth = model.render_at(poses, true_pose, intrinsics);
   if (!truth.usable) throw std::runtime_error(truth.unusable_reason);
@@ -97,8 +97,7 @@ int changed_pixels(renderer::DepthRenderer& model, const robot_model::SceneModel
       ++changed;
       continue;
     }
-    const double d = std::max(a, b);
-    const double sigma_m = (noise.noise_sigma_at_0m_mm + noise.noise_sigma_per_m2_mm * d * d) / 1000;
+    const double sigma_m = metres_from_mm(noise.sigma_mm(1000.0 * std::max(a, b)));
     if (std::abs(a - b) > 3 * sigma_m) ++changed;
   }
   return changed;
@@ -298,19 +297,17 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
 
       const robot_model::LinkPoses poses = robot_model::forward_kinematics(model_scene, reported_joints);
       if (!poses.usable) throw std::runtime_error(poses.unusable_reason);
-      renderer::RenderResult rendered_result = model.render_at(poses, reported_pose, intrinsics);
+      const renderer::RenderResult rendered_result = model.render_at(poses, reported_pose, intrinsics);
       if (!rendered_result.usable) throw std::runtime_error(rendered_result.unusable_reason);
-      const std::vector<float> rendered_result_depth = rendered_result.depth_m;
       const depth_image_t rendered = make_depth_image(config.camera.id, intrinsics, state.utime, k,
                                                       /*calibrated=*/true, rendered_result.depth_m);
-      link_labels_t labels = make_link_labels(camera, model_scene.num_robot_links, model_scene.link_names(),
-                                              std::move(rendered_result.labels));
-      renderer::set_rendered_kinematics(renderer::rendered_kinematics(model_scene, poses, reported_pose),
-                                        &labels);
+      // Labels and kinematics as tofguard-renderer publishes them.
+      const link_labels_t labels = renderer::make_rendered_link_labels(camera, rendered_result, model_scene);
 
       if (k == run.onset_frame && run.fault.kind != CampaignFault::Kind::kNone) {
-        result.changed_pixels = changed_pixels(model, model_scene, true_joints, true_pose,
-                                               rendered_result_depth, intrinsics, config.discrepancy);
+        result.changed_pixels =
+            changed_pixels(model, model_scene, true_joints, true_pose, rendered_result.depth_m, intrinsics,
+                           parameters.tolerance.noise);
       }
       const discrepancy::DiscrepancyFrame frame =
           discrepancy::compute_discrepancy(camera, rendered, labels, parameters);

@@ -25,18 +25,13 @@ namespace tofguard::discrepancy {
 
 // When |I_dis| is a mismatch rather than camera noise.
 struct Tolerance {
-  // sigma(d) = sigma_at_0m_mm + sigma_per_m2_mm * d^2, d in metres.
-  double sigma_at_0m_mm = 4.0;
-  double sigma_per_m2_mm = 1.2;
+  DepthNoise noise;
   double sigmas = 4.0;
   // Added to k*sigma: the model's own inaccuracy, millimetres.
   double model_mm = 15.0;
 
   // Largest |I_dis| still a match at camera depth `depth_mm`, millimetres.
-  double at(double depth_mm) const {
-    const double d_m = metres_from_mm(depth_mm);
-    return sigmas * (sigma_at_0m_mm + sigma_per_m2_mm * d_m * d_m) + model_mm;
-  }
+  double at(double depth_mm) const { return sigmas * noise.sigma_mm(depth_mm) + model_mm; }
 };
 
 struct Parameters {

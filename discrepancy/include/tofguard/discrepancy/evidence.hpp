@@ -25,6 +25,7 @@
 
 #include <Eigen/Core>
 
+#include "tofguard/common/depth_frame.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/link_labels_t.hpp"
@@ -47,14 +48,18 @@ struct EvidenceParameters {
   double naming_gate_sigmas = 6.0;
 };
 
-// The camera noise model and silhouette threshold the stage shares with
-// the rest of compute_discrepancy.
-struct EvidenceNoise {
-  // sigma(d) = sigma_at_0m_mm + sigma_per_m2_mm * d^2, d the camera depth, m.
+// The camera's noise model (discrepancy.noise), shared by the pixel
+// tolerance (discrepancy_image.hpp) and the evidence weights:
+// sigma(d) = sigma_at_0m_mm + sigma_per_m2_mm * d^2, d the camera depth, m.
+struct DepthNoise {
   double sigma_at_0m_mm = 4.0;
   double sigma_per_m2_mm = 1.2;
-  // Rendered depth steps over this are silhouettes (no slope across), mm.
-  double silhouette_jump_mm = 50;
+
+  // sigma at camera depth `depth_mm`, millimetres.
+  double sigma_mm(double depth_mm) const {
+    const double d_m = metres_from_mm(depth_mm);
+    return sigma_at_0m_mm + sigma_per_m2_mm * d_m * d_m;
+  }
 };
 
 // Per-pixel Jacobians of a rendered frame and its labels' kinematics.
@@ -103,11 +108,12 @@ class EvidenceJacobian {
 
 // Fills `summary`'s evidence fields (evidence_available .. robot_chi2) for a
 // usable, compared frame; `silhouette` is compute_discrepancy's mask (1 =
-// beside a silhouette). Leaves them zero (evidence_available false) when the
-// labels carry no kinematics.
+// beside a silhouette), `silhouette_jump_mm` its threshold (no slope is
+// taken across a larger rendered step). Leaves them zero
+// (evidence_available false) when the labels carry no kinematics.
 void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered, const link_labels_t& labels,
-                      const std::vector<uint8_t>& silhouette, const EvidenceNoise& noise,
-                      const EvidenceParameters& parameters, discrepancy_t* summary);
+                      const std::vector<uint8_t>& silhouette, double silhouette_jump_mm,
+                      const DepthNoise& noise, const EvidenceParameters& parameters, discrepancy_t* summary);
 
 // Clears the evidence fields (evidence_available false, everything zero).
 void clear_evidence(discrepancy_t* summary);
