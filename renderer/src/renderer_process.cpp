@@ -158,23 +158,26 @@ RenderedFrame RendererService::render(const depth_image_t& frame) {
   learn_period(frame);
   const robot_state::StateAtFrame state = state_.at(frame.camera_id, frame.utime);
   RenderResult result;
+  bool predicted = false;
   if (!state.usable()) {
     result.unusable_reason = state.unusable_reason();
   } else if (prediction_ && prediction_matches(frame, state.joints.joints, state.camera_pose.pose)) {
     prediction_stats_.hits++;
     consecutive_misses_ = 0;
     result = std::move(prediction_->result);
+    predicted = true;
   } else {
     const bool missed = prediction_ && prediction_->rendered;
     (missed ? prediction_stats_.misses : prediction_stats_.without)++;
     if (missed) ++consecutive_misses_;
     result = renderer_->render(state.joints.joints, state.camera_pose.pose, intrinsics_of(frame));
   }
-  // The kinematics at the frame's own joints and camera pose (a hit's image
-  // was rendered at the prediction's, within the tolerances).
+  // The kinematics at the frame's own joints and camera pose: the poses a
+  // render of them used (no second forward kinematics), or for a prediction
+  // (rendered at the plan's joints, within the tolerances) the frame's.
   std::optional<RenderedKinematics> kinematics;
   if (result.usable) {
-    kinematics = rendered_kinematics(scene_, state.joints.joints, state.camera_pose.pose);
+    if (predicted) kinematics = rendered_kinematics(scene_, state.joints.joints, state.camera_pose.pose);
     if (!kinematics) kinematics = rendered_kinematics(scene_, result);
   }
   RenderedFrame out = make_output(frame, std::move(result), kinematics);

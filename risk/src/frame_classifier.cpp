@@ -228,9 +228,9 @@ FrameFinding joint_error_missing_links(const FrameEvidence& e) {
 // that joint is the suspect. (An object that hides part of a link lands
 // here too: either way the arm stops.)
 FrameFinding joint_error_beside_unexplained_surfaces(const FrameEvidence& e) {
+  if (e.frame.evidence_available) return {};
   const RiskSettings& config = e.config;
   const robot_model::KinematicTree& robot = e.robot;
-  if (e.frame.evidence_available) return {};
   if (!(e.frame.near_arm_area_m2 >= config.unknown_object_min_area_m2)) return {};
   std::vector<std::string> affected;
   int64_t mismatching = 0;
