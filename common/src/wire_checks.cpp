@@ -201,6 +201,19 @@ std::string check_evidence(const discrepancy_t& d) {
   if (!(std::isfinite(d.robot_chi2) && d.robot_chi2 >= 0)) {
     return expected("robot_chi2", "a finite sum >= 0", d.robot_chi2);
   }
+  if (d.search_points < 0) return expected("search_points", "a count >= 0", d.search_points);
+  if (auto p = check_count(d.num_joints, d.joint_search_offset, "joint_search_offset", "num_joints");
+      !p.empty())
+    return p;
+  if (auto p = check_count(d.num_joints, d.joint_search_gain, "joint_search_gain", "num_joints"); !p.empty())
+    return p;
+  for (int j = 0; j < d.num_joints; ++j) {
+    const std::string at = "[" + std::to_string(j) + "]";
+    if (!std::isfinite(d.joint_search_offset[j]))
+      return expected("joint_search_offset" + at, "a finite number", d.joint_search_offset[j]);
+    if (!(std::isfinite(d.joint_search_gain[j]) && d.joint_search_gain[j] >= 0))
+      return expected("joint_search_gain" + at, "a finite number >= 0", d.joint_search_gain[j]);
+  }
   return "";
 }
 

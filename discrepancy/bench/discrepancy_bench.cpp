@@ -8,6 +8,7 @@
 #include <random>
 
 #include "tofguard/discrepancy/discrepancy_image.hpp"
+#include "tofguard/discrepancy/joint_search.hpp"
 
 namespace {
 
@@ -102,6 +103,26 @@ void BM_ComputeDiscrepancy(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * state.range(0) * state.range(1));
 }
 BENCHMARK(BM_ComputeDiscrepancy)->Args({176, 144})->Args({640, 480})->Unit(benchmark::kMicrosecond);
+
+// The naming search alone (joint_search.hpp) on the same frame: two
+// joints, their links' points.
+void BM_SearchJointOffsets(benchmark::State& state) {
+  const Frames f = make_frames(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  const tofguard::discrepancy::Parameters parameters;
+  tofguard::discrepancy::LabelKinematics kinematics;
+  if (!tofguard::discrepancy::read_label_kinematics(f.labels, f.labels.label.size(), &kinematics)) {
+    state.SkipWithError("the bench frame's kinematics do not fit");
+    return;
+  }
+  tofguard::discrepancy_t summary{};
+  for (auto _ : state) {
+    tofguard::discrepancy::search_joint_offsets(f.camera, f.rendered, f.labels, kinematics,
+                                                parameters.tolerance.noise, parameters.evidence, &summary);
+    benchmark::DoNotOptimize(summary.joint_search_gain.data());
+  }
+  state.counters["points"] = summary.search_points;
+}
+BENCHMARK(BM_SearchJointOffsets)->Args({176, 144})->Args({640, 480})->Unit(benchmark::kMicrosecond);
 
 void BM_DepthHash(benchmark::State& state) {
   const Frames f = make_frames(176, 144);

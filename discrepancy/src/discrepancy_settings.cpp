@@ -1,5 +1,7 @@
 #include "tofguard/discrepancy/discrepancy_settings.hpp"
 
+#include <cmath>
+
 namespace tofguard::discrepancy {
 
 DiscrepancySettings read_discrepancy_settings(YamlMap map) {
@@ -31,6 +33,20 @@ DiscrepancySettings read_discrepancy_settings(YamlMap map) {
     d.evidence_clip_sigmas = evidence.number("clip_sigmas", 0.5, 100);
     d.evidence_pixels_per_sample = evidence.number("pixels_per_sample", 1, 10000);
     d.evidence_naming_gate_sigmas = evidence.number("naming_gate_sigmas", 1, 100);
+    {
+      YamlMap search = evidence.map("search");
+      constexpr double kRad = M_PI / 180.0;
+      d.evidence_search_range_rad = search.number("range_deg", 0.1, 90) * kRad;
+      d.evidence_search_step_rad = search.number("step_deg", 0.01, 10) * kRad;
+      d.evidence_search_range_m = search.number("range_mm", 0.1, 1000) / 1000.0;
+      d.evidence_search_step_m = search.number("step_mm", 0.01, 100) / 1000.0;
+      d.evidence_search_max_points = static_cast<int>(search.integer("max_points", 10, 1000000));
+      if (d.evidence_search_step_rad > d.evidence_search_range_rad)
+        search.fail("step_deg", "a step no larger than range_deg");
+      if (d.evidence_search_step_m > d.evidence_search_range_m)
+        search.fail("step_mm", "a step no larger than range_mm");
+      search.finish();
+    }
     evidence.finish();
   }
   map.finish();

@@ -7,8 +7,48 @@
 #include <Eigen/Geometry>
 
 #include "tofguard/common/depth_frame.hpp"
+#include "tofguard/discrepancy/joint_search.hpp"
 
 namespace tofguard::discrepancy {
+
+bool read_label_kinematics(const link_labels_t& labels, size_t pixels, LabelKinematics* out) {
+  // The wire checks make these hold; an in-process caller may not have run
+  // them, so a misfit only switches the evidence off.
+  const auto n = static_cast<size_t>(std::max(labels.num_axes, 0));
+  if (labels.num_axes <= 0 || labels.num_joints <= 0 || labels.axis_joint.size() != n ||
+      labels.axis_multiplier.size() != n || labels.axis_prismatic.size() != n ||
+      labels.axis_origin_m.size() != n || labels.axis_direction.size() != n ||
+      labels.axis_parent.size() != n || labels.num_robot_links < 0 ||
+      labels.link_axis.size() != static_cast<size_t>(labels.num_robot_links) ||
+      labels.num_link_axes != labels.num_robot_links || labels.label.size() != pixels) {
+    return false;
+  }
+  LabelKinematics k;
+  k.num_joints = labels.num_joints;
+  k.num_robot_links = labels.num_robot_links;
+  k.num_links = labels.num_links;
+  k.axes.resize(n);
+  for (size_t m = 0; m < n; ++m) {
+    LabelAxis& a = k.axes[m];
+    if (labels.axis_origin_m[m].size() != 3 || labels.axis_direction[m].size() != 3) return false;
+    a.joint = labels.axis_joint[m];
+    a.multiplier = labels.axis_multiplier[m];
+    a.prismatic = labels.axis_prismatic[m];
+    a.origin_mm = 1000.0 * Eigen::Vector3d(labels.axis_origin_m[m][0], labels.axis_origin_m[m][1],
+                                           labels.axis_origin_m[m][2]);
+    a.direction = Eigen::Vector3d(labels.axis_direction[m][0], labels.axis_direction[m][1],
+                                  labels.axis_direction[m][2]);
+    a.parent = labels.axis_parent[m];
+    if (a.joint < 0 || a.joint >= k.num_joints || a.parent < -1 || a.parent >= static_cast<int>(m))
+      return false;
+  }
+  k.link_axis = labels.link_axis;
+  for (int a : k.link_axis) {
+    if (a < -1 || a >= static_cast<int>(n)) return false;
+  }
+  *out = std::move(k);
+  return true;
+}
 
 EvidenceJacobian::EvidenceJacobian(const depth_image_t& rendered, const link_labels_t& labels,
                                    double silhouette_jump_mm)
@@ -19,43 +59,11 @@ EvidenceJacobian::EvidenceJacobian(const depth_image_t& rendered, const link_lab
       cx_(rendered.cx),
       cy_(rendered.cy),
       jump_mm_(silhouette_jump_mm > 0 ? silhouette_jump_mm : 1e9),
-      num_joints_(labels.num_joints),
-      num_robot_links_(labels.num_robot_links),
-      num_links_(labels.num_links),
       depth_(rendered.depth_mm.data()),
       label_(labels.label.data()) {
-  // The wire checks make these hold; an in-process caller may not have run
-  // them, so a misfit only switches the evidence off.
-  const auto n = static_cast<size_t>(labels.num_axes);
   const size_t pixels = static_cast<size_t>(std::max(width_, 0)) * static_cast<size_t>(std::max(height_, 0));
-  if (labels.num_axes <= 0 || labels.num_joints <= 0 || labels.axis_joint.size() != n ||
-      labels.axis_multiplier.size() != n || labels.axis_prismatic.size() != n ||
-      labels.axis_origin_m.size() != n || labels.axis_direction.size() != n ||
-      labels.axis_parent.size() != n ||
-      labels.link_axis.size() != static_cast<size_t>(labels.num_robot_links) ||
-      labels.num_link_axes != labels.num_robot_links || rendered.depth_mm.size() != pixels ||
-      labels.label.size() != pixels || !(fx_ > 0) || !(fy_ > 0)) {
-    return;
-  }
-  axes_.resize(n);
-  for (size_t m = 0; m < n; ++m) {
-    Axis& a = axes_[m];
-    if (labels.axis_origin_m[m].size() != 3 || labels.axis_direction[m].size() != 3) return;
-    a.joint = labels.axis_joint[m];
-    a.multiplier = labels.axis_multiplier[m];
-    a.prismatic = labels.axis_prismatic[m];
-    a.origin_mm = 1000.0 * Eigen::Vector3d(labels.axis_origin_m[m][0], labels.axis_origin_m[m][1],
-                                           labels.axis_origin_m[m][2]);
-    a.direction = Eigen::Vector3d(labels.axis_direction[m][0], labels.axis_direction[m][1],
-                                  labels.axis_direction[m][2]);
-    a.parent = labels.axis_parent[m];
-    if (a.joint < 0 || a.joint >= num_joints_ || a.parent < -1 || a.parent >= static_cast<int>(m)) return;
-  }
-  link_axis_ = labels.link_axis;
-  for (int a : link_axis_) {
-    if (a < -1 || a >= static_cast<int>(n)) return;
-  }
-  available_ = true;
+  if (rendered.depth_mm.size() != pixels || !(fx_ > 0) || !(fy_ > 0)) return;
+  available_ = read_label_kinematics(labels, pixels, &kinematics_);
 }
 
 bool EvidenceJacobian::at(int i, double camera[6], double* joints, bool* moved, int* link_out) const {
@@ -63,7 +71,7 @@ bool EvidenceJacobian::at(int i, double camera[6], double* joints, bool* moved, 
   const int z_mm = depth_[i];
   if (z_mm <= 0) return false;
   const int l = label_[i];
-  const int link = link_of_label(l, num_robot_links_, num_links_);
+  const int link = link_of_label(l, kinematics_.num_robot_links, kinematics_.num_links);
   if (link < 0) return false;
   const int u = i % width_;
   const int v = i / width_;
@@ -98,12 +106,12 @@ bool EvidenceJacobian::at(int i, double camera[6], double* joints, bool* moved, 
   const Eigen::Vector3d g(-gu * fx_ / z, -gv * fy_ / z,
                           1.0 + (gu * fx_ * p.x() + gv * fy_ * p.y()) / (z * z));
   *link_out = link;
-  std::fill(joints, joints + num_joints_, 0.0);
-  const int first_axis = link < num_robot_links_ ? link_axis_[link] : -1;
+  std::fill(joints, joints + kinematics_.num_joints, 0.0);
+  const int first_axis = link < kinematics_.num_robot_links ? kinematics_.link_axis[link] : -1;
   *moved = first_axis >= 0;
   if (*moved) {
-    for (int m = first_axis; m >= 0; m = axes_[m].parent) {
-      const Axis& a = axes_[m];
+    for (int m = first_axis; m >= 0; m = kinematics_.axes[m].parent) {
+      const LabelAxis& a = kinematics_.axes[m];
       // Revolute: v = direction x (p - origin) (mm per rad); prismatic:
       // v = direction (1000 mm per m).
       const double j = a.prismatic ? 1000.0 * g.dot(a.direction) : g.dot(a.direction.cross(p - a.origin_mm));
@@ -145,6 +153,9 @@ void clear_evidence(discrepancy_t* s) {
   s->joint_naming_information.clear();
   s->robot_fit_pixels = 0;
   s->robot_chi2 = 0;
+  s->search_points = 0;
+  s->joint_search_offset.clear();
+  s->joint_search_gain.clear();
 }
 
 void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered, const link_labels_t& labels,
@@ -158,6 +169,13 @@ void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered
       silhouette.size() != static_cast<size_t>(num_pixels)) {
     return;
   }
+  // The naming search first: the static pixels that the best joint's
+  // offset explains (the real arm where the model's is not) are the arm's
+  // evidence, not the camera's, and stay out of the camera fit.
+  std::vector<uint8_t> explained_static;
+  search_joint_offsets(camera, rendered, labels, jacobian.kinematics(), noise, parameters, &s,
+                       &explained_static);
+  const bool have_explained = explained_static.size() == static_cast<size_t>(num_pixels);
   const int num_links = labels.num_links;
   const int num_joints = jacobian.num_joints();
   std::vector<double> link_sum_wr(num_links, 0.0);
@@ -181,6 +199,7 @@ void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered
     bool moved = false;
     int link = -1;
     if (!jacobian.at(i, camera_row, joint_row.data(), &moved, &link)) continue;
+    if (!moved && have_explained && explained_static[i]) continue;
     const double sigma_d = noise.sigma_mm(t);
     const double var = sigma_d * sigma_d + model_var;
     const double limit = parameters.clip_sigmas * std::sqrt(var);

@@ -84,6 +84,17 @@ double step(double cusum, double llr, double h) {
 
 }  // namespace
 
+bool searched(const discrepancy_t& f) {
+  return f.search_points > 0 && f.joint_search_gain.size() == f.joint_name.size() &&
+         f.joint_search_offset.size() == f.joint_name.size();
+}
+
+double naming_chi2(const discrepancy_t& f, int i) {
+  if (searched(f)) return f.joint_search_gain[i];
+  if (!(f.joint_naming_information[i] > 0)) return 0;
+  return f.joint_naming_score[i] * f.joint_naming_score[i] / f.joint_naming_information[i];
+}
+
 FrameFinding SequentialEvidence::camera_finding(const discrepancy_t& f) const {
   const double* c = f.camera_correction;
   FrameFinding finding;
@@ -116,6 +127,11 @@ FrameFinding SequentialEvidence::joint_finding(const discrepancy_t& f, int i) co
   if (information > 0) {
     finding.detail += "; fitted offset (seen - reported) " + fixed(unit * f.joint_score[i] / information, 1) +
                       unit_name + " ± " + fixed(unit / std::sqrt(information), 1) + unit_name;
+  }
+  if (searched(f) && f.joint_search_gain[i] > 0) {
+    finding.detail += "; named by the search: " + fixed(unit * f.joint_search_offset[i], 1) + unit_name +
+                      " explains chi^2 " + fixed(f.joint_search_gain[i], 0);
+    return finding;
   }
   const double naming = f.joint_naming_information[i];
   if (naming > 0) {
@@ -186,23 +202,23 @@ EvidenceStep SequentialEvidence::update(const discrepancy_t& f) {
   }
   if (!crossed.empty()) {
     result.crossed = true;
-    // Which one: the joint whose one-parameter naming fit (over the pixels
-    // in J's linear range, discrepancy_t.joint_naming_*) explains this
-    // frame's residual best, the largest s^2 / I, among every joint of the
-    // robot (the first test to cross may be a distal joint's, whose links
-    // the true joint's offset moves furthest); a joint whose own test has
-    // not crossed only on strong evidence of this frame alone, s^2 / I >= 2h
-    // (what would cross h in one frame), so that a weak fault's neighbours'
-    // noise does not name them. Measured on three arms: docs/safety-chain.md,
-    // "Measured".
+    // Which one: the joint whose offset explains this frame's residual
+    // best (naming_chi2: the naming search's gain, discrepancy_t.
+    // joint_search_*, else the linear naming fit's s^2 / I), among every
+    // joint of the robot (the first test to cross may be a distal joint's,
+    // whose links the true joint's offset moves furthest); a joint whose own
+    // test has not crossed only on strong evidence of this frame alone,
+    // >= 2h (what would cross h in one frame), so that a weak fault's
+    // neighbours' noise does not name them. Measured on three arms:
+    // docs/safety-chain.md, "Measured".
     int best = -1;
     int best_crossed = -1;
     double best_explained = -1;
     double best_crossed_explained = -1;
     for (int i = 0; i < f.num_joints; ++i) {
-      if (joint_cusum_.count(f.joint_name[i]) == 0 || !(f.joint_naming_information[i] > 0)) continue;
-      const double explained =
-          f.joint_naming_score[i] * f.joint_naming_score[i] / f.joint_naming_information[i];
+      if (joint_cusum_.count(f.joint_name[i]) == 0) continue;
+      const double explained = naming_chi2(f, i);
+      if (!(explained > 0)) continue;
       if (explained > best_explained) {
         best_explained = explained;
         best = i;
@@ -212,12 +228,19 @@ EvidenceStep SequentialEvidence::update(const discrepancy_t& f) {
         best_crossed = i;
       }
     }
-    const bool best_is_weak =
-        best >= 0 && joint_cusum(f.joint_name[best]) < h_ && best_explained < 2 * h_ && best_crossed >= 0;
+    // A joint whose test has not crossed must explain this frame better
+    // than the best crossed one by 2h (the difference of two hypotheses'
+    // chi-squares is twice their log-likelihood ratio: this frame alone
+    // prefers it at the threshold's level); with no crossed joint in the
+    // fit, by 2h against nothing.
+    const double crossed_explained = best_crossed >= 0 ? best_crossed_explained : 0.0;
+    const bool best_is_weak = best >= 0 && joint_cusum(f.joint_name[best]) < h_ &&
+                              best_explained - crossed_explained < 2 * h_ && best_crossed >= 0;
     const int suspect = best_is_weak ? best_crossed : best;
     if (suspect < 0) {
-      // No joint in this frame's naming fit (every robot pixel beyond the
-      // gate, or none seen): the joint whose test crossed. Still a stop.
+      // No joint explains anything this frame (no robot point seen, or
+      // every robot pixel beyond the naming fit's gate): the joint whose
+      // test crossed. Still a stop.
       result.finding.cause = risk_t::CAUSE_JOINT_ERROR;
       result.finding.suspect = crossed;
       result.finding.score = crossed_cusum;
@@ -229,7 +252,7 @@ EvidenceStep SequentialEvidence::update(const discrepancy_t& f) {
     }
     result.finding = joint_finding(f, suspect);
     if (joint_cusum(f.joint_name[suspect]) < h_) {
-      // Named by the naming fit; the evidence that crossed is another
+      // Named by the naming search (or fit); the evidence that crossed is another
       // joint's test.
       result.finding.score = crossed_cusum;
       result.finding.detail += " (the test that crossed: " + crossed + "'s, " + fixed(crossed_cusum, 1) +

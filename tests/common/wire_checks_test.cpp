@@ -91,6 +91,9 @@ discrepancy_t discrepancy_with_evidence() {
   d.joint_naming_information = {9e4, 2e3};
   d.robot_fit_pixels = 10;
   d.robot_chi2 = 9;
+  d.search_points = 10;
+  d.joint_search_offset = {0.05, -0.002};
+  d.joint_search_gain = {40, 0};
   return d;
 }
 
@@ -140,6 +143,18 @@ TEST(WireChecks, DiscrepancyEvidence) {
   d = discrepancy_with_evidence();
   d.robot_chi2 = std::nan("");
   EXPECT_EQ(field_of(d), "robot_chi2");
+  d = discrepancy_with_evidence();
+  d.search_points = -1;
+  EXPECT_EQ(field_of(d), "search_points");
+  d = discrepancy_with_evidence();
+  d.joint_search_gain.resize(3);
+  EXPECT_EQ(field_of(d), "joint_search_gain");
+  d = discrepancy_with_evidence();
+  d.joint_search_offset[1] = kNaN;
+  EXPECT_EQ(field_of(d), "joint_search_offset[1]");
+  d = discrepancy_with_evidence();
+  d.joint_search_gain[0] = -0.5;
+  EXPECT_EQ(field_of(d), "joint_search_gain[0]");
 }
 
 // Two robot links and a floor; axes a1 (revolute) then a2 (prismatic).

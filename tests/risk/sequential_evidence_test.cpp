@@ -250,6 +250,45 @@ TEST(EvidenceTests, TheSuspectIsTheJointWhoseNamingFitExplainsMost) {
   EXPECT_EQ(step.finding.suspect, "a3");
 }
 
+// A frame with the naming search (discrepancy_t.joint_search_*): the
+// suspect is the joint whose searched offset explains most, whatever the
+// linear naming fit says (out of its range it may prefer a neighbour), and
+// the detail gives the searched offset.
+TEST(EvidenceTests, TheNamingSearchOutranksTheLinearNamingFit) {
+  SequentialEvidence evidence(sim_config().risk, friend_arm(), kRateHz);
+  discrepancy_t d = evidence_frame(1);
+  d.joint_score[joint_index("a3")] = 1e5 * 6 * kDeg;  // a3's test crosses
+  d.joint_naming_score = d.joint_score;               // and its linear fit explains most
+  d.search_points = 2000;
+  d.joint_search_offset.assign(d.num_joints, 0.0);
+  d.joint_search_gain.assign(d.num_joints, 0.0);
+  d.joint_search_offset[joint_index("a2")] = -10 * kDeg;
+  d.joint_search_gain[joint_index("a2")] = 9000;
+  d.joint_search_offset[joint_index("a3")] = 4 * kDeg;
+  d.joint_search_gain[joint_index("a3")] = 2000;
+  EvidenceStep step = evidence.update(d);
+  ASSERT_TRUE(step.crossed);
+  EXPECT_EQ(step.finding.cause, risk_t::CAUSE_JOINT_ERROR);
+  EXPECT_EQ(step.finding.suspect, "a2");
+  EXPECT_NE(step.finding.detail.find("named by the search: -10.0°"), std::string::npos)
+      << step.finding.detail;
+  EXPECT_NE(step.finding.detail.find("the test that crossed: a3's"), std::string::npos)
+      << step.finding.detail;
+  // A joint whose test has not crossed must explain the frame better than
+  // the crossed one by 2h (this frame alone preferring it at the
+  // threshold's level): a2 by 1.5h does not, by 2.5h it does.
+  SequentialEvidence other(sim_config().risk, friend_arm(), kRateHz);
+  const double h = other.threshold();
+  d.joint_search_gain[joint_index("a2")] = 3.5 * h;
+  d.joint_search_gain[joint_index("a3")] = 2.0 * h;
+  step = other.update(d);
+  EXPECT_EQ(step.finding.suspect, "a3");
+  SequentialEvidence third(sim_config().risk, friend_arm(), kRateHz);
+  d.joint_search_gain[joint_index("a2")] = 4.5 * h;
+  step = third.update(d);
+  EXPECT_EQ(step.finding.suspect, "a2");
+}
+
 // A joint's test crossed but no joint is in this frame's naming fit (every
 // robot pixel beyond the gate: a gross offset): still a stop, blaming the
 // joint whose test crossed.

@@ -58,6 +58,16 @@ struct DiscrepancySettings {
   // evidence.naming_gate_sigmas: the naming fit's gate in sigmas (the
   // suspect joint is named from the pixels within it).
   double evidence_naming_gate_sigmas = 0;
+  // evidence.search.{range_deg, step_deg, range_mm, step_mm, max_points}:
+  // the naming search (joint_search.hpp): trial offsets of each revolute
+  // joint within +-range_deg in steps of step_deg (prismatic: range_mm,
+  // step_mm), over at most max_points rendered robot points. Radians and
+  // metres here.
+  double evidence_search_range_rad = 0;
+  double evidence_search_step_rad = 0;
+  double evidence_search_range_m = 0;
+  double evidence_search_step_m = 0;
+  int evidence_search_max_points = 0;
 };
 
 // Reads (and finishes) the `discrepancy` section.

@@ -20,6 +20,7 @@
 //
 // Pure computation: no LCM, no clocks; one pass over the pixels, nothing
 // allocated per pixel.
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -46,6 +47,16 @@ struct EvidenceParameters {
   // The naming fit (discrepancy_t.joint_naming_*) takes the robot's pixels
   // whose residual is within naming_gate_sigmas * sigma_i.
   double naming_gate_sigmas = 6.0;
+  // The naming search (joint_search.hpp): trial offsets within
+  // +-search_range_rad (revolute) / search_range_m (prismatic) in steps of
+  // search_step_rad / search_step_m, then a quarter step either side of
+  // the best; at most search_max_points robot points (every k-th pixel in u
+  // and v, k the smallest that keeps to it).
+  double search_range_rad = 20.0 * M_PI / 180.0;
+  double search_step_rad = 1.0 * M_PI / 180.0;
+  double search_range_m = 0.05;
+  double search_step_m = 0.0025;
+  int search_max_points = 3000;
 };
 
 // The camera's noise model (discrepancy.noise), shared by the pixel
@@ -62,6 +73,32 @@ struct DepthNoise {
   }
 };
 
+// One moving axis of link_labels_t's kinematics (optical frame, mm).
+struct LabelAxis {
+  int joint = 0;  // index into link_labels_t.joint_name
+  double multiplier = 1;
+  bool prismatic = false;
+  Eigen::Vector3d origin_mm = Eigen::Vector3d::Zero();
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitZ();
+  int parent = -1;  // the next moving axis towards the root, -1: none
+};
+
+// link_labels_t's kinematics, checked: every index in range, parents
+// before children.
+struct LabelKinematics {
+  int num_joints = 0;
+  int num_robot_links = 0;
+  int num_links = 0;
+  std::vector<LabelAxis> axes;
+  // Per robot link: the nearest moving axis above it (-1: fixed to the
+  // robot's root).
+  std::vector<int> link_axis;
+};
+
+// False when `labels` carry no kinematics (num_axes = 0) or they do not fit
+// together or the labels (`pixels` labels expected).
+bool read_label_kinematics(const link_labels_t& labels, size_t pixels, LabelKinematics* out);
+
 // Per-pixel Jacobians of a rendered frame and its labels' kinematics.
 // Keeps pointers into `rendered` and `labels`: they must outlive it.
 class EvidenceJacobian {
@@ -71,7 +108,9 @@ class EvidenceJacobian {
   // False when the labels carry no kinematics (num_axes = 0) or they do not
   // fit the labels (then at() is never true).
   bool available() const { return available_; }
-  int num_joints() const { return num_joints_; }
+  int num_joints() const { return kinematics_.num_joints; }
+  // The labels' kinematics (valid when available()).
+  const LabelKinematics& kinematics() const { return kinematics_; }
 
   // The Jacobian of pixel i (row-major index): mm per unit of each camera
   // parameter (t_x, t_y, t_z per metre, w_x, w_y, w_z per radian; the seen
@@ -84,26 +123,14 @@ class EvidenceJacobian {
   bool at(int i, double camera[6], double* joints, bool* moved, int* link) const;
 
  private:
-  struct Axis {
-    int joint;
-    double multiplier;
-    bool prismatic;
-    Eigen::Vector3d origin_mm;
-    Eigen::Vector3d direction;
-    int parent;
-  };
   bool available_ = false;
   int width_ = 0;
   int height_ = 0;
   double fx_ = 1, fy_ = 1, cx_ = 0, cy_ = 0;
   double jump_mm_ = 0;
-  int num_joints_ = 0;
-  int num_robot_links_ = 0;
-  int num_links_ = 0;
   const int16_t* depth_ = nullptr;
   const int16_t* label_ = nullptr;
-  std::vector<Axis> axes_;
-  std::vector<int> link_axis_;
+  LabelKinematics kinematics_;
 };
 
 // Fills `summary`'s evidence fields (evidence_available .. robot_chi2) for a

@@ -42,6 +42,15 @@ double camera_llr(const std::array<double, 6>& score, const std::array<double, 3
 // h = ln(hypotheses * rate_hz * 3600 * false_stop_period_h).
 double cusum_threshold(int hypotheses, double rate_hz, double false_stop_period_h);
 
+// Whether `frame` carries the naming search (discrepancy_t.joint_search_*,
+// one entry per joint).
+bool searched(const discrepancy_t& frame);
+
+// How much of frame's residual an offset of joint `index` explains, chi^2:
+// the naming search's gain when the frame carries it, else the linear
+// naming fit's s^2 / I (0 without information).
+double naming_chi2(const discrepancy_t& frame, int index);
+
 // What one frame's evidence says.
 struct EvidenceStep {
   // The frame carried evidence (discrepancy_t.evidence_available) and the

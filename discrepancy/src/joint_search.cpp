@@ -1,0 +1,266 @@
+#include "tofguard/discrepancy/joint_search.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "tofguard/common/depth_frame.hpp"
+
+namespace tofguard::discrepancy {
+namespace {
+
+// The coarse trials' points per joint (see search_joint_offsets).
+constexpr size_t kCoarsePoints = 1500;
+
+// A rendered robot point: optical frame, mm, and 1 / sigma_i (1/mm).
+struct SearchPoint {
+  Eigen::Vector3d p_mm;
+  double inv_sigma;
+};
+
+// What the points of some links cost against the measured depth when moved
+// by one rigid motion.
+class PointCost {
+ public:
+  PointCost(const depth_image_t& camera, const depth_image_t& rendered, double clip_sigmas, double weight)
+      : width_(camera.width),
+        height_(camera.height),
+        fx_(rendered.fx),
+        fy_(rendered.fy),
+        cx_(rendered.cx),
+        cy_(rendered.cy),
+        clip2_(clip_sigmas * clip_sigmas),
+        weight_(weight),
+        tof_(camera.depth_mm.data()) {}
+
+  // Marks in `mask` (1) the pixels, `block` x `block` around where each
+  // moved point lands, where the point matches the measured depth (within
+  // clip_sigmas) and `is_static`(pixel) holds.
+  template <typename IsStatic>
+  void mark_matches(const std::vector<SearchPoint>& points, const Eigen::Isometry3d& motion, int block,
+                    const IsStatic& is_static, std::vector<uint8_t>* mask) const {
+    const double clip = std::sqrt(clip2_);
+    for (const SearchPoint& point : points) {
+      const Eigen::Vector3d q = motion * point.p_mm;
+      if (!(q.z() > 1.0)) continue;
+      const double inv_z = 1.0 / q.z();
+      const double uf = fx_ * q.x() * inv_z + cx_ + 0.5;
+      const double vf = fy_ * q.y() * inv_z + cy_ + 0.5;
+      if (!(uf >= 0 && vf >= 0 && uf < width_ && vf < height_)) continue;
+      const int u = static_cast<int>(uf);
+      const int v = static_cast<int>(vf);
+      const int measured = tof_[v * width_ + u];
+      if (measured <= 0 || std::abs(q.z() - measured) * point.inv_sigma > clip) continue;
+      const int u0 = std::max(0, u - block / 2);
+      const int v0 = std::max(0, v - block / 2);
+      for (int y = v0; y < std::min(height_, v0 + block); ++y) {
+        for (int x = u0; x < std::min(width_, u0 + block); ++x) {
+          const int i = y * width_ + x;
+          if (is_static(i)) (*mask)[i] = 1;
+        }
+      }
+    }
+  }
+
+  // Every `every`-th point (the coarse trials), each standing for `every`.
+  double operator()(const std::vector<SearchPoint>& points, const Eigen::Isometry3d& motion,
+                    size_t every) const {
+    double sum = 0;
+    for (size_t n = 0; n < points.size(); n += every) {
+      const Eigen::Vector3d q = motion * points[n].p_mm;
+      if (!(q.z() > 1.0)) {
+        sum += clip2_;
+        continue;
+      }
+      // The nearest pixel: +0.5 and truncation (both >= 0 once in range).
+      const double inv_z = 1.0 / q.z();
+      const double uf = fx_ * q.x() * inv_z + cx_ + 0.5;
+      const double vf = fy_ * q.y() * inv_z + cy_ + 0.5;
+      if (!(uf >= 0 && vf >= 0 && uf < width_ && vf < height_)) {
+        sum += clip2_;
+        continue;
+      }
+      const int u = static_cast<int>(uf);
+      const int v = static_cast<int>(vf);
+      const int measured = tof_[v * width_ + u];
+      if (measured <= 0) {
+        sum += clip2_;
+        continue;
+      }
+      const double x = (q.z() - measured) * points[n].inv_sigma;
+      sum += std::min(x * x, clip2_);
+    }
+    return weight_ * static_cast<double>(every) * sum;
+  }
+
+ private:
+  int width_;
+  int height_;
+  double fx_, fy_, cx_, cy_;
+  double clip2_;
+  double weight_;
+  const int16_t* tof_;
+};
+
+// The rigid motion of one axis moved by `amount` (rad, or mm for a
+// prismatic axis) about / along its line as rendered.
+Eigen::Isometry3d axis_motion(const LabelAxis& axis, double amount) {
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  if (axis.prismatic) {
+    t.translation() = amount * axis.direction;
+  } else {
+    t.linear() = Eigen::AngleAxisd(amount, axis.direction).toRotationMatrix();
+    t.translation() = axis.origin_mm - t.linear() * axis.origin_mm;
+  }
+  return t;
+}
+
+}  // namespace
+
+void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rendered,
+                          const link_labels_t& labels, const LabelKinematics& k, const DepthNoise& noise,
+                          const EvidenceParameters& parameters, discrepancy_t* summary,
+                          std::vector<uint8_t>* explained_static) {
+  if (explained_static != nullptr) explained_static->clear();
+  discrepancy_t& s = *summary;
+  s.search_points = 0;
+  s.joint_search_offset.assign(k.num_joints, 0.0);
+  s.joint_search_gain.assign(k.num_joints, 0.0);
+  const int width = rendered.width;
+  const int height = rendered.height;
+  const size_t pixels = static_cast<size_t>(std::max(width, 0)) * static_cast<size_t>(std::max(height, 0));
+  if (k.num_joints <= 0 || camera.depth_mm.size() != pixels || rendered.depth_mm.size() != pixels ||
+      labels.label.size() != pixels || camera.width != width || !(rendered.fx > 0) || !(rendered.fy > 0)) {
+    return;
+  }
+  const int16_t* gen = rendered.depth_mm.data();
+  const int16_t* label = labels.label.data();
+  // The robot pixels a joint moves, and the stride that keeps them within
+  // search_max_points.
+  const auto moved_link = [&](size_t i) {
+    if (gen[i] <= 0) return -1;
+    const int link = link_of_label(label[i], k.num_robot_links, k.num_links);
+    return link >= 0 && link < k.num_robot_links && k.link_axis[link] >= 0 ? link : -1;
+  };
+  int64_t moved_pixels = 0;
+  for (size_t i = 0; i < pixels; ++i) moved_pixels += moved_link(i) >= 0 ? 1 : 0;
+  if (moved_pixels == 0) return;
+  int stride = 1;
+  while (moved_pixels > int64_t{parameters.search_max_points} * stride * stride) ++stride;
+  std::vector<std::vector<SearchPoint>> points_of_link(k.num_robot_links);
+  const double model_var = parameters.model_sigma_mm * parameters.model_sigma_mm;
+  for (int v = 0; v < height; v += stride) {
+    for (int u = 0; u < width; u += stride) {
+      const size_t i = static_cast<size_t>(v) * width + u;
+      const int link = moved_link(i);
+      if (link < 0) continue;
+      const double z = gen[i];
+      const double sigma_d = noise.sigma_mm(z);
+      points_of_link[link].push_back(SearchPoint{
+          Eigen::Vector3d((u - rendered.cx) * z / rendered.fx, (v - rendered.cy) * z / rendered.fy, z),
+          1.0 / std::sqrt(sigma_d * sigma_d + model_var)});
+      ++s.search_points;
+    }
+  }
+  const PointCost cost(camera, rendered, parameters.clip_sigmas,
+                       static_cast<double>(stride) * stride / parameters.pixels_per_sample);
+
+  // The links joint j moves, each with j's axes in its chain, distal first
+  // (a distal axis turns about its line as rendered, before the proximal
+  // ones move that line).
+  struct MovedLink {
+    const std::vector<SearchPoint>* points;
+    std::vector<const LabelAxis*> axes;
+  };
+  const auto moved_links = [&](int j, bool* prismatic) {
+    std::vector<MovedLink> moved;
+    for (int l = 0; l < k.num_robot_links; ++l) {
+      if (points_of_link[l].empty()) continue;
+      MovedLink m{&points_of_link[l], {}};
+      for (int a = k.link_axis[l]; a >= 0; a = k.axes[a].parent) {
+        if (k.axes[a].joint != j) continue;
+        m.axes.push_back(&k.axes[a]);
+        *prismatic = k.axes[a].prismatic;
+      }
+      if (!m.axes.empty()) moved.push_back(std::move(m));
+    }
+    return moved;
+  };
+  // The rigid motion of link m for a joint offset (rad, or m: `unit` 1000
+  // turns it into the axes' mm).
+  const auto motion_of = [](const MovedLink& m, double offset, double unit) {
+    Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
+    for (const LabelAxis* axis : m.axes)
+      motion = axis_motion(*axis, axis->multiplier * offset * unit) * motion;
+    return motion;
+  };
+
+  for (int j = 0; j < k.num_joints; ++j) {
+    bool prismatic = false;
+    const std::vector<MovedLink> moved = moved_links(j, &prismatic);
+    if (moved.empty()) continue;
+    // The coarse trials take every `coarse_every`-th point of each link
+    // (about kCoarsePoints of the joint's points in all): they only pick the
+    // basin; the gain and the refinement use every point.
+    size_t moved_points = 0;
+    for (const MovedLink& m : moved) moved_points += m.points->size();
+    const size_t coarse_every = std::max<size_t>(1, moved_points / kCoarsePoints);
+    // offset: rad, or m for a prismatic joint (mm in the motion).
+    const double unit = prismatic ? 1000.0 : 1.0;
+    const auto total_cost = [&](double offset, size_t every) {
+      double sum = 0;
+      for (const MovedLink& m : moved) sum += cost(*m.points, motion_of(m, offset, unit), every);
+      return sum;
+    };
+    const double range = prismatic ? parameters.search_range_m : parameters.search_range_rad;
+    const double step = prismatic ? parameters.search_step_m : parameters.search_step_rad;
+    const int steps = static_cast<int>(std::floor(range / step + 1e-9));
+    double coarse_best = total_cost(0.0, coarse_every);
+    double centre = 0;
+    for (int g = -steps; g <= steps; ++g) {
+      if (g == 0) continue;
+      const double c = total_cost(g * step, coarse_every);
+      if (c < coarse_best) {
+        coarse_best = c;
+        centre = g * step;
+      }
+    }
+    const double none = total_cost(0.0, 1);
+    double best = none;
+    double best_offset = 0;
+    if (centre != 0) {
+      for (double f : {0.0, -0.5, -0.25, 0.25, 0.5}) {
+        const double c = total_cost(centre + f * step, 1);
+        if (c < best) {
+          best = c;
+          best_offset = centre + f * step;
+        }
+      }
+    }
+    s.joint_search_offset[j] = best_offset;
+    s.joint_search_gain[j] = std::max(0.0, none - best);
+  }
+
+  // The static pixels the best joint's offset explains: where its moved
+  // points land and match the measured depth.
+  if (explained_static == nullptr) return;
+  explained_static->assign(pixels, 0);
+  int best_joint = -1;
+  for (int j = 0; j < k.num_joints; ++j) {
+    if (s.joint_search_gain[j] > 0 &&
+        (best_joint < 0 || s.joint_search_gain[j] > s.joint_search_gain[best_joint]))
+      best_joint = j;
+  }
+  if (best_joint < 0) return;
+  bool prismatic = false;
+  const std::vector<MovedLink> moved = moved_links(best_joint, &prismatic);
+  const auto is_static = [&](int i) { return moved_link(static_cast<size_t>(i)) < 0; };
+  for (const MovedLink& m : moved) {
+    cost.mark_matches(*m.points, motion_of(m, s.joint_search_offset[best_joint], prismatic ? 1000.0 : 1.0),
+                      stride, is_static, explained_static);
+  }
+}
+
+}  // namespace tofguard::discrepancy
