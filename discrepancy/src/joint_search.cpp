@@ -44,13 +44,9 @@ class PointCost {
     const double clip = std::sqrt(clip2_);
     for (const SearchPoint& point : points) {
       const Eigen::Vector3d q = motion * point.p_mm;
-      if (!(q.z() > 1.0)) continue;
-      const double inv_z = 1.0 / q.z();
-      const double uf = fx_ * q.x() * inv_z + cx_ + 0.5;
-      const double vf = fy_ * q.y() * inv_z + cy_ + 0.5;
-      if (!(uf >= 0 && vf >= 0 && uf < width_ && vf < height_)) continue;
-      const int u = static_cast<int>(uf);
-      const int v = static_cast<int>(vf);
+      int u = 0;
+      int v = 0;
+      if (!lands(q, &u, &v)) continue;
       const int measured = tof_[v * width_ + u];
       if (measured <= 0 || std::abs(q.z() - measured) * point.inv_sigma > clip) continue;
       const int u0 = std::max(0, u - block / 2);
@@ -70,21 +66,9 @@ class PointCost {
     double sum = 0;
     for (size_t n = 0; n < points.size(); n += every) {
       const Eigen::Vector3d q = motion * points[n].p_mm;
-      if (!(q.z() > 1.0)) {
-        sum += clip2_;
-        continue;
-      }
-      // The nearest pixel: +0.5 and truncation (both >= 0 once in range).
-      const double inv_z = 1.0 / q.z();
-      const double uf = fx_ * q.x() * inv_z + cx_ + 0.5;
-      const double vf = fy_ * q.y() * inv_z + cy_ + 0.5;
-      if (!(uf >= 0 && vf >= 0 && uf < width_ && vf < height_)) {
-        sum += clip2_;
-        continue;
-      }
-      const int u = static_cast<int>(uf);
-      const int v = static_cast<int>(vf);
-      const int measured = tof_[v * width_ + u];
+      int u = 0;
+      int v = 0;
+      const int measured = lands(q, &u, &v) ? tof_[v * width_ + u] : 0;
       if (measured <= 0) {
         sum += clip2_;
         continue;
@@ -96,6 +80,20 @@ class PointCost {
   }
 
  private:
+  // The pixel (u, v) nearest to where point q (optical frame, mm) projects;
+  // false when it is behind the camera or off the image. Rounds by +0.5
+  // and truncation (both >= 0 once in range).
+  bool lands(const Eigen::Vector3d& q, int* u, int* v) const {
+    if (!(q.z() > 1.0)) return false;
+    const double inv_z = 1.0 / q.z();
+    const double uf = fx_ * q.x() * inv_z + cx_ + 0.5;
+    const double vf = fy_ * q.y() * inv_z + cy_ + 0.5;
+    if (!(uf >= 0 && vf >= 0 && uf < width_ && vf < height_)) return false;
+    *u = static_cast<int>(uf);
+    *v = static_cast<int>(vf);
+    return true;
+  }
+
   int width_;
   int height_;
   double fx_, fy_, cx_, cy_;

@@ -234,13 +234,14 @@ EvidenceStep SequentialEvidence::update(const discrepancy_t& f) {
     // prefers it at the threshold's level); with no crossed joint in the
     // fit, by 2h against nothing.
     const double crossed_explained = best_crossed >= 0 ? best_crossed_explained : 0.0;
-    const bool best_is_weak = best >= 0 && joint_cusum(f.joint_name[best]) < h_ &&
-                              best_explained - crossed_explained < 2 * h_ && best_crossed >= 0;
+    const bool best_is_weak =
+        best >= 0 && joint_cusum(f.joint_name[best]) < h_ && best_explained - crossed_explained < 2 * h_;
     const int suspect = best_is_weak ? best_crossed : best;
     if (suspect < 0) {
       // No joint explains anything this frame (no robot point seen, or
-      // every robot pixel beyond the naming fit's gate): the joint whose
-      // test crossed. Still a stop.
+      // every robot pixel beyond the naming fit's gate), or only a joint
+      // whose test has not crossed, weakly: the joint whose test crossed.
+      // Still a stop.
       result.finding.cause = risk_t::CAUSE_JOINT_ERROR;
       result.finding.suspect = crossed;
       result.finding.score = crossed_cusum;

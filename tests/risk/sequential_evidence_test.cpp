@@ -287,6 +287,14 @@ TEST(EvidenceTests, TheNamingSearchOutranksTheLinearNamingFit) {
   d.joint_search_gain[joint_index("a2")] = 4.5 * h;
   step = third.update(d);
   EXPECT_EQ(step.finding.suspect, "a2");
+  // The crossed joint explains nothing this frame: a non-crossed one still
+  // needs 2h against nothing; below that, the crossed a3 is named.
+  SequentialEvidence fourth(sim_config().risk, friend_arm(), kRateHz);
+  d.joint_search_gain[joint_index("a2")] = 1.5 * h;
+  d.joint_search_gain[joint_index("a3")] = 0;
+  step = fourth.update(d);
+  ASSERT_TRUE(step.crossed);
+  EXPECT_EQ(step.finding.suspect, "a3");
 }
 
 // A joint's test crossed but no joint is in this frame's naming fit (every
