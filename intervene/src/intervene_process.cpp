@@ -8,6 +8,7 @@
 #include "tofguard/common/wire_checks.hpp"
 #include "tofguard/intervene/intervention_logic.hpp"
 #include "tofguard/intervene/power_actuator.hpp"
+#include "tofguard/intervene/serial_pulse_output.hpp"
 #include "tofguard/power_relay_t.hpp"
 #include "tofguard/reset_reply_t.hpp"
 #include "tofguard/safety_status_t.hpp"
@@ -49,9 +50,18 @@ int run_intervene(const InterveneProcessSettings& settings) {
   LcmNode node(settings.lcm, settings.channels, "tofguard-intervene");
   InterventionLogic logic(settings.intervention, monotonic_us(), wall_utime());
   std::unique_ptr<PowerActuator> actuator;
+  SerialPulseOutput* pulse_output = nullptr;  // the actuator, when it pulses
   if (settings.intervention.power_cut == "usb_hid_relay") {
     actuator = std::make_unique<UsbHidRelay>(settings.intervention.relay_channel,
                                              settings.intervention.relay_serial);
+  } else if (settings.intervention.power_cut == "serial_pulse") {
+    const std::string& line = settings.intervention.pulse_line;
+    auto output = std::make_unique<SerialPulseOutput>(SerialPulseSettings{
+        settings.intervention.pulse_device,
+        line == "tx" ? PulseLine::kTx : (line == "rts" ? PulseLine::kRts : PulseLine::kDtr),
+        settings.intervention.pulse_frequency_hz});
+    pulse_output = output.get();
+    actuator = std::move(output);
   } else {
     actuator = std::make_unique<LcmPowerActuator>(node.safety(), settings.channels.power);
   }
@@ -117,6 +127,18 @@ int run_intervene(const InterveneProcessSettings& settings) {
     logic.take_changed();
     publish_status();
   });
+
+  if (pulse_output != nullptr) {
+    // The pulses come from this loop: if it hangs or the process dies, they
+    // stop and the watchdog drops the power.
+    node.add_timer(pulse_output->half_period_us(), [&] {
+      const std::string error = pulse_output->half_period_tick();
+      if (error.empty()) return;
+      node.errors().report("actuator", error);
+      logic.on_actuator_result(error, monotonic_us(), wall_utime());
+      publish_if_changed();
+    });
+  }
 
   apply_power();
   logic.take_changed();

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <thread>
 
+#include "pseudo_terminal.hpp"
 #include "test_support.hpp"
 #include "tofguard/common/clock.hpp"
 #include "tofguard/heartbeat_t.hpp"
@@ -186,6 +187,60 @@ TEST(InterveneProcess, LatchedStopResetAndRestart) {
   EXPECT_TRUE(bench.statuses.front().latched);
 
   // SIGTERM: a last "stopped" status, exit code 0.
+  intervene->signal(SIGTERM);
+  EXPECT_EQ(intervene->wait(std::chrono::seconds(5)), 0);
+}
+
+// power_cut: serial_pulse on a pseudo-terminal (line tx). The output
+// follows the power, not the permission to move (a software stop keeps the
+// power so that the controller can brake): pulses while the risk stream is
+// fresh, none after kill -9 and none once the stale stream cuts the power
+// (the watchdog behind the output would drop it within its period).
+TEST(InterveneProcess, ThePulsedPowerOutputStopsWhenThePowerIsCutOrTheProcessDies) {
+  PseudoTerminal pty;
+  ASSERT_FALSE(pty.device().empty()) << "no pseudo-terminal";
+  const std::string config = sim_config_variant(
+      "intervene_serial_pulse",
+      {{"  power_cut: lcm\n", "  power_cut: serial_pulse\n  serial_pulse: {device: " + pty.device() +
+                                  ", line: tx, frequency_hz: 25}\n"}});
+  const std::vector<std::string> argv{bin_dir() + "/tofguard-intervene", "--config", config};
+  Bench bench;
+  std::string seen;
+  const auto pulses_come = [&] {
+    seen.clear();
+    return wait_until([&] { return seen.size() >= 5; }, std::chrono::seconds(3),
+                      [&] {
+                        bench.pump();
+                        seen += pty.available();
+                      }) &&
+           seen.find_first_not_of('\x55') == std::string::npos;
+  };
+  // No pulse for 300 ms (7 periods at 25 Hz) after what was in flight.
+  const auto pulses_stopped = [&] {
+    wait_until([] { return false; }, std::chrono::milliseconds(60), [&] { bench.pump(); });
+    pty.available();
+    seen.clear();
+    wait_until([] { return false; }, std::chrono::milliseconds(300),
+               [&] {
+                 bench.pump();
+                 seen += pty.available();
+               });
+    return seen.empty();
+  };
+
+  auto intervene = std::make_unique<Subprocess>("intervene-pulse-1", argv);
+  ASSERT_TRUE(pulses_come()) << seen.size() << " pulses\n" << intervene->stderr_text();
+  intervene->signal(SIGKILL);
+  intervene->wait(std::chrono::seconds(5));
+  EXPECT_TRUE(pulses_stopped()) << seen.size() << " pulses after kill -9";
+
+  intervene = std::make_unique<Subprocess>("intervene-pulse-2", argv);
+  ASSERT_TRUE(pulses_come()) << seen.size() << " pulses\n" << intervene->stderr_text();
+  bench.send_risk = false;  // the risk stream dies: power cut
+  ASSERT_TRUE(
+      bench.wait_for([](const safety_status_t& s) { return s.stop == safety_status_t::STOP_POWER_CUT; },
+                     std::chrono::seconds(2)));
+  EXPECT_TRUE(pulses_stopped()) << seen.size() << " pulses after the power cut";
   intervene->signal(SIGTERM);
   EXPECT_EQ(intervene->wait(std::chrono::seconds(5)), 0);
 }

@@ -25,13 +25,22 @@ struct InterventionSettings {
   int64_t stop_deadline_us = 0;
   int64_t joint_state_deadline_us = 0;
   double stopped_velocity = 0;  // rad/s (or m/s)
-  // power_cut: "lcm" (power_relay_t on channels.power) or "usb_hid_relay".
+  // power_cut: "lcm" (power_relay_t on channels.power), "usb_hid_relay" or
+  // "serial_pulse".
   std::string power_cut;
   // usb_hid_relay.{channel, serial}: USB HID relay board (16c0:05df): which
   // relay (1-based) switches the arm's power, wired normally open; serial ""
   // takes the only board.
   int relay_channel = 1;
   std::string relay_serial;
+  // serial_pulse.{device, line, frequency_hz}: the dynamic power output
+  // (serial_pulse_output.hpp, docs/intervention.md): a square wave of
+  // frequency_hz (1..1000) on line "dtr", "rts" or "tx" of the serial
+  // device, for a retriggerable watchdog that drops the arm's power when
+  // the pulses stop.
+  std::string pulse_device;
+  std::string pulse_line;
+  double pulse_frequency_hz = 0;
 };
 
 // Reads (and finishes) the `intervention` section.
