@@ -194,7 +194,8 @@ TEST(InterveneProcess, LatchedStopResetAndRestart) {
 // power_cut: serial_pulse on a pseudo-terminal (line tx). The output
 // follows the power, not the permission to move (a software stop keeps the
 // power so that the controller can brake): pulses while the risk stream is
-// fresh, none after kill -9 and none once the stale stream cuts the power
+// fresh, none while the process hangs (SIGSTOP), none after kill -9 and
+// none once the stale stream cuts the power
 // (the watchdog behind the output would drop it within its period).
 TEST(InterveneProcess, ThePulsedPowerOutputStopsWhenThePowerIsCutOrTheProcessDies) {
   PseudoTerminal pty;
@@ -230,6 +231,10 @@ TEST(InterveneProcess, ThePulsedPowerOutputStopsWhenThePowerIsCutOrTheProcessDie
 
   auto intervene = std::make_unique<Subprocess>("intervene-pulse-1", argv);
   ASSERT_TRUE(pulses_come()) << seen.size() << " pulses\n" << intervene->stderr_text();
+  // A hang (SIGSTOP): the loop that makes the pulses stands still.
+  intervene->signal(SIGSTOP);
+  EXPECT_TRUE(pulses_stopped()) << seen.size() << " pulses while stopped by SIGSTOP";
+  intervene->signal(SIGCONT);
   intervene->signal(SIGKILL);
   intervene->wait(std::chrono::seconds(5));
   EXPECT_TRUE(pulses_stopped()) << seen.size() << " pulses after kill -9";
