@@ -207,9 +207,9 @@ EvidenceStep SequentialEvidence::update(const discrepancy_t& f) {
     // joint_search_*, else the linear naming fit's s^2 / I), among every
     // joint of the robot (the first test to cross may be a distal joint's,
     // whose links the true joint's offset moves furthest); a joint whose own
-    // test has not crossed only on strong evidence of this frame alone,
-    // >= 2h (what would cross h in one frame), so that a weak fault's
-    // neighbours' noise does not name them. Measured on three arms:
+    // test has not crossed only on strong evidence of this frame alone (2h
+    // more than the best crossed joint explains, below), so that a weak
+    // fault's neighbours' noise does not name them. Measured on three arms:
     // docs/safety-chain.md, "Measured".
     int best = -1;
     int best_crossed = -1;
