@@ -186,12 +186,14 @@ void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rend
     }
     return moved;
   };
-  // The rigid motion of link m for a joint offset (rad, or m: `unit` 1000
-  // turns it into the axes' mm).
-  const auto motion_of = [](const MovedLink& m, double offset, double unit) {
+  // The rigid motion of link m for a joint offset (rad; m for a prismatic
+  // joint, whose axes move in mm).
+  const auto motion_of = [](const MovedLink& m, double offset) {
     Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
-    for (const LabelAxis* axis : m.axes)
+    for (const LabelAxis* axis : m.axes) {
+      const double unit = axis->prismatic ? 1000.0 : 1.0;
       motion = axis_motion(*axis, axis->multiplier * offset * unit) * motion;
+    }
     return motion;
   };
 
@@ -205,11 +207,9 @@ void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rend
     size_t moved_points = 0;
     for (const MovedLink& m : moved) moved_points += m.points->size();
     const size_t coarse_every = std::max<size_t>(1, moved_points / kCoarsePoints);
-    // offset: rad, or m for a prismatic joint (mm in the motion).
-    const double unit = prismatic ? 1000.0 : 1.0;
     const auto total_cost = [&](double offset, size_t every) {
       double sum = 0;
-      for (const MovedLink& m : moved) sum += cost(*m.points, motion_of(m, offset, unit), every);
+      for (const MovedLink& m : moved) sum += cost(*m.points, motion_of(m, offset), every);
       return sum;
     };
     const double range = prismatic ? parameters.search_range_m : parameters.search_range_rad;
@@ -256,8 +256,8 @@ void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rend
   const std::vector<MovedLink> moved = moved_links(best_joint, &prismatic);
   const auto is_static = [&](int i) { return moved_link(static_cast<size_t>(i)) < 0; };
   for (const MovedLink& m : moved) {
-    cost.mark_matches(*m.points, motion_of(m, s.joint_search_offset[best_joint], prismatic ? 1000.0 : 1.0),
-                      stride, is_static, explained_static);
+    cost.mark_matches(*m.points, motion_of(m, s.joint_search_offset[best_joint]), stride, is_static,
+                      explained_static);
   }
 }
 
