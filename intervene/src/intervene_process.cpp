@@ -55,11 +55,7 @@ int run_intervene(const InterveneProcessSettings& settings) {
     actuator = std::make_unique<UsbHidRelay>(settings.intervention.relay_channel,
                                              settings.intervention.relay_serial);
   } else if (settings.intervention.power_cut == "serial_pulse") {
-    const std::string& line = settings.intervention.pulse_line;
-    auto output = std::make_unique<SerialPulseOutput>(SerialPulseSettings{
-        settings.intervention.pulse_device,
-        line == "tx" ? PulseLine::kTx : (line == "rts" ? PulseLine::kRts : PulseLine::kDtr),
-        settings.intervention.pulse_frequency_hz});
+    auto output = std::make_unique<SerialPulseOutput>(settings.intervention.serial_pulse);
     pulse_output = output.get();
     actuator = std::move(output);
   } else {

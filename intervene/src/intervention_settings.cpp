@@ -18,9 +18,11 @@ InterventionSettings read_intervention_settings(YamlMap map) {
     map.fail("usb_hid_relay", "a mapping with channel (and serial) when power_cut is usb_hid_relay");
   }
   if (auto pulse = map.optional_map("serial_pulse")) {
-    in.pulse_device = pulse->string("device");
-    in.pulse_line = pulse->choice("line", {"dtr", "rts", "tx"});
-    in.pulse_frequency_hz = pulse->number("frequency_hz", 1, 1000);
+    in.serial_pulse.device = pulse->string("device");
+    const std::string line = pulse->choice("line", {"dtr", "rts", "tx"});
+    in.serial_pulse.line =
+        line == "tx" ? PulseLine::kTx : (line == "rts" ? PulseLine::kRts : PulseLine::kDtr);
+    in.serial_pulse.frequency_hz = pulse->number("frequency_hz", 1, 1000);
     pulse->finish();
   } else if (in.power_cut == "serial_pulse") {
     map.fail("serial_pulse", "a mapping with device, line and frequency_hz when power_cut is serial_pulse");

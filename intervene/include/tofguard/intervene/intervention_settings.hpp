@@ -8,6 +8,7 @@
 
 #include "tofguard/common/lcm_settings.hpp"
 #include "tofguard/common/yaml_reader.hpp"
+#include "tofguard/intervene/serial_pulse_output.hpp"
 
 namespace tofguard::intervene {
 
@@ -38,9 +39,7 @@ struct InterventionSettings {
   // frequency_hz (1..1000) on line "dtr", "rts" or "tx" of the serial
   // device, for a retriggerable watchdog that drops the arm's power when
   // the pulses stop.
-  std::string pulse_device;
-  std::string pulse_line;
-  double pulse_frequency_hz = 0;
+  SerialPulseSettings serial_pulse;
 };
 
 // Reads (and finishes) the `intervention` section.
