@@ -3,6 +3,7 @@
 #include <cmath>
 #include <set>
 #include <sstream>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -54,6 +55,20 @@ std::string check_count(int32_t n, const std::vector<T>& array, const std::strin
   if (array.size() != static_cast<size_t>(n)) {
     return field + ": expected " + count + " = " + std::to_string(n) + " entries, got " +
            std::to_string(array.size());
+  }
+  return "";
+}
+
+// A per-joint array of discrepancy_t's evidence: num_joints entries, each
+// finite (and >= 0 when `non_negative`).
+std::string check_joint_values(int32_t num_joints, const std::vector<double>& values,
+                               const std::string& field, bool non_negative) {
+  if (auto p = check_count(num_joints, values, field, "num_joints"); !p.empty()) return p;
+  for (int j = 0; j < num_joints; ++j) {
+    if (!std::isfinite(values[j]) || (non_negative && values[j] < 0)) {
+      return expected(field + "[" + std::to_string(j) + "]",
+                      non_negative ? "a finite number >= 0" : "a finite number", values[j]);
+    }
   }
   return "";
 }
@@ -165,55 +180,27 @@ std::string check_evidence(const discrepancy_t& d) {
   if (auto p = check_count(d.num_joints, d.joint_name, "joint_name", "num_joints"); !p.empty()) return p;
   if (auto p = check_count(d.num_joints, d.joint_fit_pixels, "joint_fit_pixels", "num_joints"); !p.empty())
     return p;
-  if (auto p = check_count(d.num_joints, d.joint_score, "joint_score", "num_joints"); !p.empty()) return p;
-  if (auto p = check_count(d.num_joints, d.joint_information, "joint_information", "num_joints");
-      !p.empty()) {
-    return p;
-  }
   if (auto p = check_names(d.joint_name, "joint_name"); !p.empty()) return p;
   for (int j = 0; j < d.num_joints; ++j) {
-    const std::string at = "[" + std::to_string(j) + "]";
-    if (d.joint_fit_pixels[j] < 0)
-      return expected("joint_fit_pixels" + at, "a count >= 0", d.joint_fit_pixels[j]);
-    if (!std::isfinite(d.joint_score[j]))
-      return expected("joint_score" + at, "a finite number", d.joint_score[j]);
-    if (!(std::isfinite(d.joint_information[j]) && d.joint_information[j] >= 0)) {
-      return expected("joint_information" + at, "a finite number >= 0", d.joint_information[j]);
+    if (d.joint_fit_pixels[j] < 0) {
+      return expected("joint_fit_pixels[" + std::to_string(j) + "]", "a count >= 0", d.joint_fit_pixels[j]);
     }
   }
-  if (auto p = check_count(d.num_joints, d.joint_naming_score, "joint_naming_score", "num_joints");
-      !p.empty())
-    return p;
-  if (auto p =
-          check_count(d.num_joints, d.joint_naming_information, "joint_naming_information", "num_joints");
-      !p.empty()) {
-    return p;
-  }
-  for (int j = 0; j < d.num_joints; ++j) {
-    const std::string at = "[" + std::to_string(j) + "]";
-    if (!std::isfinite(d.joint_naming_score[j]))
-      return expected("joint_naming_score" + at, "a finite number", d.joint_naming_score[j]);
-    if (!(std::isfinite(d.joint_naming_information[j]) && d.joint_naming_information[j] >= 0)) {
-      return expected("joint_naming_information" + at, "a finite number >= 0", d.joint_naming_information[j]);
-    }
+  // Scores and offsets may have either sign; information and gains not.
+  for (const auto& [values, field, non_negative] :
+       {std::tuple{&d.joint_score, "joint_score", false},
+        std::tuple{&d.joint_information, "joint_information", true},
+        std::tuple{&d.joint_naming_score, "joint_naming_score", false},
+        std::tuple{&d.joint_naming_information, "joint_naming_information", true},
+        std::tuple{&d.joint_search_offset, "joint_search_offset", false},
+        std::tuple{&d.joint_search_gain, "joint_search_gain", true}}) {
+    if (auto p = check_joint_values(d.num_joints, *values, field, non_negative); !p.empty()) return p;
   }
   if (d.robot_fit_pixels < 0) return expected("robot_fit_pixels", "a count >= 0", d.robot_fit_pixels);
   if (!(std::isfinite(d.robot_chi2) && d.robot_chi2 >= 0)) {
     return expected("robot_chi2", "a finite sum >= 0", d.robot_chi2);
   }
   if (d.search_points < 0) return expected("search_points", "a count >= 0", d.search_points);
-  if (auto p = check_count(d.num_joints, d.joint_search_offset, "joint_search_offset", "num_joints");
-      !p.empty())
-    return p;
-  if (auto p = check_count(d.num_joints, d.joint_search_gain, "joint_search_gain", "num_joints"); !p.empty())
-    return p;
-  for (int j = 0; j < d.num_joints; ++j) {
-    const std::string at = "[" + std::to_string(j) + "]";
-    if (!std::isfinite(d.joint_search_offset[j]))
-      return expected("joint_search_offset" + at, "a finite number", d.joint_search_offset[j]);
-    if (!(std::isfinite(d.joint_search_gain[j]) && d.joint_search_gain[j] >= 0))
-      return expected("joint_search_gain" + at, "a finite number >= 0", d.joint_search_gain[j]);
-  }
   return "";
 }
 
