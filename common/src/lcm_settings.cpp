@@ -1,5 +1,6 @@
 #include "tofguard/common/lcm_settings.hpp"
 
+#include <cstdlib>
 #include <regex>
 
 namespace tofguard {
@@ -38,6 +39,26 @@ LcmSettings read_lcm_settings(std::optional<YamlMap> section, const char* lcm_de
   return lcm;
 }
 
+std::string bus_exposure_warning(const std::string& url) {
+  const auto scheme_end = url.find("://");
+  const std::string provider = scheme_end == std::string::npos ? url : url.substr(0, scheme_end);
+  if (provider == "udpm") {
+    const auto at = url.find("ttl=");
+    if (at == std::string::npos) return "";  // LCM's default ttl is 0
+    const long ttl = std::strtol(url.c_str() + at + 4, nullptr, 10);
+    if (ttl <= 0) return "";
+    return "WARNING: LCM bus " + url + " has ttl=" + std::to_string(ttl) +
+           ": its multicast leaves this host, and every machine on that network can read and publish on it "
+           "(docs/security.md)";
+  }
+  if (provider == "tcpq") {
+    const std::string rest = url.substr(scheme_end + 3);
+    if (rest.rfind("127.", 0) == 0 || rest.rfind("localhost", 0) == 0) return "";
+    return "WARNING: LCM bus " + url + " reaches another host over TCP (docs/security.md)";
+  }
+  return "";
+}
+
 ChannelNames read_channel_names(YamlMap map) {
   ChannelNames c;
   auto name = [&map](const char* key, std::string* out) {
@@ -55,6 +76,10 @@ ChannelNames read_channel_names(YamlMap map) {
   name("reset_reply", &c.reset_reply);
   name("heartbeat", &c.heartbeat);
   name("power", &c.power);
+  name("risk_auth", &c.risk_auth);
+  name("status_auth", &c.status_auth);
+  name("power_auth", &c.power_auth);
+  name("reset_auth", &c.reset_auth);
   name("motion_estimate", &c.motion_estimate);
   name("planned_trajectory", &c.planned_trajectory);
   name("sim_true_joint_state", &c.sim_true_joint_state);

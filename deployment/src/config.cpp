@@ -11,12 +11,23 @@ Config default_wire_config(const char* lcm_default_url_env) {
   return config;
 }
 
+std::vector<std::string> start_warnings(const Config& config) {
+  std::vector<std::string> warnings;
+  if (const std::string w = auth::auth_warning(config.auth); !w.empty()) warnings.push_back(w);
+  if (const std::string w = bus_exposure_warning(config.lcm.url); !w.empty()) warnings.push_back(w);
+  if (config.lcm.image_url != config.lcm.url) {
+    if (const std::string w = bus_exposure_warning(config.lcm.image_url); !w.empty()) warnings.push_back(w);
+  }
+  return warnings;
+}
+
 Config load_config(const std::string& path, const char* lcm_default_url_env) {
   YamlMap root = load_yaml_file(path);
   Config config;
   config.file = path;
   config.lcm = read_lcm_settings(root.optional_map("lcm"), lcm_default_url_env);
   if (auto channels = root.optional_map("channels")) config.channels = read_channel_names(*channels);
+  config.auth = auth::read_auth_settings(root);
   config.robot = read_robot_settings(root.map("robot"));
   config.environment = read_environment_settings(root.optional_map("environment"));
 

@@ -45,6 +45,7 @@ int run_process(int argc, char** argv, const ProcessInfo& info, const ProcessBod
     std::cerr << info.name << ": unknown argument '" << rest[0] << "'\n";
     return kConfigErrorExitCode;
   }
+  for (const std::string& warning : start_warnings(config)) std::cerr << info.name << ": " << warning << "\n";
   install_stop_signal_handlers();
   try {
     return body(config, rest);

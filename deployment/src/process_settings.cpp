@@ -29,6 +29,7 @@ risk::RiskProcessSettings risk_process_settings(const Config& config) {
   s.robot_urdf_path = config.robot.urdf_path;
   s.camera_id = config.camera.id;
   s.camera_rate_hz = config.camera.rate_hz;
+  s.auth = config.auth;
   s.risk = config.risk;
   return s;
 }
@@ -51,6 +52,7 @@ intervene::InterveneProcessSettings intervene_process_settings(const Config& con
   intervene::InterveneProcessSettings s;
   s.lcm = config.lcm;
   s.channels = config.channels;
+  s.auth = config.auth;
   s.intervention = config.intervention;
   return s;
 }
@@ -59,6 +61,7 @@ intervene::ResetToolSettings reset_tool_settings(const Config& config) {
   intervene::ResetToolSettings s;
   s.lcm = config.lcm;
   s.channels = config.channels;
+  s.auth = config.auth;
   return s;
 }
 

@@ -2,7 +2,10 @@
 
 #include <iostream>
 #include <memory>
+#include <optional>
 
+#include "tofguard/auth/message_signer.hpp"
+#include "tofguard/auth/message_verifier.hpp"
 #include "tofguard/common/clock.hpp"
 #include "tofguard/common/lcm_node.hpp"
 #include "tofguard/common/wire_checks.hpp"
@@ -16,16 +19,22 @@
 namespace tofguard::intervene {
 namespace {
 
-// The `lcm` actuator: power_relay_t on SAFETY_POWER.
+// The `lcm` actuator: power_relay_t on SAFETY_POWER, and with a key signed
+// on SAFETY_POWER_AUTH first (power_enabled = true is a permission too).
 class LcmPowerActuator : public PowerActuator {
  public:
-  LcmPowerActuator(lcm::LCM& lcm, std::string channel) : lcm_(lcm), channel_(std::move(channel)) {}
+  LcmPowerActuator(lcm::LCM& lcm, std::string channel, std::string auth_channel, auth::MessageSigner* signer)
+      : lcm_(lcm), channel_(std::move(channel)), auth_channel_(std::move(auth_channel)), signer_(signer) {}
   std::string set_power(bool enabled, const std::string& reason) override {
     power_relay_t message;
     message.utime = wall_utime();
     message.seq = seq_++;
     message.power_enabled = enabled;
     message.reason = reason;
+    if (signer_ != nullptr) {
+      const authenticated_message_t signed_message = signer_->sign(channel_, message, wall_utime());
+      if (lcm_.publish(auth_channel_, &signed_message) != 0) return "cannot publish " + auth_channel_;
+    }
     if (lcm_.publish(channel_, &message) != 0) return "cannot publish " + channel_;
     return "";
   }
@@ -33,7 +42,28 @@ class LcmPowerActuator : public PowerActuator {
  private:
   lcm::LCM& lcm_;
   std::string channel_;
+  std::string auth_channel_;
+  auth::MessageSigner* signer_;  // null: insecure
   int64_t seq_ = 0;
+};
+
+// Messages refused by the authentication: counted as validation errors in
+// the heartbeat, reported in one line each (rate-limited per channel), and
+// summed up in the heartbeat's status.
+struct AuthRefusals {
+  int64_t count = 0;
+  std::string last;
+
+  void refuse(LcmNode& node, const std::string& channel, const std::string& why) {
+    ++count;
+    last = channel + ": " + why;
+    node.counters().validation_errors++;
+    node.errors().report(channel, channel + ": refused: " + why);
+  }
+  std::string summary() const {
+    if (count == 0) return "";
+    return "; " + std::to_string(count) + " messages refused by authentication (last: " + last + ")";
+  }
 };
 
 }  // namespace
@@ -48,6 +78,16 @@ ProcessInfo process_info() {
 
 int run_intervene(const InterveneProcessSettings& settings) {
   LcmNode node(settings.lcm, settings.channels, "tofguard-intervene");
+  const ChannelNames& channels = settings.channels;
+  // With a key, only signed risk verdicts and resets count, and the status
+  // and power commands go out signed as well as plain.
+  std::optional<auth::MessageVerifier> verifier;
+  std::optional<auth::MessageSigner> signer;
+  if (auth::authenticated(settings.auth)) {
+    verifier.emplace(settings.auth.key, settings.auth.max_age_us);
+    signer.emplace(settings.auth.key, wall_utime());
+  }
+  AuthRefusals refused;
   InterventionLogic logic(settings.intervention, monotonic_us(), wall_utime());
   std::unique_ptr<PowerActuator> actuator;
   SerialPulseOutput* pulse_output = nullptr;  // the actuator, when it pulses
@@ -59,7 +99,8 @@ int run_intervene(const InterveneProcessSettings& settings) {
     pulse_output = output.get();
     actuator = std::move(output);
   } else {
-    actuator = std::make_unique<LcmPowerActuator>(node.safety(), settings.channels.power);
+    actuator = std::make_unique<LcmPowerActuator>(node.safety(), channels.power, channels.power_auth,
+                                                  signer ? &*signer : nullptr);
   }
 
   int64_t seq = 0;
@@ -74,9 +115,14 @@ int run_intervene(const InterveneProcessSettings& settings) {
     message.cause = s.cause;
     message.reason = s.reason;
     message.since_utime = s.since_utime;
-    node.safety().publish(settings.channels.status, &message);
+    if (signer) {
+      const authenticated_message_t signed_status = signer->sign(channels.status, message, wall_utime());
+      node.safety().publish(channels.status_auth, &signed_status);
+    }
+    node.safety().publish(channels.status, &message);
     node.counters().frames_out++;
-    node.heartbeat().set_status(s.motion_allowed ? "motion allowed" : "stopped: " + s.reason);
+    node.heartbeat().set_status((s.motion_allowed ? "motion allowed" : "stopped: " + s.reason) +
+                                refused.summary());
   };
   auto apply_power = [&] {
     const std::string error = actuator->set_power(logic.status().power_enabled, logic.status().reason);
@@ -92,30 +138,73 @@ int run_intervene(const InterveneProcessSettings& settings) {
     }
   };
 
-  node.subscribe<risk_t>(
-      node.safety(), settings.channels.risk,
-      [&](const risk_t& risk) {
-        node.heartbeat().set_last_frame_utime(risk.utime);
-        logic.on_risk(risk, monotonic_us(), wall_utime());
-        publish_if_changed();
-      },
-      check_risk);
+  auto on_risk = [&](const risk_t& risk) {
+    node.heartbeat().set_last_frame_utime(risk.utime);
+    logic.on_risk(risk, monotonic_us(), wall_utime());
+    publish_if_changed();
+  };
+  if (verifier) {
+    // The plain SAFETY_RISK is not read at all: only a verdict with a valid
+    // tag is a verdict (a forged SAFE would be a permission).
+    node.subscribe<authenticated_message_t>(
+        node.safety(), channels.risk_auth, [&](const authenticated_message_t& m) {
+          std::string why;
+          const std::optional<risk_t> risk = verifier->open<risk_t>(m, channels.risk, wall_utime(), &why);
+          if (risk && (why = check_risk(*risk)).empty()) {
+            on_risk(*risk);
+          } else {
+            refused.refuse(node, channels.risk_auth, why);
+          }
+        });
+  } else {
+    node.subscribe<risk_t>(node.safety(), channels.risk, on_risk, check_risk);
+  }
   node.subscribe<joint_state_t>(
       node.safety(), settings.channels.joint_state,
       [&](const joint_state_t& joints) { logic.on_joint_state(joints, monotonic_us()); }, check_joint_state);
-  node.subscribe<reset_request_t>(
-      node.safety(), settings.channels.reset, [&](const reset_request_t& request) {
-        const ResetDecision decision = logic.on_reset(request, monotonic_us(), wall_utime());
-        reset_reply_t reply;
-        reply.utime = wall_utime();
-        reply.request_id = request.request_id;
-        reply.accepted = decision.accepted;
-        reply.reason = decision.reason;
-        std::cerr << "tofguard-intervene: reset from '" << request.who << "' (" << request.why
-                  << "): " << decision.reason << std::endl;
-        publish_if_changed();
-        node.safety().publish(settings.channels.reset_reply, &reply);
-      });
+  auto reply_to_reset = [&](int64_t request_id, const ResetDecision& decision) {
+    reset_reply_t reply;
+    reply.utime = wall_utime();
+    reply.request_id = request_id;
+    reply.accepted = decision.accepted;
+    reply.reason = decision.reason;
+    node.safety().publish(channels.reset_reply, &reply);
+  };
+  auto on_reset = [&](const reset_request_t& request) {
+    const ResetDecision decision = logic.on_reset(request, monotonic_us(), wall_utime());
+    std::cerr << "tofguard-intervene: reset from '" << request.who << "' (" << request.why
+              << "): " << decision.reason << std::endl;
+    publish_if_changed();
+    reply_to_reset(request.request_id, decision);
+  };
+  if (verifier) {
+    // A plain reset is refused (and answered, so that whoever sent it
+    // learns why); only a signed one reaches the logic.
+    node.subscribe<reset_request_t>(node.safety(), channels.reset, [&](const reset_request_t& request) {
+      refused.refuse(node, channels.reset,
+                     "not authenticated (no tag): send it signed on " + channels.reset_auth);
+      reply_to_reset(request.request_id, {false,
+                                          "refused: not authenticated: use tofguard-reset with the "
+                                          "deployment's config (its auth.key_file)"});
+    });
+    node.subscribe<authenticated_message_t>(
+        node.safety(), channels.reset_auth, [&](const authenticated_message_t& m) {
+          std::string why;
+          const std::optional<reset_request_t> request =
+              verifier->open<reset_request_t>(m, channels.reset, wall_utime(), &why);
+          if (request) {
+            on_reset(*request);
+            return;
+          }
+          refused.refuse(node, channels.reset_auth, why);
+          // Answer the request id it claims (a refusal allows nothing).
+          if (const auto claimed = decode_message<reset_request_t>(m.payload.data(), m.payload_size)) {
+            reply_to_reset(claimed->request_id, {false, "refused: not authenticated: " + why});
+          }
+        });
+  } else {
+    node.subscribe<reset_request_t>(node.safety(), channels.reset, on_reset);
+  }
   node.add_timer(static_cast<int64_t>(1e6 / settings.intervention.publish_rate_hz), [&] {
     logic.tick(monotonic_us(), wall_utime());
     logic.take_changed();
@@ -153,7 +242,11 @@ int run_intervene(const InterveneProcessSettings& settings) {
   last.cause = risk_t::CAUSE_COMPONENT_FAULT;
   last.reason = "tofguard-intervene exiting";
   last.since_utime = last.utime;
-  node.safety().publish(settings.channels.status, &last);
+  if (signer) {
+    const authenticated_message_t signed_last = signer->sign(channels.status, last, wall_utime());
+    node.safety().publish(channels.status_auth, &signed_last);
+  }
+  node.safety().publish(channels.status, &last);
   actuator->set_power(false, "tofguard-intervene exiting");
   return 0;
 }

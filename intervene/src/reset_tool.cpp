@@ -4,6 +4,7 @@
 #include <iostream>
 #include <random>
 
+#include "tofguard/auth/message_signer.hpp"
 #include "tofguard/common/clock.hpp"
 #include "tofguard/common/config_error.hpp"
 #include "tofguard/common/lcm_node.hpp"
@@ -21,7 +22,9 @@ ProcessInfo reset_info() {
   ProcessInfo info{"tofguard-reset",
                    "Sends a reset request (who and why) to tofguard-intervene and prints\n"
                    "whether it was accepted and why not. Options: --who NAME --why TEXT\n"
-                   "[--timeout-ms MS]. Exit code 0 accepted, 1 refused, 3 no answer.",
+                   "[--timeout-ms MS]. With a config that names auth.key_file the request is signed\n"
+                   "(SAFETY_RESET_AUTH); without one it is plain, and a keyed tofguard-intervene\n"
+                   "refuses it. Exit code 0 accepted, 1 refused, 3 no answer.",
                    /*config_required=*/false};
   info.takes_arguments = true;
   return info;
@@ -69,7 +72,17 @@ int run_reset(const ResetToolSettings& settings, const std::vector<std::string>&
   } waiter;
   waiter.request_id = request.request_id;
   lcm.subscribe(settings.channels.reset_reply, &Waiter::on_reply, &waiter);
-  lcm.publish(settings.channels.reset, &request);
+  if (!settings.auth.key.id.empty()) {
+    // Signed: the only reset a keyed tofguard-intervene accepts.
+    auth::MessageSigner signer(settings.auth.key, request.utime);
+    const authenticated_message_t signed_request =
+        signer.sign(settings.channels.reset, request, wall_utime());
+    lcm.publish(settings.channels.reset_auth, &signed_request);
+  } else {
+    // No key (insecure: true, or no config given): plain, which only an
+    // insecure tofguard-intervene accepts; a keyed one answers why not.
+    lcm.publish(settings.channels.reset, &request);
+  }
 
   const int64_t deadline_us = monotonic_us() + timeout_ms * 1000;
   while (!waiter.answered && monotonic_us() < deadline_us && !stop_requested()) {

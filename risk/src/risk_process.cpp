@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
+#include "tofguard/auth/message_signer.hpp"
 #include "tofguard/camera_pose_t.hpp"
 #include "tofguard/common/clock.hpp"
 #include "tofguard/common/lcm_node.hpp"
@@ -25,8 +27,16 @@ int run_risk(const RiskProcessSettings& settings) {
   const std::string camera_id = settings.camera_id;
   LcmNode node(settings.lcm, settings.channels, process_info().name);
   int64_t dangerous = 0;
+  // With a key, each verdict goes out signed first (the copy a keyed
+  // tofguard-intervene acts on), then plain (for people, logs and tools).
+  std::optional<auth::MessageSigner> signer;
+  if (auth::authenticated(settings.auth)) signer.emplace(settings.auth.key, wall_utime());
 
   auto publish = [&](const risk_t& r) {
+    if (signer) {
+      const authenticated_message_t signed_risk = signer->sign(settings.channels.risk, r, wall_utime());
+      node.safety().publish(settings.channels.risk_auth, &signed_risk);
+    }
     node.safety().publish(settings.channels.risk, &r);
     node.counters().frames_out++;
     if (r.seq >= 0) node.heartbeat().set_last_frame_utime(r.utime);

@@ -8,6 +8,7 @@
 #include <map>
 #include <sstream>
 
+#include "tofguard/authenticated_message_t.hpp"
 #include "tofguard/camera_pose_t.hpp"
 #include "tofguard/common/decode.hpp"
 #include "tofguard/common/risk_names.hpp"
@@ -166,6 +167,16 @@ std::string format(const sim_camera_fault_t& m) {
   return s.str();
 }
 
+// A signed envelope (docs/security.md): what it claims to carry. The spy
+// holds no key, so the tag is not checked here.
+std::string format(const authenticated_message_t& m) {
+  std::ostringstream s;
+  const std::string inner = type_of(m.payload.data(), static_cast<int>(m.payload.size()));
+  s << "for=" << m.channel << " seq=" << m.seq << " key=" << m.key_id
+    << " payload=" << (inner.empty() ? "?" : inner) << " (" << m.payload.size() << " bytes, tag not checked)";
+  return s.str();
+}
+
 using Formatter = std::function<std::optional<std::string>(const void*, int)>;
 
 template <class T>
@@ -187,7 +198,7 @@ const std::map<int64_t, std::pair<std::string, Formatter>>& formatters() {
       entry<reset_reply_t>(),      entry<power_relay_t>(),
       entry<sim_joint_fault_t>(),  entry<discrepancy_t>(),
       entry<motion_estimate_t>(),  entry<planned_trajectory_t>(),
-      entry<sim_camera_fault_t>(),
+      entry<sim_camera_fault_t>(), entry<authenticated_message_t>(),
   };
   return table;
 }

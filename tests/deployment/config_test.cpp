@@ -1,6 +1,7 @@
 // The deployment config: the embedded default loads, and every kind of
 // mistake gives one line naming the file, the key and what was expected.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <string>
 
@@ -178,6 +179,25 @@ INSTANTIATE_TEST_SUITE_P(
                   "  power_cut: serial_pulse\n  serial_pulse: {device: /dev/ttyUSB0, line: cts, "
                   "frequency_hz: 25}\n",
                   {"intervention.serial_pulse.line", "expected one of dtr, rts, tx", "'cts'"}},
+        // auth (docs/security.md): no section, no key, a key that is not
+        // there, both a key and insecure, a zero replay window.
+        BadConfig{"auth-section-missing",
+                  "\nauth:\n",
+                  "\nnot_auth:\n",
+                  {"auth", "no auth section", "insecure: true"}},
+        BadConfig{"auth-key-file-missing",
+                  "  key_file: auth.key\n",
+                  "",
+                  {"auth.key_file", "a key file made by tofguard-keygen"}},
+        BadConfig{"auth-key-file-absent",
+                  "key_file: auth.key",
+                  "key_file: /nonexistent/auth.key",
+                  {"auth.key_file", "/nonexistent/auth.key: no such key file", "tofguard-keygen"}},
+        BadConfig{"auth-insecure-beside-a-key",
+                  "  max_age_ms: 250\n",
+                  "  max_age_ms: 250\n  insecure: true\n",
+                  {"auth.key_file", "one or the other"}},
+        BadConfig{"auth-zero-replay-window", "max_age_ms: 250", "max_age_ms: 0", {"auth.max_age_ms"}},
         BadConfig{"plan-step-longer-than-horizon",
                   "step_ms: 20}",
                   "step_ms: 600}",
@@ -188,6 +208,50 @@ INSTANTIATE_TEST_SUITE_P(
         if (c == '-') c = '_';
       return name;
     });
+
+TEST(Config, AKeyFileOpenToOthersIsAConfigError) {
+  const std::string key = output_dir() + "/config-open.key";
+  write_file(key, std::string(64, 'a') + "\n");
+  ::chmod(key.c_str(), 0644);
+  const std::string path = sim_variant("auth-open-key", "key_file: auth.key", "key_file: " + key);
+  const std::string message = config_error(path);
+  EXPECT_NE(message.find("auth.key_file: " + key + ": key file is open to group or others (mode 0644)"),
+            std::string::npos)
+      << message;
+  ::chmod(key.c_str(), 0600);
+  EXPECT_EQ(config_error(path), "(no error)");  // the same file, owner-only: accepted
+}
+
+TEST(Config, InsecureNeedsNoKeyAndIsWarnedAbout) {
+  const std::string path = sim_variant("auth-insecure", "  key_file: auth.key\n  # The replay",
+                                       "  insecure: true\n  # The replay");
+  const deployment::Config config = deployment::load_config(path, nullptr);
+  EXPECT_TRUE(config.auth.insecure);
+  const auto warnings = deployment::start_warnings(config);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_EQ(warnings[0].rfind("WARNING: auth.insecure is true: nothing is authenticated.", 0), 0u)
+      << warnings[0];
+  // The embedded default has a key and a host-local bus: nothing to say.
+  EXPECT_TRUE(deployment::start_warnings(deployment::load_config(source_dir() + "/config/sim.yaml", nullptr))
+                  .empty());
+}
+
+TEST(Config, ABusOpenBeyondTheHostIsWarnedAbout) {
+  EXPECT_EQ(bus_exposure_warning("udpm://239.255.76.67:7667?ttl=0"), "");
+  EXPECT_EQ(bus_exposure_warning("udpm://239.255.76.67:7667"), "");  // LCM's default ttl is 0
+  EXPECT_EQ(bus_exposure_warning("memq://"), "");
+  EXPECT_EQ(bus_exposure_warning("tcpq://127.0.0.1:7700"), "");
+  EXPECT_NE(
+      bus_exposure_warning("udpm://239.255.76.67:7667?ttl=1").find("ttl=1: its multicast leaves this host"),
+      std::string::npos);
+  EXPECT_NE(bus_exposure_warning("udpm://239.255.76.67:7668?recv_buf_size=4194304&ttl=3").find("ttl=3"),
+            std::string::npos);
+  EXPECT_NE(bus_exposure_warning("tcpq://10.0.0.2:7700").find("reaches another host"), std::string::npos);
+  const std::string path = sim_variant("open-bus", "?ttl=0\"\n", "?ttl=1\"\n");
+  const auto warnings = deployment::start_warnings(deployment::load_config(path, nullptr));
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("WARNING: LCM bus udpm://239.255.76.67:7667?ttl=1"), std::string::npos);
+}
 
 TEST(Config, MissingFileIsNamed) {
   const std::string message = config_error("/nonexistent/tofguard.yaml");

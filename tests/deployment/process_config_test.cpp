@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include <csignal>
+
 #include "test_support.hpp"
 
 namespace tofguard::test {
@@ -19,15 +21,7 @@ struct Counter {
 };
 
 std::string bad_config() {
-  std::string text = read_file(source_dir() + "/config/sim.yaml");
-  const std::string from = "rate_hz: 30";
-  text.replace(text.find(from), from.size(), "rate_hz: -5");
-  for (size_t p = text.find("models/"); p != std::string::npos; p = text.find("models/", p + 40)) {
-    text.replace(p, 0, source_dir() + "/config/");
-  }
-  const std::string path = output_dir() + "/process-bad-config.yaml";
-  write_file(path, text);
-  return path;
+  return sim_config_variant("process-bad-config", {{"rate_hz: 30", "rate_hz: -5"}});
 }
 
 TEST(ProcessConfig, EveryProcessRejectsABadConfigWithExitCode2AndPublishesNothing) {
@@ -56,6 +50,28 @@ TEST(ProcessConfig, EveryProcessRejectsABadConfigWithExitCode2AndPublishesNothin
   while (safety.handleTimeout(50) > 0 || images.handleTimeout(0) > 0) {
   }
   EXPECT_EQ(counter.messages, 0);
+}
+
+// A config that runs without authentication, or opens the bus beyond the
+// host, is said so loudly at every process's start (docs/security.md).
+TEST(ProcessConfig, EveryProcessWarnsLoudlyOfAnInsecureConfigAndAnOpenBus) {
+  const std::string path = sim_config_variant(
+      "process-insecure", {{"  key_file: auth.key\n", "  insecure: true\n"}, {"?ttl=0\"\n", "?ttl=1\"\n"}});
+  for (const char* process : kProcesses) {
+    Subprocess p(std::string("insecure-") + process, {bin_dir() + "/" + process, "--config", path});
+    ASSERT_TRUE(wait_until([&] { return p.stderr_text().find("ttl=1") != std::string::npos || !p.running(); },
+                           std::chrono::seconds(10)))
+        << process;
+    const std::string err = p.stderr_text();
+    EXPECT_NE(err.find(std::string(process) + ": WARNING: auth.insecure is true: nothing is authenticated"),
+              std::string::npos)
+        << err;
+    EXPECT_NE(err.find(std::string(process) + ": WARNING: LCM bus udpm://239.255.76.67:7667?ttl=1"),
+              std::string::npos)
+        << err;
+    p.signal(SIGTERM);
+    p.wait(std::chrono::seconds(10));
+  }
 }
 
 TEST(ProcessConfig, MissingConfigArgumentIsAUsageError) {

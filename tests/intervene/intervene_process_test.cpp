@@ -1,5 +1,7 @@
 // tofguard-intervene as a real process over real LCM (private network
-// namespace), driven through its wire contract and tofguard-reset.
+// namespace), driven through its wire contract and tofguard-reset. The
+// embedded default has a key: the test signs what stands in for
+// tofguard-risk as tofguard-risk would (signed_publisher.hpp).
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <lcm/lcm-cpp.hpp>
@@ -7,9 +9,11 @@
 #include <atomic>
 #include <cmath>
 #include <filesystem>
+#include <sstream>
 #include <thread>
 
 #include "pseudo_terminal.hpp"
+#include "signed_publisher.hpp"
 #include "test_support.hpp"
 #include "tofguard/common/clock.hpp"
 #include "tofguard/heartbeat_t.hpp"
@@ -25,12 +29,16 @@ constexpr const char* kSafetyUrl = "udpm://239.255.76.67:7667?ttl=0";
 
 struct Bench {
   lcm::LCM lcm{kSafetyUrl};
+  SignedPublisher signed_lcm{lcm};
   std::vector<safety_status_t> statuses;
   power_relay_t last_power;
   int power_messages = 0;
   // What the fake risk classifier and arm keep sending while the test waits
   // (atomic: the reset feeder thread reads them too).
   bool send_risk = true;
+  // False: the risk goes out plain only, as any process on the bus could
+  // send it.
+  bool sign_risk = true;
   std::atomic<int8_t> risk_level{risk_t::SAFE};
   std::atomic<int8_t> risk_cause{risk_t::CAUSE_NONE};
   int64_t last_feed_us = 0;
@@ -61,7 +69,11 @@ struct Bench {
         r.score = 0;
         r.threshold = 0;
         r.detail = "from the test";
-        lcm.publish("SAFETY_RISK", &r);
+        if (sign_risk) {
+          signed_lcm.publish("SAFETY_RISK", r);
+        } else {
+          lcm.publish("SAFETY_RISK", &r);
+        }
       }
       joint_state_t j;
       j.utime = wall_utime();
@@ -92,8 +104,12 @@ std::vector<std::string> intervene_argv() {
   return {bin_dir() + "/tofguard-intervene", "--config", source_dir() + "/config/sim.yaml"};
 }
 
+// tofguard-reset with the deployment's config: signed with its key.
 int reset(const std::string& name, std::string* out) {
-  return run_command(name, {bin_dir() + "/tofguard-reset", "--who", "test", "--why", "checked"}, out);
+  return run_command(name,
+                     {bin_dir() + "/tofguard-reset", "--config", source_dir() + "/config/sim.yaml", "--who",
+                      "test", "--why", "checked"},
+                     out);
 }
 
 TEST(InterveneProcess, LatchedStopResetAndRestart) {
@@ -119,6 +135,7 @@ TEST(InterveneProcess, LatchedStopResetAndRestart) {
   std::atomic<int> feeder_dangerous_sent{0};
   std::thread feeder([&] {
     lcm::LCM lcm(kSafetyUrl);
+    SignedPublisher signed_lcm(lcm);
     while (resetting) {
       risk_t r;
       r.utime = wall_utime();
@@ -127,7 +144,7 @@ TEST(InterveneProcess, LatchedStopResetAndRestart) {
       r.cause = bench.risk_cause;
       r.score = 0;
       r.threshold = 0;
-      lcm.publish("SAFETY_RISK", &r);
+      signed_lcm.publish("SAFETY_RISK", r);
       if (r.level == risk_t::DANGEROUS) ++feeder_dangerous_sent;
       joint_state_t j;
       j.utime = wall_utime();
@@ -277,17 +294,18 @@ TEST(InterveneProcess, MalformedInputIsDroppedCountedAndTheGoodRisksStillJudged)
   ASSERT_TRUE(wait_until([&] { return heartbeat.seen; }, std::chrono::seconds(5), [&] { bench.pump(); }))
       << intervene.stderr_text();
 
-  // Wrong fingerprint and truncated bytes on SAFETY_RISK; a risk level that
-  // does not exist; a joint state with NaN; a reset that is not one.
+  // Wrong fingerprint and truncated bytes on SAFETY_RISK_AUTH; a signed
+  // risk whose level does not exist; a joint state with NaN; a reset that
+  // is not one.
   joint_state_t wrong_type;
   wrong_type.num_joints = 0;
-  bench.lcm.publish("SAFETY_RISK", &wrong_type);
+  bench.lcm.publish("SAFETY_RISK_AUTH", &wrong_type);
   const uint8_t truncated[5] = {1, 2, 3, 4, 5};
-  bench.lcm.publish("SAFETY_RISK", truncated, sizeof truncated);
+  bench.lcm.publish("SAFETY_RISK_AUTH", truncated, sizeof truncated);
   risk_t impossible{};
   impossible.utime = wall_utime();
   impossible.level = 9;
-  bench.lcm.publish("SAFETY_RISK", &impossible);
+  bench.signed_lcm.publish("SAFETY_RISK", impossible);
   joint_state_t nan_joint;
   nan_joint.utime = wall_utime();
   nan_joint.num_joints = 1;
@@ -311,11 +329,12 @@ TEST(InterveneProcess, MalformedInputIsDroppedCountedAndTheGoodRisksStillJudged)
   std::atomic<bool> feeding{true};
   std::thread feeder([&] {
     lcm::LCM lcm(kSafetyUrl);
+    SignedPublisher signed_lcm(lcm);
     while (feeding) {
       risk_t r{};
       r.utime = wall_utime();
       r.level = risk_t::SAFE;
-      lcm.publish("SAFETY_RISK", &r);
+      signed_lcm.publish("SAFETY_RISK", r);
       std::this_thread::sleep_for(std::chrono::milliseconds(20));  // the feed's period
     }
   });
@@ -326,6 +345,178 @@ TEST(InterveneProcess, MalformedInputIsDroppedCountedAndTheGoodRisksStillJudged)
   bench.risk_cause = risk_t::CAUSE_UNKNOWN_OBJECT;
   EXPECT_TRUE(
       bench.wait_for([](const safety_status_t& s) { return !s.motion_allowed; }, std::chrono::seconds(2)));
+}
+
+}  // namespace
+}  // namespace tofguard::test
+
+namespace tofguard::test {
+namespace {
+
+// Signed risks at the bench's level (and a still arm) every 20 ms from a
+// thread of its own, while the test's thread waits for tofguard-reset.
+class Feeder {
+ public:
+  explicit Feeder(Bench& bench) : bench_(bench), thread_([this] { run(); }) {}
+  ~Feeder() {
+    running_ = false;
+    thread_.join();
+  }
+
+ private:
+  void run() {
+    lcm::LCM lcm(kSafetyUrl);
+    SignedPublisher signed_lcm(lcm);
+    while (running_) {
+      risk_t r{};
+      r.utime = wall_utime();
+      r.seq = 1;
+      r.level = bench_.risk_level;
+      r.cause = bench_.risk_cause;
+      signed_lcm.publish("SAFETY_RISK", r);
+      joint_state_t j;
+      j.utime = wall_utime();
+      j.num_joints = 1;
+      j.name = {"a1"};
+      j.position = {0};
+      j.velocity = {0};
+      lcm.publish("JOINT_STATE", &j);
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));  // the feed's period
+    }
+  }
+  Bench& bench_;
+  std::atomic<bool> running_{true};
+  std::thread thread_;
+};
+
+// docs/security.md. With a key, tofguard-intervene acts only on signed risk
+// verdicts and resets: a stream of plain SAFE verdicts (anyone on the bus
+// can send one) is no risk stream at all, a plain reset is refused and
+// answered, a replayed signed SAFE verdict is refused, and each refusal is
+// counted in the heartbeat. The controller's example verifier accepts the
+// signed status and refuses one forged with another key.
+TEST(InterveneProcess, OnlySignedVerdictsAndResetsAllowMotion) {
+  Bench bench;
+  HeartbeatOf heartbeat;
+  heartbeat.process = "tofguard-intervene";
+  bench.lcm.subscribe("SAFETY_HEARTBEAT", &HeartbeatOf::on, &heartbeat);
+
+  // 1. Plain SAFE verdicts only: taken for no verdict at all, so the risk
+  // deadline cuts the power, and a signed reset is refused.
+  bench.sign_risk = false;
+  auto intervene = std::make_unique<Subprocess>("intervene-auth-1", intervene_argv());
+  ASSERT_TRUE(
+      bench.wait_for([](const safety_status_t& s) { return s.stop == safety_status_t::STOP_POWER_CUT; },
+                     std::chrono::seconds(3)))
+      << intervene->stderr_text();
+  EXPECT_EQ(bench.statuses.back().reason.rfind("no SAFETY_RISK received for", 0), 0u)
+      << bench.statuses.back().reason;
+  std::string out;
+  EXPECT_EQ(reset("auth-reset-plain-risk", &out), 1) << out;
+  EXPECT_NE(out.find("refused: no SAFETY_RISK received yet"), std::string::npos) << out;
+  intervene->signal(SIGKILL);
+  intervene->wait(std::chrono::seconds(5));
+
+  // 2. Signed verdicts: a plain reset (tofguard-reset without the config's
+  // key) is refused with the reason, and counted.
+  bench.sign_risk = true;
+  heartbeat.seen = false;
+  intervene = std::make_unique<Subprocess>("intervene-auth-2", intervene_argv());
+  ASSERT_TRUE(wait_until([&] { return heartbeat.seen && bench.power_messages > 3; }, std::chrono::seconds(5),
+                         [&] { bench.pump(); }));
+  const int64_t refused_before = heartbeat.last.validation_errors;
+  {
+    Feeder feeder(bench);
+    EXPECT_EQ(
+        run_command("auth-reset-plain", {bin_dir() + "/tofguard-reset", "--who", "x", "--why", "y"}, &out), 1)
+        << out;
+    EXPECT_NE(out.find("refused: not authenticated"), std::string::npos) << out;
+    // A signed reset is accepted.
+    EXPECT_EQ(reset("auth-reset-signed", &out), 0) << out;
+  }
+  ASSERT_TRUE(
+      bench.wait_for([](const safety_status_t& s) { return s.motion_allowed; }, std::chrono::seconds(2)));
+
+  // 3. A signed SAFE verdict recorded now, replayed after a DANGEROUS stop:
+  // refused as a replay, the stop stays.
+  risk_t safe{};
+  safe.utime = wall_utime();
+  safe.level = risk_t::SAFE;
+  const authenticated_message_t recorded = bench.signed_lcm.publish_signed_only("SAFETY_RISK", safe);
+  bench.risk_level = risk_t::DANGEROUS;
+  bench.risk_cause = risk_t::CAUSE_UNKNOWN_OBJECT;
+  ASSERT_TRUE(
+      bench.wait_for([](const safety_status_t& s) { return !s.motion_allowed; }, std::chrono::seconds(2)));
+  bench.send_risk = false;
+  for (int i = 0; i < 3; ++i) bench.lcm.publish("SAFETY_RISK_AUTH", &recorded);
+  ASSERT_TRUE(wait_until([&] { return heartbeat.last.status.find("replayed: seq") != std::string::npos; },
+                         std::chrono::seconds(2), [&] { bench.pump(); }))
+      << heartbeat.last.status;
+  EXPECT_GE(heartbeat.last.validation_errors, refused_before + 4);  // the plain reset, 3 replays
+  EXPECT_NE(heartbeat.last.status.find("messages refused by authentication"), std::string::npos);
+  EXPECT_FALSE(bench.statuses.empty() || bench.statuses.back().motion_allowed);
+
+  // 4. The controller's side: the example verifier accepts the signed
+  // statuses and refuses a "motion allowed" forged with another key.
+  const std::string other_key = output_dir() + "/intervene-auth-other.key";
+  std::filesystem::remove(other_key);
+  ASSERT_EQ(run_command("auth-keygen-other", {bin_dir() + "/tofguard-keygen", other_key}), 0);
+  SignedPublisher forger(bench.lcm, other_key);
+  // The same stream recorded, for the Python example.
+  const std::string log = output_dir() + "/intervene-auth-status.lcmlog";
+  std::filesystem::remove(log);
+  Subprocess logger("auth-lcm-logger", {"/usr/bin/lcm-logger", "-q", "-f", "-c", "SAFETY_STATUS_AUTH",
+                                        std::string("--lcm-url=") + kSafetyUrl, log});
+  ASSERT_TRUE(wait_until([&] { return std::filesystem::exists(log) && std::filesystem::file_size(log) > 0; },
+                         std::chrono::seconds(5), [&] { bench.pump(); }))
+      << logger.stderr_text();
+  Subprocess controller("auth-controller", {bin_dir() + "/tofguard-verify-status-example", "--key",
+                                            default_key_file(), "--count", "25", "--timeout-ms", "3000"});
+  bench.send_risk = true;
+  safety_status_t forged{};
+  forged.utime = wall_utime();
+  forged.motion_allowed = true;
+  forged.reason = "forged";
+  ASSERT_TRUE(wait_until([&] { return !controller.running(); }, std::chrono::seconds(5),
+                         [&] {
+                           bench.pump();
+                           forger.publish_signed_only("SAFETY_STATUS", forged);
+                         }));
+  EXPECT_EQ(controller.wait(std::chrono::seconds(1)), 0) << controller.stderr_text();
+  const std::string seen = controller.stdout_text();
+  EXPECT_NE(seen.find("accepted seq="), std::string::npos) << seen;
+  EXPECT_EQ(seen.find("motion_allowed=1"), std::string::npos) << seen;  // stopped, and the forgery refused
+  EXPECT_NE(seen.find("refused: signed with key"), std::string::npos) << seen;
+
+  // The Python example on the recorded stream gives the same verdicts.
+  // (Stop the logger once 5 more statuses came here: it has them too.)
+  const size_t statuses_now = bench.statuses.size();
+  wait_until([&] { return bench.statuses.size() >= statuses_now + 5; }, std::chrono::seconds(2),
+             [&] { bench.pump(); });
+  logger.signal(SIGINT);
+  ASSERT_EQ(logger.wait(std::chrono::seconds(5)), 0) << logger.stderr_text();
+  std::string python_out, python_err;
+  ASSERT_EQ(run_command("auth-python-example",
+                        {"/usr/bin/python3", source_dir() + "/auth/examples/verify_status.py", "--key",
+                         default_key_file(), log},
+                        &python_out, &python_err),
+            0)
+      << python_err;
+  size_t python_accepted = 0;
+  for (size_t at = 0; (at = python_out.find("accepted seq=", at)) != std::string::npos; ++at)
+    ++python_accepted;
+  EXPECT_GE(python_accepted, 25u) << python_out;
+  EXPECT_EQ(python_out.find("motion_allowed=1"), std::string::npos) << python_out;
+  EXPECT_NE(python_out.find("refused: signed with key"), std::string::npos) << python_out;
+  // Every status the C++ example accepted, the Python one accepted too.
+  std::istringstream cpp_lines(seen);
+  for (std::string line; std::getline(cpp_lines, line);) {
+    if (line.rfind("accepted ", 0) == 0) {
+      EXPECT_NE(python_out.find(line + "\n"), std::string::npos) << line;
+    }
+  }
+  intervene->signal(SIGTERM);
+  EXPECT_EQ(intervene->wait(std::chrono::seconds(5)), 0);
 }
 
 }  // namespace

@@ -7,6 +7,7 @@ Layers, bottom to top (docs/architecture.md):
 
   lcmtypes      generated wire types, included as "tofguard/<name>_t.hpp"
   common        "tofguard/common/..."
+  auth          message authentication (may include common)
   robot_model   the URDF's kinematic tree and geometry
   robot_state   joint and camera-pose histories (may include robot_model)
   components    camera, renderer, sim, discrepancy, risk, estimator,
@@ -37,6 +38,7 @@ LAYER_RANK = {
     "lcmtypes": 0,
     "common": 1,
     "robot_model": 2,
+    "auth": 2,
     "robot_state": 2,
     "component": 3,
     "deployment": 4,
@@ -66,6 +68,7 @@ ALLOWED_COMPONENT_DEPENDENCIES = {
 ALLOWED_SAME_LAYER = {
     "robot_state": ["robot_model"],
     "robot_model": [],
+    "auth": [],
 }
 
 # Includes that break a rule today and the issue-13 item that removes each.
@@ -103,9 +106,9 @@ def layer_of_file(rel):
     name = parts[-1]
     if len(parts) == 2 and (name == "main.cpp" or name.endswith("_main.cpp")):
         return ("top", top)
-    if len(parts) >= 2 and parts[1] in ("bench", "tools"):
+    if len(parts) >= 2 and parts[1] in ("bench", "tools", "examples"):
         return ("top", top)
-    if top in ("lcmtypes", "common", "robot_model", "robot_state", "deployment"):
+    if top in ("lcmtypes", "common", "auth", "robot_model", "robot_state", "deployment"):
         return (top, top)
     if top in COMPONENTS:
         return ("component", top)
@@ -120,7 +123,7 @@ def layer_of_header(header):
     if len(parts) == 2:
         return ("lcmtypes", "lcmtypes")  # tofguard/<type>_t.hpp, generated
     name = parts[1]
-    if name in ("common", "robot_model", "robot_state", "deployment"):
+    if name in ("common", "auth", "robot_model", "robot_state", "deployment"):
         return (name, name)
     if name in COMPONENTS:
         return ("component", name)

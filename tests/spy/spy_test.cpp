@@ -11,7 +11,9 @@
 
 #include "sample_messages.hpp"
 #include "test_support.hpp"
+#include "tofguard/authenticated_message_t.hpp"
 #include "tofguard/motion_estimate_t.hpp"
+#include "tofguard/safety_status_t.hpp"
 #include "tofguard/spy/message_format.hpp"
 #include "tofguard/spy/status_board.hpp"
 
@@ -177,6 +179,33 @@ TEST(Spy, StatusBoardShowsPermissionRiskHeartbeatsRatesAndLatency) {
   const std::string later = board.render(t0_us + 1'000'000, utime0);
   EXPECT_NE(later.find("STALE"), std::string::npos) << later;
   EXPECT_NE(later.find("MISSING"), std::string::npos) << later;
+}
+
+}  // namespace
+}  // namespace tofguard::test
+
+namespace tofguard::test {
+namespace {
+
+// A signed envelope (docs/security.md) shows what it claims to carry; the
+// spy holds no key and says it did not check the tag.
+TEST(MessageFormat, ASignedEnvelopeShowsItsChannelSeqKeyAndPayloadType) {
+  safety_status_t status{};
+  status.reason = "x";
+  authenticated_message_t m{};
+  m.utime = 1;
+  m.seq = 1700000000000005;
+  m.channel = "SAFETY_STATUS";
+  m.key_id = "0123456789abcdef";
+  m.payload.resize(static_cast<size_t>(status.getEncodedSize()));
+  status.encode(m.payload.data(), 0, static_cast<int>(m.payload.size()));
+  m.payload_size = static_cast<int32_t>(m.payload.size());
+  std::vector<uint8_t> bytes(static_cast<size_t>(m.getEncodedSize()));
+  m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  EXPECT_EQ(spy::format_message("SAFETY_STATUS_AUTH", bytes.data(), static_cast<int>(bytes.size())),
+            "SAFETY_STATUS_AUTH authenticated_message_t for=SAFETY_STATUS seq=1700000000000005 "
+            "key=0123456789abcdef payload=safety_status_t (" +
+                std::to_string(m.payload.size()) + " bytes, tag not checked)");
 }
 
 }  // namespace

@@ -22,24 +22,12 @@ namespace tofguard::test {
 constexpr const char* kSafetyUrl = "udpm://239.255.76.67:7667?ttl=0";
 constexpr const char* kImageUrl = "udpm://239.255.76.67:7668?ttl=0&recv_buf_size=4194304";
 
-// config/sim.yaml with model paths made absolute and each (from, to)
-// replacement applied (`from` must occur), written to the test outputs.
+// config/sim.yaml with its paths made absolute and each (from, to)
+// replacement applied (`from` must occur), written to the test outputs as
+// chain-<name>.yaml.
 inline std::string chain_config(const std::string& name,
                                 const std::vector<std::pair<std::string, std::string>>& replacements = {}) {
-  std::string text = read_file(source_dir() + "/config/sim.yaml");
-  for (const auto& [from, to] : replacements) {
-    const auto at = text.find(from);
-    if (at == std::string::npos) throw std::runtime_error("sim.yaml lacks: " + from);
-    text.replace(at, from.size(), to);
-  }
-  for (const char* prefix : {" models/", "[models/"}) {
-    for (size_t p = text.find(prefix); p != std::string::npos; p = text.find(prefix, p + 1)) {
-      text.replace(p + 1, 0, source_dir() + "/config/");
-    }
-  }
-  const std::string path = output_dir() + "/chain-" + name + ".yaml";
-  write_file(path, text);
-  return path;
+  return sim_config_variant("chain-" + name, replacements);
 }
 
 template <class T>

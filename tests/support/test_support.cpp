@@ -41,6 +41,11 @@ Subprocess::Subprocess(const std::string& name, const std::vector<std::string>& 
   std::filesystem::create_directories(output_dir());
   stdout_path_ = output_dir() + "/" + name + ".stdout";
   stderr_path_ = output_dir() + "/" + name + ".stderr";
+  // Emptied here, before the child starts: a test that polls the output
+  // must never read an earlier run's text (the child truncates them only
+  // once it runs).
+  std::ofstream(stdout_path_, std::ios::trunc);
+  std::ofstream(stderr_path_, std::ios::trunc);
   std::vector<char*> args;
   for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
@@ -119,6 +124,11 @@ std::string sim_config_variant(const std::string& name,
        p = text.find("models/", p + models.size() + 1)) {
     if (p > 0 && text[p - 1] == '/') continue;
     text.replace(p, 7, models);
+  }
+  // The embedded default's key (made by scripts/build), by absolute path.
+  const std::string key_line = "key_file: auth.key";
+  if (const auto at = text.find(key_line); at != std::string::npos) {
+    text.replace(at, key_line.size(), "key_file: " + source_dir() + "/config/auth.key");
   }
   // A top-level section in `appended` replaces sim.yaml's own.
   std::stringstream added(appended);

@@ -35,6 +35,14 @@ struct ChannelNames {
   std::string heartbeat = "SAFETY_HEARTBEAT";
   // The power-cut actuator `lcm` (power_relay_t, positive logic).
   std::string power = "SAFETY_POWER";
+  // The authenticated companions of the four channels that can allow motion
+  // (authenticated_message_t, docs/security.md): the signed copy of
+  // SAFETY_RISK, SAFETY_STATUS and SAFETY_POWER, and the only SAFETY_RESET
+  // a keyed tofguard-intervene accepts.
+  std::string risk_auth = "SAFETY_RISK_AUTH";
+  std::string status_auth = "SAFETY_STATUS_AUTH";
+  std::string power_auth = "SAFETY_POWER_AUTH";
+  std::string reset_auth = "SAFETY_RESET_AUTH";
   // tofguard-estimator's joint offsets and camera correction
   // (motion_estimate_t) and the arm controller's plan (planned_trajectory_t).
   std::string motion_estimate = "MOTION_ESTIMATE";
@@ -56,6 +64,11 @@ std::string resolve_lcm_url(const std::string& from_config, const char* lcm_defa
 // next port with recv_buf_size=4194304 (a 176x144..640x480 frame must fit in
 // the socket's buffer, or it is silently lost); other providers unchanged.
 std::string derive_image_url(const std::string& safety_url);
+
+// "" when `url` keeps the bus on this host, else one loud line saying how it
+// opens it: udpm with ttl > 0 (multicast routed beyond the host), or tcpq to
+// another host. memq, file and udpm with ttl=0 (LCM's default) stay local.
+std::string bus_exposure_warning(const std::string& url);
 
 // The optional `lcm` section (url, image_url; both optional), resolved as
 // above. `lcm_default_url_env` is the value of LCM_DEFAULT_URL (nullptr when

@@ -17,7 +17,9 @@
 // config file's folder.
 #include <optional>
 #include <string>
+#include <vector>
 
+#include "tofguard/auth/auth_settings.hpp"
 #include "tofguard/camera/depth_camera_settings.hpp"
 #include "tofguard/common/camera_settings.hpp"
 #include "tofguard/common/config_error.hpp"
@@ -51,6 +53,8 @@ struct Config {
   std::string file;
   LcmSettings lcm;
   ChannelNames channels;
+  // Required: a key, or an explicit insecure: true.
+  auth::AuthSettings auth;
   RobotSettings robot;
   EnvironmentSettings environment;
   CameraSection camera;
@@ -67,6 +71,10 @@ struct Config {
 // Loads and validates `path`; throws ConfigError. `lcm_default_url_env` is
 // the value of LCM_DEFAULT_URL (nullptr when unset).
 Config load_config(const std::string& path, const char* lcm_default_url_env);
+
+// The loud lines every process prints at start for this config: running
+// without authentication, an LCM bus open beyond the host.
+std::vector<std::string> start_warnings(const Config& config);
 
 // Only the LCM URLs (from LCM_DEFAULT_URL or the host-local default) and the
 // default channel names: for tools that need no deployment config.

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <string>
 
+#include "tofguard/auth/auth_settings.hpp"
 #include "tofguard/common/lcm_settings.hpp"
 #include "tofguard/common/yaml_reader.hpp"
 #include "tofguard/intervene/serial_pulse_output.hpp"
@@ -49,6 +50,9 @@ InterventionSettings read_intervention_settings(YamlMap section);
 struct InterveneProcessSettings {
   LcmSettings lcm;
   ChannelNames channels;
+  // With a key: risk verdicts and resets are taken only from the
+  // authenticated channels, and the status and power commands are signed.
+  auth::AuthSettings auth;
   InterventionSettings intervention;
 };
 
@@ -56,6 +60,10 @@ struct InterveneProcessSettings {
 struct ResetToolSettings {
   LcmSettings lcm;
   ChannelNames channels;
+  // With a key the request goes out signed on channels.reset_auth; without
+  // a config (no key file) it goes out plain, which only an insecure
+  // tofguard-intervene accepts.
+  auth::AuthSettings auth;
 };
 
 }  // namespace tofguard::intervene

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "tofguard/auth/auth_settings.hpp"
 #include "tofguard/common/lcm_settings.hpp"
 #include "tofguard/common/yaml_reader.hpp"
 
@@ -126,6 +127,9 @@ struct RiskProcessSettings {
   // camera.rate_hz: frames per second, for the evidence tests' threshold
   // (false stops per hour = hypotheses * frames per hour / e^h).
   double camera_rate_hz = 0;
+  // With a key every verdict also goes out signed on channels.risk_auth
+  // (the only risk stream a keyed tofguard-intervene trusts).
+  auth::AuthSettings auth;
   RiskSettings risk;
 };
 
