@@ -155,8 +155,10 @@ std::string format(const planned_trajectory_t& m) {
   std::ostringstream s;
   s << "utime=" << m.utime << " joints=" << m.num_joints << " points=" << m.num_points;
   if (m.num_points > 0) {
+    // In double: the message is not checked here, and the difference of two
+    // arbitrary int64 times overflows (tests/fuzz/regressions/spy_format/).
     s << " span_ms=" << std::fixed << std::setprecision(1)
-      << (m.point_utime.back() - m.point_utime.front()) / 1000.0;
+      << (static_cast<double>(m.point_utime.back()) - static_cast<double>(m.point_utime.front())) / 1000.0;
   }
   return s.str();
 }

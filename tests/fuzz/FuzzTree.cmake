@@ -1,0 +1,71 @@
+# The libFuzzer tree (TOFGUARD_FUZZ=ON, included from the top-level
+# CMakeLists.txt; scripts/fuzz configures it with clang in build-fuzz/).
+# It builds only what the targets below reach: the LCM headers, common/
+# (decoding, wire checks, the YAML reader), robot_model/ (URDF, assimp),
+# the config loader with the settings readers it calls, and spy's message
+# formatter. Everything is compiled with AddressSanitizer,
+# UndefinedBehaviorSanitizer and libFuzzer's coverage instrumentation, so a
+# bug in tofguard's own code is seen where it happens; the system libraries
+# (lcm, yaml-cpp, urdfdom, assimp) are the Debian builds, not instrumented.
+if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+  message(FATAL_ERROR "TOFGUARD_FUZZ needs clang (scripts/fuzz sets CMAKE_CXX_COMPILER=clang++-14)")
+endif()
+
+# -fno-sanitize-recover: a UB report stops the run like a crash does, so the
+# input is saved. Assertions stay on (no NDEBUG): Eigen's index checks are
+# part of what is tested.
+set(TOFGUARD_SANITIZERS -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer)
+add_compile_options(${TOFGUARD_SANITIZERS} -fsanitize=fuzzer-no-link -O1 -g)
+add_link_options(-fsanitize=address,undefined)
+
+add_subdirectory(lcmtypes)
+add_subdirectory(common)
+add_subdirectory(robot_model)
+
+set(fuzz_dir ${CMAKE_CURRENT_LIST_DIR})
+
+# load_config and the settings readers it calls, compiled from the
+# components' sources here (the components' own libraries would pull in
+# the renderer's EGL, OpenCV, libuvc and libusb, which no reader needs).
+add_library(tofguard_fuzz_config
+  deployment/src/config.cpp
+  camera/src/depth_camera_settings.cpp
+  discrepancy/src/discrepancy_settings.cpp
+  estimator/src/estimator_settings.cpp
+  intervene/src/intervention_settings.cpp
+  launch/src/launch_settings.cpp
+  renderer/src/renderer_settings.cpp
+  risk/src/risk_settings.cpp
+  sim/src/sim_settings.cpp)
+target_include_directories(tofguard_fuzz_config PUBLIC
+  deployment/include camera/include discrepancy/include estimator/include intervene/include launch/include
+  renderer/include risk/include sim/include robot_state/include view/include)
+target_link_libraries(tofguard_fuzz_config PUBLIC tofguard_common tofguard_robot_model)
+
+# tofguard-spy's formatter: it decodes every message type it sees.
+add_library(tofguard_fuzz_spy spy/src/message_format.cpp)
+target_include_directories(tofguard_fuzz_spy PUBLIC spy/include)
+target_link_libraries(tofguard_fuzz_spy PUBLIC tofguard_common)
+
+# tofguard_fuzz_target(NAME <name> LIBS <...>): tests/fuzz/<name>_fuzz.cpp
+# as a libFuzzer binary bin/<name>_fuzz.
+function(tofguard_fuzz_target)
+  cmake_parse_arguments(ARG "" "NAME" "LIBS" ${ARGN})
+  add_executable(${ARG_NAME}_fuzz ${fuzz_dir}/${ARG_NAME}_fuzz.cpp)
+  target_include_directories(${ARG_NAME}_fuzz PRIVATE ${fuzz_dir})
+  target_compile_definitions(${ARG_NAME}_fuzz PRIVATE TOFGUARD_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+  target_link_libraries(${ARG_NAME}_fuzz PRIVATE ${ARG_LIBS})
+  target_link_options(${ARG_NAME}_fuzz PRIVATE -fsanitize=fuzzer)
+endfunction()
+
+tofguard_fuzz_target(NAME wire_messages LIBS tofguard_common)
+tofguard_fuzz_target(NAME spy_format LIBS tofguard_fuzz_spy)
+tofguard_fuzz_target(NAME config LIBS tofguard_fuzz_config)
+tofguard_fuzz_target(NAME urdf LIBS tofguard_scene_model)
+tofguard_fuzz_target(NAME mesh LIBS tofguard_scene_model)
+
+# Seeds that cannot be written by hand: one valid encoded message of each
+# type (their fingerprints change with the .lcm files, so they are made at
+# build time rather than committed). scripts/fuzz runs it.
+add_executable(make_wire_seeds ${fuzz_dir}/make_wire_seeds.cpp)
+target_link_libraries(make_wire_seeds PRIVATE tofguard_lcmtypes)
