@@ -33,7 +33,14 @@ struct Controller {
   std::string status_channel;
   int accepted = 0;
 
-  void on_message(const lcm::ReceiveBuffer*, const std::string&, const tofguard::authenticated_message_t* m) {
+  // Raw bytes, not LCM's typed subscription: decode_authenticated_message
+  // bounds the allocation before decoding.
+  void on_message(const lcm::ReceiveBuffer* buffer, const std::string&) {
+    const auto m = tofguard::auth::decode_authenticated_message(buffer->data, buffer->data_size);
+    if (!m) {
+      std::cout << "refused: not an authenticated_message_t" << std::endl;
+      return;
+    }
     std::string refusal;
     const auto status = verifier.open<tofguard::safety_status_t>(*m, status_channel, wall_utime(), &refusal);
     if (!status) {

@@ -58,7 +58,14 @@ function(tofguard_fuzz_target)
   target_link_options(${ARG_NAME}_fuzz PRIVATE -fsanitize=fuzzer)
 endfunction()
 
-tofguard_fuzz_target(NAME wire_messages LIBS tofguard_common)
+# libsodium and auth/'s header-only verifier, for the signed envelopes.
+find_package(PkgConfig REQUIRED)
+pkg_check_modules(SODIUM REQUIRED IMPORTED_TARGET libsodium)
+add_library(tofguard_fuzz_auth INTERFACE)
+target_include_directories(tofguard_fuzz_auth INTERFACE ${PROJECT_SOURCE_DIR}/auth/include)
+target_link_libraries(tofguard_fuzz_auth INTERFACE tofguard_lcmtypes PkgConfig::SODIUM)
+
+tofguard_fuzz_target(NAME wire_messages LIBS tofguard_common tofguard_fuzz_auth)
 tofguard_fuzz_target(NAME spy_format LIBS tofguard_fuzz_spy)
 tofguard_fuzz_target(NAME config LIBS tofguard_fuzz_config)
 tofguard_fuzz_target(NAME urdf LIBS tofguard_scene_model)
@@ -68,4 +75,5 @@ tofguard_fuzz_target(NAME mesh LIBS tofguard_scene_model)
 # type (their fingerprints change with the .lcm files, so they are made at
 # build time rather than committed). scripts/fuzz runs it.
 add_executable(make_wire_seeds ${fuzz_dir}/make_wire_seeds.cpp)
-target_link_libraries(make_wire_seeds PRIVATE tofguard_lcmtypes)
+target_include_directories(make_wire_seeds PRIVATE ${fuzz_dir})
+target_link_libraries(make_wire_seeds PRIVATE tofguard_lcmtypes tofguard_fuzz_auth)

@@ -6,12 +6,15 @@
 // fingerprint, which changes with its .lcm file.
 //
 // Usage: make_wire_seeds OUTPUT_FOLDER
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <string>
 #include <vector>
 
+#include "fuzz_auth_key.hpp"
+#include "tofguard/authenticated_message_t.hpp"
 #include "tofguard/camera_pose_t.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/discrepancy_image_t.hpp"
@@ -164,6 +167,25 @@ void discrepancies() {
   write("discrepancy", m);
 }
 
+// `message` signed for `channel` with the fuzz key, as
+// authenticated_message_t (the signer's work, done here with the
+// header-only tag so that the fuzz tree needs no tofguard_auth library).
+template <class T>
+void write_signed(const std::string& name, const std::string& channel, const T& message) {
+  authenticated_message_t m{};
+  m.utime = 1000;
+  m.seq = 1000;
+  m.channel = channel;
+  const auth::AuthKey key = fuzz_auth_key();
+  m.key_id = key.id;
+  m.payload.resize(static_cast<size_t>(message.getEncodedSize()));
+  message.encode(m.payload.data(), 0, static_cast<int>(m.payload.size()));
+  m.payload_size = static_cast<int32_t>(m.payload.size());
+  const auth::Tag tag = auth::compute_tag(key, m);
+  std::copy(tag.begin(), tag.end(), m.tag);
+  write(name, m);
+}
+
 void risks_and_status() {
   risk_t r{};
   r.utime = 1000;
@@ -184,6 +206,8 @@ void risks_and_status() {
   s.reason = "risk DANGEROUS";
   s.since_utime = 900;
   write("safety_status", s);
+  write_signed("risk_signed", "SAFETY_RISK", r);
+  write_signed("safety_status_signed", "SAFETY_STATUS", s);
   heartbeat_t h{};
   h.utime = 1000;
   h.process = "tofguard-camera";
@@ -243,6 +267,7 @@ void tools_and_faults() {
   q.who = "operator";
   q.why = "checked the arm";
   write("reset_request", q);
+  write_signed("reset_request_signed", "SAFETY_RESET", q);
   reset_reply_t a{};
   a.utime = 1001;
   a.request_id = 7;

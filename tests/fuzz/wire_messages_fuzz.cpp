@@ -11,6 +11,9 @@
 #include <cstdint>
 #include <string>
 
+#include "fuzz_auth_key.hpp"
+#include "tofguard/auth/message_verifier.hpp"
+#include "tofguard/authenticated_message_t.hpp"
 #include "tofguard/camera_pose_t.hpp"
 #include "tofguard/common/camera_pose_message.hpp"
 #include "tofguard/common/decode.hpp"
@@ -99,5 +102,19 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   as<reset_reply_t>(data, size, [&](const reset_reply_t& m) { sink += m.reason.size(); });
   as<power_relay_t>(data, size, [&](const power_relay_t& m) { sink += m.reason.size(); });
   as<discrepancy_image_t>(data, size, [&](const discrepancy_image_t& m) { sink += m.rgb.size(); });
+  // A signed message, as tofguard-intervene opens SAFETY_RISK_AUTH and
+  // SAFETY_RESET_AUTH and a controller SAFETY_STATUS_AUTH (the key is
+  // make_wire_seeds' fuzz key, so its seeds pass the tag), and the
+  // controller's bounded decoder on the same bytes.
+  static tofguard::auth::MessageVerifier verifier(tofguard::fuzz_auth_key(), 1'000'000'000'000'000);
+  auto open_all = [&](const authenticated_message_t& m) {
+    std::string why;
+    if (auto r = verifier.open<risk_t>(m, "SAFETY_RISK", m.utime, &why)) sink += consume(check_risk(*r));
+    if (auto q = verifier.open<reset_request_t>(m, "SAFETY_RESET", m.utime, &why)) sink += q->who.size();
+    if (auto s = verifier.open<safety_status_t>(m, "SAFETY_STATUS", m.utime, &why)) sink += s->reason.size();
+    sink += consume(why);
+  };
+  as<authenticated_message_t>(data, size, open_all);
+  if (const auto m = tofguard::auth::decode_authenticated_message(data, size)) sink += m->payload.size();
   return 0;
 }

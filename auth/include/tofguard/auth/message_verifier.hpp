@@ -25,6 +25,37 @@
 
 namespace tofguard::auth {
 
+// An authenticated_message_t decoded from the bytes of an LCM message, or
+// nullopt when they are not one. LCM's generated decoder allocates
+// payload_size bytes before it reads them: this checks first that the
+// strings and the payload fit in the bytes received, so that a 40-byte
+// forgery cannot make a controller allocate 2 GB.
+inline std::optional<authenticated_message_t> decode_authenticated_message(const void* data, size_t size) {
+  const auto* bytes = static_cast<const uint8_t*>(data);
+  auto be = [bytes](size_t at, int n) {
+    uint64_t v = 0;
+    for (int i = 0; i < n; ++i) v = (v << 8) | bytes[at + static_cast<size_t>(i)];
+    return v;
+  };
+  size_t at = 8 + 8 + 8;                  // fingerprint, utime, seq
+  for (int text = 0; text < 2; ++text) {  // channel, key_id: length (with NUL) and bytes
+    if (size < at + 4) return std::nullopt;
+    const auto length = static_cast<int32_t>(be(at, 4));
+    if (length < 1 || static_cast<size_t>(length) > size - at - 4) return std::nullopt;
+    at += 4 + static_cast<size_t>(length);
+  }
+  if (size < at + 4) return std::nullopt;
+  const auto payload_size = static_cast<int32_t>(be(at, 4));
+  if (payload_size < 0 || static_cast<size_t>(payload_size) + kTagBytes != size - at - 4) return std::nullopt;
+  authenticated_message_t m;
+  try {
+    if (m.decode(data, 0, static_cast<int>(size)) != static_cast<int>(size)) return std::nullopt;
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  return m;
+}
+
 class MessageVerifier {
  public:
   // max_age_us: the largest |receiver's wall clock - utime| accepted,
