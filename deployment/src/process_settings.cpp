@@ -71,6 +71,7 @@ sim::JointsSimProcessSettings joints_sim_process_settings(const Config& config) 
   s.channels = config.channels;
   s.robot = config.robot;
   s.config_file = config.file;
+  s.auth = config.auth;
   s.joints_sim = config.joints_sim;
   return s;
 }

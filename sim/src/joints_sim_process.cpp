@@ -2,9 +2,11 @@
 
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "tofguard/auth/message_verifier.hpp"
 #include "tofguard/common/clock.hpp"
 #include "tofguard/common/config_error.hpp"
 #include "tofguard/common/lcm_node.hpp"
@@ -56,13 +58,32 @@ int run_joints_sim(const JointsSimProcessSettings& settings) {
 
   bool status_allows = false;
   int64_t status_arrival_us = -1;
-  node.subscribe<safety_status_t>(
-      node.safety(), settings.channels.status,
-      [&](const safety_status_t& s) {
-        status_allows = s.motion_allowed;
-        status_arrival_us = monotonic_us();
-      },
-      check_safety_status);
+  auto on_status = [&](const safety_status_t& s) {
+    status_allows = s.motion_allowed;
+    status_arrival_us = monotonic_us();
+  };
+  // The simulated arm's controller does what a real one must
+  // (docs/security.md): with a key it moves only on a verified
+  // SAFETY_STATUS_AUTH; the plain SAFETY_STATUS is not read at all.
+  std::optional<auth::MessageVerifier> verifier;
+  if (auth::authenticated(settings.auth)) {
+    verifier.emplace(settings.auth.key, settings.auth.max_age_us);
+    node.subscribe<authenticated_message_t>(
+        node.safety(), settings.channels.status_auth, [&](const authenticated_message_t& m) {
+          std::string why;
+          const auto status =
+              verifier->open<safety_status_t>(m, settings.channels.status, wall_utime(), &why);
+          if (status && (why = check_safety_status(*status)).empty()) {
+            on_status(*status);
+            return;
+          }
+          node.counters().validation_errors++;
+          node.errors().report(settings.channels.status_auth,
+                               settings.channels.status_auth + ": refused: " + why);
+        });
+  } else {
+    node.subscribe<safety_status_t>(node.safety(), settings.channels.status, on_status, check_safety_status);
+  }
   node.subscribe<sim_joint_fault_t>(
       node.safety(), settings.channels.sim_joint_fault,
       [&](const sim_joint_fault_t& fault) {

@@ -24,11 +24,21 @@ add_subdirectory(robot_model)
 
 set(fuzz_dir ${CMAKE_CURRENT_LIST_DIR})
 
+# libsodium and auth/'s header-only verifier, for the signed envelopes
+# and the config's auth section.
+find_package(PkgConfig REQUIRED)
+pkg_check_modules(SODIUM REQUIRED IMPORTED_TARGET libsodium)
+add_library(tofguard_fuzz_auth INTERFACE)
+target_include_directories(tofguard_fuzz_auth INTERFACE ${PROJECT_SOURCE_DIR}/auth/include)
+target_link_libraries(tofguard_fuzz_auth INTERFACE tofguard_lcmtypes PkgConfig::SODIUM)
+
+
 # load_config and the settings readers it calls, compiled from the
 # components' sources here (the components' own libraries would pull in
 # the renderer's EGL, OpenCV, libuvc and libusb, which no reader needs).
 add_library(tofguard_fuzz_config
   deployment/src/config.cpp
+  auth/src/auth_settings.cpp
   camera/src/depth_camera_settings.cpp
   discrepancy/src/discrepancy_settings.cpp
   estimator/src/estimator_settings.cpp
@@ -40,7 +50,7 @@ add_library(tofguard_fuzz_config
 target_include_directories(tofguard_fuzz_config PUBLIC
   deployment/include camera/include discrepancy/include estimator/include intervene/include launch/include
   renderer/include risk/include sim/include robot_state/include view/include)
-target_link_libraries(tofguard_fuzz_config PUBLIC tofguard_common tofguard_robot_model)
+target_link_libraries(tofguard_fuzz_config PUBLIC tofguard_common tofguard_robot_model tofguard_fuzz_auth)
 
 # tofguard-spy's formatter: it decodes every message type it sees.
 add_library(tofguard_fuzz_spy spy/src/message_format.cpp)
@@ -57,13 +67,6 @@ function(tofguard_fuzz_target)
   target_link_libraries(${ARG_NAME}_fuzz PRIVATE ${ARG_LIBS})
   target_link_options(${ARG_NAME}_fuzz PRIVATE -fsanitize=fuzzer)
 endfunction()
-
-# libsodium and auth/'s header-only verifier, for the signed envelopes.
-find_package(PkgConfig REQUIRED)
-pkg_check_modules(SODIUM REQUIRED IMPORTED_TARGET libsodium)
-add_library(tofguard_fuzz_auth INTERFACE)
-target_include_directories(tofguard_fuzz_auth INTERFACE ${PROJECT_SOURCE_DIR}/auth/include)
-target_link_libraries(tofguard_fuzz_auth INTERFACE tofguard_lcmtypes PkgConfig::SODIUM)
 
 tofguard_fuzz_target(NAME wire_messages LIBS tofguard_common tofguard_fuzz_auth)
 tofguard_fuzz_target(NAME spy_format LIBS tofguard_fuzz_spy)

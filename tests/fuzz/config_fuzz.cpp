@@ -6,12 +6,14 @@
 // The input is written to config.yaml in a scratch folder that also holds
 // `models` (a link to config/models), so that config/sim.yaml and its
 // variants (the seeds) resolve their relative URDF paths as they do in the
-// source tree.
+// source tree, and `auth.key` (the fuzz key, mode 0600) for their
+// auth.key_file.
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <string>
 
+#include "fuzz_auth_key.hpp"
 #include "fuzz_scratch.hpp"
 #include "tofguard/common/config_error.hpp"
 #include "tofguard/deployment/config.hpp"
@@ -23,6 +25,12 @@ const tofguard::fuzz::Scratch& scratch() {
   static const bool linked = [] {
     std::filesystem::create_directory_symlink(
         std::filesystem::path(TOFGUARD_SOURCE_DIR) / "config" / "models", s.folder() / "models");
+    const tofguard::auth::AuthKey key = tofguard::fuzz_auth_key();
+    char hex[2 * tofguard::auth::kKeyBytes + 1];
+    sodium_bin2hex(hex, sizeof hex, key.bytes.data(), key.bytes.size());
+    const std::string key_file = s.write("auth.key", std::string(hex) + "\n");
+    std::filesystem::permissions(key_file,
+                                 std::filesystem::perms::owner_read | std::filesystem::perms::owner_write);
     return true;
   }();
   (void)linked;

@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "signed_publisher.hpp"
 #include "test_support.hpp"
 #include "tofguard/common/clock.hpp"
 #include "tofguard/common/planned_trajectory.hpp"
@@ -23,6 +24,7 @@ struct Listener {
   std::vector<planned_trajectory_t> plans;
   std::vector<joint_state_t> all_reported;
   int reported_count = 0;
+  SignedPublisher signed_lcm{lcm};
   bool allow = false;
   int64_t last_status_us = 0;
   Listener() {
@@ -46,7 +48,7 @@ struct Listener {
       s.utime = wall_utime();
       s.motion_allowed = true;
       s.reason = "test";
-      lcm.publish("SAFETY_STATUS", &s);
+      signed_lcm.publish("SAFETY_STATUS", s);  // as a keyed tofguard-intervene does
     }
     lcm.handleTimeout(5);
   }

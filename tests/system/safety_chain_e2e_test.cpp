@@ -20,6 +20,7 @@
 #include <thread>
 
 #include "test_support.hpp"
+#include "tofguard/authenticated_message_t.hpp"
 #include "tofguard/camera_pose_t.hpp"
 #include "tofguard/common/clock.hpp"
 #include "tofguard/common/risk_names.hpp"
@@ -124,6 +125,20 @@ class Chain {
     safety_.publish(config_.channels.motion_estimate, junk, sizeof junk);
     safety_.publish(config_.channels.motion_estimate, &nan_joints);
     safety_.publish(config_.channels.planned_trajectory, junk, sizeof junk);
+    // The signed channels (docs/security.md): garbage, and a valid envelope
+    // signed with no key anyone holds.
+    safety_.publish(config_.channels.risk_auth, junk, sizeof junk);
+    safety_.publish(config_.channels.status_auth, junk, sizeof junk);
+    safety_.publish(config_.channels.reset_auth, &nan_joints);
+    authenticated_message_t forged{};
+    forged.utime = wall_utime();
+    forged.seq = forged.utime + 1'000'000'000;
+    forged.channel = config_.channels.status;
+    forged.key_id = "0000000000000000";
+    forged.payload_size = 3;
+    forged.payload = {1, 2, 3};
+    safety_.publish(config_.channels.status_auth, &forged);
+    safety_.publish(config_.channels.risk_auth, &forged);
     ++malformed_rounds;
   }
 

@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 
+#include "tofguard/auth/auth_settings.hpp"
 #include "tofguard/camera/depth_camera_settings.hpp"
 #include "tofguard/common/camera_settings.hpp"
 #include "tofguard/common/lcm_settings.hpp"
@@ -74,6 +75,9 @@ struct JointsSimProcessSettings {
   // The config file's path, for the errors SimulatedArm finds against the
   // URDF.
   std::string config_file;
+  // As the arm's controller: with a key it takes the permission to move only
+  // from the verified SAFETY_STATUS_AUTH.
+  auth::AuthSettings auth;
   JointsSimSettings joints_sim;
 };
 
