@@ -1,7 +1,9 @@
 #include "tofguard/launch/launch_process.hpp"
 
+#include <sys/statvfs.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
 
@@ -20,6 +22,14 @@ std::string own_dir() {
   std::error_code ec;
   const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
   return ec ? std::string() : exe.parent_path().string();
+}
+
+// Bytes free for an unprivileged writer on the filesystem of `dir`, or -1
+// when it cannot be read.
+int64_t free_bytes(const std::string& dir) {
+  struct statvfs fs {};
+  if (statvfs(dir.c_str(), &fs) != 0) return -1;
+  return static_cast<int64_t>(fs.f_bavail) * static_cast<int64_t>(fs.f_frsize);
 }
 
 }  // namespace
@@ -106,9 +116,30 @@ int run_launch(const LaunchProcessSettings& settings) {
   std::cout << group.status_table() << std::flush;
 
   int64_t next_prune_us = 0;
+  int64_t next_space_check_us = 0;
+  bool disk_full = false;
   while (!stop_requested()) {
     const int64_t now_us = monotonic_us();
     group.poll(now_us);
+    // A full disk loses the black box (lcm-logger cannot write; it is not
+    // required, so the safety chain goes on): say so once when it happens,
+    // once when space is back, checked every second. "Full": less than one
+    // recording file's worth (max_file_mb) or 1 MB free, whichever is less.
+    if (launch.recorder.enabled && now_us >= next_space_check_us) {
+      next_space_check_us = now_us + 1'000'000;
+      const int64_t free = free_bytes(recordings);
+      const int64_t low =
+          std::min<int64_t>(1'000'000, static_cast<int64_t>(launch.recorder.max_file_mb * 1e6));
+      if (free >= 0 && free < low && !disk_full) {
+        disk_full = true;
+        say("recorder: ERROR: disk full at " + recordings + " (" + std::to_string(free) +
+            " bytes free): black-box recordings are being lost; the safety chain is not affected");
+      } else if (free >= low && disk_full) {
+        disk_full = false;
+        say("recorder: disk space back at " + recordings + " (" + std::to_string(free) +
+            " bytes free): recording again");
+      }
+    }
     if (launch.recorder.enabled && now_us >= next_prune_us) {
       next_prune_us = now_us + 5'000'000;
       const auto doomed = files_to_delete(

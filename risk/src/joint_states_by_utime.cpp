@@ -2,10 +2,11 @@
 
 namespace tofguard::risk {
 
-void JointStatesByUtime::add(const joint_state_t& state) {
-  if (!states_.empty() && state.utime < states_.back().utime) return;
+bool JointStatesByUtime::add(const joint_state_t& state) {
+  if (!states_.empty() && state.utime <= states_.back().utime) return false;
   states_.push_back(state);
   while (states_.front().utime < state.utime - keep_us_) states_.pop_front();
+  return true;
 }
 
 const joint_state_t* JointStatesByUtime::at(int64_t utime) const {

@@ -26,9 +26,19 @@ RiskMonitor::RiskMonitor(const RiskSettings& settings, const ChannelNames& chann
       evidence_(settings, robot_, camera_rate_hz),
       decision_(settings) {}
 
-void RiskMonitor::on_joint_state(const joint_state_t& state, int64_t now_us) {
+std::string RiskMonitor::on_joint_state(const joint_state_t& state, int64_t now_us) {
+  // After the stream went stale it may start afresh (a driver restarted,
+  // its clock set back), but never with a copy of the newest state: a
+  // driver stuck resending it must stay stale.
+  if (deadlines_.joint_state_expired(now_us) && state.utime != joint_states_.newest_utime()) {
+    joint_states_.clear();
+  }
+  if (!joint_states_.add(state)) {
+    return "joint state utime " + std::to_string(state.utime) +
+           " is not newer than the newest taken (a duplicate, out of order, or the driver's clock set back)";
+  }
   deadlines_.on_joint_state(now_us);
-  joint_states_.add(state);
+  return "";
 }
 
 std::string RiskMonitor::check_joint_names(const std::vector<std::string>& names,
@@ -92,7 +102,30 @@ std::vector<risk_t> RiskMonitor::judge(std::vector<ClassifiedFrame> released, in
 }
 
 std::vector<risk_t> RiskMonitor::on_frame(const discrepancy_t& frame, int64_t now_us) {
-  deadlines_.on_discrepancy(now_us);
+  const bool in_order = !any_frame_ || (frame.seq > newest_seq_ && frame.utime > newest_utime_);
+  const bool judged_before =
+      std::find(judged_seqs_.begin(), judged_seqs_.end(), frame.seq) != judged_seqs_.end();
+  if (in_order || (deadlines_.discrepancy_expired(now_us) && !judged_before)) {
+    // In order, or the stream starts afresh after it went stale.
+    any_frame_ = true;
+    newest_seq_ = frame.seq;
+    newest_utime_ = frame.utime;
+    deadlines_.on_discrepancy(now_us);
+  } else if (frame.usable || judged_before) {
+    // A duplicate or an older frame must never count as a fresh SAFE
+    // frame (nor keep the deadline fed): refused.
+    ++refused_frames_;
+    last_refusal_ = "frame seq " + std::to_string(frame.seq) + " utime " + std::to_string(frame.utime) +
+                    (judged_before ? " was judged already (a duplicate)"
+                                   : " is not newer than frame seq " + std::to_string(newest_seq_) +
+                                         " utime " + std::to_string(newest_utime_) +
+                                         " (out of order, or the camera's clock set back)");
+    return {};
+  }
+  // (An unusable frame never judged, late: judged below, without feeding
+  // the deadline; it can only stop the arm.)
+  judged_seqs_.push_back(frame.seq);
+  if (judged_seqs_.size() > 64) judged_seqs_.pop_front();
   return judge(gate_.admit(classify(frame), now_us), now_us);
 }
 

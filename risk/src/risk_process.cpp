@@ -55,7 +55,17 @@ int run_risk(const RiskProcessSettings& settings) {
   };
   node.subscribe<discrepancy_t>(
       node.safety(), settings.channels.discrepancy,
-      [&](const discrepancy_t& d) { publish_all(monitor.on_frame(d, monotonic_us())); }, check_discrepancy);
+      [&](const discrepancy_t& d) {
+        const int64_t refused_before = monitor.refused_frames();
+        publish_all(monitor.on_frame(d, monotonic_us()));
+        if (monitor.refused_frames() != refused_before) {
+          // A duplicate or out-of-order frame: no verdict (RiskMonitor::on_frame).
+          node.counters().frames_dropped++;
+          node.errors().report(settings.channels.discrepancy + " order",
+                               settings.channels.discrepancy + ": refused: " + monitor.last_refusal());
+        }
+      },
+      check_discrepancy);
   node.subscribe<motion_estimate_t>(
       node.safety(), settings.channels.motion_estimate,
       [&](const motion_estimate_t& e) { publish_all(monitor.on_estimate(e, monotonic_us())); },
@@ -80,7 +90,14 @@ int run_risk(const RiskProcessSettings& settings) {
       [camera_id](const depth_image_t& image) { return check_depth_image_from(image, camera_id); });
   node.subscribe<joint_state_t>(
       node.safety(), settings.channels.joint_state,
-      [&](const joint_state_t& s) { monitor.on_joint_state(s, monotonic_us()); },
+      [&](const joint_state_t& s) {
+        const std::string refused = monitor.on_joint_state(s, monotonic_us());
+        if (!refused.empty()) {
+          node.counters().frames_dropped++;
+          node.errors().report(settings.channels.joint_state + " order",
+                               settings.channels.joint_state + ": refused: " + refused);
+        }
+      },
       [&](const joint_state_t& s) {
         std::string problem = check_joint_state(s);
         if (problem.empty()) problem = monitor.check_joint_names(s);

@@ -205,7 +205,9 @@ joint_state_t joints_at(int64_t utime, double a1) {
 
 void feed_all(RiskMonitor* m, int64_t now) {
   m->on_depth(now);
-  m->on_joint_state(joints_at(1, 0), now);
+  // A new state each time (a repeated one is refused as a duplicate), older
+  // than the frames of these tests.
+  m->on_joint_state(joints_at(1 + (now - kStart), 0), now);
   for (const char* p : {"tofguard-camera", "tofguard-renderer", "tofguard-discrepancy"}) {
     m->on_heartbeat(heartbeat(p), now);
   }
@@ -345,6 +347,8 @@ TEST(EstimateWait, CleanFramesAndSensorFaultsDoNotWaitAndEstimatesCanBeSwitchedO
   const discrepancy_t good = summary_of(default_arm(), 101);
   ASSERT_EQ(m.on_frame(good, kStart).size(), 1u);
   discrepancy_t unusable = good;
+  unusable.seq = good.seq + 1;  // the next frame (a repeated seq is refused)
+  unusable.utime = good.utime + 33'000;
   unusable.usable = false;
   unusable.unusable_kind = discrepancy_t::UNUSABLE_RENDERER;
   unusable.unusable_reason = "renderer: joint a3 missing";

@@ -304,10 +304,20 @@ joint_state_t joints(double velocity) {
   return s;
 }
 
+// A joint state taken at `utime` (each new: a repeated one is refused).
+joint_state_t joints_at_time(double velocity, int64_t utime) {
+  joint_state_t s = joints(velocity);
+  s.utime = utime;
+  return s;
+}
+
 // Everything fresh at `now`.
 void feed_all(RiskMonitor* m, int64_t now) {
   m->on_depth(now);
-  m->on_joint_state(joints(0.5), now);
+  // A new joint state each time (a repeated one is refused as a duplicate).
+  joint_state_t state = joints(0.5);
+  state.utime = now;
+  m->on_joint_state(state, now);
   for (const char* p : {"tofguard-camera", "tofguard-renderer", "tofguard-discrepancy"}) {
     m->on_heartbeat(heartbeat(p), now);
   }
@@ -316,7 +326,16 @@ void feed_all(RiskMonitor* m, int64_t now) {
 // The verdict on one frame through the production path (on_frame, which
 // releases it at once: sim.yaml does not wait for estimates, and a frame
 // without a model mismatch never waits).
-risk_t judged_at_once(RiskMonitor* m, const discrepancy_t& frame, int64_t now) {
+// A frame offered again is renumbered as the camera's next frame (seq and
+// utime one more than the last judged): the monitor refuses a repeated or
+// older frame (RiskMonitor::on_frame).
+risk_t judged_at_once(RiskMonitor* m, discrepancy_t frame, int64_t now) {
+  static std::map<const RiskMonitor*, std::pair<int64_t, int64_t>> last;  // seq, utime
+  if (last.count(m) && frame.seq <= last[m].first) {
+    frame.seq = last[m].first + 1;
+    frame.utime = std::max(frame.utime, last[m].second + 1);
+  }
+  last[m] = {frame.seq, frame.utime};
   const std::vector<risk_t> verdicts = m->on_frame(frame, now);
   EXPECT_EQ(verdicts.size(), 1u) << "frame " << frame.seq << " should be judged on arrival";
   return verdicts.empty() ? risk_t{} : verdicts.front();
@@ -350,13 +369,13 @@ TEST(RiskMonitor, EachInputHasItsOwnDeadlineAndCause) {
   feed_all(&m, now);
   judged_at_once(&m, d, now);
   now += 101 * kMs;
-  m.on_joint_state(joints(0.5), now);
+  m.on_joint_state(joints_at_time(0.5, now), now);
   for (const char* p : {"tofguard-camera", "tofguard-renderer", "tofguard-discrepancy"})
     m.on_heartbeat(heartbeat(p), now);
   auto r = m.check_deadlines(now);
   ASSERT_TRUE(r);
   EXPECT_EQ(r->suspect, "TOF_DEPTH");
-  EXPECT_EQ(r->utime, d.utime);  // the last frame's utime, however old
+  EXPECT_GE(r->utime, d.utime);  // the last frame's utime, however old (d renumbered)
 
   // Joint state stalls: 100 ms.
   feed_all(&m, now);
@@ -373,7 +392,7 @@ TEST(RiskMonitor, EachInputHasItsOwnDeadlineAndCause) {
   // A frame judged meanwhile is dangerous too, with its own seq.
   const risk_t frame = judged_at_once(&m, d, now);
   EXPECT_EQ(frame.level, risk_t::DANGEROUS);
-  EXPECT_EQ(frame.seq, 40);
+  EXPECT_GE(frame.seq, 40);  // d, renumbered as a new frame
   EXPECT_EQ(frame.suspect, "JOINT_STATE");
 
   // A heartbeat stops: 250 ms -> component fault naming the process.
@@ -381,7 +400,7 @@ TEST(RiskMonitor, EachInputHasItsOwnDeadlineAndCause) {
   for (int i = 0; i < 6; ++i) {
     now += 50 * kMs;
     m.on_depth(now);
-    m.on_joint_state(joints(0.5), now);
+    m.on_joint_state(joints_at_time(0.5, now), now);
     judged_at_once(&m, d, now);
     m.on_heartbeat(heartbeat("tofguard-camera"), now);
     m.on_heartbeat(heartbeat("tofguard-discrepancy"), now);
@@ -435,8 +454,8 @@ TEST(RiskMonitor, MismatchIsWarningUntilDebouncedThenDangerousAndClearsAfterClea
     const risk_t r = judged_at_once(&m, bad, now);
     EXPECT_EQ(r.cause, risk_t::CAUSE_JOINT_ERROR);
     EXPECT_EQ(r.suspect, "a2");
-    EXPECT_EQ(r.seq, 100);
-    EXPECT_EQ(r.utime, bad.utime);
+    EXPECT_EQ(r.seq, 100 + i);  // the same image as consecutive frames
+    EXPECT_GE(r.utime, bad.utime);
     levels.push_back(r.level);
   }
   // debounce_frames = 3.
@@ -451,7 +470,7 @@ TEST(RiskMonitor, MismatchIsWarningUntilDebouncedThenDangerousAndClearsAfterClea
     EXPECT_EQ(r.level, risk_t::DANGEROUS);
     EXPECT_EQ(r.cause, risk_t::CAUSE_JOINT_ERROR);
     EXPECT_EQ(r.suspect, "a2");
-    EXPECT_EQ(r.detail.rfind("diagnosis open since seq 100: joint a2", 0), 0u) << r.detail;
+    EXPECT_EQ(r.detail.rfind("diagnosis open since seq 102: joint a2", 0), 0u) << r.detail;
     EXPECT_NE(r.detail.find("this frame: no finding"), std::string::npos) << r.detail;
   }
   now += 33 * kMs;
@@ -480,9 +499,9 @@ TEST(RiskMonitor, FrozenImageNeedsAMovingArm) {
   discrepancy_t frozen = summary_of(default_arm());
   frozen.repeat_count = 3;
   m.on_depth(kStart);
-  m.on_joint_state(joints(0.0), kStart);
+  m.on_joint_state(joints_at_time(0.0, 1), kStart);
   EXPECT_EQ(judged_at_once(&m, frozen, kStart).level, risk_t::SAFE);
-  m.on_joint_state(joints(-0.3), kStart);
+  m.on_joint_state(joints_at_time(-0.3, 2), kStart);
   const risk_t r = judged_at_once(&m, frozen, kStart);
   EXPECT_EQ(r.cause, risk_t::CAUSE_SENSOR_FAULT);
   EXPECT_NE(r.detail.find("frozen"), std::string::npos);

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iostream>
 
 #include "chain_bus.hpp"
 #include "synthetic_estimates.hpp"
@@ -349,6 +350,82 @@ TEST_F(RiskProcess, MalformedInputOnEveryChannelIsDroppedAndCounted) {
   EXPECT_NE(
       process_->stderr_text().find("MOTION_ESTIMATE: estimated_position[2] (a3): expected a finite number"),
       std::string::npos)
+      << process_->stderr_text();
+}
+
+// Fault injection (clock jumps, duplicates, out-of-order seq): a frame
+// judged once is never judged again, an older one or one whose camera clock
+// went back is refused, and a joint driver stuck resending its last state
+// goes stale. Each refusal is counted (frames_dropped) and reported.
+TEST_F(RiskProcess, DuplicateOutOfOrderAndClockJumpedInputsAreRefusedAndCounted) {
+  ASSERT_TRUE(feed_until_judged(good_, 5));
+  auto verdicts_for = [&](int64_t seq) {
+    int n = 0;
+    for (const auto& r : bus_.risks.messages) n += r.seq == seq;
+    return n;
+  };
+  auto frame = [&](int64_t seq, int64_t utime) {
+    discrepancy_t d = good_;
+    d.seq = seq;
+    d.utime = utime;
+    bus_.safety.publish("SAFETY_DISCREPANCY", &d);
+  };
+  ASSERT_TRUE(wait_until([&] { return bus_.last_heartbeat("tofguard-risk").utime > 0; }, kDeadline,
+                         [&] { bus_.poll(); }));
+  const int64_t dropped_before = bus_.last_heartbeat("tofguard-risk").frames_dropped;
+  frame(5, depth_frame({}, 5).utime);               // a duplicate
+  frame(3, depth_frame({}, 3).utime);               // an older seq
+  frame(6, depth_frame({}, 5).utime - 10'000'000);  // the camera's clock set back 10 s
+  seq_ = 6;
+  ASSERT_TRUE(feed_until_judged(good_, 9));
+  EXPECT_EQ(verdicts_for(5), 1);
+  EXPECT_EQ(verdicts_for(3), 1);
+  EXPECT_EQ(verdicts_for(6), 0);
+  EXPECT_EQ(risk_for(9)->level, risk_t::SAFE) << risk_for(9)->detail;
+  ASSERT_TRUE(
+      wait_until([&] { return bus_.last_heartbeat("tofguard-risk").frames_dropped - dropped_before == 3; },
+                 kDeadline, [&] { bus_.poll(); }))
+      << bus_.last_heartbeat("tofguard-risk").frames_dropped - dropped_before << "\n"
+      << process_->stderr_text();
+  EXPECT_NE(process_->stderr_text().find("SAFETY_DISCREPANCY: refused: frame seq 5"), std::string::npos)
+      << process_->stderr_text();
+
+  // A camera clock jumping forward: the frame is newer, judged.
+  frame(10, depth_frame({}, 9).utime + 10'000'000);
+  ASSERT_TRUE(wait_until([&] { return verdicts_for(10) == 1; }, kDeadline, [&] { bus_.poll(); }));
+
+  // A joint driver stuck resending the same state (same utime) while
+  // everything else is fresh: JOINT_STATE goes stale within its deadline.
+  joint_state_t stuck = moving_arm();
+  const size_t verdicts_before = bus_.risks.messages.size();
+  int64_t first_stuck_us = 0;
+  int64_t seq = 100;  // newer than the jumped frame's seq
+  int64_t utime = depth_frame({}, 9).utime + 10'100'000;
+  auto stale_joints = [&] {
+    for (size_t i = verdicts_before; i < bus_.risks.messages.size(); ++i) {
+      const risk_t& r = bus_.risks.messages[i];
+      if (r.level == risk_t::DANGEROUS && r.suspect == "JOINT_STATE") return bus_.risks.arrival_us[i];
+    }
+    return int64_t{0};
+  };
+  ASSERT_TRUE(run_until(
+      bus_, [&] { return stale_joints() > 0; }, kDeadline, 10,
+      [&] {
+        bus_.safety.publish("JOINT_STATE", &stuck);
+        if (first_stuck_us == 0) first_stuck_us = monotonic_us();
+        bus_.beat("tofguard-camera");
+        bus_.beat("tofguard-discrepancy");
+        bus_.beat("tofguard-renderer");
+        depth_image_t image = depth_frame({500, 600, 700, 800}, ++seq, 2, 2);
+        bus_.images.publish("TOF_DEPTH", &image);
+        frame(seq, utime += 10'000);
+      }))
+      << process_->stderr_text();
+  const int64_t latency = stale_joints() - first_stuck_us;
+  std::cout << "joint driver resending its last state: JOINT_STATE stale " << latency / 1000.0
+            << " ms after the first copy" << std::endl;
+  EXPECT_LE(latency, 100'000 + 200'000);
+  EXPECT_NE(process_->stderr_text().find("JOINT_STATE: refused: joint state utime"), std::string::npos)
       << process_->stderr_text();
 }
 

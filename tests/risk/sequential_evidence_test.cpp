@@ -353,6 +353,7 @@ void feed_all(risk::RiskMonitor* m, int64_t now) {
   s.name = {"a1"};
   s.position = {0};
   s.velocity = {0.5};
+  s.utime = now;  // a new state each time (a repeated one is refused as a duplicate)
   m->on_joint_state(s, now);
   for (const char* p : {"tofguard-camera", "tofguard-renderer", "tofguard-discrepancy"}) {
     m->on_heartbeat(heartbeat(p), now);

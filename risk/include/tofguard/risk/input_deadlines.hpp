@@ -39,6 +39,17 @@ class InputDeadlines {
   // its limit in milliseconds; nothing while every input is fresh.
   std::optional<FrameFinding> first_expired(int64_t now_us) const;
 
+  // Whether the joint-state / discrepancy stream has been silent past its
+  // deadline (so the arm has been stopped on it): a stream that restarts
+  // with older seqs or utimes (a restarted driver, a clock set back) may
+  // then start afresh.
+  bool joint_state_expired(int64_t now_us) const {
+    return now_us - joint_state_.last_us > joint_state_.limit_us;
+  }
+  bool discrepancy_expired(int64_t now_us) const {
+    return now_us - discrepancy_.last_us > discrepancy_.limit_us;
+  }
+
  private:
   struct Deadline {
     std::string what;  // channel or process name

@@ -15,9 +15,14 @@ class JointStatesByUtime {
   // Keeps the states whose utime is within `keep_us` of the newest.
   explicit JointStatesByUtime(int64_t keep_us = 2'000'000) : keep_us_(keep_us) {}
 
-  // A joint state older than the newest kept one (out of order) is not
-  // added: the record stays sorted by utime.
-  void add(const joint_state_t& state);
+  // A joint state not newer than the newest kept one (out of order, or a
+  // duplicate) is not added: the record stays sorted by utime. Returns
+  // whether it was added.
+  bool add(const joint_state_t& state);
+  // The newest state's utime (-1 when none).
+  int64_t newest_utime() const { return states_.empty() ? -1 : states_.back().utime; }
+  // Forgets every state (a stream that starts afresh).
+  void clear() { states_.clear(); }
 
   // The newest joint state taken at or before `utime`; for a frame older
   // than all of them, the oldest; nullptr when there is none.

@@ -26,6 +26,7 @@
 // verdict makes it DANGEROUS.
 // docs/safety-chain.md gives every rule.
 #include <cstdint>
+#include <deque>
 #include <optional>
 #include <string>
 #include <vector>
@@ -59,7 +60,14 @@ class RiskMonitor {
 
   // Arrivals of valid messages.
   void on_depth(int64_t now_us) { deadlines_.on_depth(now_us); }
-  void on_joint_state(const joint_state_t& state, int64_t now_us);
+  // A joint state not newer (utime) than the newest one taken — a duplicate,
+  // one out of order, a driver's clock set back — is refused: it neither
+  // feeds the joint-state deadline nor the record (a driver stuck resending
+  // its last state must go stale, fault injection). Once the stream has
+  // gone stale (the arm stopped on it) the next state other than a copy of
+  // the newest starts it afresh.
+  // Returns "" when taken, else why not (the caller counts and reports it).
+  std::string on_joint_state(const joint_state_t& state, int64_t now_us);
   void on_camera_pose(int64_t now_us) { deadlines_.on_camera_pose(now_us); }
   void on_heartbeat(const heartbeat_t& heartbeat, int64_t now_us) {
     deadlines_.on_heartbeat(heartbeat.process, now_us);
@@ -69,7 +77,20 @@ class RiskMonitor {
 
   // A frame arrives: the verdicts ready now, in frame order (none while
   // this frame or one before it waits for its estimate).
+  //
+  // Frames must come newer than the last one judged, in both seq and utime:
+  // a duplicate or an older seq (a replayed or repeated message) and a
+  // camera clock set back (seq up, utime down) are refused — no verdict,
+  // the discrepancy deadline not fed, counted in refused_frames() with
+  // last_refusal() saying why. Exceptions: an unusable frame never judged
+  // before (a frame whose rendering timed out is published after newer
+  // ones) is judged, since it can only stop the arm; and once the
+  // discrepancy stream has gone stale (the arm stopped on it) the next
+  // frame not judged before starts the stream afresh (a restarted camera,
+  // a clock set back).
   std::vector<risk_t> on_frame(const discrepancy_t& frame, int64_t now_us);
+  int64_t refused_frames() const { return refused_frames_; }
+  const std::string& last_refusal() const { return last_refusal_; }
   // A valid estimate (check_motion_estimate, this camera, the robot's
   // joints): the verdicts it releases.
   std::vector<risk_t> on_estimate(const motion_estimate_t& estimate, int64_t now_us);
@@ -108,6 +129,13 @@ class RiskMonitor {
   SequentialEvidence evidence_;
   DecisionRule decision_;
   int64_t last_frame_utime_ = 0;
+  // The newest frame taken in order (seq, utime) and the seqs judged lately.
+  bool any_frame_ = false;
+  int64_t newest_seq_ = 0;
+  int64_t newest_utime_ = 0;
+  std::deque<int64_t> judged_seqs_;
+  int64_t refused_frames_ = 0;
+  std::string last_refusal_;
 };
 
 }  // namespace tofguard::risk
