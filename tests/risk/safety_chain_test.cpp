@@ -7,6 +7,7 @@
 
 #include "chain_bus.hpp"
 #include "synthetic_frames.hpp"
+#include "tofguard/common/clock.hpp"
 #include "tofguard/joint_state_t.hpp"
 
 namespace tofguard::test {
@@ -42,6 +43,7 @@ class SafetyChain : public ::testing::Test {
   // rendered frame and labels of the model.
   void step(const std::vector<Box>& scene, bool renderer_alive = true) {
     joint_state_t joints{};
+    joints.utime = wall_utime();  // a newer one each period (an old one is refused)
     joints.robot_id = "friend-sim";
     joints.num_joints = 1;
     joints.name = {"a1"};
