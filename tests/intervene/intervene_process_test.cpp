@@ -100,6 +100,47 @@ struct Bench {
   }
 };
 
+// Signed risks at the bench's level (and a still arm) every 20 ms from a
+// thread of its own, while the test's thread waits for tofguard-reset.
+class Feeder {
+ public:
+  explicit Feeder(Bench& bench) : bench_(bench), thread_([this] { run(); }) {}
+  ~Feeder() {
+    running_ = false;
+    thread_.join();
+  }
+  // Risks sent with the DANGEROUS level: once one went out, none of the
+  // SAFE ones before it can arrive after it (one socket, in order).
+  int dangerous_sent() const { return dangerous_sent_; }
+
+ private:
+  void run() {
+    lcm::LCM lcm(kSafetyUrl);
+    SignedPublisher signed_lcm(lcm);
+    while (running_) {
+      risk_t r{};
+      r.utime = wall_utime();
+      r.seq = 1;
+      r.level = bench_.risk_level;
+      r.cause = bench_.risk_cause;
+      signed_lcm.publish("SAFETY_RISK", r);
+      if (r.level == risk_t::DANGEROUS) ++dangerous_sent_;
+      joint_state_t j;
+      j.utime = wall_utime();
+      j.num_joints = 1;
+      j.name = {"a1"};
+      j.position = {0};
+      j.velocity = {0};
+      lcm.publish("JOINT_STATE", &j);
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));  // the feed's period
+    }
+  }
+  Bench& bench_;
+  std::atomic<bool> running_{true};
+  std::atomic<int> dangerous_sent_{0};
+  std::thread thread_;
+};
+
 std::vector<std::string> intervene_argv() {
   return {bin_dir() + "/tofguard-intervene", "--config", source_dir() + "/config/sim.yaml"};
 }
@@ -128,34 +169,7 @@ TEST(InterveneProcess, LatchedStopResetAndRestart) {
       wait_until([&] { return bench.power_messages > 3; }, std::chrono::seconds(5), [&] { bench.pump(); }));
   std::string out;
   // tofguard-reset blocks; keep the feed going from a thread of its own.
-  std::atomic<bool> resetting{true};
-  // Risks the feeder sent with the DANGEROUS level: once one went out, none
-  // of its earlier SAFE ones can arrive after the stop (one socket, in
-  // order).
-  std::atomic<int> feeder_dangerous_sent{0};
-  std::thread feeder([&] {
-    lcm::LCM lcm(kSafetyUrl);
-    SignedPublisher signed_lcm(lcm);
-    while (resetting) {
-      risk_t r;
-      r.utime = wall_utime();
-      r.seq = 1;
-      r.level = bench.risk_level;
-      r.cause = bench.risk_cause;
-      r.score = 0;
-      r.threshold = 0;
-      signed_lcm.publish("SAFETY_RISK", r);
-      if (r.level == risk_t::DANGEROUS) ++feeder_dangerous_sent;
-      joint_state_t j;
-      j.utime = wall_utime();
-      j.num_joints = 1;
-      j.name = {"a1"};
-      j.position = {0};
-      j.velocity = {0};
-      lcm.publish("JOINT_STATE", &j);
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));  // the feed's period
-    }
-  });
+  auto feeder = std::make_unique<Feeder>(bench);
   EXPECT_EQ(reset("reset-accepted", &out), 0) << out;
   EXPECT_NE(out.find("reset accepted"), std::string::npos) << out;
   ASSERT_TRUE(
@@ -177,12 +191,11 @@ TEST(InterveneProcess, LatchedStopResetAndRestart) {
   // A reset while DANGEROUS is refused, with the reason. (Not before the
   // feeder thread's stream says DANGEROUS too: a SAFE it read just before
   // the change could otherwise be tofguard-intervene's newest risk.)
-  ASSERT_TRUE(
-      wait_until([&] { return feeder_dangerous_sent > 0; }, std::chrono::seconds(2), [&] { bench.pump(); }));
+  ASSERT_TRUE(wait_until([&] { return feeder->dangerous_sent() > 0; }, std::chrono::seconds(2),
+                         [&] { bench.pump(); }));
   EXPECT_EQ(reset("reset-refused", &out), 1) << out;
   EXPECT_NE(out.find("refused: diagnosis open: joint error"), std::string::npos) << out;
-  resetting = false;
-  feeder.join();
+  feeder.reset();
 
   // The risk stream dies -> power cut.
   bench.send_risk = false;
@@ -326,21 +339,10 @@ TEST(InterveneProcess, MalformedInputIsDroppedCountedAndTheGoodRisksStillJudged)
   // The good SAFE risks keep coming (pump): a reset is accepted, and a
   // DANGEROUS one still stops the arm.
   std::string out;
-  std::atomic<bool> feeding{true};
-  std::thread feeder([&] {
-    lcm::LCM lcm(kSafetyUrl);
-    SignedPublisher signed_lcm(lcm);
-    while (feeding) {
-      risk_t r{};
-      r.utime = wall_utime();
-      r.level = risk_t::SAFE;
-      signed_lcm.publish("SAFETY_RISK", r);
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));  // the feed's period
-    }
-  });
-  EXPECT_EQ(reset("reset-after-malformed", &out), 0) << out;
-  feeding = false;
-  feeder.join();
+  {
+    Feeder feeder(bench);  // SAFE, the bench's level
+    EXPECT_EQ(reset("reset-after-malformed", &out), 0) << out;
+  }
   bench.risk_level = risk_t::DANGEROUS;
   bench.risk_cause = risk_t::CAUSE_UNKNOWN_OBJECT;
   EXPECT_TRUE(
@@ -352,42 +354,6 @@ TEST(InterveneProcess, MalformedInputIsDroppedCountedAndTheGoodRisksStillJudged)
 
 namespace tofguard::test {
 namespace {
-
-// Signed risks at the bench's level (and a still arm) every 20 ms from a
-// thread of its own, while the test's thread waits for tofguard-reset.
-class Feeder {
- public:
-  explicit Feeder(Bench& bench) : bench_(bench), thread_([this] { run(); }) {}
-  ~Feeder() {
-    running_ = false;
-    thread_.join();
-  }
-
- private:
-  void run() {
-    lcm::LCM lcm(kSafetyUrl);
-    SignedPublisher signed_lcm(lcm);
-    while (running_) {
-      risk_t r{};
-      r.utime = wall_utime();
-      r.seq = 1;
-      r.level = bench_.risk_level;
-      r.cause = bench_.risk_cause;
-      signed_lcm.publish("SAFETY_RISK", r);
-      joint_state_t j;
-      j.utime = wall_utime();
-      j.num_joints = 1;
-      j.name = {"a1"};
-      j.position = {0};
-      j.velocity = {0};
-      lcm.publish("JOINT_STATE", &j);
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));  // the feed's period
-    }
-  }
-  Bench& bench_;
-  std::atomic<bool> running_{true};
-  std::thread thread_;
-};
 
 // docs/security.md. With a key, tofguard-intervene acts only on signed risk
 // verdicts and resets: a stream of plain SAFE verdicts (anyone on the bus
