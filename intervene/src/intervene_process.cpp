@@ -6,6 +6,7 @@
 
 #include "tofguard/auth/message_signer.hpp"
 #include "tofguard/auth/message_verifier.hpp"
+#include "tofguard/auth/signed_publish.hpp"
 #include "tofguard/common/clock.hpp"
 #include "tofguard/common/lcm_node.hpp"
 #include "tofguard/common/wire_checks.hpp"
@@ -31,12 +32,7 @@ class LcmPowerActuator : public PowerActuator {
     message.seq = seq_++;
     message.power_enabled = enabled;
     message.reason = reason;
-    if (signer_ != nullptr) {
-      const authenticated_message_t signed_message = signer_->sign(channel_, message, wall_utime());
-      if (lcm_.publish(auth_channel_, &signed_message) != 0) return "cannot publish " + auth_channel_;
-    }
-    if (lcm_.publish(channel_, &message) != 0) return "cannot publish " + channel_;
-    return "";
+    return auth::publish_signed(lcm_, signer_, channel_, auth_channel_, message, wall_utime());
   }
 
  private:
@@ -87,6 +83,7 @@ int run_intervene(const InterveneProcessSettings& settings) {
     verifier.emplace(settings.auth.key, settings.auth.max_age_us);
     signer.emplace(settings.auth.key, wall_utime());
   }
+  auth::MessageSigner* const signer_or_null = signer ? &*signer : nullptr;
   AuthRefusals refused;
   InterventionLogic logic(settings.intervention, monotonic_us(), wall_utime());
   std::unique_ptr<PowerActuator> actuator;
@@ -100,7 +97,7 @@ int run_intervene(const InterveneProcessSettings& settings) {
     actuator = std::move(output);
   } else {
     actuator = std::make_unique<LcmPowerActuator>(node.safety(), channels.power, channels.power_auth,
-                                                  signer ? &*signer : nullptr);
+                                                  signer_or_null);
   }
 
   int64_t seq = 0;
@@ -115,11 +112,8 @@ int run_intervene(const InterveneProcessSettings& settings) {
     message.cause = s.cause;
     message.reason = s.reason;
     message.since_utime = s.since_utime;
-    if (signer) {
-      const authenticated_message_t signed_status = signer->sign(channels.status, message, wall_utime());
-      node.safety().publish(channels.status_auth, &signed_status);
-    }
-    node.safety().publish(channels.status, &message);
+    auth::publish_signed(node.safety(), signer_or_null, channels.status, channels.status_auth, message,
+                         wall_utime());
     node.counters().frames_out++;
     node.heartbeat().set_status((s.motion_allowed ? "motion allowed" : "stopped: " + s.reason) +
                                 refused.summary());
@@ -242,11 +236,8 @@ int run_intervene(const InterveneProcessSettings& settings) {
   last.cause = risk_t::CAUSE_COMPONENT_FAULT;
   last.reason = "tofguard-intervene exiting";
   last.since_utime = last.utime;
-  if (signer) {
-    const authenticated_message_t signed_last = signer->sign(channels.status, last, wall_utime());
-    node.safety().publish(channels.status_auth, &signed_last);
-  }
-  node.safety().publish(channels.status, &last);
+  auth::publish_signed(node.safety(), signer_or_null, channels.status, channels.status_auth, last,
+                       wall_utime());
   actuator->set_power(false, "tofguard-intervene exiting");
   return 0;
 }

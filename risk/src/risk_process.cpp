@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "tofguard/auth/message_signer.hpp"
+#include "tofguard/auth/signed_publish.hpp"
 #include "tofguard/camera_pose_t.hpp"
 #include "tofguard/common/clock.hpp"
 #include "tofguard/common/lcm_node.hpp"
@@ -33,11 +34,8 @@ int run_risk(const RiskProcessSettings& settings) {
   if (auth::authenticated(settings.auth)) signer.emplace(settings.auth.key, wall_utime());
 
   auto publish = [&](const risk_t& r) {
-    if (signer) {
-      const authenticated_message_t signed_risk = signer->sign(settings.channels.risk, r, wall_utime());
-      node.safety().publish(settings.channels.risk_auth, &signed_risk);
-    }
-    node.safety().publish(settings.channels.risk, &r);
+    auth::publish_signed(node.safety(), signer ? &*signer : nullptr, settings.channels.risk,
+                         settings.channels.risk_auth, r, wall_utime());
     node.counters().frames_out++;
     if (r.seq >= 0) node.heartbeat().set_last_frame_utime(r.utime);
     if (r.level == risk_t::DANGEROUS) ++dangerous;

@@ -10,6 +10,7 @@
 #include "test_support.hpp"
 #include "tofguard/auth/auth_key.hpp"
 #include "tofguard/auth/message_signer.hpp"
+#include "tofguard/auth/signed_publish.hpp"
 #include "tofguard/common/clock.hpp"
 
 namespace tofguard::test {
@@ -25,8 +26,7 @@ class SignedPublisher {
 
   template <class T>
   void publish(const std::string& channel, const T& message) {
-    publish_signed_only(channel, message);
-    lcm_.publish(channel, &message);
+    auth::publish_signed(lcm_, &signer_, channel, channel + "_AUTH", message, wall_utime());
   }
   // Only the signed copy (e.g. a reset, which a keyed sender never sends
   // plain). Returns what was sent, for replays.
