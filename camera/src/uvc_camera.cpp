@@ -110,6 +110,8 @@ std::string list_usb_devices() {
     text = std::string("cannot list USB devices: libusb: ") + libusb_error_name(static_cast<int>(count));
   } else if (count == 0) {
     text = "USB devices found: none";
+    // An empty list is still allocated (its terminating null): freed too.
+    libusb_free_device_list(list, 1);
   } else {
     text = "USB devices found:";
     for (ssize_t i = 0; i < count; ++i) {

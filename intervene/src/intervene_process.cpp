@@ -164,8 +164,19 @@ int run_intervene(const InterveneProcessSettings& settings) {
     reply.reason = decision.reason;
     node.safety().publish(channels.reset_reply, &reply);
   };
+  // tofguard-reset sends its request again until answered (a datagram can
+  // be lost): a repeat of the last request id gets the same answer, not a
+  // second decision.
+  int64_t last_reset_request_id = 0;
+  ResetDecision last_reset_decision;
   auto on_reset = [&](const reset_request_t& request) {
+    if (last_reset_request_id != 0 && request.request_id == last_reset_request_id) {
+      reply_to_reset(request.request_id, last_reset_decision);
+      return;
+    }
     const ResetDecision decision = logic.on_reset(request, monotonic_us(), wall_utime());
+    last_reset_request_id = request.request_id;
+    last_reset_decision = decision;
     std::cerr << "tofguard-intervene: reset from '" << request.who << "' (" << request.why
               << "): " << decision.reason << std::endl;
     publish_if_changed();

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <iostream>
+#include <optional>
 #include <random>
 
 #include "tofguard/auth/message_signer.hpp"
@@ -72,21 +73,35 @@ int run_reset(const ResetToolSettings& settings, const std::vector<std::string>&
   } waiter;
   waiter.request_id = request.request_id;
   lcm.subscribe(settings.channels.reset_reply, &Waiter::on_reply, &waiter);
-  if (!settings.auth.key.id.empty()) {
-    // Signed: the only reset a keyed tofguard-intervene accepts.
-    auth::MessageSigner signer(settings.auth.key, request.utime);
-    const authenticated_message_t signed_request =
-        signer.sign(settings.channels.reset, request, wall_utime());
-    lcm.publish(settings.channels.reset_auth, &signed_request);
-  } else {
-    // No key (insecure: true, or no config given): plain, which only an
-    // insecure tofguard-intervene accepts; a keyed one answers why not.
-    lcm.publish(settings.channels.reset, &request);
-  }
+  std::optional<auth::MessageSigner> signer;
+  if (!settings.auth.key.id.empty()) signer.emplace(settings.auth.key, request.utime);
+  auto send = [&] {
+    if (signer) {
+      // Signed: the only reset a keyed tofguard-intervene accepts. Each
+      // send is signed afresh (a new seq: a repeated envelope would be
+      // refused as a replay); the request id stays the same.
+      const authenticated_message_t signed_request =
+          signer->sign(settings.channels.reset, request, wall_utime());
+      lcm.publish(settings.channels.reset_auth, &signed_request);
+    } else {
+      // No key (insecure: true, or no config given): plain, which only an
+      // insecure tofguard-intervene accepts; a keyed one answers why not.
+      lcm.publish(settings.channels.reset, &request);
+    }
+  };
 
+  // UDP multicast can lose a datagram (a full receive buffer at a busy
+  // tofguard-intervene, a lossy bus): the request goes again every
+  // kResendPeriodMs until answered. tofguard-intervene answers a repeat
+  // of the same request id with its first answer.
+  constexpr int64_t kResendPeriodMs = 250;
   const int64_t deadline_us = monotonic_us() + timeout_ms * 1000;
   while (!waiter.answered && monotonic_us() < deadline_us && !stop_requested()) {
-    lcm.handleTimeout(static_cast<int>(std::max<int64_t>(1, (deadline_us - monotonic_us()) / 1000)));
+    send();
+    const int64_t resend_us = std::min(deadline_us, monotonic_us() + kResendPeriodMs * 1000);
+    while (!waiter.answered && monotonic_us() < resend_us && !stop_requested()) {
+      lcm.handleTimeout(static_cast<int>(std::max<int64_t>(1, (resend_us - monotonic_us()) / 1000)));
+    }
   }
   if (!waiter.answered) {
     std::cout << "no answer on " << settings.channels.reset_reply << " within " << timeout_ms
