@@ -94,16 +94,24 @@ ArmSpheres cover_arm_with_spheres(const SceneModel& scene, double cell_m) {
   return cover;
 }
 
-double distance_to_arm_m(const ArmSpheres& cover, const LinkPoses& poses,
-                         const Eigen::Vector3d& point_world) {
-  TOFGUARD_DEMAND(poses.usable, "distance to the arm asked at unusable link poses");
-  double nearest = std::numeric_limits<double>::infinity();
+PlacedArmSpheres place_arm_spheres(const ArmSpheres& cover, const LinkPoses& poses) {
+  TOFGUARD_DEMAND(poses.usable, "the arm's spheres placed at unusable link poses");
+  PlacedArmSpheres placed;
+  placed.reserve(cover.spheres.size());
   for (const LinkSphere& sphere : cover.spheres) {
     TOFGUARD_DEMAND(static_cast<size_t>(sphere.link_index) < poses.world_from_link.size(),
                     "the sphere cover and the link poses come from different models");
-    const Eigen::Vector3d center_world =
-        poses.world_from_link[static_cast<size_t>(sphere.link_index)] * sphere.center_link_m;
-    nearest = std::min(nearest, std::max(0.0, (point_world - center_world).norm() - sphere.radius_m));
+    placed.push_back({poses.world_from_link[static_cast<size_t>(sphere.link_index)] * sphere.center_link_m,
+                      sphere.radius_m});
+  }
+  return placed;
+}
+
+double distance_to_arm_m(const PlacedArmSpheres& placed, const Eigen::Vector3d& point_world) {
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const PlacedSphere& sphere : placed) {
+    nearest =
+        std::min(nearest, std::max(0.0, (point_world - sphere.center_world_m).norm() - sphere.radius_m));
   }
   return nearest;
 }

@@ -49,24 +49,22 @@ TEST(ArmSpheres, DistancesAreNeverFartherThanTheSurfaceAndAtMostTwoRadiiNearer) 
   EXPECT_LE(cover.max_radius_m, 0.02 * std::sqrt(3.0) + 0.02);
   const LinkPoses poses = forward_kinematics(scene, {{"j1", 0.0}});
   ASSERT_TRUE(poses.usable);
+  const PlacedArmSpheres placed = place_arm_spheres(cover, poses);
   const Eigen::Vector3d lo(0, -0.05, -0.05), hi(0.4, 0.05, 0.05);
   std::mt19937 random(7);
   std::uniform_real_distribution<double> coordinate(-0.6, 0.8);
-  int checked = 0;
   for (int i = 0; i < 2000; ++i) {
     const Eigen::Vector3d p(coordinate(random), coordinate(random), coordinate(random));
     const double truth = distance_to_box(p, lo, hi);
-    const double seen = distance_to_arm_m(cover, poses, p);
+    const double seen = distance_to_arm_m(placed, p);
     EXPECT_LE(seen, truth + 1e-9) << p.transpose();
     EXPECT_GE(seen, truth - 2 * cover.max_radius_m - 1e-9) << p.transpose();
-    ++checked;
   }
-  EXPECT_EQ(checked, 2000);
   // Points on the surface are at distance 0; the environment's box (0.3 m
   // along y) does not count: a point on it is its distance from the arm.
-  EXPECT_LE(distance_to_arm_m(cover, poses, Eigen::Vector3d(0.4, 0, 0)), 1e-9);
-  EXPECT_LE(distance_to_arm_m(cover, poses, Eigen::Vector3d(0.2, 0.05, 0.01)), 1e-9);
-  const double at_table = distance_to_arm_m(cover, poses, Eigen::Vector3d(0, 0.2, 0));
+  EXPECT_LE(distance_to_arm_m(placed, Eigen::Vector3d(0.4, 0, 0)), 1e-9);
+  EXPECT_LE(distance_to_arm_m(placed, Eigen::Vector3d(0.2, 0.05, 0.01)), 1e-9);
+  const double at_table = distance_to_arm_m(placed, Eigen::Vector3d(0, 0.2, 0));
   EXPECT_LE(at_table, 0.15 + 1e-9);
   EXPECT_GE(at_table, 0.15 - 2 * cover.max_radius_m);
 }
@@ -75,11 +73,11 @@ TEST(ArmSpheres, TheCoverMovesWithTheJoints) {
   const SceneModel scene = box_arm();
   const ArmSpheres cover = cover_arm_with_spheres(scene, 0.02);
   const Eigen::Vector3d tip_when_turned(0, 0.4, 0);  // l1's far end with j1 at +90 deg
-  const LinkPoses straight = forward_kinematics(scene, {{"j1", 0.0}});
-  const LinkPoses turned = forward_kinematics(scene, {{"j1", M_PI / 2}});
-  EXPECT_LE(distance_to_arm_m(cover, turned, tip_when_turned), 1e-9);
+  const PlacedArmSpheres straight = place_arm_spheres(cover, forward_kinematics(scene, {{"j1", 0.0}}));
+  const PlacedArmSpheres turned = place_arm_spheres(cover, forward_kinematics(scene, {{"j1", M_PI / 2}}));
+  EXPECT_LE(distance_to_arm_m(turned, tip_when_turned), 1e-9);
   // Straight, the nearest arm point to (0, 0.4, 0) is (0, 0.05, 0): 0.35 m.
-  const double seen = distance_to_arm_m(cover, straight, tip_when_turned);
+  const double seen = distance_to_arm_m(straight, tip_when_turned);
   EXPECT_LE(seen, 0.35 + 1e-9);
   EXPECT_GE(seen, 0.35 - 2 * cover.max_radius_m);
 }
@@ -93,6 +91,7 @@ void expect_every_corner_covered(const SceneModel& scene, const std::string& nam
     q[scene.actuated_joint_names[j]] = 0.3 * (j + 1);
   const LinkPoses poses = forward_kinematics(scene, q);
   ASSERT_TRUE(poses.usable) << poses.unusable_reason;
+  const PlacedArmSpheres placed = place_arm_spheres(cover, poses);
   size_t corners = 0, triangles = 0;
   for (const Shape& shape : scene.shapes) {
     if (shape.link_index >= scene.num_robot_links) continue;
@@ -103,7 +102,7 @@ void expect_every_corner_covered(const SceneModel& scene, const std::string& nam
       const Eigen::Vector3d p =
           poses.world_from_link[static_cast<size_t>(shape.link_index)] *
           (shape.link_from_shape * shape.scale.cwiseProduct(mesh.vertices[i].cast<double>()));
-      ASSERT_LE(distance_to_arm_m(cover, poses, p), 1e-9) << name << " corner " << i;
+      ASSERT_LE(distance_to_arm_m(placed, p), 1e-9) << name << " corner " << i;
       ++corners;
     }
   }

@@ -47,9 +47,20 @@ struct ArmSpheres {
 // area / cell_m^2).
 ArmSpheres cover_arm_with_spheres(const SceneModel& scene, double cell_m);
 
-// Distance (m) from `point_world` (world frame) to the cover at the link
-// poses given (forward_kinematics of the frame's joint state; they must be
-// usable), 0 inside a sphere. +infinity when the cover is empty.
-double distance_to_arm_m(const ArmSpheres& cover, const LinkPoses& poses, const Eigen::Vector3d& point_world);
+// The cover placed at one joint state: each sphere's centre in the world
+// frame. Made once per frame; every distance query of that frame uses it.
+struct PlacedSphere {
+  Eigen::Vector3d center_world_m = Eigen::Vector3d::Zero();
+  double radius_m = 0;
+};
+using PlacedArmSpheres = std::vector<PlacedSphere>;
+
+// Places the cover at the link poses given (forward_kinematics of the
+// frame's joint state; they must be usable and of the cover's model).
+PlacedArmSpheres place_arm_spheres(const ArmSpheres& cover, const LinkPoses& poses);
+
+// Distance (m) from `point_world` (world frame) to the placed cover, 0
+// inside a sphere. +infinity when the cover is empty.
+double distance_to_arm_m(const PlacedArmSpheres& placed, const Eigen::Vector3d& point_world);
 
 }  // namespace tofguard::robot_model
