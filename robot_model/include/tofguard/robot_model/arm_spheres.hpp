@@ -11,7 +11,10 @@
 // and, since every sphere holds a point of the surface,
 //   distance_to_arm_m(p) >= true distance - 2 * max_radius_m.
 // The error is towards "near", towards a stop; its bound is stated by the
-// cover itself (max_radius_m), not assumed.
+// cover itself (max_radius_m), not assumed. Only the surface is covered: a
+// point deep inside a link is at most its distance to the link's surface
+// (half the link's thickness), not 0; a camera sees surfaces, and one
+// inside the modelled arm is nearer than the arm anyway.
 //
 // Frames and units as in kinematic_tree.hpp: centres in their link's frame,
 // metres; distances in metres.
