@@ -119,7 +119,8 @@ std::string check_labels(const link_labels_t& labels) {
 }
 
 // Stage 2, silhouette mask: 1 for the pixels beside a rendered depth step
-// larger than silhouette_jump_mm (or the model's outline), 4-neighbours. A
+// larger than silhouette_jump_mm (silhouette_step: in whole millimetres, one
+// less) or the model's outline, 4-neighbours. A
 // ToF pixel there mixes both surfaces, so its I_dis says nothing about a
 // link's pose; on a thin link (a finger three pixels wide) it would
 // otherwise be most of the link.
@@ -136,7 +137,7 @@ std::vector<uint8_t> silhouette_mask(const depth_image_t& rendered, double silho
         if (n < 0) continue;
         const int a = gen[i] > 0 ? gen[i] : 0;
         const int b = gen[n] > 0 ? gen[n] : 0;
-        if ((a > 0) != (b > 0) || std::abs(a - b) > silhouette_jump_mm) {
+        if ((a > 0) != (b > 0) || (a > 0 && silhouette_step(a, b, silhouette_jump_mm))) {
           silhouette[i] = 1;
           silhouette[n] = 1;
         }

@@ -79,7 +79,7 @@ bool EvidenceJacobian::at(int i, double camera[6], double* joints, bool* moved, 
   // over the neighbours on the same link and surface, one-sided with one.
   const auto qualifies = [&](int n) {
     const int d = depth_[n];
-    return d > 0 && label_[n] == l && std::abs(d - z_mm) <= jump_mm_;
+    return d > 0 && label_[n] == l && !silhouette_step(d, z_mm, jump_mm_);
   };
   const auto slope = [&](bool has_minus, int minus, bool has_plus, int plus, double* g) {
     const bool a = has_minus && qualifies(minus);

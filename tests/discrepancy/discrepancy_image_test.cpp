@@ -293,5 +293,30 @@ TEST(Discrepancy, MixedPixelsOnAThinLinksSilhouetteDoNotCountAgainstIt) {
   EXPECT_EQ(seen.largest_blob_pixels, 0);
 }
 
+TEST(Discrepancy, AStepJustOverTheJumpIsASilhouetteInWholeMillimetres) {
+  // A link 10 px wide at 1.5 m, 50.4 mm in front of the surface behind it:
+  // the camera mixes its edge pixels (a scene step over silhouette_jump_mm),
+  // but the rendered depths, rounded to the millimetre, differ by 50. The
+  // mixed pixels must stay out of the link's counts (and the evidence) all
+  // the same: on a still arm the same pixel is mixed in every frame.
+  SyntheticImage model = draw({{80, 40, 90, 100, kArmMm, 1}});
+  for (size_t i = 0; i < model.depth_mm.size(); ++i) {
+    if (model.label[i] != 1) model.depth_mm[i] = kArmMm + 50;
+  }
+  std::vector<int16_t> camera = model.depth_mm;
+  for (int v = 40; v < 100; ++v) {
+    camera[v * kWidth + 80] = kArmMm + 25;
+    camera[v * kWidth + 89] = kArmMm + 25;
+  }
+  discrepancy::Parameters parameters;
+  parameters.silhouette_jump_mm = 50;
+  const auto seen = compute_discrepancy(depth_frame(camera, 1), depth_frame(model.depth_mm, 1),
+                                        labels_frame(model.label, 1), parameters)
+                        .summary;
+  // The link's inner 8 x 58 pixels count; its outline does not.
+  EXPECT_EQ(seen.link_compared[0], 8 * 58);
+  EXPECT_EQ(seen.link_match[0], 8 * 58);
+}
+
 }  // namespace
 }  // namespace tofguard::test

@@ -22,6 +22,7 @@
 // allocated per pixel.
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <vector>
 
 #include <Eigen/Core>
@@ -98,6 +99,19 @@ struct LabelKinematics {
 // False when `labels` carry no kinematics (num_axes = 0) or they do not fit
 // together or the labels (`pixels` labels expected).
 bool read_label_kinematics(const link_labels_t& labels, size_t pixels, LabelKinematics* out);
+
+// Whether two neighbouring rendered depths (whole millimetres, both > 0)
+// lie across a silhouette: a step in the scene larger than
+// `silhouette_jump_mm`, where a ToF pixel mixes both surfaces. Each rendered
+// depth is rounded to the millimetre, so a scene step just over the jump
+// (50.4 mm over 50) can read one millimetre less in whole millimetres (50):
+// a rendered step over silhouette_jump_mm - 1 counts. Missing one leaves a
+// mixed pixel in the evidence with a slope taken across the step: on a
+// still arm the same pixel, the same bias in every frame (a 23 mm mixed
+// pixel beside a 50 mm step carried most of a7's score on the default arm).
+inline bool silhouette_step(int a_mm, int b_mm, double silhouette_jump_mm) {
+  return std::abs(a_mm - b_mm) > silhouette_jump_mm - 1.0;
+}
 
 // Per-pixel Jacobians of a rendered frame and its labels' kinematics.
 // Keeps pointers into `rendered` and `labels`: they must outlive it.
