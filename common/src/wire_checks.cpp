@@ -137,6 +137,67 @@ std::string check_kinematics(const link_labels_t& l) {
   return "";
 }
 
+// link_labels_t's arm cover (arm_cover_max_radius_m .. arm_sphere_radius_m).
+std::string check_arm_cover(const link_labels_t& l) {
+  if (auto p = check_count(l.num_arm_spheres, l.arm_sphere_link, "arm_sphere_link", "num_arm_spheres");
+      !p.empty())
+    return p;
+  if (auto p =
+          check_count(l.num_arm_spheres, l.arm_sphere_center_m, "arm_sphere_center_m", "num_arm_spheres");
+      !p.empty())
+    return p;
+  if (auto p =
+          check_count(l.num_arm_spheres, l.arm_sphere_radius_m, "arm_sphere_radius_m", "num_arm_spheres");
+      !p.empty())
+    return p;
+  if (!std::isfinite(l.arm_cover_max_radius_m) || l.arm_cover_max_radius_m < 0) {
+    return expected("arm_cover_max_radius_m", "a finite radius >= 0 (m)", l.arm_cover_max_radius_m);
+  }
+  for (int k = 0; k < l.num_arm_spheres; ++k) {
+    const std::string at = "[" + std::to_string(k) + "]";
+    if (l.arm_sphere_link[k] < 0 || l.arm_sphere_link[k] >= l.num_robot_links) {
+      return expected("arm_sphere_link" + at,
+                      "a robot link index 0..num_robot_links-1 = " + std::to_string(l.num_robot_links - 1),
+                      l.arm_sphere_link[k]);
+    }
+    if (l.arm_sphere_center_m[k].size() != 3) return "arm_sphere_center_m" + at + ": expected 3 coordinates";
+    for (int c = 0; c < 3; ++c) {
+      if (!std::isfinite(l.arm_sphere_center_m[k][c])) {
+        return expected("arm_sphere_center_m" + at, "finite coordinates (m)", l.arm_sphere_center_m[k][c]);
+      }
+    }
+    const double r = l.arm_sphere_radius_m[k];
+    if (!std::isfinite(r) || r < 0 || r > l.arm_cover_max_radius_m) {
+      return expected("arm_sphere_radius_m" + at,
+                      "a radius 0..arm_cover_max_radius_m = " + std::to_string(l.arm_cover_max_radius_m), r);
+    }
+  }
+  return "";
+}
+
+// discrepancy_t's protective-field fields (field_bin_m ..
+// unexplained_area_within_m2).
+std::string check_field(const discrepancy_t& d) {
+  if (auto p = check_count(d.num_field_bins, d.unexplained_area_within_m2, "unexplained_area_within_m2",
+                           "num_field_bins");
+      !p.empty())
+    return p;
+  if (d.num_field_bins > 0 && !(std::isfinite(d.field_bin_m) && d.field_bin_m > 0)) {
+    return expected("field_bin_m", "a bin width > 0 (m)", d.field_bin_m);
+  }
+  float previous = 0;
+  for (int k = 0; k < d.num_field_bins; ++k) {
+    const float area = d.unexplained_area_within_m2[k];
+    if (!(std::isfinite(area) && area >= previous)) {
+      return expected("unexplained_area_within_m2[" + std::to_string(k) + "]",
+                      "a finite cumulative area >= the previous bin's " + std::to_string(previous) + " m^2",
+                      area);
+    }
+    previous = area;
+  }
+  return "";
+}
+
 // discrepancy_t's evidence fields.
 std::string check_evidence(const discrepancy_t& d) {
   const auto finite_array = [](const double* v, int n, const std::string& field) -> std::string {
@@ -193,7 +254,8 @@ std::string check_evidence(const discrepancy_t& d) {
         std::tuple{&d.joint_naming_score, "joint_naming_score", false},
         std::tuple{&d.joint_naming_information, "joint_naming_information", true},
         std::tuple{&d.joint_search_offset, "joint_search_offset", false},
-        std::tuple{&d.joint_search_gain, "joint_search_gain", true}}) {
+        std::tuple{&d.joint_search_gain, "joint_search_gain", true},
+        std::tuple{&d.joint_reach_m, "joint_reach_m", true}}) {
     if (auto p = check_joint_values(d.num_joints, *values, field, non_negative); !p.empty()) return p;
   }
   if (d.robot_fit_pixels < 0) return expected("robot_fit_pixels", "a count >= 0", d.robot_fit_pixels);
@@ -270,7 +332,8 @@ std::string check_link_labels(const link_labels_t& labels) {
   if (labels.num_pixels != pixels) {
     return expected("num_pixels", "width*height = " + std::to_string(pixels), labels.num_pixels);
   }
-  return check_kinematics(labels);
+  if (auto problem = check_kinematics(labels); !problem.empty()) return problem;
+  return check_arm_cover(labels);
 }
 
 std::string check_risk(const risk_t& risk) {
@@ -410,6 +473,7 @@ std::string check_discrepancy(const discrepancy_t& d) {
   if (!std::isfinite(d.near_arm_area_m2) || !std::isfinite(d.largest_blob_area_m2)) {
     return "near_arm_area_m2 / largest_blob_area_m2: expected finite areas";
   }
+  if (auto p = check_field(d); !p.empty()) return p;
   return check_evidence(d);
 }
 

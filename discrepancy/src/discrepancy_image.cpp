@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "tofguard/common/demand.hpp"
+#include "tofguard/discrepancy/arm_distance.hpp"
 
 namespace tofguard::discrepancy {
 namespace {
@@ -156,9 +157,10 @@ struct PixelClasses {
   int count[6] = {0, 0, 0, 0, 0, 0};  // per discrepancy_t::PIXEL_*
   int num_compared = 0;               // camera and model both have a surface
   double sum_abs_dis_mm = 0;          // over the compared pixels
-  // 255 where a modelled surface mismatches (for blobs), and where the
-  // camera sees a nearer surface (occluded or unexpected, for near-arm
-  // objects); silhouette pixels left out of both except unmodelled ones.
+  // 255 where the camera sees farther than a modelled surface (for blobs),
+  // and where it sees a nearer surface (occluded or unexpected, for the
+  // protective fields); silhouette pixels left out of both except
+  // unmodelled ones.
   cv::Mat1b mismatch_mask;
   cv::Mat1b nearer_mask;
   // 0 where the model has a robot link, 255 elsewhere (distance transform).
@@ -217,7 +219,6 @@ void classify_pixels(const depth_image_t& camera, const depth_image_t& rendered,
       } else if (d > 0) {
         c = robot ? discrepancy_t::PIXEL_OCCLUDED : discrepancy_t::PIXEL_UNEXPECTED_SURFACE;
         nearer[i] = silhouette[i] ? 0 : 255;
-        mismatch[i] = silhouette[i] ? 0 : 255;
       } else {
         c = robot ? discrepancy_t::PIXEL_ROBOT_MISSING : discrepancy_t::PIXEL_ENVIRONMENT_MISSING;
         mismatch[i] = silhouette[i] ? 0 : 255;
@@ -316,8 +317,8 @@ class PixelFootprint {
   double inv_fx_fy_;
 };
 
-// Stage 5, blobs: the largest 8-connected component of the opened mismatch
-// mask, its pixel count and metric area.
+// Stage 5, blobs: the largest 8-connected component of the opened mask of
+// farther mismatches, its pixel count and metric area.
 void largest_blob(const cv::Mat1b& mismatch_mask, int opening_radius_px, const PixelFootprint& footprint,
                   discrepancy_t* s) {
   const cv::Mat1b blobs = opened(mismatch_mask, opening_radius_px);
@@ -342,65 +343,70 @@ void largest_blob(const cv::Mat1b& mismatch_mask, int opening_radius_px, const P
   s->largest_blob_area_m2 = static_cast<float>(area);
 }
 
-// Stage 6, near-arm surfaces: nearer surfaces (after the same opening)
-// within near_arm_m of the modelled arm. For an occluded pixel the distance
-// is how far in front of the arm the surface is; for an unexpected surface
-// it is the 3-D distance to the modelled arm point at the nearest robot
-// pixel in the image (an approximation of the distance to the arm's visible
-// surface). Pixel count, area (m^2) and smallest distance (m; -1: none).
-void near_arm_surfaces(const depth_image_t& camera, const depth_image_t& rendered,
-                       const DiscrepancyFrame& frame, const PixelClasses& classes,
-                       const Parameters& parameters, const PixelFootprint& footprint, discrepancy_t* s) {
-  const cv::Mat1b candidates = opened(classes.nearer_mask, parameters.opening_radius_px);
+// Stage 6, unexplained nearer surfaces and the protective fields: every
+// occluded or unexpected-surface pixel (after the same opening)
+// back-projected at the camera's depth, and its distance to the arm: 0 for
+// an occluded pixel (it hides part of the arm, and what cannot be seen is
+// occupied), else the distance to the arm's cover (arm_distance.hpp; 0 for
+// every pixel when the labels carry no cover). Fills
+// near_arm_* (within near_arm_m) and the cumulative areas by distance
+// (field_*).
+void unexplained_surfaces(const depth_image_t& camera, const link_labels_t& labels,
+                          const DiscrepancyFrame& frame, const PixelClasses& classes,
+                          const Parameters& parameters, const PixelFootprint& footprint, discrepancy_t* s) {
   s->near_arm_min_distance_m = -1;
-  if (!classes.any_robot || cv::countNonZero(candidates) == 0) return;
+  s->field_available = labels.num_arm_spheres > 0;
+  const int num_bins = static_cast<int>(std::ceil(parameters.field_range_m / parameters.field_bin_m - 1e-9));
+  s->field_bin_m = static_cast<float>(parameters.field_bin_m);
+  s->num_field_bins = num_bins;
+  std::vector<double> area_in_bin(num_bins, 0.0);
+  const cv::Mat1b candidates = opened(classes.nearer_mask, parameters.opening_radius_px);
+  const ArmDistance arm(labels);
   const int width = camera.width;
   const int num_pixels = width * camera.height;
   const int16_t* tof = camera.depth_mm.data();
-  const int16_t* gen = rendered.depth_mm.data();
   const uint8_t* pixel_class = frame.pixel_class.ptr<uint8_t>();
-  cv::Mat1f distance_px;
-  cv::Mat1i nearest;
-  cv::distanceTransform(classes.not_robot, distance_px, nearest, cv::DIST_L2, cv::DIST_MASK_5,
-                        cv::DIST_LABEL_PIXEL);
-  // Each robot pixel carries its own label: label -> pixel index.
-  std::vector<int> pixel_of_label;
-  const int* nearest_label = nearest.ptr<int>();
-  const uint8_t* robot_free = classes.not_robot.ptr<uint8_t>();
-  for (int i = 0; i < num_pixels; ++i) {
-    if (robot_free[i] == 0) {
-      const int k = nearest_label[i];
-      if (k >= static_cast<int>(pixel_of_label.size())) pixel_of_label.resize(k + 1, -1);
-      pixel_of_label[k] = i;
-    }
-  }
-  // The camera-frame point (optical frame, m) of pixel i at depth_mm.
-  auto point_m = [&](int i, int depth_mm) {
-    const double z = metres_from_mm(depth_mm);
-    return cv::Point3d((i % width - camera.cx) * z / camera.fx, (i / width - camera.cy) * z / camera.fy, z);
-  };
   const uint8_t* candidate = candidates.ptr<uint8_t>();
+  const double up_to_m = std::max(parameters.field_range_m, parameters.near_arm_m);
   double min_distance = std::numeric_limits<double>::infinity();
-  double area = 0;
+  double near_area = 0;
   for (int i = 0; i < num_pixels; ++i) {
     if (candidate[i] == 0) continue;
-    double distance_m;
-    if (pixel_class[i] == discrepancy_t::PIXEL_OCCLUDED) {
-      distance_m = metres_from_mm(gen[i] - tof[i]);
-    } else {
-      const int k = nearest_label[i];
-      const int arm = k < static_cast<int>(pixel_of_label.size()) ? pixel_of_label[k] : -1;
-      if (arm < 0) continue;
-      distance_m = cv::norm(point_m(i, tof[i]) - point_m(arm, gen[arm]));
+    double distance_m = 0;
+    if (s->field_available && pixel_class[i] != discrepancy_t::PIXEL_OCCLUDED) {
+      // The camera-frame point (optical frame, m) of pixel i at its depth.
+      const double z = metres_from_mm(tof[i]);
+      const Eigen::Vector3d point((i % width - camera.cx) * z / camera.fx,
+                                  (i / width - camera.cy) * z / camera.fy, z);
+      distance_m = arm.distance_m(point, up_to_m);
     }
+    const double area = footprint.m2(i);
     if (distance_m <= parameters.near_arm_m) {
       s->near_arm_pixels++;
-      area += footprint.m2(i);
+      near_area += area;
       min_distance = std::min(min_distance, distance_m);
     }
+    // Bin k holds (k*bin, (k+1)*bin]; distance 0 goes to bin 0.
+    const int bin = std::max(0, static_cast<int>(std::ceil(distance_m / parameters.field_bin_m)) - 1);
+    if (bin < num_bins) area_in_bin[bin] += area;
   }
-  s->near_arm_area_m2 = static_cast<float>(area);
+  s->near_arm_area_m2 = static_cast<float>(near_area);
   if (s->near_arm_pixels > 0) s->near_arm_min_distance_m = static_cast<float>(min_distance);
+  s->unexplained_area_within_m2.resize(num_bins);
+  double cumulative = 0;
+  for (int k = 0; k < num_bins; ++k) {
+    cumulative += area_in_bin[k];
+    s->unexplained_area_within_m2[k] = static_cast<float>(cumulative);
+  }
+}
+
+// The arm's reach about each joint (arm_distance.hpp), num_joints entries
+// (num_joints is 0 without kinematics; all 0 without a cover).
+void joint_reach(const link_labels_t& labels, discrepancy_t* s) {
+  s->joint_reach_m.assign(s->num_joints, 0.0);
+  if (!s->field_available) return;
+  const std::vector<double> reach = joint_reach_m(labels);
+  if (reach.size() == static_cast<size_t>(s->num_joints)) s->joint_reach_m = reach;
 }
 
 }  // namespace
@@ -414,6 +420,8 @@ Parameters parameters_from(const DiscrepancySettings& config) {
   p.opening_radius_px = config.opening_radius_px;
   p.silhouette_jump_mm = config.silhouette_jump_mm;
   p.near_arm_m = config.near_arm_m;
+  p.field_range_m = config.field_range_m;
+  p.field_bin_m = config.field_bin_m;
   p.max_depth_mm = config.max_depth_mm;
   p.evidence.model_sigma_mm = config.evidence_model_sigma_mm;
   p.evidence.clip_sigmas = config.evidence_clip_sigmas;
@@ -513,10 +521,11 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
   const DisHistograms histograms = per_link_statistics(frame, camera, rendered, labels, silhouette, &s);
   const PixelFootprint footprint(camera, rendered);
   largest_blob(classes.mismatch_mask, parameters.opening_radius_px, footprint, &s);
-  near_arm_surfaces(camera, rendered, frame, classes, parameters, footprint, &s);
+  unexplained_surfaces(camera, labels, frame, classes, parameters, footprint, &s);
   // Stage 7, evidence (evidence.hpp).
   compute_evidence(camera, rendered, labels, silhouette, parameters.silhouette_jump_mm,
                    parameters.tolerance.noise, parameters.evidence, &s);
+  joint_reach(labels, &s);
   return frame;
 }
 

@@ -19,6 +19,14 @@ DiscrepancySettings read_discrepancy_settings(YamlMap map) {
   d.opening_radius_px = static_cast<int>(map.integer("opening_radius_px", 0, 10));
   d.silhouette_jump_mm = map.number("silhouette_jump_mm", 1, 10000);
   d.near_arm_m = map.number("near_arm_m", 0, 10);
+  {
+    YamlMap field = map.map("field");
+    d.field_range_m = field.number("range_m", 0.01, 20);
+    d.field_bin_m = field.number("bin_m", 0.001, 1);
+    if (d.field_bin_m > d.field_range_m) field.fail("bin_m", "a bin no wider than range_m");
+    if (d.field_range_m / d.field_bin_m > 10000) field.fail("bin_m", "at most 10000 bins up to range_m");
+    field.finish();
+  }
   d.max_depth_mm = map.number("max_depth_mm", 1, 32767);
   {
     YamlMap colour = map.map("colour_image");

@@ -137,13 +137,57 @@ void set_rendered_kinematics(const RenderedKinematics& k, link_labels_t* labels)
   }
 }
 
+RenderedArmCover rendered_arm_cover(const robot_model::ArmSpheres& cover,
+                                    const robot_model::LinkPoses& link_poses,
+                                    const Eigen::Isometry3d& world_from_optical) {
+  const robot_model::PlacedArmSpheres placed = robot_model::place_arm_spheres(cover, link_poses);
+  const Eigen::Isometry3d optical_from_world = world_from_optical.inverse();
+  RenderedArmCover out;
+  out.max_radius_m = cover.max_radius_m;
+  out.spheres.resize(placed.size());
+  for (size_t k = 0; k < placed.size(); ++k) {
+    out.spheres[k].link = cover.spheres[k].link_index;
+    out.spheres[k].center_m = optical_from_world * placed[k].center_world_m;
+    out.spheres[k].radius_m = placed[k].radius_m;
+  }
+  return out;
+}
+
+void set_rendered_arm_cover(const RenderedArmCover& cover, link_labels_t* labels) {
+  const auto n = static_cast<int32_t>(cover.spheres.size());
+  // Float centres are off by < 1e-6 m (at most tens of metres away): each
+  // radius grows by kFloatMarginM so that the sphere on the wire still
+  // holds its triangles, and the maximum by twice that (float rounding of
+  // the grown radius).
+  constexpr double kFloatMarginM = 1e-6;
+  labels->arm_cover_max_radius_m = cover.max_radius_m + 2 * kFloatMarginM;
+  labels->num_arm_spheres = n;
+  labels->arm_sphere_link.resize(n);
+  // [num_arm_spheres][3]: a vector of 3-vectors in LCM's C++.
+  labels->arm_sphere_center_m.assign(n, std::vector<float>(3, 0.0f));
+  labels->arm_sphere_radius_m.resize(n);
+  for (int32_t k = 0; k < n; ++k) {
+    const RenderedArmCover::Sphere& sphere = cover.spheres[k];
+    labels->arm_sphere_link[k] = static_cast<int16_t>(sphere.link);
+    for (int c = 0; c < 3; ++c) labels->arm_sphere_center_m[k][c] = static_cast<float>(sphere.center_m[c]);
+    labels->arm_sphere_radius_m[k] = static_cast<float>(sphere.radius_m + kFloatMarginM);
+  }
+}
+
 link_labels_t make_rendered_link_labels(const depth_image_t& frame, const RenderResult& result,
-                                        const robot_model::KinematicTree& tree) {
+                                        const robot_model::KinematicTree& tree,
+                                        const robot_model::ArmSpheres& cover) {
   if (!result.usable) {
     return make_unusable_link_labels(frame, tree.num_robot_links, tree.link_names(), result.unusable_reason);
   }
   link_labels_t labels = make_link_labels(frame, tree.num_robot_links, tree.link_names(), result.labels);
   if (const auto k = rendered_kinematics(tree, result)) set_rendered_kinematics(*k, &labels);
+  if (result.world_from_link.size() == tree.links.size()) {
+    robot_model::LinkPoses poses;
+    poses.usable = true;
+    poses.world_from_link = result.world_from_link;
+    set_rendered_arm_cover(rendered_arm_cover(cover, poses, result.world_from_optical), &labels);
+  }
   return labels;
 }
 

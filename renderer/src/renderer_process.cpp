@@ -47,6 +47,7 @@ RendererService::RendererService(const RendererProcessSettings& settings)
     : settings_(settings),
       scene_(robot_model::load_scene(settings.robot.urdf_path, settings.environment.urdf_paths,
                                      scene_options(settings.renderer, settings.robot))),
+      arm_cover_(robot_model::cover_arm_with_spheres(scene_, settings.renderer.arm_cover_cell_m)),
       renderer_(make_renderer(scene_, settings.renderer)),
       state_(state_history_settings(settings.renderer, settings.robot.id, settings.camera)) {}
 
@@ -172,21 +173,37 @@ RenderedFrame RendererService::render(const depth_image_t& frame) {
     if (missed) ++consecutive_misses_;
     result = renderer_->render(state.joints.joints, state.camera_pose.pose, intrinsics_of(frame));
   }
-  // The kinematics at the frame's own joints and camera pose: the poses a
-  // render of them used (no second forward kinematics), or for a prediction
-  // (rendered at the plan's joints, within the tolerances) the frame's.
+  // The kinematics and the arm's cover at the frame's own joints and
+  // camera pose: the poses a render of them used (no second forward
+  // kinematics), or for a prediction (rendered at the plan's joints, within
+  // the tolerances) the frame's.
   std::optional<RenderedKinematics> kinematics;
+  std::optional<RenderedArmCover> arm_cover;
   if (result.usable) {
-    if (predicted) kinematics = rendered_kinematics(scene_, state.joints.joints, state.camera_pose.pose);
-    if (!kinematics) kinematics = rendered_kinematics(scene_, result);
+    robot_model::LinkPoses poses;
+    std::optional<Eigen::Isometry3d> optical;
+    if (predicted) {
+      poses = robot_model::forward_kinematics(scene_, state.joints.joints);
+      optical = world_from_optical(scene_, poses, state.camera_pose.pose);
+    }
+    if (!optical && result.world_from_link.size() == scene_.links.size()) {
+      poses.usable = true;
+      poses.world_from_link = result.world_from_link;
+      optical = result.world_from_optical;
+    }
+    if (optical) {
+      kinematics = rendered_kinematics(scene_, poses, *optical);
+      arm_cover = rendered_arm_cover(arm_cover_, poses, *optical);
+    }
   }
-  RenderedFrame out = make_output(frame, std::move(result), kinematics);
+  RenderedFrame out = make_output(frame, std::move(result), kinematics, arm_cover);
   plan_prediction(frame);
   return out;
 }
 
 RenderedFrame RendererService::make_output(const depth_image_t& frame, RenderResult result,
-                                           const std::optional<RenderedKinematics>& kinematics) const {
+                                           const std::optional<RenderedKinematics>& kinematics,
+                                           const std::optional<RenderedArmCover>& arm_cover) const {
   RenderedFrame out;
   if (!result.usable) {
     out.labels =
@@ -195,6 +212,7 @@ RenderedFrame RendererService::make_output(const depth_image_t& frame, RenderRes
   }
   out.labels = make_link_labels(frame, scene_.num_robot_links, scene_.link_names(), std::move(result.labels));
   if (kinematics) set_rendered_kinematics(*kinematics, &out.labels);
+  if (arm_cover) set_rendered_arm_cover(*arm_cover, &out.labels);
   // The model's depth is exact: calibrated (no distance calibration to
   // apply), no amplitude.
   out.depth = make_depth_image(frame.camera_id, intrinsics_of(frame), frame.utime, frame.seq,

@@ -11,6 +11,7 @@ RendererSettings read_renderer_settings(YamlMap renderer) {
   if (r.far_m <= r.near_m) {
     renderer.fail("far_m", "a distance greater than near_m", std::to_string(r.far_m));
   }
+  r.arm_cover_cell_m = renderer.number("arm_cover_cell_m", 0.005, 0.5);
   r.max_extrapolation_us = renderer.milliseconds_as_us("max_extrapolation_ms", 0, 1000);
   {
     YamlMap poses = renderer.map("camera_pose");

@@ -259,16 +259,56 @@ FrameFinding joint_error_beside_unexplained_surfaces(const FrameEvidence& e) {
                      "unexplained; the links above " + joint + " match");
 }
 
-// UNKNOWN_OBJECT: nearer surfaces the model does not explain close to the
-// arm (area in m^2).
+// UNKNOWN_OBJECT: an unexplained nearer surface of at least
+// unknown_object_min_area_m2 inside the protective separation S (DANGEROUS
+// after the debounce), or inside the warning field (WARNING only). Beyond:
+// nothing, whatever its size (protective_field.hpp).
 FrameFinding unknown_object(const FrameEvidence& e) {
   const discrepancy_t& f = e.frame;
   const double min_area_m2 = e.config.unknown_object_min_area_m2;
-  if (!(f.near_arm_area_m2 >= min_area_m2)) return {};
-  return finding(risk_t::CAUSE_UNKNOWN_OBJECT, "", f.near_arm_area_m2, min_area_m2,
-                 "unknown object near the arm (area m^2): " + fixed(f.near_arm_area_m2 * 1e4, 1) + " cm^2 (" +
-                     std::to_string(f.near_arm_pixels) + " px) within reach, nearest " +
-                     fixed(f.near_arm_min_distance_m * 100, 1) + " cm from the arm");
+  const FieldSize& field = e.context.field;
+  const std::optional<double> distance_m = object_distance_m(f, min_area_m2);
+  if (!std::isfinite(field.protective_m)) {
+    // The arm's speed cannot be bounded: every object measured is inside S.
+    if (!distance_m) return {};
+    return finding(risk_t::CAUSE_UNKNOWN_OBJECT, "", *distance_m, field_range_m(f),
+                   "unknown object " + fixed(*distance_m * 100, 0) +
+                       " cm from the arm (distance m), inside the protective field: the arm's speed cannot "
+                       "be bounded (" +
+                       e.context.field_unbounded_reason + ")");
+  }
+  // An object beyond the range is not measured: a protective field reaching
+  // beyond it is not monitored.
+  if (field.protective_m > field_range_m(f)) {
+    return finding(
+        risk_t::CAUSE_UNCLASSIFIED, "discrepancy.field.range_m", field.protective_m, field_range_m(f),
+        "protective field not monitored (separation m): S = " + fixed(field.protective_m, 2) +
+            " m at arm speed " + fixed(field.arm_speed_m_s, 2) +
+            " m/s reaches beyond discrepancy.field.range_m = " + fixed(field_range_m(f), 2) + " m");
+  }
+  if (!distance_m) return {};
+  const std::string sizes = "S = " + fixed(field.protective_m, 2) + " m at arm speed " +
+                            fixed(field.arm_speed_m_s, 2) + " m/s, warning field to " +
+                            fixed(field.warning_m, 2) + " m";
+  const std::string what =
+      fixed(
+          f.unexplained_area_within_m2[static_cast<int>(std::lround(*distance_m / f.field_bin_m)) - 1] * 1e4,
+          0) +
+      " cm^2 within " + fixed(*distance_m * 100, 0) + " cm of the arm";
+  if (*distance_m <= field.protective_m) {
+    return finding(risk_t::CAUSE_UNKNOWN_OBJECT, "", *distance_m, field.protective_m,
+                   "unknown object " + fixed(*distance_m * 100, 0) +
+                       " cm from the arm, inside the protective field (distance m): " + what + "; " + sizes);
+  }
+  if (*distance_m <= field.warning_m) {
+    FrameFinding w =
+        finding(risk_t::CAUSE_UNKNOWN_OBJECT, "", *distance_m, field.protective_m,
+                "unknown object " + fixed(*distance_m * 100, 0) +
+                    " cm from the arm, in the warning field (distance m): " + what + "; " + sizes);
+    w.warning_only = true;
+    return w;
+  }
+  return {};
 }
 
 // UNCLASSIFIED: a large mismatch none of the rules above explains (area of

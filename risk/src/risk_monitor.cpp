@@ -24,7 +24,8 @@ RiskMonitor::RiskMonitor(const RiskSettings& settings, const ChannelNames& chann
       plan_(settings, robot_.prismatic_joint_names),
       gate_(settings, robot_.prismatic_joint_names),
       evidence_(settings, robot_, camera_rate_hz),
-      decision_(settings) {}
+      decision_(settings),
+      response_time_s_(chain_response_time_s(settings, camera_rate_hz)) {}
 
 std::string RiskMonitor::on_joint_state(const joint_state_t& state, int64_t now_us) {
   // After the stream went stale it may start afresh (a driver restarted,
@@ -60,6 +61,8 @@ ClassifiedFrame RiskMonitor::classify(const discrepancy_t& frame) const {
     for (double v : at_capture->velocity) fastest = std::max(fastest, std::abs(v));
     context.arm_moving = fastest >= settings_.moving_joint_speed_rad_s;
   }
+  context.field = field_size(settings_, response_time_s_,
+                             arm_speed_bound_m_s(frame, at_capture, &context.field_unbounded_reason));
   ClassifiedFrame c;
   c.frame = frame;
   c.finding = classify_frame(frame, robot_, settings_, context);

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "tofguard/risk/protective_field.hpp"
+
 namespace tofguard::risk {
 
 RiskSettings read_risk_settings(YamlMap map) {
@@ -51,6 +53,28 @@ RiskSettings read_risk_settings(YamlMap map) {
   }
   r.unknown_object_min_area_m2 = map.number("unknown_object_min_area_m2", 1e-6, 100);
   r.unclassified_blob_area_m2 = map.number("unclassified_blob_area_m2", 1e-6, 100);
+  {
+    YamlMap field = map.map("field");
+    r.field_approach_speed_m_s = field.number("approach_speed_m_s", 0.1, 10);
+    r.field_chain_latency_us = field.milliseconds_as_us("chain_latency_ms", 0, 10000);
+    r.field_stopping_time_us = field.milliseconds_as_us("stopping_time_ms", 0, 100000);
+    r.field_stopping_distance_m = field.number("stopping_distance_m", 0, 10);
+    r.field_intrusion_distance_m = field.number("intrusion_distance_m", 0, 10);
+    r.field_warning_margin_m = field.number("warning_margin_m", 0, 10);
+    // ISO 13855: an object smaller than the detection capability d can
+    // reach through by C = 8 (d - 14 mm) before it is seen (0.85 m beyond
+    // d = 40 mm); a smaller C would leave that reach unguarded.
+    const double detection_capability_m = std::sqrt(r.unknown_object_min_area_m2);
+    const double needed_m = iso13855_intrusion_distance_m(detection_capability_m);
+    if (r.field_intrusion_distance_m < needed_m - 1e-9) {
+      field.fail("intrusion_distance_m",
+                 "at least ISO 13855's C = " + std::to_string(needed_m) +
+                     " m for the detection capability sqrt(unknown_object_min_area_m2) = " +
+                     std::to_string(detection_capability_m * 1000) + " mm",
+                 std::to_string(r.field_intrusion_distance_m));
+    }
+    field.finish();
+  }
   {
     YamlMap estimate = map.map("estimate");
     r.estimate_enabled = estimate.boolean("enabled");

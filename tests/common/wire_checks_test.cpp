@@ -94,6 +94,7 @@ discrepancy_t discrepancy_with_evidence() {
   d.search_points = 10;
   d.joint_search_offset = {0.05, -0.002};
   d.joint_search_gain = {40, 0};
+  d.joint_reach_m = {0.8, 0.5};
   return d;
 }
 

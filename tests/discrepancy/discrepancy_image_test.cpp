@@ -16,8 +16,10 @@ Parameters sim_parameters() { return Parameters{}; }
 
 DiscrepancyFrame compare(const SyntheticImage& model, const std::vector<int16_t>& camera_depth,
                          const Parameters& parameters = sim_parameters()) {
-  return compute_discrepancy(depth_frame(camera_depth, 7), depth_frame(model.depth_mm, 7),
-                             labels_frame(model.label, 7), parameters);
+  link_labels_t labels = labels_frame(model.label, 7);
+  add_pixel_cover(&labels, model.depth_mm);
+  return compute_discrepancy(depth_frame(camera_depth, 7), depth_frame(model.depth_mm, 7), labels,
+                             parameters);
 }
 
 constexpr int kPixels = kWidth * kHeight;
@@ -89,13 +91,15 @@ TEST(Discrepancy, ShiftedLinkIsMissingWhereModelledAndUnexpectedBesideIt) {
   EXPECT_DOUBLE_EQ(s.sum_abs_dis_mm, 400 * 500.0);
   EXPECT_DOUBLE_EQ(s.normalized_sum_abs_dis, 400 * 500.0 / (kPixels * 8000.0));
   EXPECT_NEAR(s.mismatch_fraction, 400.0 / kPixels, 1e-6);
-  // Two separate 10x20 blobs.
+  // Blobs are of farther mismatches only: the 10x20 where link2 is missing.
   EXPECT_EQ(s.largest_blob_pixels, 200);
   // The unexpected surface lies beside the arm: all of it near the arm; the
-  // closest pixel is one column (1.5 m / 200 px = 7.5 mm) from it.
+  // closest pixel's centre is one column (1.5 m / 200 px = 7.5 mm) from the
+  // nearest sphere's centre, whose radius is half a pixel's diagonal.
+  EXPECT_TRUE(s.field_available);
   EXPECT_EQ(s.near_arm_pixels, 200);
   EXPECT_NEAR(s.near_arm_area_m2, 200 * (1.5 / 200) * (1.5 / 200), 1e-7);
-  EXPECT_NEAR(s.near_arm_min_distance_m, 0.0075, 1e-6);
+  EXPECT_NEAR(s.near_arm_min_distance_m, 0.0075 * (1 - std::sqrt(0.5)), 1e-5);
   EXPECT_EQ(f.pixel_class(70, 65), discrepancy_t::PIXEL_ROBOT_MISSING);
   EXPECT_EQ(f.pixel_class(70, 105), discrepancy_t::PIXEL_UNEXPECTED_SURFACE);
   EXPECT_EQ(f.dis_mm(70, 65), -500);
@@ -112,10 +116,20 @@ TEST(Discrepancy, ObjectInFrontOfTheArmIsOccludedAndNearTheArm) {
   EXPECT_EQ(s.num_unexpected_surface, 200);
   EXPECT_EQ(s.num_robot_missing, 0);
   EXPECT_EQ(s.link_nearer[0], 200);
-  EXPECT_EQ(s.largest_blob_pixels, 400);
-  EXPECT_NEAR(s.largest_blob_area_m2, 400 * (1.4 / 200) * (1.4 / 200), 2e-5);
+  // Nearer surfaces make no blob: they are judged by their distance.
+  EXPECT_EQ(s.largest_blob_pixels, 0);
+  // The half that hides base_link is at the arm (what cannot be seen is
+  // occupied); the other half is 0.1 m in front of the arm's plane and at
+  // most 10 px (7 cm) beside it.
   EXPECT_EQ(s.near_arm_pixels, 400);
-  EXPECT_NEAR(s.near_arm_min_distance_m, 0.1, 0.02);
+  EXPECT_FLOAT_EQ(s.near_arm_min_distance_m, 0);
+  const double pixel_m2 = (1.4 / 200) * (1.4 / 200);
+  ASSERT_EQ(s.num_field_bins, 150);  // Parameters' default: 1.5 m in 1 cm bins
+  EXPECT_NEAR(s.unexplained_area_within_m2[0], 200 * pixel_m2, 1e-6);
+  // The other half: 9.5-10.6 cm from the arm's cover (noise: sigma 6.4 mm
+  // at 1.4 m), none within 6 cm, all within 13 cm.
+  EXPECT_NEAR(s.unexplained_area_within_m2[5], 200 * pixel_m2, 1e-5);
+  EXPECT_NEAR(s.unexplained_area_within_m2[12], 400 * pixel_m2, 1e-5);
 }
 
 TEST(Discrepancy, ObjectFarFromTheArmIsNotNearTheArm) {
@@ -124,25 +138,42 @@ TEST(Discrepancy, ObjectFarFromTheArmIsNotNearTheArm) {
   scene.push_back({140, 10, 160, 30, 1900, 0});  // 0.5 m from the arm
   const discrepancy_t s = compare(model, draw(scene).depth_mm).summary;
   EXPECT_EQ(s.num_unexpected_surface, 400);
-  EXPECT_EQ(s.largest_blob_pixels, 400);
-  EXPECT_NEAR(s.largest_blob_area_m2, 400 * (1.9 / 200) * (1.9 / 200), 1e-6);
+  EXPECT_EQ(s.largest_blob_pixels, 0);
   EXPECT_EQ(s.near_arm_pixels, 0);
   EXPECT_FLOAT_EQ(s.near_arm_min_distance_m, -1);
+  // In 3-D: its nearest corner (u 140, v 29 at 1.9 m) is 0.65 m from
+  // link2's corner (u 99, v 60 at 1.5 m), its farthest (u 159, v 10) 0.87 m.
+  const double pixel_m2 = (1.9 / 200) * (1.9 / 200);
+  EXPECT_FLOAT_EQ(s.unexplained_area_within_m2[62], 0);  // within 0.63 m
+  EXPECT_GT(s.unexplained_area_within_m2[65], 0);        // within 0.66 m
+  EXPECT_LT(s.unexplained_area_within_m2[85], 400 * pixel_m2 - 1e-6);
+  EXPECT_NEAR(s.unexplained_area_within_m2[87], 400 * pixel_m2, 1e-6);  // within 0.88 m
+  EXPECT_NEAR(s.unexplained_area_within_m2[149], 400 * pixel_m2, 1e-6);
 }
 
 TEST(Discrepancy, ThinSilhouetteSliversAreNotBlobs) {
   const SyntheticImage model = draw(default_arm());
-  // The camera's link2 one pixel wider: a one-pixel column of mismatch.
+  // The camera's link2 one pixel wider: a one-pixel column of nearer
+  // surface beside the model.
   std::vector<Box> scene = default_arm();
   scene.push_back({100, 60, 101, 80, kArmMm, 3});
   const discrepancy_t s = compare(model, draw(scene).depth_mm).summary;
   EXPECT_EQ(s.num_unexpected_surface, 20);
-  EXPECT_EQ(s.largest_blob_pixels, 0);
   EXPECT_EQ(s.near_arm_pixels, 0);
-  // Without the opening the sliver counts.
+  EXPECT_FLOAT_EQ(s.unexplained_area_within_m2.back(), 0);
+  // The model's link2 one pixel wider than the camera's: a one-pixel column
+  // where the camera sees farther.
+  std::vector<Box> wider = default_arm();
+  wider.push_back({100, 60, 101, 80, kArmMm, 3});
+  const SyntheticImage wide_model = draw(wider);
+  const discrepancy_t narrower = compare(wide_model, model.depth_mm).summary;
+  EXPECT_EQ(narrower.num_robot_missing, 20);
+  EXPECT_EQ(narrower.largest_blob_pixels, 0);
+  // Without the opening the slivers count.
   Parameters raw = sim_parameters();
   raw.opening_radius_px = 0;
-  EXPECT_EQ(compare(model, draw(scene).depth_mm, raw).summary.largest_blob_pixels, 20);
+  EXPECT_EQ(compare(wide_model, model.depth_mm, raw).summary.largest_blob_pixels, 20);
+  EXPECT_EQ(compare(model, draw(scene).depth_mm, raw).summary.near_arm_pixels, 20);
 }
 
 TEST(Discrepancy, ConstantOffsetScoresAsTheSeedDefines) {
@@ -157,7 +188,14 @@ TEST(Discrepancy, ConstantOffsetScoresAsTheSeedDefines) {
   EXPECT_FLOAT_EQ(s.environment_median_dis_mm, 100);
   EXPECT_EQ(s.num_occluded, 2400);
   EXPECT_EQ(s.num_unexpected_surface, kPixels - 2400);
-  EXPECT_EQ(s.largest_blob_pixels, kPixels);
+  // Everything seen nearer: no blob of farther mismatches; every pixel is
+  // an unexplained nearer surface, the arm's own (2400 px) at the arm.
+  EXPECT_EQ(s.largest_blob_pixels, 0);
+  EXPECT_EQ(s.near_arm_min_distance_m, 0);
+  // 100 mm nearer everywhere, the same the other way round: a blob of them all.
+  std::vector<int16_t> farther = model.depth_mm;
+  for (int16_t& d : farther) d = static_cast<int16_t>(d + 100);
+  EXPECT_EQ(compare(model, farther).summary.largest_blob_pixels, kPixels);
 }
 
 TEST(Discrepancy, InvalidPixelsAreCountedAndNotCompared) {

@@ -44,7 +44,7 @@ Frame render_frame(renderer::DepthRenderer* r, const robot_model::KinematicTree&
   f.result = r->render_at(poses, world_from_optical, in);
   EXPECT_TRUE(f.result.usable) << f.result.unusable_reason;
   f.depth = make_depth_image("cam", in, 1, 1, true, f.result.depth_m);
-  f.labels = renderer::make_rendered_link_labels(f.depth, f.result, tree);
+  f.labels = renderer::make_rendered_link_labels(f.depth, f.result, tree, robot_model::ArmSpheres{});
   return f;
 }
 

@@ -48,15 +48,30 @@ const robot_model::KinematicTree& friend_arm() {
 discrepancy_t summary_of(const std::vector<Box>& camera_scene, int64_t seq = 7, uint32_t noise_seed = 1) {
   const SyntheticImage model = draw(default_arm());
   const SyntheticImage seen = draw(camera_scene);
+  link_labels_t labels = labels_frame(model.label, seq);
+  add_pixel_cover(&labels, model.depth_mm);
   return discrepancy::compute_discrepancy(depth_frame(with_noise(seen.depth_mm, noise_seed), seq),
-                                          depth_frame(model.depth_mm, seq), labels_frame(model.label, seq),
+                                          depth_frame(model.depth_mm, seq), labels,
                                           discrepancy::parameters_from(sim_config().discrepancy))
       .summary;
 }
 
-FrameFinding classify(const discrepancy_t& d, bool arm_moving = false) {
+// The synthetic scene is small (176 x 144 px at 2 m): the frame rules are
+// tested with fields of 0.3 m (protective) and 0.5 m (warning); sim.yaml's
+// own sizes are tested in ProtectiveField below.
+risk::FieldSize test_field() {
+  risk::FieldSize field;
+  field.arm_speed_m_s = 0;
+  field.protective_m = 0.3;
+  field.warning_m = 0.5;
+  return field;
+}
+
+FrameFinding classify(const discrepancy_t& d, bool arm_moving = false,
+                      const risk::FieldSize& field = test_field()) {
   ClassifierContext context;
   context.arm_moving = arm_moving;
+  context.field = field;
   return classify_frame(d, friend_arm(), sim_config().risk, context);
 }
 
@@ -73,11 +88,12 @@ TEST(FrameClassifier, RulesAreEvaluatedInTheDocumentedOrder) {
   // An object near the arm that also makes a large blob is an unknown
   // object, not unclassified: the earlier rule wins.
   discrepancy_t d = summary_of(default_arm());
-  d.near_arm_area_m2 = 0.002f;
-  d.near_arm_pixels = 40;
   d.largest_blob_area_m2 = 0.5f;
+  place_unexplained_surface(&d, 0.1, 0.002);
   EXPECT_EQ(classify(d).cause, risk_t::CAUSE_UNKNOWN_OBJECT);
-  d.near_arm_area_m2 = 0.001f;  // below risk.unknown_object_min_area_m2 = 0.0015
+  d = summary_of(default_arm());
+  d.largest_blob_area_m2 = 0.5f;
+  place_unexplained_surface(&d, 0.1, 0.001);  // below risk.unknown_object_min_area_m2 = 0.0015
   EXPECT_EQ(classify(d).cause, risk_t::CAUSE_UNCLASSIFIED);
 }
 
@@ -194,27 +210,83 @@ TEST(FrameClassifier, ObjectInFrontOfTheArmIsAnUnknownObject) {
   std::vector<Box> scene = default_arm();
   scene.push_back({30, 110, 50, 130, 1400, 0});  // 0.1 m in front of base_link
   const discrepancy_t d = summary_of(scene);
-  const FrameFinding f = classify(d);
-  EXPECT_EQ(f.cause, risk_t::CAUSE_UNKNOWN_OBJECT) << f.detail;
-  EXPECT_NEAR(f.score, d.near_arm_area_m2, 1e-9);
   // 20 x 20 px at 1.4 m, less the two columns beside base_link's modelled
   // outline (u = 39, 40: silhouette pixels).
-  EXPECT_NEAR(f.score, (400 - 2 * 20) * (1.4 / 200) * (1.4 / 200), 1e-4);
-  EXPECT_DOUBLE_EQ(f.threshold, 0.0015);
+  EXPECT_NEAR(d.near_arm_area_m2, (400 - 2 * 20) * (1.4 / 200) * (1.4 / 200), 1e-4);
+  const FrameFinding f = classify(d);
+  EXPECT_EQ(f.cause, risk_t::CAUSE_UNKNOWN_OBJECT) << f.detail;
+  EXPECT_FALSE(f.warning_only);
+  // The half in front of base_link hides it: at the arm (the first 1 cm
+  // bin), inside S.
+  EXPECT_NEAR(f.score, 0.01, 1e-6);
+  EXPECT_DOUBLE_EQ(f.threshold, 0.3);
+  EXPECT_NE(f.detail.find("unknown object 1 cm from the arm, inside the protective field"), std::string::npos)
+      << f.detail;
 }
 
 TEST(FrameClassifier, SmallObjectFarFromTheArmIsSafe) {
   std::vector<Box> scene = default_arm();
-  scene.push_back({140, 10, 150, 20, 1900, 0});  // 10x10 px, 0.5 m away
+  scene.push_back({140, 10, 150, 20, 1900, 0});  // 10x10 px, 0.65 m away
   EXPECT_EQ(classify(summary_of(scene)).cause, risk_t::CAUSE_NONE);
 }
 
-TEST(FrameClassifier, LargeUnexplainedMismatchFarFromTheArmIsUnclassified) {
+// Protective and warning fields: S 0.3 m, warning to 0.5 m (test_field).
+TEST(FrameClassifier, ALargeSurfaceBeyondTheProtectiveFieldWarnsAndBeyondTheWarningFieldIsSafe) {
   std::vector<Box> scene = default_arm();
-  scene.push_back({110, 0, 176, 50, 1900, 0});  // 66x50 px at 1.9 m: 0.30 m^2
-  const FrameFinding f = classify(summary_of(scene));
+  scene.push_back({110, 0, 176, 50, 1900, 0});  // 66x50 px at 1.9 m: 0.30 m^2, 0.45 m from the arm
+  const discrepancy_t d = summary_of(scene);
+  const FrameFinding f = classify(d);
+  EXPECT_EQ(f.cause, risk_t::CAUSE_UNKNOWN_OBJECT) << f.detail;
+  EXPECT_TRUE(f.warning_only);
+  EXPECT_NEAR(f.score, 0.45, 0.02);
+  EXPECT_NE(f.detail.find("in the warning field"), std::string::npos) << f.detail;
+  risk::FieldSize small = test_field();
+  small.warning_m = 0.4;
+  EXPECT_EQ(classify(d, false, small).cause, risk_t::CAUSE_NONE);
+  // Whatever its size: the same surface within S stops.
+  risk::FieldSize large = test_field();
+  large.protective_m = 0.5;
+  large.warning_m = 0.7;
+  const FrameFinding stop = classify(d, false, large);
+  EXPECT_EQ(stop.cause, risk_t::CAUSE_UNKNOWN_OBJECT);
+  EXPECT_FALSE(stop.warning_only);
+}
+
+TEST(FrameClassifier, ArmSpeedThatCannotBeBoundedPutsEveryObjectInsideTheField) {
+  std::vector<Box> scene = default_arm();
+  scene.push_back({140, 10, 150, 20, 1900, 0});  // 10x10 px, 0.65 m away
+  risk::FieldSize unbounded;                     // as a frame without a joint state or reach leaves it
+  const FrameFinding f = classify(summary_of(scene), false, unbounded);
+  EXPECT_EQ(f.cause, risk_t::CAUSE_UNKNOWN_OBJECT) << f.detail;
+  EXPECT_FALSE(f.warning_only);
+}
+
+TEST(FrameClassifier, ProtectiveFieldBeyondTheMeasuredRangeStops) {
+  risk::FieldSize beyond = test_field();
+  beyond.protective_m = 2.5;  // sim.yaml's discrepancy.field.range_m: 2 m
+  beyond.warning_m = 2.8;
+  const FrameFinding f = classify(summary_of(default_arm()), false, beyond);
   EXPECT_EQ(f.cause, risk_t::CAUSE_UNCLASSIFIED) << f.detail;
-  EXPECT_NEAR(f.score, 3300 * (1.9 / 200) * (1.9 / 200), 1e-3);
+  EXPECT_EQ(f.suspect, "discrepancy.field.range_m");
+}
+
+TEST(FrameClassifier, LargeFartherMismatchIsUnclassified) {
+  // The model has a 66x50 px environment surface at 1.9 m that the camera
+  // sees 0.1 m farther (the floor): a blob of farther mismatch, 0.30 m^2.
+  std::vector<Box> modelled = default_arm();
+  modelled.push_back({110, 0, 176, 50, 1900, link_labels_t::ENVIRONMENT_FIRST});
+  const SyntheticImage model = draw(modelled);
+  const SyntheticImage seen = draw(default_arm());
+  link_labels_t labels = labels_frame(model.label, 7);
+  add_pixel_cover(&labels, model.depth_mm);
+  const discrepancy_t d = discrepancy::compute_discrepancy(
+                              depth_frame(with_noise(seen.depth_mm, 1), 7), depth_frame(model.depth_mm, 7),
+                              labels, discrepancy::parameters_from(sim_config().discrepancy))
+                              .summary;
+  const FrameFinding f = classify(d);
+  EXPECT_EQ(f.cause, risk_t::CAUSE_UNCLASSIFIED) << f.detail;
+  // Less its outline (silhouette pixels), at the camera's depth (2 m).
+  EXPECT_NEAR(f.score, (66 - 1) * (50 - 1) * (2.0 / 200) * (2.0 / 200), 0.005);
 }
 
 TEST(FrameClassifier, ShiftOverArmAndEnvironmentIsACalibrationError) {

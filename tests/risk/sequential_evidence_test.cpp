@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "synthetic_frames.hpp"
 #include "test_support.hpp"
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/risk/evidence_tests.hpp"
@@ -426,8 +427,7 @@ TEST(RiskMonitorEvidence, TheDiagnosisClosesOnlyAfterClearFramesWithoutAnyFindin
   }
   // ... and any finding restarts the count: an unknown object for one frame.
   discrepancy_t object = source.frame(seq++);
-  object.near_arm_area_m2 = 0.01f;
-  object.near_arm_pixels = 200;
+  place_unexplained_surface(&object, 0.05, 0.01);
   r = judge(&m, object, &now);
   EXPECT_EQ(r.level, risk_t::DANGEROUS);
   EXPECT_EQ(r.cause, risk_t::CAUSE_CALIBRATION_ERROR);  // the diagnosis, not the new finding
@@ -476,7 +476,7 @@ TEST(RiskMonitorEvidence, FramesQueuedBehindAnEstimateWaitAreJudgedInOrder) {
   int64_t now = kStart;
   feed_all(&m, now);
   discrepancy_t object = source.frame(1);
-  object.near_arm_area_m2 = 0.01f;  // an unknown object: a model mismatch that waits
+  place_unexplained_surface(&object, 0.05, 0.01);  // an unknown object: a model mismatch that waits
   EXPECT_TRUE(m.on_frame(object, now).empty());
   now += 20 * kMs;
   feed_all(&m, now);

@@ -251,6 +251,8 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
   const robot_model::SceneModel model_scene =
       robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths, options);
   renderer::DepthRenderer model(model_scene, config.renderer.near_m, config.renderer.far_m);
+  const robot_model::ArmSpheres arm_cover =
+      robot_model::cover_arm_with_spheres(model_scene, config.renderer.arm_cover_cell_m);
   const robot_model::KinematicTree robot_tree = robot_model::load_kinematic_tree(config.robot.urdf_path);
   const discrepancy::Parameters parameters = discrepancy::parameters_from(config.discrepancy);
   const Intrinsics intrinsics = config.camera.intrinsics;
@@ -302,7 +304,8 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
       const depth_image_t rendered = make_depth_image(config.camera.id, intrinsics, state.utime, k,
                                                       /*calibrated=*/true, rendered_result.depth_m);
       // Labels and kinematics as tofguard-renderer publishes them.
-      const link_labels_t labels = renderer::make_rendered_link_labels(camera, rendered_result, model_scene);
+      const link_labels_t labels =
+          renderer::make_rendered_link_labels(camera, rendered_result, model_scene, arm_cover);
 
       if (k == run.onset_frame && run.fault.kind != CampaignFault::Kind::kNone) {
         result.changed_pixels =

@@ -3,6 +3,7 @@
 // floor (environment link "floor") 2 m from the camera and boxes that stand
 // for robot links, drawn with a z-buffer (nearer wins). Pixel footprint at
 // depth Z is (Z/fx)^2 with fx = fy = 200 px.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <random>
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "tofguard/depth_image_t.hpp"
+#include "tofguard/discrepancy_t.hpp"
 #include "tofguard/link_labels_t.hpp"
 
 namespace tofguard::test {
@@ -95,6 +97,62 @@ inline link_labels_t labels_frame(const std::vector<int16_t>& label, int64_t seq
   m.num_axes = 0;
   m.num_link_axes = 0;
   return m;
+}
+
+// Gives `labels` a cover of the model's robot surface (link_labels_t.arm_*):
+// one sphere per robot pixel of the model, at the pixel's ray
+// back-projected to its depth `model_depth_mm` (optical frame, fx = fy =
+// kFocalPx, principal point at the image centre), holding the pixel's
+// square patch of the box face (radius: half its diagonal).
+inline void add_pixel_cover(link_labels_t* labels, const std::vector<int16_t>& model_depth_mm) {
+  const int width = labels->width;
+  const double cx = width / 2.0;
+  const double cy = labels->height / 2.0;
+  labels->arm_sphere_link.clear();
+  labels->arm_sphere_center_m.clear();
+  labels->arm_sphere_radius_m.clear();
+  labels->arm_cover_max_radius_m = 0;
+  for (size_t i = 0; i < labels->label.size(); ++i) {
+    const int l = labels->label[i];
+    if (l < link_labels_t::ROBOT_FIRST || l >= link_labels_t::ROBOT_FIRST + labels->num_robot_links) continue;
+    const double z = model_depth_mm[i] * 1e-3;
+    // Pixel (u, v) is the ray through (u, v) (OpenCV's convention: integer
+    // coordinates are pixel centres).
+    const double u = static_cast<double>(i % width);
+    const double v = static_cast<double>(i / width);
+    const double radius = std::sqrt(2.0) / 2 * z / kFocalPx + 1e-6;
+    labels->arm_sphere_link.push_back(static_cast<int16_t>(l - link_labels_t::ROBOT_FIRST));
+    labels->arm_sphere_center_m.push_back({static_cast<float>((u - cx) * z / kFocalPx),
+                                           static_cast<float>((v - cy) * z / kFocalPx),
+                                           static_cast<float>(z)});
+    labels->arm_sphere_radius_m.push_back(static_cast<float>(radius));
+    labels->arm_cover_max_radius_m = std::max(labels->arm_cover_max_radius_m, radius + 1e-6);
+  }
+  labels->num_arm_spheres = static_cast<int32_t>(labels->arm_sphere_link.size());
+}
+
+// Adds an unexplained nearer surface of `area_m2` at `distance_m` from the
+// arm to d's cumulative areas by distance (discrepancy_t.field_*); a frame
+// without bins gets sim.yaml's (1 cm up to 2 m). Also counts it in
+// near_arm_* when within 0.2 m (sim.yaml's discrepancy.near_arm_m).
+inline void place_unexplained_surface(discrepancy_t* d, double distance_m, double area_m2) {
+  if (d->num_field_bins == 0) {
+    d->field_bin_m = 0.01f;
+    d->num_field_bins = 200;
+    d->unexplained_area_within_m2.assign(200, 0.0f);
+  }
+  for (int k = 0; k < d->num_field_bins; ++k) {
+    if ((k + 1) * static_cast<double>(d->field_bin_m) >= distance_m - 1e-9) {
+      d->unexplained_area_within_m2[k] += static_cast<float>(area_m2);
+    }
+  }
+  if (distance_m <= 0.2) {
+    d->near_arm_area_m2 += static_cast<float>(area_m2);
+    d->near_arm_pixels += 1;
+    d->near_arm_min_distance_m = d->near_arm_min_distance_m < 0
+                                     ? static_cast<float>(distance_m)
+                                     : std::min(d->near_arm_min_distance_m, static_cast<float>(distance_m));
+  }
 }
 
 inline link_labels_t unusable_labels(int64_t seq, const std::string& reason) {

@@ -42,8 +42,13 @@ struct Parameters {
   // silhouettes, where ToF pixels mix both surfaces: the pixels beside them
   // are left out of link counts and blobs, mm. 0 = no silhouettes.
   double silhouette_jump_mm = 0;
-  // Distance from the modelled arm within which nearer surfaces count, m.
+  // Distance from the modelled arm within which nearer surfaces count as
+  // near it (discrepancy_t.near_arm_*), m.
   double near_arm_m = 0.2;
+  // The protective fields' distances (discrepancy_t.field_*): counted up
+  // to field_range_m in bins of field_bin_m, m.
+  double field_range_m = 1.5;
+  double field_bin_m = 0.01;
   // Logical maximum of |I_dis| per pixel for the normalised seed score, mm.
   double max_depth_mm = 8000;
   // The evidence stage (evidence.hpp).

@@ -38,9 +38,15 @@ struct DiscrepancySettings {
   // and background (mixed pixels): the pixels on either side of one are
   // left out of the per-link counts and the blobs, millimetres.
   double silhouette_jump_mm = 0;
-  // near_arm_m: surfaces nearer than the model within this distance of the
-  // modelled arm count as near the arm, metres.
+  // near_arm_m: surfaces nearer than the model within this 3-D distance of
+  // the modelled arm count as near the arm (discrepancy_t.near_arm_*),
+  // metres.
   double near_arm_m = 0;
+  // field.{range_m, bin_m}: unexplained nearer surfaces are counted by
+  // their distance to the arm up to range_m, in bins of bin_m, for the
+  // protective and warning fields (discrepancy_t.field_*), metres.
+  double field_range_m = 0;
+  double field_bin_m = 0;
   // max_depth_mm: the seed score's logical maximum per pixel, millimetres.
   double max_depth_mm = 0;
   // colour_image.{enabled, channel, full_scale_mm}: the optional colour

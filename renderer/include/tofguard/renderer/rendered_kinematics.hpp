@@ -18,6 +18,7 @@
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/link_labels_t.hpp"
 #include "tofguard/renderer/depth_renderer.hpp"
+#include "tofguard/robot_model/arm_spheres.hpp"
 #include "tofguard/robot_model/kinematic_tree.hpp"
 #include "tofguard/robot_model/kinematics.hpp"
 
@@ -82,10 +83,33 @@ std::optional<RenderedKinematics> rendered_kinematics(const robot_model::Kinemat
 // labels->num_robot_links entries.
 void set_rendered_kinematics(const RenderedKinematics& kinematics, link_labels_t* labels);
 
-// The complete TOF_LABELS message of `frame` for a render (labels and
-// kinematics); unusable (no kinematics) when the result is. For in-process
-// chains (simulator + renderer + discrepancy without LCM).
+// The arm's cover of spheres (robot_model/arm_spheres.hpp) as rendered:
+// placed at `link_poses` (usable, of the cover's model) and seen from
+// `world_from_optical`, for link_labels_t's arm_* fields (the protective
+// fields, docs/safety-chain.md). Centres in the optical frame, metres.
+struct RenderedArmCover {
+  struct Sphere {
+    int link = -1;  // robot link index (link_labels_t.link_name order)
+    Eigen::Vector3d center_m = Eigen::Vector3d::Zero();
+    double radius_m = 0;
+  };
+  std::vector<Sphere> spheres;
+  double max_radius_m = 0;
+};
+RenderedArmCover rendered_arm_cover(const robot_model::ArmSpheres& cover,
+                                    const robot_model::LinkPoses& link_poses,
+                                    const Eigen::Isometry3d& world_from_optical);
+
+// Writes the cover into link_labels_t's arm_cover_max_radius_m ..
+// arm_sphere_radius_m (replacing what was there).
+void set_rendered_arm_cover(const RenderedArmCover& cover, link_labels_t* labels);
+
+// The complete TOF_LABELS message of `frame` for a render (labels,
+// kinematics and the arm's cover placed as rendered; an empty `cover`
+// gives none); unusable (no kinematics, no cover) when the result is. For
+// in-process chains (simulator + renderer + discrepancy without LCM).
 link_labels_t make_rendered_link_labels(const depth_image_t& frame, const RenderResult& result,
-                                        const robot_model::KinematicTree& tree);
+                                        const robot_model::KinematicTree& tree,
+                                        const robot_model::ArmSpheres& cover);
 
 }  // namespace tofguard::renderer

@@ -126,7 +126,8 @@ class RendererService {
     RenderResult result;  // usable when rendered and worth using
   };
   RenderedFrame make_output(const depth_image_t& frame, RenderResult result,
-                            const std::optional<RenderedKinematics>& kinematics) const;
+                            const std::optional<RenderedKinematics>& kinematics,
+                            const std::optional<RenderedArmCover>& arm_cover) const;
   void learn_period(const depth_image_t& frame);
   void plan_prediction(const depth_image_t& frame);
   // True when `prediction_` may stand for `frame` rendered at `joints` and `pose`.
@@ -135,6 +136,9 @@ class RendererService {
 
   RendererProcessSettings settings_;
   robot_model::SceneModel scene_;
+  // The robot's cover of spheres (renderer.arm_cover_cell_m), placed with
+  // every frame's labels.
+  robot_model::ArmSpheres arm_cover_;
   std::unique_ptr<DepthRenderer> renderer_;
   robot_state::StateHistory state_;
   std::optional<depth_image_t> pending_;

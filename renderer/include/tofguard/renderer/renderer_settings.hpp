@@ -21,6 +21,12 @@ struct RendererSettings {
   // near_m, far_m: clip distances along the optical axis, metres.
   double near_m = 0;
   double far_m = 0;
+  // arm_cover_cell_m: the cell of the arm's cover of spheres that goes out
+  // with every frame's labels for the 3-D protective fields
+  // (robot_model/arm_spheres.hpp): the cover's distances err towards the
+  // arm by at most twice its largest sphere (about the cell's diagonal),
+  // metres.
+  double arm_cover_cell_m = 0;
   // max_extrapolation_ms: a camera frame whose utime lies further than this
   // beyond the newest joint state is marked unusable instead of
   // extrapolated; microseconds.

@@ -11,6 +11,7 @@
 
 #include "tofguard/common/risk_names.hpp"
 #include "tofguard/discrepancy_t.hpp"
+#include "tofguard/risk/protective_field.hpp"
 #include "tofguard/risk/risk_settings.hpp"
 #include "tofguard/robot_model/kinematic_tree.hpp"
 
@@ -41,6 +42,11 @@ struct ClassifierContext {
   // taken at or before its utime) has a joint faster than
   // risk.sensor.moving_joint_speed_rad_s.
   bool arm_moving = false;
+  // The protective and warning fields at the frame (protective_field.hpp):
+  // S and S + margin for the arm's speed bound at its capture; +infinity
+  // when that speed cannot be bounded (why in field_unbounded_reason).
+  FieldSize field;
+  std::string field_unbounded_reason;
 };
 
 // A robot link seen well enough to judge (>= risk.joint_error.min_link_pixels

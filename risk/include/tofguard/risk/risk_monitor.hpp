@@ -128,6 +128,8 @@ class RiskMonitor {
   EstimateGate gate_;
   SequentialEvidence evidence_;
   DecisionRule decision_;
+  // T_r of the protective fields, s (chain_response_time_s).
+  double response_time_s_ = 0;
   int64_t last_frame_utime_ = 0;
   // The newest frame taken in order (seq, utime) and the seqs judged lately.
   bool any_frame_ = false;

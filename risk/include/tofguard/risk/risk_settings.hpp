@@ -57,8 +57,28 @@ struct RiskSettings {
   // calibration_error.environment_mismatch_fraction, robot_link_fraction.
   double calibration_environment_mismatch_fraction = 0;
   double calibration_robot_link_fraction = 0;
+  // unknown_object_min_area_m2: the smallest area of unexplained surface
+  // that counts as an object (square metres); its square root is the
+  // detection capability that sizes field.intrusion_distance_m.
   double unknown_object_min_area_m2 = 0;
+  // unclassified_blob_area_m2: the largest component of farther
+  // mismatches (robot or environment missing) above which an unexplained
+  // mismatch stops the arm (square metres).
   double unclassified_blob_area_m2 = 0;
+
+  // field.*: the protective and warning fields (protective_field.hpp,
+  // docs/safety-chain.md "Protective fields"): approach_speed_m_s K (m/s),
+  // chain_latency_ms (a frame's capture to the stop output, us), the
+  // robot's stopping_time_ms T_s (us) and stopping_distance_m S_s (m), the
+  // intrusion_distance_m C (m; at least ISO 13855's for the detection
+  // capability sqrt(unknown_object_min_area_m2)), and warning_margin_m
+  // (the warning field's depth beyond S, m).
+  double field_approach_speed_m_s = 0;
+  int64_t field_chain_latency_us = 0;
+  int64_t field_stopping_time_us = 0;
+  double field_stopping_distance_m = 0;
+  double field_intrusion_distance_m = 0;
+  double field_warning_margin_m = 0;
 
   // estimate.*: the motion estimate (MOTION_ESTIMATE, docs/safety-chain.md):
   // a frame with a model mismatch waits at most estimate_wait (monotonic,
