@@ -167,7 +167,8 @@ std::string check_arm_cover(const link_labels_t& l) {
       }
     }
     const double r = l.arm_sphere_radius_m[k];
-    if (!std::isfinite(r) || r < 0 || r > l.arm_cover_max_radius_m) {
+    // (float radii against a double maximum: one float rounding allowed)
+    if (!std::isfinite(r) || r < 0 || r > l.arm_cover_max_radius_m * (1 + 1e-6)) {
       return expected("arm_sphere_radius_m" + at,
                       "a radius 0..arm_cover_max_radius_m = " + std::to_string(l.arm_cover_max_radius_m), r);
     }

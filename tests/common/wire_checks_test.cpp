@@ -158,6 +158,25 @@ TEST(WireChecks, DiscrepancyEvidence) {
   EXPECT_EQ(field_of(d), "joint_search_gain[0]");
 }
 
+TEST(WireChecks, DiscrepancyProtectiveField) {
+  discrepancy_t d = discrepancy_with_evidence();
+  d.field_available = true;
+  d.field_bin_m = 0.01f;
+  d.num_field_bins = 3;
+  d.unexplained_area_within_m2 = {0, 0.001f, 0.001f};
+  EXPECT_EQ(check_discrepancy(d), "");
+  d.unexplained_area_within_m2 = {0, 0.001f, 0.0005f};  // cumulative areas never shrink
+  EXPECT_EQ(field_of(d), "unexplained_area_within_m2[2]");
+  d.unexplained_area_within_m2 = {0, 0.001f};
+  EXPECT_EQ(field_of(d), "unexplained_area_within_m2");
+  d.unexplained_area_within_m2 = {0, 0.001f, 0.001f};
+  d.field_bin_m = 0;
+  EXPECT_EQ(field_of(d), "field_bin_m");
+  d = discrepancy_with_evidence();
+  d.joint_reach_m[1] = -1;
+  EXPECT_EQ(field_of(d), "joint_reach_m[1]");
+}
+
 // Two robot links and a floor; axes a1 (revolute) then a2 (prismatic).
 link_labels_t labels_with_kinematics() {
   link_labels_t l{};
@@ -230,6 +249,28 @@ TEST(WireChecks, LinkLabelsKinematics) {
   l = labels_with_kinematics();
   l.joint_name.pop_back();
   EXPECT_EQ(field_of(l), "joint_name");
+}
+
+TEST(WireChecks, LinkLabelsArmCover) {
+  link_labels_t l = labels_with_kinematics();
+  l.arm_cover_max_radius_m = 0.02;
+  l.num_arm_spheres = 2;
+  l.arm_sphere_link = {0, 1};
+  l.arm_sphere_center_m = {{0, 0, 1}, {0.1, 0, 1}};
+  l.arm_sphere_radius_m = {0.02f, 0.01f};
+  EXPECT_EQ(check_link_labels(l), "");
+  link_labels_t bad = l;
+  bad.arm_sphere_link[1] = 2;  // the floor: not a robot link
+  EXPECT_EQ(field_of(bad), "arm_sphere_link[1]");
+  bad = l;
+  bad.arm_sphere_radius_m[0] = 0.03f;  // beyond arm_cover_max_radius_m
+  EXPECT_EQ(field_of(bad), "arm_sphere_radius_m[0]");
+  bad = l;
+  bad.arm_sphere_center_m[1][2] = std::nanf("");
+  EXPECT_EQ(field_of(bad), "arm_sphere_center_m[1]");
+  bad = l;
+  bad.arm_sphere_radius_m.pop_back();
+  EXPECT_EQ(field_of(bad), "arm_sphere_radius_m");
 }
 
 TEST(WireChecks, Heartbeat) {

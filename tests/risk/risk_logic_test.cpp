@@ -9,6 +9,7 @@
 #include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/discrepancy/discrepancy_image.hpp"
 #include "tofguard/risk/frame_classifier.hpp"
+#include "tofguard/risk/protective_field.hpp"
 #include "tofguard/risk/risk_monitor.hpp"
 #include "tofguard/robot_model/kinematic_tree.hpp"
 
@@ -77,6 +78,74 @@ FrameFinding classify(const discrepancy_t& d, bool arm_moving = false,
 
 // The frame rules are one ordered table (docs/safety-chain.md, "Frame
 // rules"): the first that applies is the finding.
+// sim.yaml's fields (docs/safety-chain.md, "Protective fields"): T_r =
+// (1 + 3) / 30 Hz + 60 ms, S at rest = 1.6 (T_r + 0.15) + 0.03 + 0.2.
+TEST(ProtectiveField, SizedFromTheConfigAndTheArmsSpeed) {
+  const risk::RiskSettings& settings = sim_config().risk;
+  const double response_s = risk::chain_response_time_s(settings, 30.0);
+  EXPECT_NEAR(response_s, 4.0 / 30 + 0.06, 1e-12);
+  const risk::FieldSize at_rest = risk::field_size(settings, response_s, 0);
+  EXPECT_NEAR(at_rest.protective_m, 1.6 * (response_s + 0.15) + 0.03 + 0.2, 1e-12);
+  EXPECT_NEAR(at_rest.protective_m, 0.779, 1e-3);
+  EXPECT_NEAR(at_rest.warning_m, at_rest.protective_m + 0.3, 1e-12);
+  // Each m/s of arm speed adds T_r.
+  EXPECT_NEAR(risk::field_size(settings, response_s, 1.0).protective_m - at_rest.protective_m, response_s,
+              1e-12);
+  // At 25 Hz the response is longer, and so is S.
+  EXPECT_GT(risk::field_size(settings, risk::chain_response_time_s(settings, 25.0), 0).protective_m,
+            at_rest.protective_m);
+}
+
+TEST(ProtectiveField, ArmSpeedBoundFromTheJointsReachAndTheirSpeeds) {
+  discrepancy_t d{};
+  d.field_available = true;
+  d.num_joints = 2;
+  d.joint_name = {"a1", "a2"};
+  d.joint_reach_m = {0.8, 0.5};
+  joint_state_t state{};
+  state.name = {"a2", "a1"};
+  state.position = {0, 0};
+  state.velocity = {-0.4, 0.5};
+  std::string why;
+  EXPECT_NEAR(risk::arm_speed_bound_m_s(d, &state, &why), 0.5 * 0.8 + 0.4 * 0.5, 1e-12);
+  // Anything that keeps the speed from being bounded: +infinity, and why.
+  EXPECT_TRUE(std::isinf(risk::arm_speed_bound_m_s(d, nullptr, &why)));
+  EXPECT_NE(why.find("no joint state"), std::string::npos) << why;
+  joint_state_t without_speeds = state;
+  without_speeds.velocity.clear();
+  EXPECT_TRUE(std::isinf(risk::arm_speed_bound_m_s(d, &without_speeds, &why)));
+  EXPECT_NE(why.find("joint 'a1' has no speed"), std::string::npos) << why;
+  discrepancy_t no_cover = d;
+  no_cover.field_available = false;
+  EXPECT_TRUE(std::isinf(risk::arm_speed_bound_m_s(no_cover, &state, &why)));
+  discrepancy_t no_kinematics = d;
+  no_kinematics.num_joints = 0;
+  no_kinematics.joint_name.clear();
+  no_kinematics.joint_reach_m.clear();
+  EXPECT_TRUE(std::isinf(risk::arm_speed_bound_m_s(no_kinematics, &state, &why)));
+  // A field never sized protects everything.
+  const risk::FieldSize unsized;
+  EXPECT_TRUE(std::isinf(unsized.protective_m));
+}
+
+TEST(ProtectiveField, Iso13855IntrusionDistance) {
+  EXPECT_DOUBLE_EQ(risk::iso13855_intrusion_distance_m(0.014), 0);
+  EXPECT_NEAR(risk::iso13855_intrusion_distance_m(0.030), 0.128, 1e-12);
+  EXPECT_NEAR(risk::iso13855_intrusion_distance_m(std::sqrt(0.0015)), 0.1978, 1e-4);  // sim.yaml's d
+  EXPECT_DOUBLE_EQ(risk::iso13855_intrusion_distance_m(0.041), 0.85);
+}
+
+TEST(ProtectiveField, ObjectDistanceIsWhereTheAreaReachesTheMinimum) {
+  discrepancy_t d = summary_of(default_arm());
+  EXPECT_FALSE(risk::object_distance_m(d, 0.0015).has_value());
+  place_unexplained_surface(&d, 0.30, 0.001);
+  EXPECT_FALSE(risk::object_distance_m(d, 0.0015).has_value()) << "too small alone";
+  place_unexplained_surface(&d, 0.42, 0.001);
+  ASSERT_TRUE(risk::object_distance_m(d, 0.0015).has_value());
+  EXPECT_NEAR(*risk::object_distance_m(d, 0.0015), 0.42, 1e-6);
+  EXPECT_NEAR(risk::field_range_m(d), 2.0, 1e-6);
+}
+
 TEST(FrameClassifier, RulesAreEvaluatedInTheDocumentedOrder) {
   std::vector<std::string> names;
   for (const risk::FrameRule& rule : risk::frame_rules()) names.push_back(rule.name);

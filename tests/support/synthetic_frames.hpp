@@ -142,7 +142,7 @@ inline void place_unexplained_surface(discrepancy_t* d, double distance_m, doubl
     d->unexplained_area_within_m2.assign(200, 0.0f);
   }
   for (int k = 0; k < d->num_field_bins; ++k) {
-    if ((k + 1) * static_cast<double>(d->field_bin_m) >= distance_m - 1e-9) {
+    if ((k + 1) * static_cast<double>(d->field_bin_m) >= distance_m - 1e-6) {
       d->unexplained_area_within_m2[k] += static_cast<float>(area_m2);
     }
   }
