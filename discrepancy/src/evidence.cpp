@@ -223,8 +223,16 @@ void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered
         s.joint_naming_information[j] += w * jj * jj;
       }
     } else {
-      ++s.camera_fit_pixels;
       s.static_chi2 += w * r * r;
+      // A static pixel beyond the gate is outside the camera's linear model
+      // as the naming fit's are outside the joints': a pose off by the
+      // test's delta (2 cm, 1 degree) moves smooth static surfaces by a few
+      // sigma, while an object in front of them (a person walking past
+      // the wall) differs by tens of centimetres. Its clipped residual
+      // would say only that something is there, and the protective fields
+      // judge that; in the camera fit it would pull the pose.
+      if (!in_naming_fit) continue;
+      ++s.camera_fit_pixels;
       // The upper triangle by hand: Eigen's rankUpdate on a 6x6
       // selfadjoint view costs more than the rest of the pixel.
       for (int a = 0; a < 6; ++a) {

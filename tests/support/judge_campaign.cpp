@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <stdexcept>
@@ -14,8 +15,10 @@
 #include "tofguard/common/risk_names.hpp"
 #include "tofguard/discrepancy/discrepancy_image.hpp"
 #include "tofguard/renderer/rendered_kinematics.hpp"
+#include "tofguard/risk/protective_field.hpp"
 #include "tofguard/risk/risk_monitor.hpp"
 #include "tofguard/risk_t.hpp"
+#include "tofguard/robot_model/arm_spheres.hpp"
 #include "tofguard/robot_model/kinematic_tree.hpp"
 #include "tofguard/robot_model/kinematics.hpp"
 
@@ -239,6 +242,151 @@ std::vector<CampaignRun> nominal_runs(double seconds, double run_s, uint64_t see
   return runs;
 }
 
+std::vector<CampaignRun> object_runs(const CampaignArm& arm, const std::vector<double>& distances_m,
+                                     double beyond_m) {
+  const risk::RiskSettings& r = arm.config.risk;
+  const risk::FieldSize at_rest =
+      risk::field_size(r, risk::chain_response_time_s(r, arm.config.camera.rate_hz), 0);
+  std::vector<CampaignRun> runs;
+  uint64_t seed = 5000;
+  int side = 1;
+  auto add = [&](CampaignFault fault, double start_s) {
+    CampaignRun run;
+    fault.kind = CampaignFault::Kind::kObject;
+    run.fault = std::move(fault);
+    run.onset_frame = 15;
+    run.frames_after_onset = 45;
+    run.start_s = start_s;
+    run.noise_seed = seed++;
+    runs.push_back(run);
+  };
+  for (double d : distances_m) {
+    for (double start_s : {0.0, 2.5}) {
+      CampaignFault f;
+      f.object_distance_m = d;
+      f.object_side = side;
+      side = -side;
+      f.object_in_field = d < at_rest.protective_m;
+      f.label = "object " + std::to_string(std::lround(d * 100)) + " cm";
+      add(f, start_s);
+    }
+  }
+  for (double start_s : {0.0, 1.7, 3.4}) {
+    CampaignFault hand;
+    hand.object_size_m = Eigen::Vector3d(0.1, 0.1, 0.2);
+    hand.object_distance_m = at_rest.warning_m + 0.2;
+    hand.object_side = side;
+    side = -side;
+    hand.object_speed_m_s = r.field_approach_speed_m_s;
+    hand.object_approaches = true;
+    hand.label = "hand approaching";
+    add(hand, start_s);
+  }
+  for (double start_s : {0.0, 2.0}) {
+    CampaignFault person;
+    person.object_size_m = Eigen::Vector3d(0.4, 0.3, 1.7);
+    person.object_distance_m = at_rest.warning_m + beyond_m;
+    person.object_side = side;
+    side = -side;
+    person.object_speed_m_s = 1.0;
+    person.object_in_field = false;
+    person.label = "person walking past";
+    add(person, start_s);
+    CampaignFault cart = person;
+    cart.object_size_m = Eigen::Vector3d(0.6, 0.4, 0.8);
+    cart.object_side = side;
+    side = -side;
+    cart.label = "cart passing";
+    add(cart, start_s + 1.0);
+  }
+  return runs;
+}
+
+namespace {
+
+// The distance from the axis-aligned box (centre, half edges; world) to
+// the nearest sphere of `placed`, m (0 when they touch).
+double box_to_arm_m(const Eigen::Vector3d& center, const Eigen::Vector3d& half,
+                    const robot_model::PlacedArmSpheres& placed) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const robot_model::PlacedSphere& s : placed) {
+    const Eigen::Vector3d outside = ((s.center_world_m - center).cwiseAbs() - half).cwiseMax(0.0);
+    best = std::min(best, outside.norm() - s.radius_m);
+  }
+  return std::max(0.0, best);
+}
+
+// An object counts as in view from this many pixels (15 cm^2, the
+// smallest object counted, is about 18 px at 2 m with fx = 221 px).
+constexpr int kObjectSeenPixels = 20;
+
+// Where a kObject fault's box starts and how it moves (world, m and m/s).
+struct ObjectPath {
+  Eigen::Vector3d start = Eigen::Vector3d::Zero();
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+};
+
+// The box placed `fault.object_distance_m` from the arm along `direction`
+// from `anchor` (bisection on the cover's distance).
+Eigen::Vector3d place_along(const CampaignFault& fault, const robot_model::PlacedArmSpheres& placed,
+                            const Eigen::Vector3d& anchor, const Eigen::Vector3d& direction) {
+  const Eigen::Vector3d half = fault.object_size_m / 2;
+  double lo = 0;
+  double hi = 5;
+  for (int i = 0; i < 60; ++i) {
+    const double mid = (lo + hi) / 2;
+    (box_to_arm_m(anchor + mid * direction, half, placed) < fault.object_distance_m ? lo : hi) = mid;
+  }
+  return anchor + hi * direction;
+}
+
+// Where the box starts: at its distance from the arm's point farthest
+// from its root (a hand reaches for the tool), in whichever of 16
+// directions (8 about the optical axis, level with the point or 45 degrees
+// away from the camera) the camera sees most of it, preferring
+// fault.object_side's half of the image on a tie; and how it moves.
+ObjectPath place_object(const CampaignFault& fault, const robot_model::PlacedArmSpheres& placed,
+                        const Eigen::Isometry3d& world_from_optical, renderer::DepthRenderer* view,
+                        const robot_model::LinkPoses& poses, const Intrinsics& intrinsics) {
+  Eigen::Vector3d anchor = Eigen::Vector3d::Zero();
+  for (const robot_model::PlacedSphere& s : placed) {
+    if (s.center_world_m.norm() > anchor.norm()) anchor = s.center_world_m;
+  }
+  const Eigen::Matrix3d r = world_from_optical.linear();
+  ObjectPath path;
+  int best_pixels = -1;
+  for (int away = 0; away < 2; ++away) {
+    for (int k = 0; k < 8; ++k) {
+      const double angle = fault.object_side * k * 3.141592653589793 / 4;
+      const Eigen::Vector3d in_image(std::cos(angle), std::sin(angle), away);
+      const Eigen::Vector3d direction = (r * in_image).normalized();
+      const Eigen::Vector3d start = place_along(fault, placed, anchor, direction);
+      renderer::ExtraObject box;
+      box.size_m = fault.object_size_m;
+      box.world_from_object.translation() = start;
+      const renderer::RenderResult seen = view->render_at(poses, world_from_optical, intrinsics, {box});
+      int pixels = 0;
+      for (int16_t label : seen.labels) pixels += label == kLabelExtraObjectFirst ? 1 : 0;
+      if (pixels > best_pixels) {
+        best_pixels = pixels;
+        path.start = start;
+      }
+    }
+  }
+  const Eigen::Vector3d to_arm = (anchor - path.start).normalized();
+  if (fault.object_approaches) {
+    path.velocity = fault.object_speed_m_s * to_arm;
+  } else {
+    // Horizontally across the line to the arm (world z up).
+    Eigen::Vector3d across = Eigen::Vector3d::UnitZ().cross(to_arm);
+    if (across.norm() < 1e-6) across = Eigen::Vector3d::UnitX();
+    path.velocity = fault.object_speed_m_s * across.normalized();
+  }
+  return path;
+}
+
+}  // namespace
+
 std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vector<CampaignRun>& runs) {
   const deployment::Config& config = arm.config;
   SimulatedFrames truth(config);
@@ -253,6 +401,9 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
   renderer::DepthRenderer model(model_scene, config.renderer.near_m, config.renderer.far_m);
   const robot_model::ArmSpheres arm_cover =
       robot_model::cover_arm_with_spheres(model_scene, config.renderer.arm_cover_cell_m);
+  // The objects' true distances: a finer cover (1 cm cells, within 3 cm
+  // of the surface) than the renderer's.
+  const robot_model::ArmSpheres truth_cover = robot_model::cover_arm_with_spheres(model_scene, 0.01);
   const robot_model::KinematicTree robot_tree = robot_model::load_kinematic_tree(config.robot.urdf_path);
   const discrepancy::Parameters parameters = discrepancy::parameters_from(config.discrepancy);
   const Intrinsics intrinsics = config.camera.intrinsics;
@@ -267,6 +418,10 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
     result.label = run.fault.label;
     const int num_frames = run.onset_frame + run.frames_after_onset;
     std::map<std::string, double> previous_t;
+    const bool object_fault = run.fault.kind == CampaignFault::Kind::kObject;
+    ObjectPath object_path;
+    std::vector<renderer::ExtraObject> objects;
+    double object_distance_m = 0;
     for (int k = 0; k < num_frames; ++k) {
       const double t_s = run.start_s + k * period_s;
       const int64_t now_us = (k + 1) * period_us;
@@ -292,8 +447,39 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
                                               ? reported_pose * run.fault.camera_error
                                               : reported_pose;
 
-      const std::vector<float> depth_m = truth.capture(true_joints, true_pose, intrinsics,
-                                                       run.noise_seed * 100000 + static_cast<uint64_t>(k));
+      objects.clear();
+      if (faulty && object_fault) {
+        const robot_model::PlacedArmSpheres placed = robot_model::place_arm_spheres(
+            truth_cover, robot_model::forward_kinematics(model_scene, true_joints));
+        if (k == run.onset_frame) {
+          object_path = place_object(run.fault, placed, true_pose, &model,
+                                     robot_model::forward_kinematics(model_scene, true_joints), intrinsics);
+        }
+        renderer::ExtraObject box;
+        box.kind = renderer::ExtraObject::Kind::kBox;
+        box.size_m = run.fault.object_size_m;
+        box.world_from_object.translation() =
+            object_path.start + object_path.velocity * ((k - run.onset_frame) * period_s);
+        objects.push_back(box);
+        object_distance_m = box_to_arm_m(box.world_from_object.translation(), box.size_m / 2, placed);
+        // The camera's view of it, without noise.
+        const renderer::RenderResult seen = model.render_at(
+            robot_model::forward_kinematics(model_scene, true_joints), true_pose, intrinsics, objects);
+        int pixels = 0;
+        for (int16_t label : seen.labels) pixels += label == kLabelExtraObjectFirst ? 1 : 0;
+        if (k == run.onset_frame) {
+          result.object_distance_at_onset_m = object_distance_m;
+          result.object_min_distance_m = object_distance_m;
+          result.object_pixels = pixels;
+        }
+        // First seen: as large as the smallest object counted, at 2 m.
+        if (result.object_first_seen_m < 0 && pixels >= kObjectSeenPixels) {
+          result.object_first_seen_m = object_distance_m;
+        }
+        result.object_min_distance_m = std::min(result.object_min_distance_m, object_distance_m);
+      }
+      const std::vector<float> depth_m = truth.capture(
+          true_joints, true_pose, intrinsics, run.noise_seed * 100000 + static_cast<uint64_t>(k), objects);
       const depth_image_t camera =
           make_depth_image(config.camera.id, intrinsics, state.utime, k, /*calibrated=*/true, depth_m);
 
@@ -343,8 +529,18 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
       monitor.on_joint_state(state, now_us);
       for (const risk_t& verdict : monitor.on_frame(frame.summary, now_us)) {
         ++result.frames_judged;
+        // An object outside the protective field must never stop the arm:
+        // its stops count as false stops, unless the arm's speed had grown
+        // the field over it then (an UNKNOWN_OBJECT stop whose S reaches the
+        // object's true distance, within the 3 cm the true distance's cover
+        // may err).
+        const bool inside_s_then =
+            object_fault && verdict.seq >= run.onset_frame && verdict.level == risk_t::DANGEROUS &&
+            verdict.cause == risk_t::CAUSE_UNKNOWN_OBJECT && object_distance_m <= verdict.threshold + 0.03;
         const bool after_onset =
-            verdict.seq >= run.onset_frame && run.fault.kind != CampaignFault::Kind::kNone;
+            verdict.seq >= run.onset_frame && run.fault.kind != CampaignFault::Kind::kNone &&
+            (!object_fault || run.fault.object_in_field || inside_s_then || result.stopped);
+        if (verdict.seq >= run.onset_frame && verdict.level == risk_t::WARNING) ++result.warnings_after_onset;
         if (verdict.level == risk_t::DANGEROUS && !after_onset && !result.false_stop) {
           result.false_stop = true;
           result.false_stop_detail = "seq " + std::to_string(verdict.seq) + ": " + verdict.detail;
@@ -357,6 +553,10 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
           result.cause = verdict.cause;
           result.suspect = verdict.suspect;
           result.detail = verdict.detail;
+          result.stop_score = verdict.score;
+          result.stop_threshold = verdict.threshold;
+          // Judged in the frame it belongs to: the object's distance then.
+          result.object_distance_at_stop_m = object_distance_m;
           continue;
         }
         if (verdict.level == risk_t::SAFE) ++result.safe_after_stop;
@@ -369,7 +569,14 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
     } else if (run.fault.kind == CampaignFault::Kind::kCameraPose) {
       result.right_cause = result.stopped && result.cause == risk_t::CAUSE_CALIBRATION_ERROR;
       result.right_suspect = result.right_cause;
+    } else if (object_fault) {
+      result.right_cause = result.stopped && result.cause == risk_t::CAUSE_UNKNOWN_OBJECT;
+      result.right_suspect = result.right_cause;
+      result.object = true;
+      result.approaching = run.fault.object_approaches;
     }
+    result.expected_stop =
+        run.fault.kind != CampaignFault::Kind::kNone && !(object_fault && !run.fault.object_in_field);
     results.push_back(result);
   }
   return results;
@@ -389,9 +596,13 @@ std::string campaign_report(const std::string& arm, const std::vector<CampaignRe
   std::map<std::string, Tally> by_kind;
   std::ostringstream misses;
   for (const CampaignResult& r : results) {
+    if (r.object) continue;  // object_report
     std::string kind = r.label;
     if (r.label.rfind("camera", 0) == 0) {
       kind = "camera pose";
+    } else if (r.label.rfind("object", 0) == 0 || r.label.rfind("hand", 0) == 0 ||
+               r.label.rfind("person", 0) == 0 || r.label.rfind("cart", 0) == 0) {
+      kind = r.label;
     } else if (r.label != "nominal") {
       // "<joint> +<deg> deg"
       const size_t sign = r.label.find_last_of("+-");
@@ -471,6 +682,116 @@ std::string campaign_report(const std::string& arm, const std::vector<CampaignRe
         << " per million; N(0,1): 63), largest |t| " << fixed_text(max_abs, 1)
         << "; from frame to frame (noise alone): variance "
         << fixed_text(differences > 0 ? difference_sum_sq / static_cast<double>(differences) : 0, 2) << "\n";
+  }
+  const std::string m = misses.str();
+  if (!m.empty()) out << "\n" << m;
+  return out.str();
+}
+
+std::string object_report(const std::string& arm, const std::vector<CampaignResult>& results,
+                          const deployment::Config& config) {
+  struct Tally {
+    int runs = 0, detected = 0, right_cause = 0, false_stops = 0, frames = 0, warnings = 0, pixels = 0;
+    bool expected = true;
+    std::vector<int> latency;
+    std::vector<double> onset_m, min_m, at_stop_m, s_m, first_seen_m;
+  };
+  const risk::RiskSettings& r = config.risk;
+  // What the person covers after the verdict while the chain and the robot
+  // stop, at K: the stop must come at least this much farther than C.
+  const double after_verdict_m =
+      r.field_approach_speed_m_s * (r.field_chain_latency_us + r.field_stopping_time_us) * 1e-6 +
+      r.field_stopping_distance_m;
+  const double period_s = 1.0 / config.camera.rate_hz;
+  std::map<std::string, Tally> by_kind;
+  std::vector<std::string> order;
+  std::ostringstream misses;
+  const auto cm = [](double m) { return fixed_text(100 * m, 0); };
+  for (const CampaignResult& res : results) {
+    if (!res.object) continue;
+    if (by_kind.find(res.label) == by_kind.end()) order.push_back(res.label);
+    Tally& t = by_kind[res.label];
+    ++t.runs;
+    t.expected = res.expected_stop;
+    t.frames += res.frames_judged;
+    t.warnings += res.warnings_after_onset;
+    t.pixels += res.object_pixels;
+    t.onset_m.push_back(res.object_distance_at_onset_m);
+    if (res.object_first_seen_m >= 0) t.first_seen_m.push_back(res.object_first_seen_m);
+    t.min_m.push_back(res.object_min_distance_m);
+    t.false_stops += res.false_stop ? 1 : 0;
+    if (res.false_stop)
+      misses << "- " << arm << ", " << res.label << ": false stop, " << res.false_stop_detail << "\n";
+    if (!res.expected_stop) {
+      // Only a stop inside S at the time (the arm's speed grew the field).
+      t.detected += res.stopped ? 1 : 0;
+      t.right_cause += res.right_cause ? 1 : 0;
+      if (res.stopped) t.s_m.push_back(res.stop_threshold);
+      continue;
+    }
+    t.detected += res.stopped ? 1 : 0;
+    t.right_cause += res.right_cause ? 1 : 0;
+    if (res.stopped) {
+      t.latency.push_back(res.stop_frames);
+      t.at_stop_m.push_back(res.object_distance_at_stop_m);
+      if (res.right_cause) t.s_m.push_back(res.stop_threshold);
+    }
+    if (!res.stopped) {
+      misses << "- " << arm << ", " << res.label << ": not stopped (" << res.object_pixels << " px seen, "
+             << cm(res.object_distance_at_onset_m) << " cm from the arm at the onset, "
+             << cm(res.object_min_distance_m) << " cm at the nearest)\n";
+    } else if (!res.right_cause) {
+      misses << "- " << arm << ", " << res.label << ": stopped as " << risk_cause_name(res.cause) << " ("
+             << res.detail << ")\n";
+    }
+    // An object that approaches into view from beyond S must be stopped
+    // while it is farther than C plus what it covers until the arm has
+    // halted (ISO 13855's promise); one first seen inside S cannot be
+    // (the camera's view limits the field).
+    if (res.approaching && res.object_first_seen_m >= 0 && res.stopped &&
+        res.object_first_seen_m < res.stop_threshold) {
+      misses << "- " << arm << ", " << res.label << ": first in view " << cm(res.object_first_seen_m)
+             << " cm from the arm, inside S = " << cm(res.stop_threshold) << " cm\n";
+    } else if (res.approaching && res.stopped &&
+               res.object_distance_at_stop_m - after_verdict_m < r.field_intrusion_distance_m) {
+      misses << "- " << arm << ", " << res.label << ": stopped at " << cm(res.object_distance_at_stop_m)
+             << " cm: less than C + K (latency + T_s) + S_s = "
+             << cm(r.field_intrusion_distance_m + after_verdict_m) << " cm\n";
+    }
+  }
+  const auto median = [](std::vector<double> v) {
+    if (v.empty()) return std::string("-");
+    std::sort(v.begin(), v.end());
+    return fixed_text(100 * v[v.size() / 2], 0);
+  };
+  const auto least = [](const std::vector<double>& v) {
+    return v.empty() ? std::string("-") : fixed_text(100 * *std::min_element(v.begin(), v.end()), 0);
+  };
+  std::ostringstream out;
+  out << "| " << arm
+      << " | runs | in the field at rest | object px at onset (mean) | distance at onset, median (cm) | "
+         "first in view, "
+         "median (cm) | nearest (cm) | "
+         "stopped | as unknown object | median / max frames to stop (ms) | distance at the stop, least (cm) "
+         "| "
+         "S at the stop, median (cm) | WARNING frames | false stops |\n"
+      << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+  for (const std::string& kind : order) {
+    Tally& t = by_kind[kind];
+    std::string latency = "-";
+    if (!t.latency.empty()) {
+      std::sort(t.latency.begin(), t.latency.end());
+      const int med = t.latency[t.latency.size() / 2];
+      const int max = t.latency.back();
+      latency = std::to_string(med) + " / " + std::to_string(max) + " (" +
+                std::to_string(std::lround(med * period_s * 1000)) + " / " +
+                std::to_string(std::lround(max * period_s * 1000)) + ")";
+    }
+    out << "| " << kind << " | " << t.runs << " | " << (t.expected ? "yes" : "no") << " | "
+        << t.pixels / t.runs << " | " << median(t.onset_m) << " | " << median(t.first_seen_m) << " | "
+        << least(t.min_m) << " | " << t.detected << " | " << t.right_cause << " | " << latency << " | "
+        << least(t.at_stop_m) << " | " << median(t.s_m) << " | " << t.warnings << " | " << t.false_stops
+        << " |\n";
   }
   const std::string m = misses.str();
   if (!m.empty()) out << "\n" << m;

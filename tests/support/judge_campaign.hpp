@@ -51,7 +51,7 @@ std::optional<CampaignArm> kinova_gen3_campaign_arm(const std::string& shared_di
 
 // A fault from frame `onset_frame` on (none: kind kNone).
 struct CampaignFault {
-  enum class Kind { kNone, kJointOffset, kCameraPose };
+  enum class Kind { kNone, kJointOffset, kCameraPose, kObject };
   Kind kind = Kind::kNone;
   // kJointOffset: the joint reports `offset` (rad; m prismatic) more than
   // its true position.
@@ -60,6 +60,22 @@ struct CampaignFault {
   // kCameraPose: the camera really is at reported * error (error in the
   // reported optical frame), while the renderer keeps the reported pose.
   Eigen::Isometry3d camera_error = Eigen::Isometry3d::Identity();
+  // kObject: a box of object_size_m (edges along the world's axes) that
+  // the camera sees and the model does not, placed at the onset so that
+  // its nearest point is object_distance_m from the arm's surface (the
+  // arm's cover of 1 cm cells at the onset's true joints: within 3 cm of
+  // the true surface), beside the arm's farthest point from its root, on
+  // the image's right (object_side +1) or left (-1). From then on it moves
+  // at object_speed_m_s: straight at that point (object_approaches), else
+  // horizontally across the line to it (a person or cart walking past).
+  // object_in_field: whether it is meant to be stopped (inside the
+  // protective field) or not (a stop is then a false stop).
+  Eigen::Vector3d object_size_m = Eigen::Vector3d::Constant(0.1);
+  double object_distance_m = 0;
+  int object_side = 1;
+  double object_speed_m_s = 0;
+  bool object_approaches = false;
+  bool object_in_field = true;
   std::string label;  // for the report, e.g. "a4 +3 deg"
 };
 
@@ -95,6 +111,25 @@ struct CampaignResult {
   // at the true and at the reported joints and pose). A fault that changes
   // no pixel cannot be seen by any camera rule.
   int changed_pixels = 0;
+  // kObject: pixels where the camera sees the object at the onset; its true
+  // distance to the arm (the 1 cm cover) at the onset, the least over the
+  // run, and at the stop's frame; the stop's score and threshold (for an
+  // unknown object: its distance and S, m); WARNING verdicts after the
+  // onset.
+  int object_pixels = 0;
+  // Its true distance when the camera first saw it (>= 20 px), -1: never.
+  double object_first_seen_m = -1;
+  double object_distance_at_onset_m = 0;
+  double object_min_distance_m = 0;
+  double object_distance_at_stop_m = 0;
+  double stop_score = 0;
+  double stop_threshold = 0;
+  int warnings_after_onset = 0;
+  // Whether the fault should stop the arm (false for nominal runs and
+  // objects outside the protective field).
+  bool expected_stop = false;
+  bool object = false;
+  bool approaching = false;
   // Before the onset (nominal frames): the standardised scores
   // t = s / sqrt(I) of every joint and camera parameter with information,
   // which the sequential tests take to be N(0, 1) without a fault
@@ -121,11 +156,28 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
 std::vector<CampaignRun> standard_fault_runs(const CampaignArm& arm,
                                              const std::vector<double>& joint_offsets_deg);
 
+// Issue 15's objects on `arm`: a 10 cm cube held still beside the arm at
+// each of `distances_m`; a hand-sized box (10 x 10 x 20 cm) approaching
+// at K = risk.field.approach_speed_m_s from beyond the warning field; and
+// a person (0.4 x 0.3 x 1.7 m) and a cart (0.6 x 0.4 x 0.8 m) walking past
+// at 1 m/s, `beyond_m` beyond the warning field of the arm at rest.
+std::vector<CampaignRun> object_runs(const CampaignArm& arm, const std::vector<double>& distances_m,
+                                     double beyond_m);
+
 // Nominal: `seconds` of frames without a fault, split into runs of `run_s`.
 std::vector<CampaignRun> nominal_runs(double seconds, double run_s, uint64_t seed);
 
-// A markdown table of `results` per fault kind and a line per run that
-// missed a target.
+// A markdown table of the object runs of `results` per kind (issue 15):
+// runs, the object's pixels and distances, detection, latency, the
+// distance at the stop and S, warnings and false stops; and a line per run
+// that missed a target (an object in the field not stopped, or stopped
+// only nearer than risk.field.intrusion_distance_m plus what K covers in
+// the chain's latency and the robot's stop; an object outside stopped).
+std::string object_report(const std::string& arm, const std::vector<CampaignResult>& results,
+                          const deployment::Config& config);
+
+// A markdown table of `results` (object runs left out) per fault kind and a
+// line per run that missed a target.
 std::string campaign_report(const std::string& arm, const std::vector<CampaignResult>& results,
                             double frame_period_s);
 

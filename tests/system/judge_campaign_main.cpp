@@ -5,6 +5,11 @@
 //
 //   tofguard-judge-campaign [--arms default,iiwa14,kinova] [--offsets-deg 3,5,10]
 //                           [--nominal-s SECONDS] [--no-faults] [--shared DIR]
+//                           [--objects-cm 5,10,20,40,80] [--beyond-cm 10]
+//
+// --objects-cm: issue 15's objects (object_runs): a 10 cm cube still at each
+// distance from the arm, a hand approaching at K, a person and a cart
+// walking past --beyond-cm beyond the warning field of the arm at rest.
 //
 // Prints a markdown table per arm (and every run that missed a target).
 #include <cstdlib>
@@ -27,9 +32,10 @@ std::vector<std::string> split(const std::string& text) {
 }
 
 int usage(const std::string& why) {
-  std::cerr << "tofguard-judge-campaign: " << why
-            << "\nusage: tofguard-judge-campaign [--arms default,iiwa14,kinova] [--offsets-deg 3,5,10] "
-               "[--nominal-s SECONDS] [--no-faults] [--shared DIR]\n";
+  std::cerr
+      << "tofguard-judge-campaign: " << why
+      << "\nusage: tofguard-judge-campaign [--arms default,iiwa14,kinova] [--offsets-deg 3,5,10] "
+         "[--nominal-s SECONDS] [--no-faults] [--shared DIR] [--objects-cm 5,10,20,40,80] [--beyond-cm 10]\n";
   return 2;
 }
 
@@ -41,6 +47,8 @@ int main(int argc, char** argv) {
   std::vector<double> offsets_deg = {3, 5, 10};
   double nominal_s = 0;
   bool faults = true;
+  std::vector<double> objects_m;
+  double beyond_m = 0.1;
   std::string shared = shared_dir();
   for (int i = 1; i < argc; ++i) {
     const std::string option = argv[i];
@@ -58,6 +66,10 @@ int main(int argc, char** argv) {
         for (const std::string& v : split(value)) offsets_deg.push_back(std::stod(v));
       } else if (option == "--nominal-s") {
         nominal_s = std::stod(value);
+      } else if (option == "--objects-cm") {
+        for (const std::string& v : split(value)) objects_m.push_back(std::stod(v) / 100);
+      } else if (option == "--beyond-cm") {
+        beyond_m = std::stod(value) / 100;
       } else if (option == "--shared") {
         shared = value;
       } else {
@@ -90,9 +102,14 @@ int main(int argc, char** argv) {
         const std::vector<CampaignRun> nominal = nominal_runs(nominal_s, 60, 7);
         runs.insert(runs.end(), nominal.begin(), nominal.end());
       }
+      if (!objects_m.empty()) {
+        const std::vector<CampaignRun> objects = object_runs(*arm, objects_m, beyond_m);
+        runs.insert(runs.end(), objects.begin(), objects.end());
+      }
       const std::vector<CampaignResult> results = run_campaign(*arm, runs);
-      std::cout << campaign_report(arm->name, results, 1.0 / arm->config.camera.rate_hz) << "\n"
-                << std::flush;
+      std::cout << campaign_report(arm->name, results, 1.0 / arm->config.camera.rate_hz) << "\n";
+      if (!objects_m.empty()) std::cout << object_report(arm->name, results, arm->config) << "\n";
+      std::cout << std::flush;
     }
   } catch (const std::exception& e) {
     std::cerr << "tofguard-judge-campaign: " << e.what() << "\n";
