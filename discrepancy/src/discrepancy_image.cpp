@@ -119,35 +119,6 @@ std::string check_labels(const link_labels_t& labels) {
   return "";
 }
 
-// Stage 2, silhouette mask: 1 for the pixels beside a rendered depth step
-// larger than silhouette_jump_mm (silhouette_step: in whole millimetres, one
-// less) or the model's outline, 4-neighbours. A
-// ToF pixel there mixes both surfaces, so its I_dis says nothing about a
-// link's pose; on a thin link (a finger three pixels wide) it would
-// otherwise be most of the link.
-std::vector<uint8_t> silhouette_mask(const depth_image_t& rendered, double silhouette_jump_mm) {
-  const int width = rendered.width;
-  const int height = rendered.height;
-  const int16_t* gen = rendered.depth_mm.data();
-  std::vector<uint8_t> silhouette(static_cast<size_t>(width) * height, 0);
-  for (int v = 0; v < height && silhouette_jump_mm > 0; ++v) {
-    for (int u = 0; u < width; ++u) {
-      const int i = v * width + u;
-      const int neighbours[2] = {u + 1 < width ? i + 1 : -1, v + 1 < height ? i + width : -1};
-      for (int n : neighbours) {
-        if (n < 0) continue;
-        const int a = gen[i] > 0 ? gen[i] : 0;
-        const int b = gen[n] > 0 ? gen[n] : 0;
-        if ((a > 0) != (b > 0) || (a > 0 && silhouette_step(a, b, silhouette_jump_mm))) {
-          silhouette[i] = 1;
-          silhouette[n] = 1;
-        }
-      }
-    }
-  }
-  return silhouette;
-}
-
 // What the pixel classes leave for the later stages.
 struct PixelClasses {
   PixelClasses(int height, int width)
@@ -410,6 +381,30 @@ void joint_reach(const link_labels_t& labels, discrepancy_t* s) {
 }
 
 }  // namespace
+
+// Stage 2 (the header says why).
+std::vector<uint8_t> silhouette_mask(const depth_image_t& rendered, double silhouette_jump_mm) {
+  const int width = rendered.width;
+  const int height = rendered.height;
+  const int16_t* gen = rendered.depth_mm.data();
+  std::vector<uint8_t> silhouette(static_cast<size_t>(width) * height, 0);
+  for (int v = 0; v < height && silhouette_jump_mm > 0; ++v) {
+    for (int u = 0; u < width; ++u) {
+      const int i = v * width + u;
+      const int neighbours[2] = {u + 1 < width ? i + 1 : -1, v + 1 < height ? i + width : -1};
+      for (int n : neighbours) {
+        if (n < 0) continue;
+        const int a = gen[i] > 0 ? gen[i] : 0;
+        const int b = gen[n] > 0 ? gen[n] : 0;
+        if ((a > 0) != (b > 0) || (a > 0 && silhouette_step(a, b, silhouette_jump_mm))) {
+          silhouette[i] = 1;
+          silhouette[n] = 1;
+        }
+      }
+    }
+  }
+  return silhouette;
+}
 
 Parameters parameters_from(const DiscrepancySettings& config) {
   Parameters p;

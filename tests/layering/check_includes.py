@@ -11,7 +11,7 @@ Layers, bottom to top (docs/architecture.md):
   robot_model   the URDF's kinematic tree and geometry
   robot_state   joint and camera-pose histories (may include robot_model)
   components    camera, renderer, sim, discrepancy, risk, estimator,
-                intervene, launch, spy, view: each may include the layers
+                intervene, launch, spy, view, tune: each may include the layers
                 below and the components in ALLOWED_COMPONENT_DEPENDENCIES
   deployment    the top-level config loader and process runner (everything
                 below)
@@ -45,7 +45,8 @@ LAYER_RANK = {
     "top": 5,
 }
 
-COMPONENTS = ["camera", "renderer", "sim", "discrepancy", "risk", "estimator", "intervene", "launch", "spy", "view"]
+COMPONENTS = ["camera", "renderer", "sim", "discrepancy", "risk", "estimator", "intervene", "launch", "spy", "view",
+              "tune"]
 
 # Which other components a component may include. Everything not listed
 # here is a dependency running sideways and must go through a message or a
@@ -61,6 +62,9 @@ ALLOWED_COMPONENT_DEPENDENCIES = {
     "launch": [],
     "spy": [],
     "view": ["discrepancy"],  # the viewer colours I_dis as tofguard-discrepancy does
+    # tofguard-tune judges a recording as the chain does: renders it, compares it,
+    # runs the sequential tests on it
+    "tune": ["renderer", "discrepancy", "risk"],
 }
 
 # Within robot_model / robot_state: robot_state may include robot_model,

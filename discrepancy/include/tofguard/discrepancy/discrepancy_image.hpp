@@ -75,6 +75,16 @@ struct DiscrepancyFrame {
 DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_image_t& rendered,
                                      const link_labels_t& labels, const Parameters& parameters);
 
+// compute_discrepancy's silhouette mask (row-major, 1 = beside a
+// silhouette): the pixels beside a rendered depth step larger than
+// `silhouette_jump_mm` (silhouette_step: in whole millimetres, one less) or
+// the model's outline, 4-neighbours. A ToF pixel there mixes both surfaces,
+// so its I_dis says nothing about a link's pose (on a thin link, a finger
+// three pixels wide, it would otherwise be most of the link) nor about the
+// camera's noise (tofguard-tune leaves them out of its fit).
+// `silhouette_jump_mm` <= 0: no silhouettes.
+std::vector<uint8_t> silhouette_mask(const depth_image_t& rendered, double silhouette_jump_mm);
+
 // The summary of a camera frame that cannot be compared (`kind` is one of
 // discrepancy_t::UNUSABLE_*): identity, calibrated flag and invalid pixels
 // filled in, everything else zero (depth_hash and repeat_count are the

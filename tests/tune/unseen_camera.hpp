@@ -1,0 +1,24 @@
+#pragma once
+// The camera tofguard-tune's tests tune: config/sim.yaml's simulated camera
+// with noise the default config has never seen, sigma(r) = 8 mm + 2.0 mm/m^2
+// r^2 along the ray (the default's: 4.75 + 1.01 r^2), at 25 Hz (30).
+// discrepancy.noise stays the default's (4 + 1.2 d^2): what tofguard-tune
+// replaces.
+#include <string>
+
+#include "test_support.hpp"
+
+namespace tofguard::test {
+
+inline constexpr double kUnseenSigma0Mm = 8.0;
+inline constexpr double kUnseenSigmaPerM2Mm = 2.0;
+inline constexpr double kUnseenRateHz = 25;
+
+// The config's path (output_dir()/<name>.yaml).
+inline std::string unseen_camera_config(const std::string& name) {
+  return sim_config_variant(name, {{"noise: {sigma0_mm: 4.75, sigma_per_m2_mm: 1.01}",
+                                    "noise: {sigma0_mm: 8.0, sigma_per_m2_mm: 2.0}"},
+                                   {"  rate_hz: 30\n", "  rate_hz: 25\n"}});
+}
+
+}  // namespace tofguard::test

@@ -1,0 +1,410 @@
+#include "tofguard/tune/recording_tuner.hpp"
+
+#include <lcm/lcm-cpp.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <iomanip>
+#include <map>
+#include <sstream>
+
+#include "tofguard/camera_pose_t.hpp"
+#include "tofguard/common/decode.hpp"
+#include "tofguard/common/depth_frame.hpp"
+#include "tofguard/common/wire_checks.hpp"
+#include "tofguard/depth_image_t.hpp"
+#include "tofguard/discrepancy/discrepancy_image.hpp"
+#include "tofguard/joint_state_t.hpp"
+#include "tofguard/renderer/renderer_process.hpp"
+#include "tofguard/risk/evidence_tests.hpp"
+#include "tofguard/robot_model/kinematic_tree.hpp"
+
+namespace tofguard::tune {
+namespace {
+
+// A camera frame with what tofguard-renderer made of it.
+struct RenderedPair {
+  depth_image_t camera;
+  depth_image_t rendered;
+  link_labels_t labels;
+};
+
+// The pixels the noise is measured on: compared (camera and model both have
+// a surface), not beside a silhouette (compute_discrepancy's mask: mixed
+// pixels), on a modelled link. 1 = used.
+std::vector<uint8_t> noise_pixels(const RenderedPair& frame, double silhouette_jump_mm) {
+  const std::vector<uint8_t> silhouette = discrepancy::silhouette_mask(frame.rendered, silhouette_jump_mm);
+  const size_t n = frame.camera.depth_mm.size();
+  std::vector<uint8_t> used(n, 0);
+  for (size_t i = 0; i < n; ++i) {
+    const bool on_link =
+        link_of_label(frame.labels.label[i], frame.labels.num_robot_links, frame.labels.num_links) >= 0;
+    used[i] = frame.camera.depth_mm[i] > 0 && frame.rendered.depth_mm[i] > 0 && !silhouette[i] && on_link;
+  }
+  return used;
+}
+
+const char* const kCameraParameters[6] = {"camera t_x", "camera t_y", "camera t_z",
+                                          "camera r_x", "camera r_y", "camera r_z"};
+
+// The sequential tests over every frame with `noise` and `pixels_per_sample`.
+EvidenceRun run_evidence(const std::vector<RenderedPair>& frames, const TuneSettings& settings,
+                         const robot_model::KinematicTree& tree, double sigma_at_0m_mm,
+                         double sigma_per_m2_mm, double pixels_per_sample) {
+  EvidenceRun run;
+  run.sigma_at_0m_mm = sigma_at_0m_mm;
+  run.sigma_per_m2_mm = sigma_per_m2_mm;
+  run.pixels_per_sample = pixels_per_sample;
+  discrepancy::Parameters parameters = discrepancy::parameters_from(settings.discrepancy);
+  parameters.tolerance.noise.sigma_at_0m_mm = sigma_at_0m_mm;
+  parameters.tolerance.noise.sigma_per_m2_mm = sigma_per_m2_mm;
+  parameters.evidence.pixels_per_sample = pixels_per_sample;
+  risk::SequentialEvidence evidence(settings.risk, tree, settings.renderer.camera.rate_hz);
+  std::map<std::string, ScoreStatistics> statistics;
+  std::map<std::string, double> max_cusum;
+  std::vector<std::string> order;
+  auto statistics_of = [&](const std::string& name) -> ScoreStatistics& {
+    if (!statistics.count(name)) order.push_back(name);
+    return statistics[name];
+  };
+  for (const RenderedPair& frame : frames) {
+    const discrepancy::DiscrepancyFrame result =
+        discrepancy::compute_discrepancy(frame.camera, frame.rendered, frame.labels, parameters);
+    // The false mismatches on the fitted pixels.
+    const std::vector<uint8_t> used = noise_pixels(frame, settings.discrepancy.silhouette_jump_mm);
+    for (size_t i = 0; i < used.size(); ++i) {
+      if (!used[i]) continue;
+      const int t = frame.camera.depth_mm[i];
+      ++run.pixels;
+      if (std::abs(frame.rendered.depth_mm[i] - t) > parameters.tolerance.at(t)) ++run.mismatches;
+    }
+    const discrepancy_t& d = result.summary;
+    if (!d.usable || !d.evidence_available) continue;
+    for (int j = 0; j < d.num_joints; ++j)
+      statistics_of(d.joint_name[j]).add(d.joint_score[j], d.joint_information[j]);
+    for (int a = 0; a < 6; ++a)
+      statistics_of(kCameraParameters[a]).add(d.camera_score[a], d.camera_information[7 * a]);
+    const risk::EvidenceStep step = evidence.update(d);
+    if (step.crossed) {
+      if (run.frames_crossed == 0) {
+        run.first_crossing = "frame seq " + std::to_string(d.seq) + ": " + step.finding.detail;
+      }
+      ++run.frames_crossed;
+    }
+    auto note = [&](const std::string& hypothesis, double cusum) {
+      max_cusum[hypothesis] = std::max(max_cusum[hypothesis], cusum);
+      if (cusum > run.max_cusum) {
+        run.max_cusum = cusum;
+        run.max_cusum_hypothesis = hypothesis;
+      }
+    };
+    note("camera", evidence.camera_cusum());
+    for (int j = 0; j < d.num_joints; ++j) note(d.joint_name[j], evidence.joint_cusum(d.joint_name[j]));
+  }
+  for (const std::string& name : order) {
+    const ScoreStatistics& s = statistics.at(name);
+    ParameterScores p;
+    p.name = name;
+    p.scores = s.count();
+    p.variance = s.variance();
+    p.frame_to_frame_variance = s.frame_to_frame_variance();
+    p.max_abs_t = s.max_abs();
+    p.max_cusum = max_cusum[name.rfind("camera", 0) == 0 ? std::string("camera") : name];
+    run.parameters.push_back(p);
+  }
+  return run;
+}
+
+std::string fixed(double value, int decimals) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(decimals) << value;
+  return s.str();
+}
+
+}  // namespace
+
+TuneResult tune_recording(const TuneSettings& settings, const std::string& log_path,
+                          const TuneOptions& options) {
+  TuneResult result;
+  result.log_path = log_path;
+  lcm::LogFile log(log_path, "r");
+  if (!log.good()) {
+    result.error = log_path + ": cannot open as an LCM log";
+    return result;
+  }
+  const ChannelNames& channels = settings.renderer.channels;
+  const std::string& camera_id = settings.renderer.camera.id;
+  renderer::RendererService service(settings.renderer);
+
+  // Frames wait until a joint state at or after their utime has come (the
+  // joints are then interpolated, never extrapolated) or the log ends.
+  std::deque<depth_image_t> waiting;
+  std::vector<RenderedPair> frames;
+  int64_t newest_joint_utime = INT64_MIN;
+  int64_t first_utime = 0, last_utime = 0;
+  std::map<std::string, std::pair<double, double>> joint_range;
+  auto render = [&](const depth_image_t& camera) {
+    renderer::RenderedFrame rendered = service.render(camera);
+    if (!rendered.depth) {
+      if (result.unusable_frames++ == 0) result.first_unusable_reason = rendered.labels.unusable_reason;
+      return;
+    }
+    RenderedPair pair{camera, std::move(*rendered.depth), std::move(rendered.labels)};
+    // The amplitude is not compared: not kept.
+    pair.camera.num_amplitude = 0;
+    pair.camera.amplitude.clear();
+    frames.push_back(std::move(pair));
+  };
+  for (const lcm::LogEvent* event = log.readNextEvent(); event != nullptr; event = log.readNextEvent()) {
+    if (event->channel == channels.joint_state) {
+      const auto state = decode_message<joint_state_t>(event->data, event->datalen);
+      if (!state || !check_joint_state(*state).empty() || !service.on_joint_state(*state)) continue;
+      ++result.joint_states;
+      newest_joint_utime = std::max(newest_joint_utime, state->utime);
+      for (int j = 0; j < state->num_joints; ++j) {
+        auto [it, fresh] = joint_range.try_emplace(state->name[j], state->position[j], state->position[j]);
+        if (!fresh) {
+          it->second.first = std::min(it->second.first, state->position[j]);
+          it->second.second = std::max(it->second.second, state->position[j]);
+        }
+      }
+      while (!waiting.empty() && waiting.front().utime <= newest_joint_utime) {
+        render(waiting.front());
+        waiting.pop_front();
+      }
+    } else if (event->channel == channels.camera_pose) {
+      const auto pose = decode_message<camera_pose_t>(event->data, event->datalen);
+      if (pose && check_camera_pose(*pose).empty()) service.on_camera_pose(*pose);
+    } else if (event->channel == channels.depth && result.depth_frames < options.max_frames) {
+      const auto frame = decode_message<depth_image_t>(event->data, event->datalen);
+      if (!frame || !check_depth_image_from(*frame, camera_id).empty()) continue;
+      if (result.depth_frames++ == 0) first_utime = frame->utime;
+      last_utime = frame->utime;
+      waiting.push_back(*frame);
+    }
+  }
+  while (!waiting.empty()) {
+    render(waiting.front());
+    waiting.pop_front();
+  }
+  result.used_frames = static_cast<int>(frames.size());
+  result.seconds = (last_utime - first_utime) * 1e-6;
+  if (result.depth_frames > 1 && last_utime > first_utime) {
+    result.measured_rate_hz = (result.depth_frames - 1) / result.seconds;
+  }
+  for (const auto& [joint, range] : joint_range) {
+    if (range.second - range.first > result.largest_motion) {
+      result.largest_motion = range.second - range.first;
+      result.most_moving_joint = joint;
+    }
+  }
+
+  if (result.used_frames < options.min_frames) {
+    std::ostringstream why;
+    why << log_path << ": too few frames to tune on: " << result.used_frames << " rendered of "
+        << result.depth_frames << " " << channels.depth << " frames of camera '" << camera_id << "' ("
+        << result.joint_states << " " << channels.joint_state << " messages";
+    if (result.unusable_frames > 0) why << "; first unusable: " << result.first_unusable_reason;
+    why << "); need " << options.min_frames;
+    result.error = why.str();
+    return result;
+  }
+  if (result.largest_motion < options.min_motion) {
+    result.error = log_path + ": no motion: no joint moved more than " + fixed(options.min_motion, 3) +
+                   " rad (m) over the recording (largest: " + fixed(result.largest_motion, 4) +
+                   "); record the arm moving through its workspace";
+    return result;
+  }
+
+  // Pass 1: the samples and the fit.
+  NoiseSamples samples(options.fit);
+  const double jump_mm = settings.discrepancy.silhouette_jump_mm;
+  for (const RenderedPair& frame : frames) {
+    const std::vector<uint8_t> used = noise_pixels(frame, jump_mm);
+    for (size_t i = 0; i < used.size(); ++i) {
+      if (used[i])
+        samples.add(frame.camera.depth_mm[i], frame.rendered.depth_mm[i] - frame.camera.depth_mm[i]);
+    }
+  }
+  result.fit = samples.fit();
+  if (!result.fit.ok) {
+    result.error = log_path + ": cannot fit the noise: " + result.fit.error;
+    return result;
+  }
+
+  // Pass 2: the neighbours' correlation of the standardised residuals'
+  // frame-to-frame differences, (z_k - z_k-1) / sqrt(2) on the pixels used
+  // in both frames: a bias fixed to a pixel (the distance calibration's
+  // residual, the model's) cancels, as in the frame-to-frame var(t), and
+  // only the noise's own correlation is left (measured on the residuals
+  // themselves, the default scene's static bias gave rho 0.011 and 1.17).
+  SpatialCorrelation correlation;
+  std::vector<float> previous_z;
+  std::vector<uint8_t> previous_used;
+  for (const RenderedPair& frame : frames) {
+    const std::vector<uint8_t> used = noise_pixels(frame, jump_mm);
+    std::vector<float> z(used.size(), 0.0f);
+    for (size_t i = 0; i < used.size(); ++i) {
+      if (!used[i]) continue;
+      const int t = frame.camera.depth_mm[i];
+      const double dis = frame.rendered.depth_mm[i] - t;
+      z[i] = static_cast<float>((dis - result.fit.median_mm_at(t)) / result.fit.sigma_mm(metres_from_mm(t)));
+    }
+    if (previous_z.size() == z.size()) {
+      std::vector<float> difference(z.size(), 0.0f);
+      std::vector<uint8_t> both(z.size(), 0);
+      for (size_t i = 0; i < z.size(); ++i) {
+        both[i] = used[i] && previous_used[i];
+        if (both[i]) difference[i] = static_cast<float>((z[i] - previous_z[i]) / std::sqrt(2.0));
+      }
+      correlation.add_frame(difference, both, frame.camera.width, frame.camera.height);
+    }
+    previous_z = std::move(z);
+    previous_used = used;
+  }
+  result.measured_pixels_per_sample = correlation.pixels_per_sample();
+  result.rho_u1 = correlation.rho(0, 1);
+  result.rho_v1 = correlation.rho(1, 1);
+  const double configured_pps = settings.discrepancy.evidence_pixels_per_sample;
+  result.pixels_per_sample_changed = std::abs(result.measured_pixels_per_sample - configured_pps) >
+                                     options.pixels_per_sample_change * configured_pps;
+  result.pixels_per_sample = result.pixels_per_sample_changed
+                                 ? std::round(result.measured_pixels_per_sample * 10) / 10
+                                 : configured_pps;
+
+  // Pass 3: the sequential tests with the fitted model (and the config's).
+  const robot_model::KinematicTree tree = robot_model::load_kinematic_tree(settings.renderer.robot.urdf_path);
+  const risk::SequentialEvidence reference(settings.risk, tree, settings.renderer.camera.rate_hz);
+  result.threshold_h = reference.threshold();
+  result.warning_level = reference.warning_level();
+  result.hypotheses = reference.hypotheses();
+  result.tuned = run_evidence(frames, settings, tree, result.fit.sigma_at_0m_mm, result.fit.sigma_per_m2_mm,
+                              result.pixels_per_sample);
+  if (options.compare_with_config) {
+    result.has_config_run = true;
+    result.configured = run_evidence(frames, settings, tree, settings.discrepancy.noise_sigma_at_0m_mm,
+                                     settings.discrepancy.noise_sigma_per_m2_mm, configured_pps);
+  }
+
+  // Usable only when the tuned model makes the recording look nominal.
+  if (result.tuned.mismatch_fraction() > options.max_mismatch_fraction) {
+    result.error = log_path + ": not nominal: " + fixed(100 * result.tuned.mismatch_fraction(), 2) +
+                   " % of the compared pixels mismatch even with the fitted noise (allowed " +
+                   fixed(100 * options.max_mismatch_fraction, 2) +
+                   " %): an object, a fault or a model that does not fit the scene";
+    return result;
+  }
+  if (result.tuned.frames_crossed > 0) {
+    result.error = log_path + ": not nominal: a sequential test crossed h = " + fixed(result.threshold_h, 2) +
+                   " with the fitted noise, " + result.tuned.first_crossing;
+    return result;
+  }
+  for (const ParameterScores& p : result.tuned.parameters) {
+    if (p.scores >= options.min_scores && p.frame_to_frame_variance > options.max_frame_to_frame_variance) {
+      result.error = log_path + ": the fitted noise does not make the scores N(0, 1): " + p.name +
+                     "'s frame-to-frame var(t) is " + fixed(p.frame_to_frame_variance, 2) + " (allowed " +
+                     fixed(options.max_frame_to_frame_variance, 2) +
+                     "): spatially correlated noise (pixels_per_sample) or a bias that changes every frame";
+      return result;
+    }
+  }
+  result.usable = true;
+  return result;
+}
+
+std::string tune_report(const TuneResult& r, const TuneSettings& settings) {
+  std::ostringstream out;
+  out << "recording: " << r.log_path << "\n"
+      << "  " << r.depth_frames << " frames of camera '" << settings.renderer.camera.id << "' over "
+      << fixed(r.seconds, 1) << " s (" << fixed(r.measured_rate_hz, 1) << " Hz measured, camera.rate_hz "
+      << settings.renderer.camera.rate_hz << "), " << r.used_frames << " rendered, " << r.unusable_frames
+      << " unusable" << (r.unusable_frames > 0 ? " (" + r.first_unusable_reason + ")" : "") << "; "
+      << r.joint_states << " joint states, most moving joint " << r.most_moving_joint << " over "
+      << fixed(r.largest_motion, 3) << " rad (m)\n";
+  if (r.measured_rate_hz > 0 && settings.renderer.camera.rate_hz > 0 &&
+      std::abs(r.measured_rate_hz / settings.renderer.camera.rate_hz - 1) > 0.1) {
+    out << "  note: the frames came at " << fixed(r.measured_rate_hz, 1)
+        << " Hz, not camera.rate_hz; h is computed from camera.rate_hz\n";
+  }
+  if (r.fit.bins.empty()) return out.str();
+  const NoiseFit& f = r.fit;
+  out << "noise fit: sigma(d) = " << fixed(f.sigma_at_0m_mm, 2) << " + " << fixed(f.sigma_per_m2_mm, 3)
+      << " d^2 mm (config: " << settings.discrepancy.noise_sigma_at_0m_mm << " + "
+      << settings.discrepancy.noise_sigma_per_m2_mm << " d^2), on " << f.samples << " pixels in "
+      << f.bins.size() << " depth bins " << fixed(f.min_depth_m, 2) << ".." << fixed(f.max_depth_m, 2)
+      << " m; bins holding 1 % of them within " << fixed(100 * f.worst_bin_ratio_error, 1)
+      << " % of the model\n"
+      << "  method: per " << fixed(f.bin_m, 2) << " m depth bin the median of I_dis (a bias) removed, "
+      << "sigma = 1.4826 MAD; a, b by least squares of sigma on d^2 weighted n / sigma^2\n"
+      << "  depth_m   pixels  median_mm  sigma_mm  model_mm\n";
+  for (const DepthBin& b : f.bins) {
+    out << "  " << std::setw(7) << fixed(b.depth_m, 2) << std::setw(9) << b.samples << std::setw(11)
+        << fixed(b.median_mm, 2) << std::setw(10) << fixed(b.sigma_mm, 2) << std::setw(10)
+        << fixed(f.sigma_mm(b.depth_m), 2) << "\n";
+  }
+  if (r.tuned.parameters.empty() && r.tuned.pixels == 0) return out.str();
+  out << "spatial correlation of neighbouring residuals (frame-to-frame differences): rho_u(1) "
+      << fixed(r.rho_u1, 3) << ", rho_v(1) " << fixed(r.rho_v1, 3) << " -> pixels_per_sample "
+      << fixed(r.measured_pixels_per_sample, 2) << " (config "
+      << settings.discrepancy.evidence_pixels_per_sample
+      << (r.pixels_per_sample_changed ? ", replaced" : ", kept") << ")\n";
+  auto describe = [&](const std::string& label, const EvidenceRun& run) {
+    out << label << ": sigma(d) = " << fixed(run.sigma_at_0m_mm, 2) << " + " << fixed(run.sigma_per_m2_mm, 3)
+        << " d^2, pixels_per_sample " << run.pixels_per_sample << "\n"
+        << "  false-mismatch rate per pixel at |I_dis| > " << settings.discrepancy.tolerance_sigmas
+        << " sigma + " << settings.discrepancy.model_tolerance_mm << " mm: " << run.mismatches << " of "
+        << run.pixels << " (" << std::setprecision(3) << run.mismatch_fraction() << ")\n"
+        << "  largest CUSUM " << fixed(run.max_cusum, 2) << " (" << run.max_cusum_hypothesis << ") against h "
+        << fixed(r.threshold_h, 2) << " (" << r.hypotheses << " hypotheses, warning at "
+        << fixed(r.warning_level, 2) << "); frames at h: " << run.frames_crossed << "\n"
+        << "  parameter     scores   var(t)  frame-to-frame  max|t|  max CUSUM\n";
+    for (const ParameterScores& p : run.parameters) {
+      out << "  " << std::left << std::setw(12) << p.name << std::right << std::setw(8) << p.scores
+          << std::setw(9) << fixed(p.variance, 2) << std::setw(16) << fixed(p.frame_to_frame_variance, 2)
+          << std::setw(8) << fixed(p.max_abs_t, 2) << std::setw(11) << fixed(p.max_cusum, 2) << "\n";
+    }
+  };
+  describe("with the fitted noise", r.tuned);
+  if (r.has_config_run) describe("with the config's noise (before tuning)", r.configured);
+  return out.str();
+}
+
+std::string tuned_config_lines(const TuneResult& r, const std::string& date) {
+  const NoiseFit& f = r.fit;
+  std::ostringstream out;
+  out << "# tofguard-tune " << date << " on " << r.log_path << ": " << r.used_frames << " frames ("
+      << fixed(r.seconds, 1) << " s), " << f.samples << " pixels off silhouettes, depth "
+      << fixed(f.min_depth_m, 2) << ".." << fixed(f.max_depth_m, 2) << " m.\n"
+      << "# Paste under `discrepancy:`, replacing the lines of the same keys.\n"
+      << "  # Fitted: per 0.1 m depth bin 1.4826 MAD of I_dis about the bin's median, least squares\n"
+      << "  # in d^2 (bins holding 1 % of the pixels within " << fixed(100 * f.worst_bin_ratio_error, 1)
+      << " % of it). With it on this\n"
+      << "  # recording: per-pixel false-mismatch rate " << std::setprecision(2)
+      << r.tuned.mismatch_fraction() << ", largest frame-to-frame var(t) ";
+  double worst = 0;
+  std::string worst_name;
+  for (const ParameterScores& p : r.tuned.parameters) {
+    if (p.frame_to_frame_variance > worst) {
+      worst = p.frame_to_frame_variance;
+      worst_name = p.name;
+    }
+  }
+  out << fixed(worst, 2) << " (" << worst_name << "),\n"
+      << "  # largest CUSUM " << fixed(r.tuned.max_cusum, 1) << " of h " << fixed(r.threshold_h, 1) << ".\n"
+      << "  noise: {sigma_at_0m_mm: " << fixed(f.sigma_at_0m_mm, 2)
+      << ", sigma_per_m2_mm: " << fixed(f.sigma_per_m2_mm, 3) << "}\n";
+  if (r.pixels_per_sample_changed) {
+    out << "  # under `evidence:`. Measured from the residuals' correlation between neighbours\n"
+        << "  # (rho_u(1) " << fixed(r.rho_u1, 3) << ", rho_v(1) " << fixed(r.rho_v1, 3)
+        << "), same pixels.\n"
+        << "    pixels_per_sample: " << r.pixels_per_sample << "\n";
+  } else {
+    out << "  # evidence.pixels_per_sample: the config's " << r.pixels_per_sample << " stands (measured "
+        << fixed(r.measured_pixels_per_sample, 2) << "; rho_u(1) " << fixed(r.rho_u1, 3) << ", rho_v(1) "
+        << fixed(r.rho_v1, 3) << ").\n";
+  }
+  return out.str();
+}
+
+}  // namespace tofguard::tune
