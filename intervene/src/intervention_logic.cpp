@@ -66,8 +66,33 @@ bool InterventionLogic::take_changed() {
 }
 
 bool InterventionLogic::risk_fresh(int64_t now_us) const {
-  // Before the first risk, the deadline runs from start-up.
-  return now_us - risk_arrival_us_ <= config_.risk_deadline_us;
+  // Before the first risk, the deadline runs from start-up. After this
+  // process was held up, only a risk that arrived a deadline later is
+  // known not to have waited in the socket buffer meanwhile.
+  return now_us - risk_arrival_us_ <= config_.risk_deadline_us && risk_arrival_us_ >= trusted_from_us_;
+}
+
+void InterventionLogic::check_not_held_up(int64_t now_us, int64_t now_utime, bool from_tick) {
+  // The timer calls tick() at the publish rate: a longer silence than the
+  // risk deadline means this process did not run (stopped, starved,
+  // swapped). What it handles next was queued meanwhile and arrives "now"
+  // on the monotonic clock: a SAFE verdict from before the hang would look
+  // fresh. So: stopped and the power cut, and no risk is fresh until one
+  // arrives a deadline after the hang was seen. (The first tick starts
+  // the watch.)
+  const int64_t silent_us = now_us - last_tick_us_;
+  if (from_tick) last_tick_us_ = std::max(last_tick_us_, now_us);
+  if (!watching_ || silent_us <= config_.risk_deadline_us) {
+    watching_ = watching_ || from_tick;
+    return;
+  }
+  if (!from_tick) last_tick_us_ = now_us;  // seen once, not again for every queued message
+  trusted_from_us_ = now_us + config_.risk_deadline_us;
+  stop(
+      safety_status_t::STOP_POWER_CUT, risk_t::CAUSE_COMPONENT_FAULT,
+      "tofguard-intervene did not run for " + ms(silent_us) +
+          " (held up or starved, longer than the risk deadline): the inputs queued meanwhile are not trusted",
+      now_us, now_utime);
 }
 
 void InterventionLogic::stop(int8_t kind, int8_t cause, const std::string& reason, int64_t now_us,
@@ -98,6 +123,7 @@ void InterventionLogic::stop(int8_t kind, int8_t cause, const std::string& reaso
 }
 
 void InterventionLogic::on_risk(const risk_t& risk, int64_t now_us, int64_t now_utime) {
+  check_not_held_up(now_us, now_utime, /*from_tick=*/false);
   risk_ = risk;
   risk_arrival_us_ = now_us;
   received_risk_ = true;
@@ -130,6 +156,7 @@ void InterventionLogic::on_actuator_result(const std::string& error, int64_t now
 }
 
 void InterventionLogic::tick(int64_t now_us, int64_t now_utime) {
+  check_not_held_up(now_us, now_utime, /*from_tick=*/true);
   if (!risk_fresh(now_us)) {
     const std::string reason = received_risk_
                                    ? "SAFETY_RISK stale: none for " + ms(now_us - risk_arrival_us_)
@@ -154,6 +181,7 @@ void InterventionLogic::tick(int64_t now_us, int64_t now_utime) {
 }
 
 ResetDecision InterventionLogic::on_reset(const reset_request_t& request, int64_t now_us, int64_t now_utime) {
+  check_not_held_up(now_us, now_utime, /*from_tick=*/false);
   if (request.who.empty() || request.why.empty()) {
     return {false, "refused: a reset needs who and why"};
   }

@@ -176,6 +176,36 @@ TEST(InterventionLogic, StaleRiskStreamCutsThePowerAtItsDeadline) {
   EXPECT_EQ(logic.status().reason, "SAFETY_RISK stale: none for 201 ms");
 }
 
+TEST(InterventionLogic, HeldUpLongerThanTheRiskDeadlineStopsAndDistrustsWhatWasQueued) {
+  InterventionLogic logic = running_logic();
+  logic.tick(20 * kMs, kUtime0);
+  logic.on_risk(risk(risk_t::SAFE), 30 * kMs, kUtime0);
+  logic.tick(40 * kMs, kUtime0);
+  EXPECT_TRUE(logic.status().motion_allowed);
+  // Held up (SIGSTOP) for a second: the SAFE verdicts queued meanwhile
+  // arrive at once, "fresh" on the monotonic clock.
+  logic.on_risk(risk(risk_t::SAFE), 1040 * kMs, kUtime0);
+  EXPECT_FALSE(logic.status().motion_allowed);
+  EXPECT_EQ(logic.status().stop, safety_status_t::STOP_POWER_CUT);
+  EXPECT_TRUE(logic.status().latched);
+  EXPECT_EQ(logic.status().cause, risk_t::CAUSE_COMPONENT_FAULT);
+  EXPECT_NE(logic.status().reason.find("tofguard-intervene did not run for 1000 ms"), std::string::npos)
+      << logic.status().reason;
+  logic.on_risk(risk(risk_t::SAFE), 1041 * kMs, kUtime0);
+  logic.tick(1042 * kMs, kUtime0);
+  // A queued reset is refused: no risk counts until one arrives a deadline
+  // (200 ms) after the hang was seen.
+  EXPECT_FALSE(logic.on_reset(reset(), 1043 * kMs, kUtime0).accepted);
+  for (int64_t t = 1060; t <= 1220; t += 20) {
+    logic.on_risk(risk(risk_t::SAFE), t * kMs, kUtime0);
+    logic.tick(t * kMs + 1, kUtime0);
+  }
+  EXPECT_FALSE(logic.on_reset(reset(), 1225 * kMs, kUtime0).accepted);
+  logic.on_risk(risk(risk_t::SAFE), 1245 * kMs, kUtime0);
+  EXPECT_TRUE(logic.on_reset(reset(), 1246 * kMs, kUtime0).accepted);
+  EXPECT_TRUE(logic.status().motion_allowed);
+}
+
 TEST(InterventionLogic, NoRiskEverCutsThePowerAfterStartUp) {
   InterventionLogic logic(test_config(), 0, kUtime0);
   logic.tick(200 * kMs, kUtime0);

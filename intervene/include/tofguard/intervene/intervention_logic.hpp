@@ -19,6 +19,10 @@
 //   reported, and no reset is accepted until the actuator works again.
 // - A reset is accepted only while the current risk is SAFE and fresh, the
 //   actuator works and who/why are given; it clears the latch.
+// - No tick() (it runs at the publish rate) for longer than
+//   risk_deadline_ms -> this process was held up: power cut, latched, and
+//   no risk counts as fresh until one arrives risk_deadline_ms later (what
+//   was queued meanwhile arrives "now" but is old).
 #include <cstdint>
 #include <string>
 
@@ -65,6 +69,9 @@ class InterventionLogic {
  private:
   void stop(int8_t kind, int8_t cause, const std::string& reason, int64_t now_us, int64_t now_utime);
   bool risk_fresh(int64_t now_us) const;
+  // Stops (power cut) when no tick() came for longer than the risk
+  // deadline (watched from the first tick on).
+  void check_not_held_up(int64_t now_us, int64_t now_utime, bool from_tick);
 
   InterventionSettings config_;
   Status status_;
@@ -79,6 +86,12 @@ class InterventionLogic {
   std::string fastest_joint_;
   int64_t joint_state_arrival_us_ = -1;
   std::string actuator_error_;
+  // The last tick's time (monotonic), whether a tick came yet, and from
+  // when a risk's arrival may count as fresh again after this process was
+  // held up.
+  int64_t last_tick_us_ = 0;
+  bool watching_ = false;
+  int64_t trusted_from_us_ = 0;
 };
 
 }  // namespace tofguard::intervene
