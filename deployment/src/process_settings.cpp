@@ -1,5 +1,7 @@
 #include "tofguard/deployment/process_settings.hpp"
 
+#include "tofguard/risk/protective_field.hpp"
+
 namespace tofguard::deployment {
 
 renderer::RendererProcessSettings renderer_process_settings(const Config& config) {
@@ -128,6 +130,10 @@ view::ViewSettings view_settings(const Config& config) {
   s.discrepancy = config.discrepancy;
   s.far_m = config.renderer.far_m;
   s.camera_rate_hz = config.camera.rate_hz;
+  s.fields.protective_at_rest_m =
+      risk::field_size(config.risk, risk::chain_response_time_s(config.risk, config.camera.rate_hz), 0)
+          .protective_m;
+  s.fields.warning_margin_m = config.risk.field_warning_margin_m;
   return s;
 }
 

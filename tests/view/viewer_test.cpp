@@ -142,6 +142,47 @@ TEST(Viewer, ExportsOnePngPerCameraFrameWithNearerRedAndFartherBlue) {
   EXPECT_EQ(discrepancy_pixel(55, 80), cv::Vec3b(0, 0, 0)) << "the arm's matching part";
 }
 
+// The fields on the camera panel: a cover of one sphere (5 cm) at the
+// arm's middle (pixel 55, 70 at 1 m): the arm (1 m from the camera, within
+// 0.15 m of the sphere) lies inside a 0.3 m protective field, the floor
+// (2 m) beyond a 0.5 m warning field; the arm's outline is drawn red.
+TEST(Viewer, DrawsTheProtectiveFieldsOutlineOnTheCameraPanel) {
+  const depth_image_t camera = frame(10, false);
+  link_labels_t l = labels(10);
+  l.num_arm_spheres = 1;
+  l.arm_cover_max_radius_m = 0.05;
+  l.arm_sphere_link = {0};
+  l.arm_sphere_center_m = {
+      {static_cast<float>((55 - 87.3) / 221.0), static_cast<float>((70 - 71.8) / 220.5), 1.0f}};
+  l.arm_sphere_radius_m = {0.05f};
+  const cv::Mat1b classes = view::field_classes(camera, l, 0.3, 0.5);
+  EXPECT_EQ(classes(70, 55), 2);
+  EXPECT_EQ(classes(41, 41), 2) << "the arm's corner: 0.1 m from the sphere";
+  EXPECT_EQ(classes(70, 100), 0) << "the floor, a metre behind";
+  EXPECT_EQ(cv::countNonZero(classes), 30 * 60) << "exactly the arm";
+  // Moved 0.6 m nearer to the floor, the sphere puts part of the floor in
+  // the warning field.
+  l.arm_sphere_center_m[0][2] = 1.6f;
+  EXPECT_GT(cv::countNonZero(view::field_classes(camera, l, 0.3, 0.5) == 1), 0);
+  l.arm_sphere_center_m[0][2] = 1.0f;
+
+  view::FrameSet set;
+  set.camera = camera;
+  set.rendered = frame(10, false);
+  set.labels = l;
+  const int scale = view::panel_scale(kW);
+  const cv::Mat3b with_fields =
+      view::compose_view(set, discrepancy::Parameters{}, 8000, 200, view::FieldSizes{0.3, 0.2});
+  const cv::Mat3b without = view::compose_view(set, discrepancy::Parameters{}, 8000, 200);
+  const int banner = with_fields.rows - kH * scale;
+  auto camera_pixel = [&](const cv::Mat3b& view, int u, int v) {
+    return view(banner + v * scale + scale / 2, u * scale + scale / 2);
+  };
+  EXPECT_EQ(camera_pixel(with_fields, 40, 70), cv::Vec3b(0, 0, 255)) << "the arm's outline, red";
+  EXPECT_EQ(camera_pixel(with_fields, 55, 70), camera_pixel(without, 55, 70)) << "inside: the depth colour";
+  EXPECT_NE(camera_pixel(without, 40, 70), cv::Vec3b(0, 0, 255));
+}
+
 TEST(Viewer, VerdictText) {
   view::FrameSet set;
   set.camera = frame(42, true);

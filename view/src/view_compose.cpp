@@ -2,6 +2,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include <cstdio>
 #include <type_traits>
 
 #include <opencv2/imgproc.hpp>
@@ -9,6 +10,7 @@
 #include "tofguard/common/decode.hpp"
 #include "tofguard/common/risk_names.hpp"
 #include "tofguard/common/wire_checks.hpp"
+#include "tofguard/discrepancy/arm_distance.hpp"
 
 namespace tofguard::view {
 namespace {
@@ -37,7 +39,42 @@ cv::Mat3b blank_panel(int width, int height, int scale, const std::string& text)
   return panel;
 }
 
+// Outlines the classes of `classes` on the scaled panel: a pixel whose
+// right or lower neighbour lies in a lower class is on the outline of its
+// own class's field.
+void draw_field_outlines(const cv::Mat1b& classes, int scale, cv::Mat3b* panel) {
+  const cv::Vec3b colour[3] = {{0, 0, 0}, {0, 220, 255}, {0, 0, 255}};  // BGR: -, yellow, red
+  for (int v = 0; v < classes.rows; ++v) {
+    for (int u = 0; u < classes.cols; ++u) {
+      const uchar c = classes(v, u);
+      if (c == 0) continue;
+      const bool edge = (u + 1 < classes.cols && classes(v, u + 1) < c) || (u > 0 && classes(v, u - 1) < c) ||
+                        (v + 1 < classes.rows && classes(v + 1, u) < c) || (v > 0 && classes(v - 1, u) < c);
+      if (edge) (*panel)(cv::Rect(u * scale, v * scale, scale, scale)).setTo(colour[c]);
+    }
+  }
+}
+
 }  // namespace
+
+cv::Mat1b field_classes(const depth_image_t& camera, const link_labels_t& labels, double protective_m,
+                        double warning_m) {
+  cv::Mat1b classes(camera.height, camera.width, uchar(0));
+  const discrepancy::ArmDistance arm(labels);
+  if (arm.empty() || labels.width != camera.width || labels.height != camera.height) return classes;
+  for (int i = 0; i < camera.width * camera.height; ++i) {
+    const int16_t d = camera.depth_mm[i];
+    if (d <= 0) continue;
+    const double z = d * 1e-3;
+    const Eigen::Vector3d point((i % camera.width - camera.cx) * z / camera.fx,
+                                (i / camera.width - camera.cy) * z / camera.fy, z);
+    const double distance = arm.distance_m(point, warning_m + 0.01);
+    classes(i / camera.width, i % camera.width) = distance <= protective_m ? 2
+                                                  : distance <= warning_m  ? 1
+                                                                           : 0;
+  }
+  return classes;
+}
 
 int panel_scale(int width) { return std::max(1, (320 + width - 1) / width); }
 
@@ -53,11 +90,25 @@ std::string verdict_text(const FrameSet& frames) {
 }
 
 cv::Mat3b compose_view(const FrameSet& frames, const discrepancy::Parameters& parameters, double max_depth_mm,
-                       double full_scale_mm) {
+                       double full_scale_mm, const FieldSizes& fields) {
   const int w = frames.camera.width;
   const int h = frames.camera.height;
   const int scale = panel_scale(w);
   cv::Mat3b camera = depth_panel(frames.camera, max_depth_mm, scale);
+  if (frames.labels && fields.protective_at_rest_m > 0) {
+    // The frame's own S when its verdict gives it, else S at rest.
+    const bool from_verdict =
+        frames.risk && frames.risk->cause == risk_t::CAUSE_UNKNOWN_OBJECT && frames.risk->threshold > 0;
+    const double protective_m = from_verdict ? frames.risk->threshold : fields.protective_at_rest_m;
+    const double warning_m = protective_m + fields.warning_margin_m;
+    draw_field_outlines(field_classes(frames.camera, *frames.labels, protective_m, warning_m), scale,
+                        &camera);
+    char legend[96];
+    std::snprintf(legend, sizeof legend, "fields: S %.2f m%s, warning %.2f m", protective_m,
+                  from_verdict ? "" : " (arm at rest)", warning_m);
+    cv::putText(camera, legend, cv::Point(6, camera.rows - 8), cv::FONT_HERSHEY_SIMPLEX, 0.4,
+                cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  }
   cv::Mat3b rendered = frames.rendered ? depth_panel(*frames.rendered, max_depth_mm, scale)
                                        : blank_panel(w, h, scale, "no rendered frame");
   cv::Mat3b dis = blank_panel(w, h, scale, "no comparison");

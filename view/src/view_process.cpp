@@ -39,7 +39,7 @@ int export_log(const ViewSettings& settings, const std::string& log_path, const 
   if (!video) std::filesystem::create_directories(out);
   int written = 0;
   for (const auto& [seq, set] : frames.by_seq) {
-    const cv::Mat3b view = compose_view(set, parameters, max_depth_mm, full_scale);
+    const cv::Mat3b view = compose_view(set, parameters, max_depth_mm, full_scale, settings.fields);
     if (video) {
       if (!writer.isOpened()) {
         writer.open(out, cv::VideoWriter::fourcc('m', 'p', '4', 'v'), settings.camera_rate_hz, view.size());
@@ -104,8 +104,9 @@ int live(const ViewSettings& settings) {
     for (auto it = pending.rbegin(); it != pending.rend(); ++it) {
       const FrameSet& set = it->second;
       if (set.camera.width > 0 && set.rendered && set.labels) {
-        cv::imshow("tofguard-view", compose_view(set, parameters, settings.far_m * 1000,
-                                                 settings.discrepancy.colour_image_full_scale_mm));
+        cv::imshow("tofguard-view",
+                   compose_view(set, parameters, settings.far_m * 1000,
+                                settings.discrepancy.colour_image_full_scale_mm, settings.fields));
         pending.erase(pending.begin(), std::next(it).base());
         break;
       }

@@ -25,13 +25,32 @@ struct FrameSet {
   std::optional<risk_t> risk;  // the verdict on this frame, if known
 };
 
+// The protective and warning fields to draw (docs/safety-chain.md,
+// "Protective fields"): S with the arm at rest and the warning margin
+// beyond it, metres (protective_at_rest_m <= 0: none drawn). On a frame
+// whose verdict is an unknown object, that verdict's threshold (the S of
+// its frame) is drawn instead.
+struct FieldSizes {
+  double protective_at_rest_m = 0;
+  double warning_margin_m = 0;
+};
+
+// Per camera pixel, where its surface lies (labels' arm cover; CV_8U):
+// 2 inside the protective field (within protective_m of the arm), 1 inside
+// the warning field, 0 beyond it, without a return, or when the labels
+// carry no cover.
+cv::Mat1b field_classes(const depth_image_t& camera, const link_labels_t& labels, double protective_m,
+                        double warning_m);
+
 // Integer scale so that a panel is at least 320 pixels wide.
 int panel_scale(int width);
 
 // The three panels and the verdict line; `parameters` decide what is a
-// match (the deployment's discrepancy tolerance).
+// match (the deployment's discrepancy tolerance). The camera panel shows
+// the fields' outlines on the seen surfaces: red the protective field's,
+// yellow the warning field's.
 cv::Mat3b compose_view(const FrameSet& frames, const discrepancy::Parameters& parameters, double max_depth_mm,
-                       double full_scale_mm);
+                       double full_scale_mm, const FieldSizes& fields = {});
 
 // The verdict line: e.g. "seq 42  DANGEROUS joint error, suspect a4 | ...",
 // or "seq 42  no verdict".

@@ -2,6 +2,7 @@
 // What tofguard-view needs from the deployment config.
 #include "tofguard/common/lcm_settings.hpp"
 #include "tofguard/discrepancy/discrepancy_settings.hpp"
+#include "tofguard/view/view_compose.hpp"
 
 namespace tofguard::view {
 
@@ -15,6 +16,9 @@ struct ViewSettings {
   double far_m = 0;
   // camera.rate_hz: an exported video's frame rate.
   double camera_rate_hz = 0;
+  // The fields drawn on the camera panel: S with the arm at rest (from
+  // risk.field and the camera's rate) and risk.field.warning_margin_m.
+  FieldSizes fields;
 };
 
 }  // namespace tofguard::view
