@@ -45,6 +45,7 @@ add_library(tofguard_fuzz_config
   intervene/src/intervention_settings.cpp
   launch/src/launch_settings.cpp
   renderer/src/renderer_settings.cpp
+  risk/src/protective_field.cpp
   risk/src/risk_settings.cpp
   sim/src/sim_settings.cpp)
 target_include_directories(tofguard_fuzz_config PUBLIC
