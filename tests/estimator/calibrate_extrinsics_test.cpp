@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "estimator_test_support.hpp"
+#include "log_events.hpp"
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/depth_image_t.hpp"
@@ -23,19 +24,6 @@ namespace {
 
 using test::deg;
 using test::to_deg;
-
-template <class T>
-void write_event(lcm::LogFile* log, int64_t utime, const std::string& channel, const T& message) {
-  std::vector<uint8_t> data(message.getEncodedSize());
-  message.encode(data.data(), 0, static_cast<int>(data.size()));
-  lcm::LogEvent event;
-  event.eventnum = 0;
-  event.timestamp = utime;
-  event.channel = channel;
-  event.datalen = static_cast<int32_t>(data.size());
-  event.data = data.data();
-  log->writeEvent(&event);
-}
 
 // A log of `poses` (one camera frame each, joint states 5 ms before and
 // after it), frames from the simulated camera at the config's true pose.
@@ -60,15 +48,15 @@ std::string write_log(const std::string& name, const deployment::Config& config,
     }
     state.num_joints = static_cast<int32_t>(state.name.size());
     state.utime = utime - 5000;
-    write_event(&log, state.utime, config.channels.joint_state, state);
+    tofguard::test::write_log_event(&log, state.utime, config.channels.joint_state, state);
     if (with_depth) {
       const std::vector<float> depth_m = frames.capture(poses[k], camera, in, k + 1);
       const depth_image_t frame = make_depth_image(config.camera.id, config.camera.intrinsics, utime,
                                                    static_cast<int64_t>(k), true, depth_m);
-      write_event(&log, utime, config.channels.depth, frame);
+      tofguard::test::write_log_event(&log, utime, config.channels.depth, frame);
     }
     state.utime = utime + 5000;
-    write_event(&log, state.utime, config.channels.joint_state, state);
+    tofguard::test::write_log_event(&log, state.utime, config.channels.joint_state, state);
     utime += 200000;
   }
   return path;

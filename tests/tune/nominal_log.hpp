@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "log_events.hpp"
 #include "simulated_frames.hpp"
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/depth_image_t.hpp"
@@ -56,17 +57,6 @@ inline int write_nominal_log(const std::string& path, const deployment::Config& 
     }
     return q;
   };
-  auto write = [&](int64_t timestamp, const std::string& channel, const auto& message) {
-    std::vector<uint8_t> data(static_cast<size_t>(message.getEncodedSize()));
-    message.encode(data.data(), 0, static_cast<int>(data.size()));
-    lcm::LogEvent event;
-    event.eventnum = 0;
-    event.timestamp = timestamp;
-    event.channel = channel;
-    event.datalen = static_cast<int32_t>(data.size());
-    event.data = data.data();
-    log.writeEvent(&event);
-  };
   // Publication times: joint state j at its utime, frame k one period after
   // its capture; joint states first at equal times.
   const int64_t end_us = lead_in_us + frames * period_us + period_us;
@@ -79,7 +69,7 @@ inline int write_nominal_log(const std::string& path, const deployment::Config& 
                          options.noise_seed * 1'000'000 + static_cast<uint64_t>(next_frame), options.objects);
       const depth_image_t frame = make_depth_image(config.camera.id, config.camera.intrinsics, capture,
                                                    next_frame, /*calibrated=*/true, depth_m);
-      write(capture + period_us, config.channels.depth, frame);
+      write_log_event(&log, capture + period_us, config.channels.depth, frame);
       ++next_frame;
     }
     joint_state_t state{};
@@ -94,7 +84,7 @@ inline int write_nominal_log(const std::string& path, const deployment::Config& 
       state.velocity.push_back(options.still ? 0.0 : m.amplitude * w * std::cos(w * t_s + m.phase_rad));
     }
     state.num_joints = static_cast<int32_t>(state.name.size());
-    write(state.utime, config.channels.joint_state, state);
+    write_log_event(&log, state.utime, config.channels.joint_state, state);
   }
   return frames;
 }

@@ -7,6 +7,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "log_events.hpp"
 #include "test_support.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/link_labels_t.hpp"
@@ -72,19 +73,6 @@ link_labels_t labels(int64_t seq) {
   return m;
 }
 
-template <class T>
-void write(lcm::LogFile& log, const std::string& channel, const T& message, int64_t timestamp) {
-  std::vector<uint8_t> bytes(message.getEncodedSize());
-  message.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-  lcm::LogEvent event;
-  event.eventnum = 0;
-  event.timestamp = timestamp;
-  event.channel = channel;
-  event.datalen = static_cast<int32_t>(bytes.size());
-  event.data = bytes.data();
-  log.writeEvent(&event);
-}
-
 TEST(Viewer, ExportsOnePngPerCameraFrameWithNearerRedAndFartherBlue) {
   const std::string log_path = output_dir() + "/viewer.lcmlog";
   const std::string out = output_dir() + "/viewer-frames";
@@ -94,10 +82,10 @@ TEST(Viewer, ExportsOnePngPerCameraFrameWithNearerRedAndFartherBlue) {
     lcm::LogFile log(log_path, "w");
     for (int64_t seq = 10; seq < 13; ++seq) {
       const int64_t t = 1700000000000000 + seq * 33333;
-      write(log, "TOF_DEPTH", frame(seq, true), t);
+      write_log_event(&log, t, "TOF_DEPTH", frame(seq, true));
       if (seq == 12) continue;  // the last frame never got its rendering
-      write(log, "TOF_RENDERED", frame(seq, false), t + 5000);
-      write(log, "TOF_LABELS", labels(seq), t + 5000);
+      write_log_event(&log, t + 5000, "TOF_RENDERED", frame(seq, false));
+      write_log_event(&log, t + 5000, "TOF_LABELS", labels(seq));
       risk_t risk;
       risk.utime = t;
       risk.seq = seq;
@@ -106,7 +94,7 @@ TEST(Viewer, ExportsOnePngPerCameraFrameWithNearerRedAndFartherBlue) {
       risk.score = 1;
       risk.threshold = 0.5;
       risk.detail = "test";
-      write(log, "SAFETY_RISK", risk, t + 9000);
+      write_log_event(&log, t + 9000, "SAFETY_RISK", risk);
     }
   }
   std::string stdout_text, stderr_text;
