@@ -10,6 +10,9 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
 #include "simulated_frames.hpp"
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/common/risk_names.hpp"
@@ -114,6 +117,36 @@ std::string fixed_text(double value, int decimals) {
   return s.str();
 }
 
+// The unit of a fault group's magnitude, "" for groups without one.
+std::string magnitude_unit(const std::string& group) {
+  if (group == "joint offset" || group == "camera rotation") return "deg";
+  if (group == "camera translation" || group == "object held still") return "cm";
+  return "";
+}
+
+// " 5 deg" for a group with a magnitude, "" otherwise.
+std::string magnitude_text(const std::string& group, double magnitude) {
+  const std::string unit = magnitude_unit(group);
+  if (unit.empty()) return "";
+  std::ostringstream s;
+  s << " " << magnitude << " " << unit;
+  return s.str();
+}
+
+// The value of nearest rank `q` (0..1) of sorted `v`.
+double quantile(const std::vector<double>& sorted, double q) {
+  const size_t rank = static_cast<size_t>(std::ceil(q * static_cast<double>(sorted.size())));
+  return sorted[std::clamp<size_t>(rank, 1, sorted.size()) - 1];
+}
+
+// "median / p99 / max" of latencies in seconds, as ms; "-" when none.
+std::string latency_text(std::vector<double> latency_s) {
+  if (latency_s.empty()) return "-";
+  std::sort(latency_s.begin(), latency_s.end());
+  const auto ms = [](double s) { return std::to_string(std::lround(1000 * s)); };
+  return ms(quantile(latency_s, 0.5)) + " / " + ms(quantile(latency_s, 0.99)) + " / " + ms(latency_s.back());
+}
+
 }  // namespace
 
 CampaignArm default_campaign_arm() {
@@ -174,8 +207,24 @@ std::optional<CampaignArm> kinova_gen3_campaign_arm(const std::string& shared_di
                               {0, 0, 0.5});
 }
 
-std::vector<CampaignRun> standard_fault_runs(const CampaignArm& arm,
-                                             const std::vector<double>& joint_offsets_deg) {
+CampaignArm with_camera_rate(const CampaignArm& arm, double rate_hz) {
+  CampaignArm rated = arm;
+  rated.config.camera.rate_hz = rate_hz;
+  rated.name = arm.name + ", " + fixed_text(rate_hz, 0) + " Hz";
+  return rated;
+}
+
+CampaignArm with_camera_turned(const CampaignArm& arm, double turn_deg) {
+  CampaignArm turned = arm;
+  const Eigen::Isometry3d turn(Eigen::AngleAxisd(turn_deg * kDegToRad, Eigen::Vector3d::UnitZ()));
+  const Eigen::Isometry3d pose = turn * arm.config.camera.pose.frame_from_optical();
+  turned.config.camera.pose = CameraPose(arm.config.camera.pose.frame_id, pose.translation(),
+                                         UnitQuaternion(Eigen::Quaterniond(pose.linear())));
+  turned.name = arm.name + ", camera turned " + fixed_text(turn_deg, 0) + " deg";
+  return turned;
+}
+
+std::vector<CampaignRun> fault_runs(const CampaignArm& arm, const FaultMagnitudes& magnitudes) {
   std::vector<CampaignRun> runs;
   uint64_t seed = 1000;
   auto add = [&](CampaignFault fault) {
@@ -187,9 +236,11 @@ std::vector<CampaignRun> standard_fault_runs(const CampaignArm& arm,
   };
   int n = 0;
   for (const sim::JointMotion& m : arm.config.joints_sim.motion) {
-    for (double deg : joint_offsets_deg) {
+    for (double deg : magnitudes.joint_offsets_deg) {
       CampaignFault f;
       f.kind = CampaignFault::Kind::kJointOffset;
+      f.group = "joint offset";
+      f.magnitude = deg;
       f.joint = m.joint;
       const double sign = (n++ % 2 == 0) ? 1.0 : -1.0;
       f.offset = sign * deg * kDegToRad;
@@ -199,37 +250,64 @@ std::vector<CampaignRun> standard_fault_runs(const CampaignArm& arm,
       add(f);
     }
   }
-  struct CameraCase {
-    const char* label;
-    Eigen::Vector3d translation_m;
-    Eigen::Vector3d rotation_axis;
-    double rotation_deg;
-  };
-  const CameraCase cases[] = {
-      {"camera 2 cm along x", {0.02, 0, 0}, Eigen::Vector3d::UnitX(), 0},
-      {"camera 2 cm along y", {0, -0.02, 0}, Eigen::Vector3d::UnitX(), 0},
-      {"camera 2 cm along z (optical axis)", {0, 0, 0.02}, Eigen::Vector3d::UnitX(), 0},
-      {"camera 3 cm along z (optical axis)", {0, 0, -0.03}, Eigen::Vector3d::UnitX(), 0},
-      {"camera turned 1 deg about x", {0, 0, 0}, Eigen::Vector3d::UnitX(), 1},
-      {"camera turned 1 deg about y", {0, 0, 0}, Eigen::Vector3d::UnitY(), -1},
-      {"camera turned 1 deg about z", {0, 0, 0}, Eigen::Vector3d::UnitZ(), 1},
-  };
-  for (const CameraCase& c : cases) {
+  // Along / about the reported optical frame's axes (x right, y down, z
+  // the optical axis), the sign alternating with axis and magnitude.
+  const char* const axis_names[] = {"x", "y", "z (optical axis)"};
+  auto camera_fault = [&](const std::string& group, double magnitude, int axis, double sign) {
     CampaignFault f;
     f.kind = CampaignFault::Kind::kCameraPose;
+    f.group = group;
+    f.magnitude = magnitude;
     f.camera_error = Eigen::Isometry3d::Identity();
-    f.camera_error.translation() = c.translation_m;
-    f.camera_error.linear() =
-        Eigen::AngleAxisd(c.rotation_deg * kDegToRad, c.rotation_axis).toRotationMatrix();
-    f.label = c.label;
+    std::ostringstream label;
+    if (group == "camera translation") {
+      f.camera_error.translation()[axis] = sign * magnitude / 100;
+      label << "camera " << magnitude << " cm along " << axis_names[axis];
+    } else {
+      f.camera_error.linear() =
+          Eigen::AngleAxisd(sign * magnitude * kDegToRad, Eigen::Vector3d::Unit(axis)).toRotationMatrix();
+      label << "camera turned " << magnitude << " deg about " << std::string(axis_names[axis]).substr(0, 1);
+    }
+    f.label = label.str();
     add(f);
+  };
+  for (size_t i = 0; i < magnitudes.camera_translations_cm.size(); ++i)
+    for (int axis = 0; axis < 3; ++axis)
+      camera_fault("camera translation", magnitudes.camera_translations_cm[i], axis,
+                   (i + static_cast<size_t>(axis)) % 2 == 0 ? 1.0 : -1.0);
+  for (size_t i = 0; i < magnitudes.camera_rotations_deg.size(); ++i)
+    for (int axis = 0; axis < 3; ++axis)
+      camera_fault("camera rotation", magnitudes.camera_rotations_deg[i], axis,
+                   (i + static_cast<size_t>(axis)) % 2 == 0 ? 1.0 : -1.0);
+  return runs;
+}
+
+std::vector<CampaignRun> stream_fault_runs(int runs_each) {
+  std::vector<CampaignRun> runs;
+  uint64_t seed = 3000;
+  const std::pair<CampaignFault::Kind, const char*> kinds[] = {
+      {CampaignFault::Kind::kFrozenImage, "camera image frozen"},
+      {CampaignFault::Kind::kCameraStall, "camera stream stalled"},
+      {CampaignFault::Kind::kJointStall, "joint stream stalled"},
+  };
+  for (const auto& [kind, label] : kinds) {
+    for (int i = 0; i < runs_each; ++i) {
+      CampaignRun run;
+      run.fault.kind = kind;
+      run.fault.group = label;
+      run.fault.label = label;
+      run.frames_after_onset = 30;
+      run.start_s = 1.3 * i;
+      run.noise_seed = seed++;
+      runs.push_back(run);
+    }
   }
   return runs;
 }
 
-std::vector<CampaignRun> nominal_runs(double seconds, double run_s, uint64_t seed) {
+std::vector<CampaignRun> nominal_runs(double seconds, double run_s, double rate_hz, uint64_t seed) {
   std::vector<CampaignRun> runs;
-  const int frames_per_run = static_cast<int>(std::lround(run_s * 30));
+  const int frames_per_run = static_cast<int>(std::lround(run_s * rate_hz));
   for (double t = 0; t < seconds; t += run_s) {
     CampaignRun run;
     run.fault.label = "nominal";
@@ -242,11 +320,35 @@ std::vector<CampaignRun> nominal_runs(double seconds, double run_s, uint64_t see
   return runs;
 }
 
+namespace {
+
+// The protective and warning fields of `arm` at rest.
+risk::FieldSize field_at_rest(const CampaignArm& arm) {
+  const risk::RiskSettings& r = arm.config.risk;
+  return risk::field_size(r, risk::chain_response_time_s(r, arm.config.camera.rate_hz), 0);
+}
+
+// A person (0.4 x 0.3 x 1.7 m) or a cart (0.6 x 0.4 x 0.8 m) walking past
+// at 1 m/s, `beyond_m` beyond the warning field of the arm at rest.
+CampaignFault passer(const risk::FieldSize& at_rest, double beyond_m, bool cart, int side) {
+  CampaignFault f;
+  f.kind = CampaignFault::Kind::kObject;
+  f.object_size_m = cart ? Eigen::Vector3d(0.6, 0.4, 0.8) : Eigen::Vector3d(0.4, 0.3, 1.7);
+  f.object_distance_m = at_rest.warning_m + beyond_m;
+  f.object_side = side;
+  f.object_speed_m_s = 1.0;
+  f.object_in_field = false;
+  f.label = cart ? "cart passing" : "person walking past";
+  f.group = f.label;
+  return f;
+}
+
+}  // namespace
+
 std::vector<CampaignRun> object_runs(const CampaignArm& arm, const std::vector<double>& distances_m,
                                      double beyond_m) {
   const risk::RiskSettings& r = arm.config.risk;
-  const risk::FieldSize at_rest =
-      risk::field_size(r, risk::chain_response_time_s(r, arm.config.camera.rate_hz), 0);
+  const risk::FieldSize at_rest = field_at_rest(arm);
   std::vector<CampaignRun> runs;
   uint64_t seed = 5000;
   int side = 1;
@@ -268,6 +370,8 @@ std::vector<CampaignRun> object_runs(const CampaignArm& arm, const std::vector<d
       side = -side;
       f.object_in_field = d < at_rest.protective_m;
       f.label = "object " + std::to_string(std::lround(d * 100)) + " cm";
+      f.group = "object held still";
+      f.magnitude = d * 100;
       add(f, start_s);
     }
   }
@@ -280,24 +384,38 @@ std::vector<CampaignRun> object_runs(const CampaignArm& arm, const std::vector<d
     hand.object_speed_m_s = r.field_approach_speed_m_s;
     hand.object_approaches = true;
     hand.label = "hand approaching";
+    hand.group = hand.label;
     add(hand, start_s);
   }
   for (double start_s : {0.0, 2.0}) {
-    CampaignFault person;
-    person.object_size_m = Eigen::Vector3d(0.4, 0.3, 1.7);
-    person.object_distance_m = at_rest.warning_m + beyond_m;
-    person.object_side = side;
+    add(passer(at_rest, beyond_m, /*cart=*/false, side), start_s);
     side = -side;
-    person.object_speed_m_s = 1.0;
-    person.object_in_field = false;
-    person.label = "person walking past";
-    add(person, start_s);
-    CampaignFault cart = person;
-    cart.object_size_m = Eigen::Vector3d(0.6, 0.4, 0.8);
-    cart.object_side = side;
+    add(passer(at_rest, beyond_m, /*cart=*/true, side), start_s + 1.0);
     side = -side;
-    cart.label = "cart passing";
-    add(cart, start_s + 1.0);
+  }
+  return runs;
+}
+
+std::vector<CampaignRun> passer_runs(const CampaignArm& arm, double seconds, uint64_t seed) {
+  // Each run: 1 s of the scene alone, then 4 s of a person or a cart
+  // crossing (4 m at 1 m/s: in view and out again), 0.1 m beyond the
+  // warning field where it comes nearest.
+  const risk::FieldSize at_rest = field_at_rest(arm);
+  const double rate_hz = arm.config.camera.rate_hz;
+  std::vector<CampaignRun> runs;
+  int side = 1;
+  for (double t = 0; t < seconds; t += 5.0) {
+    CampaignRun run;
+    const bool cart = runs.size() % 2 == 1;
+    run.fault = passer(at_rest, 0.1, cart, side);
+    if (runs.size() % 2 == 1) side = -side;
+    // It starts where its path comes nearest the arm and walks on across
+    // the view, on alternating sides of the image.
+    run.onset_frame = static_cast<int>(std::lround(rate_hz));
+    run.frames_after_onset = static_cast<int>(std::lround(4 * rate_hz));
+    run.start_s = t;
+    run.noise_seed = seed++;
+    runs.push_back(run);
   }
   return runs;
 }
@@ -416,6 +534,26 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
     risk::RiskMonitor monitor(config.risk, config.channels, robot_tree, config.camera.rate_hz, 0);
     CampaignResult result;
     result.label = run.fault.label;
+    result.group = run.fault.group;
+    result.magnitude = run.fault.magnitude;
+    using Kind = CampaignFault::Kind;
+    const Kind kind = run.fault.kind;
+    const bool stall = kind == Kind::kCameraStall || kind == Kind::kJointStall;
+    discrepancy::RepeatCounter repeats;
+    std::vector<float> last_depth_m;  // the image a frozen camera repeats
+    // Records the first DANGEROUS verdict at or after the onset.
+    auto record_stop = [&](const risk_t& verdict, int frames, double latency_s, double object_distance_m) {
+      result.stopped = true;
+      result.stop_frames = frames;
+      result.stop_latency_s = latency_s;
+      result.cause = verdict.cause;
+      result.suspect = verdict.suspect;
+      result.detail = verdict.detail;
+      result.stop_score = verdict.score;
+      result.stop_threshold = verdict.threshold;
+      // Judged in the frame it belongs to: the object's distance then.
+      result.object_distance_at_stop_m = object_distance_m;
+    };
     const int num_frames = run.onset_frame + run.frames_after_onset;
     std::map<std::string, double> previous_t;
     const bool object_fault = run.fault.kind == CampaignFault::Kind::kObject;
@@ -478,8 +616,28 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
         }
         result.object_min_distance_m = std::min(result.object_min_distance_m, object_distance_m);
       }
-      const std::vector<float> depth_m = truth.capture(
-          true_joints, true_pose, intrinsics, run.noise_seed * 100000 + static_cast<uint64_t>(k), objects);
+      // A stalled stream: its messages stop at the onset; the monitor's
+      // deadlines, checked every millisecond, must stop the arm. The
+      // latency runs from when the first missing message was due.
+      if (stall && faulty && !result.stopped) {
+        const int64_t due_us = (run.onset_frame + 1) * period_us;
+        for (int64_t t_us = now_us - period_us + 1000; t_us <= now_us; t_us += 1000) {
+          const std::optional<risk_t> timeout = monitor.check_deadlines(t_us);
+          if (!timeout) continue;
+          record_stop(*timeout, k - run.onset_frame + 1, 1e-6 * static_cast<double>(t_us - due_us), 0);
+          break;
+        }
+      }
+      if (kind == Kind::kCameraStall && faulty) {
+        monitor.on_joint_state(state, now_us);  // the joints go on
+        continue;
+      }
+      std::vector<float> depth_m =
+          kind == Kind::kFrozenImage && faulty && !last_depth_m.empty()
+              ? last_depth_m
+              : truth.capture(true_joints, true_pose, intrinsics,
+                              run.noise_seed * 100000 + static_cast<uint64_t>(k), objects);
+      last_depth_m = depth_m;
       const depth_image_t camera =
           make_depth_image(config.camera.id, intrinsics, state.utime, k, /*calibrated=*/true, depth_m);
 
@@ -498,8 +656,11 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
             changed_pixels(model, model_scene, true_joints, true_pose, rendered_result.depth_m, intrinsics,
                            parameters.tolerance.noise);
       }
-      const discrepancy::DiscrepancyFrame frame =
+      discrepancy::DiscrepancyFrame frame =
           discrepancy::compute_discrepancy(camera, rendered, labels, parameters);
+      // As tofguard-discrepancy counts a camera repeating its image.
+      frame.summary.depth_hash = discrepancy::depth_hash(camera.depth_mm);
+      frame.summary.repeat_count = repeats.update(frame.summary.depth_hash);
       if (k < run.onset_frame || run.fault.kind == CampaignFault::Kind::kNone) {
         const discrepancy_t& d = frame.summary;
         auto add_score = [&](double score, double information) {
@@ -526,7 +687,7 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
             add_score(d.camera_score[a], d.camera_information[7 * a]);
       }
       monitor.on_depth(now_us);
-      monitor.on_joint_state(state, now_us);
+      if (!(kind == Kind::kJointStall && faulty)) monitor.on_joint_state(state, now_us);
       for (const risk_t& verdict : monitor.on_frame(frame.summary, now_us)) {
         ++result.frames_judged;
         // An object outside the protective field must never stop the arm:
@@ -548,15 +709,8 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
         if (!after_onset) continue;
         if (!result.stopped) {
           if (verdict.level != risk_t::DANGEROUS) continue;
-          result.stopped = true;
-          result.stop_frames = static_cast<int>(verdict.seq) - run.onset_frame + 1;
-          result.cause = verdict.cause;
-          result.suspect = verdict.suspect;
-          result.detail = verdict.detail;
-          result.stop_score = verdict.score;
-          result.stop_threshold = verdict.threshold;
-          // Judged in the frame it belongs to: the object's distance then.
-          result.object_distance_at_stop_m = object_distance_m;
+          const int frames = static_cast<int>(verdict.seq) - run.onset_frame + 1;
+          record_stop(verdict, frames, frames * period_s, object_distance_m);
           continue;
         }
         if (verdict.level == risk_t::SAFE) ++result.safe_after_stop;
@@ -574,6 +728,16 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
       result.right_suspect = result.right_cause;
       result.object = true;
       result.approaching = run.fault.object_approaches;
+    } else if (kind == Kind::kFrozenImage || stall) {
+      // A sensor fault naming the stream that froze or stopped (a stalled
+      // camera starves the discrepancy stream too: either is right).
+      result.right_cause = result.stopped && result.cause == risk_t::CAUSE_SENSOR_FAULT;
+      const std::string& c = config.channels.joint_state;
+      const bool names_stream = kind == Kind::kJointStall
+                                    ? result.suspect == c
+                                    : result.suspect == config.channels.depth ||
+                                          (stall && result.suspect == config.channels.discrepancy);
+      result.right_suspect = result.right_cause && names_stream;
     }
     result.expected_stop =
         run.fault.kind != CampaignFault::Kind::kNone && !(object_fault && !run.fault.object_in_field);
@@ -587,28 +751,21 @@ std::string campaign_report(const std::string& arm, const std::vector<CampaignRe
   struct Tally {
     int runs = 0, detected = 0, right_cause = 0, right_suspect = 0, false_stops = 0, safe_after = 0,
         switches = 0, frames = 0;
-    std::vector<int> latency;
+    std::vector<double> latency_s;
     int64_t scores = 0, scores_beyond_4 = 0;
     double score_sum_sq = 0, score_max_abs = 0;
     int64_t differences = 0;
     double difference_sum_sq = 0;
   };
-  std::map<std::string, Tally> by_kind;
+  // By group, then magnitude (numerically).
+  std::map<std::pair<std::string, double>, Tally> by_kind;
   std::ostringstream misses;
+  int64_t nominal_frames = 0;
+  int nominal_false_stops = 0;
   for (const CampaignResult& r : results) {
     if (r.object) continue;  // object_report
-    std::string kind = r.label;
-    if (r.label.rfind("camera", 0) == 0) {
-      kind = "camera pose";
-    } else if (r.label.rfind("object", 0) == 0 || r.label.rfind("hand", 0) == 0 ||
-               r.label.rfind("person", 0) == 0 || r.label.rfind("cart", 0) == 0) {
-      kind = r.label;
-    } else if (r.label != "nominal") {
-      // "<joint> +<deg> deg"
-      const size_t sign = r.label.find_last_of("+-");
-      kind = "joint offset " + r.label.substr(sign + 1);
-    }
-    Tally& t = by_kind[kind];
+    const std::string kind = r.group.empty() ? "nominal" : r.group;
+    Tally& t = by_kind[{kind, r.magnitude}];
     t.scores += r.nominal_scores;
     t.score_sum_sq += r.nominal_score_sum_sq;
     t.scores_beyond_4 += r.nominal_scores_beyond_4;
@@ -620,13 +777,17 @@ std::string campaign_report(const std::string& arm, const std::vector<CampaignRe
     t.false_stops += r.false_stop ? 1 : 0;
     if (r.false_stop)
       misses << "- " << arm << ", " << r.label << ": false stop, " << r.false_stop_detail << "\n";
-    if (kind == "nominal") continue;
+    if (kind == "nominal") {
+      nominal_frames += r.frames_judged;
+      nominal_false_stops += r.false_stop ? 1 : 0;
+      continue;
+    }
     t.detected += r.stopped ? 1 : 0;
     t.right_cause += r.right_cause ? 1 : 0;
     t.right_suspect += r.right_suspect ? 1 : 0;
     t.safe_after += r.safe_after_stop;
     t.switches += r.suspect_changes;
-    if (r.stopped) t.latency.push_back(r.stop_frames);
+    if (r.stopped) t.latency_s.push_back(r.stop_latency_s);
     if (std::getenv("TOFGUARD_CAMPAIGN_VERBOSE") != nullptr) {
       misses << "  " << r.label << " (" << r.changed_pixels
              << " px changed): " << (r.stopped ? std::to_string(r.stop_frames) + " frames, " : "no stop, ")
@@ -644,25 +805,24 @@ std::string campaign_report(const std::string& arm, const std::vector<CampaignRe
              << r.suspect_changes << " other cause/suspect\n";
     }
   }
+  if (by_kind.empty()) return "";
   std::ostringstream out;
   out << "| " << arm
-      << " | runs | frames | detected | right cause | right suspect at stop | median / max frames to stop "
-         "(ms) | SAFE after stop | suspect changes | false stops |\n"
+      << " | runs | frames | detected | right cause | right suspect at stop | latency from onset, median / "
+         "p99 / max (ms) | SAFE after stop | suspect changes | false stops |\n"
       << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
-  for (auto& [kind, t] : by_kind) {
-    std::string latency = "-";
-    if (!t.latency.empty()) {
-      std::sort(t.latency.begin(), t.latency.end());
-      const int median = t.latency[t.latency.size() / 2];
-      const int max = t.latency.back();
-      std::ostringstream l;
-      l << median << " / " << max << " (" << std::lround(median * frame_period_s * 1000) << " / "
-        << std::lround(max * frame_period_s * 1000) << ")";
-      latency = l.str();
-    }
-    out << "| " << kind << " | " << t.runs << " | " << t.frames << " | " << t.detected << " | "
-        << t.right_cause << " | " << t.right_suspect << " | " << latency << " | " << t.safe_after << " | "
-        << t.switches << " | " << t.false_stops << " |\n";
+  for (auto& [key, t] : by_kind) {
+    const auto& [group, magnitude] = key;
+    out << "| " << group << magnitude_text(group, magnitude) << " | " << t.runs << " | " << t.frames << " | "
+        << t.detected << " | " << t.right_cause << " | " << t.right_suspect << " | "
+        << latency_text(t.latency_s) << " | " << t.safe_after << " | " << t.switches << " | " << t.false_stops
+        << " |\n";
+  }
+  if (nominal_frames > 0) {
+    const double hours = static_cast<double>(nominal_frames) * frame_period_s / 3600;
+    out << "\nNominal: " << nominal_frames << " frames (" << fixed_text(hours * 60, 1) << " min at "
+        << fixed_text(1 / frame_period_s, 0) << " Hz), " << nominal_false_stops << " false stops ("
+        << fixed_text(nominal_false_stops / hours, 1) << " per hour)\n";
   }
   int64_t scores = 0, beyond = 0, differences = 0;
   double sum_sq = 0, max_abs = 0, difference_sum_sq = 0;
@@ -693,7 +853,7 @@ std::string object_report(const std::string& arm, const std::vector<CampaignResu
   struct Tally {
     int runs = 0, detected = 0, right_cause = 0, false_stops = 0, frames = 0, warnings = 0, pixels = 0;
     bool expected = true;
-    std::vector<int> latency;
+    std::vector<double> latency_s;
     std::vector<double> onset_m, min_m, at_stop_m, s_m, first_seen_m;
   };
   const risk::RiskSettings& r = config.risk;
@@ -702,7 +862,6 @@ std::string object_report(const std::string& arm, const std::vector<CampaignResu
   const double after_verdict_m =
       r.field_approach_speed_m_s * (r.field_chain_latency_us + r.field_stopping_time_us) * 1e-6 +
       r.field_stopping_distance_m;
-  const double period_s = 1.0 / config.camera.rate_hz;
   std::map<std::string, Tally> by_kind;
   std::vector<std::string> order;
   std::ostringstream misses;
@@ -732,7 +891,7 @@ std::string object_report(const std::string& arm, const std::vector<CampaignResu
     t.detected += res.stopped ? 1 : 0;
     t.right_cause += res.right_cause ? 1 : 0;
     if (res.stopped) {
-      t.latency.push_back(res.stop_frames);
+      t.latency_s.push_back(res.stop_latency_s);
       t.at_stop_m.push_back(res.object_distance_at_stop_m);
       if (res.right_cause) t.s_m.push_back(res.stop_threshold);
     }
@@ -772,30 +931,173 @@ std::string object_report(const std::string& arm, const std::vector<CampaignResu
       << " | runs | in the field at rest | object px at onset (mean) | distance at onset, median (cm) | "
          "first in view, "
          "median (cm) | nearest (cm) | "
-         "stopped | as unknown object | median / max frames to stop (ms) | distance at the stop, least (cm) "
+         "stopped | as unknown object | latency from onset, median / p99 / max (ms) | distance at the stop, "
+         "least (cm) "
          "| "
          "S at the stop, median (cm) | WARNING frames | false stops |\n"
       << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
   for (const std::string& kind : order) {
     Tally& t = by_kind[kind];
-    std::string latency = "-";
-    if (!t.latency.empty()) {
-      std::sort(t.latency.begin(), t.latency.end());
-      const int med = t.latency[t.latency.size() / 2];
-      const int max = t.latency.back();
-      latency = std::to_string(med) + " / " + std::to_string(max) + " (" +
-                std::to_string(std::lround(med * period_s * 1000)) + " / " +
-                std::to_string(std::lround(max * period_s * 1000)) + ")";
-    }
     out << "| " << kind << " | " << t.runs << " | " << (t.expected ? "yes" : "no") << " | "
         << t.pixels / t.runs << " | " << median(t.onset_m) << " | " << median(t.first_seen_m) << " | "
-        << least(t.min_m) << " | " << t.detected << " | " << t.right_cause << " | " << latency << " | "
-        << least(t.at_stop_m) << " | " << median(t.s_m) << " | " << t.warnings << " | " << t.false_stops
-        << " |\n";
+        << least(t.min_m) << " | " << t.detected << " | " << t.right_cause << " | "
+        << latency_text(t.latency_s) << " | " << least(t.at_stop_m) << " | " << median(t.s_m) << " | "
+        << t.warnings << " | " << t.false_stops << " |\n";
   }
   const std::string m = misses.str();
   if (!m.empty()) out << "\n" << m;
   return out.str();
+}
+
+std::string campaign_tsv(const std::string& arm, const std::vector<CampaignResult>& results, bool header) {
+  std::ostringstream out;
+  if (header) {
+    out << "arm\tgroup\tmagnitude\tunit\tlabel\texpected_stop\tstopped\tright_cause\tright_suspect\t"
+           "latency_ms\tfalse_stop\tframes\tchanged_pixels\n";
+  }
+  for (const CampaignResult& r : results) {
+    out << arm << "\t" << (r.group.empty() ? "nominal" : r.group) << "\t" << r.magnitude << "\t"
+        << magnitude_unit(r.group) << "\t" << r.label << "\t" << r.expected_stop << "\t" << r.stopped << "\t"
+        << r.right_cause << "\t" << r.right_suspect << "\t"
+        << (r.stopped ? fixed_text(1000 * r.stop_latency_s, 1) : std::string("")) << "\t" << r.false_stop
+        << "\t" << r.frames_judged << "\t" << r.changed_pixels << "\n";
+  }
+  return out.str();
+}
+
+namespace {
+
+const cv::Scalar kPlotColours[] = {{200, 60, 30}, {30, 120, 220}, {40, 160, 40}, {160, 40, 160},
+                                   {0, 160, 200}, {90, 90, 90},   {220, 140, 0}, {120, 60, 0}};
+
+struct PlotPoint {
+  int runs = 0, detected = 0;
+  std::vector<double> latency_ms;
+};
+// arm -> magnitude -> runs there.
+using PlotSeries = std::map<std::string, std::map<double, PlotPoint>>;
+
+// One panel: a curve per arm of `value(point, 0)` against the magnitude
+// (and of `value(point, 1)`, thinner and open, when `with_second`), in the
+// rectangle `area` of `image`; `value` returns NaN for no value.
+template <typename Value>
+void draw_panel(cv::Mat* image, const cv::Rect& area, const PlotSeries& series, const std::string& title,
+                const std::string& x_label, double y_max, const std::string& y_label, Value value,
+                bool with_second = false) {
+  const cv::Scalar black(0, 0, 0), grey(200, 200, 200);
+  double x_max = 0;
+  std::vector<double> ticks;
+  for (const auto& [arm, points] : series)
+    for (const auto& [m, p] : points) {
+      x_max = std::max(x_max, m);
+      if (std::find(ticks.begin(), ticks.end(), m) == ticks.end()) ticks.push_back(m);
+    }
+  x_max *= 1.08;
+  if (!(y_max > 0)) y_max = 1;
+  const int left = area.x + 70, right = area.x + area.width - 20, top = area.y + 70,
+            bottom = area.y + area.height - 50;
+  auto px = [&](double x, double y) {
+    return cv::Point(left + static_cast<int>((right - left) * x / x_max),
+                     bottom - static_cast<int>((bottom - top) * std::min(y, y_max) / y_max));
+  };
+  const int font = cv::FONT_HERSHEY_SIMPLEX;
+  cv::putText(*image, title, {area.x + 10, area.y + 25}, font, 0.6, black, 1, cv::LINE_AA);
+  for (int i = 0; i <= 4; ++i) {
+    const double y = y_max * i / 4;
+    cv::line(*image, px(0, y), px(x_max, y), grey, 1);
+    cv::putText(*image, fixed_text(y, y_max < 10 ? 1 : 0), {area.x + 5, px(0, y).y + 5}, font, 0.4, black, 1,
+                cv::LINE_AA);
+  }
+  for (double t : ticks) {
+    cv::line(*image, px(t, 0), px(t, 0) + cv::Point(0, 5), black, 1);
+    std::ostringstream l;
+    l << t;
+    cv::putText(*image, l.str(), px(t, 0) + cv::Point(-8, 20), font, 0.4, black, 1, cv::LINE_AA);
+  }
+  cv::line(*image, px(0, 0), px(x_max, 0), black, 1);
+  cv::line(*image, px(0, 0), px(0, y_max), black, 1);
+  cv::putText(*image, x_label, {(left + right) / 2 - 40, bottom + 40}, font, 0.45, black, 1, cv::LINE_AA);
+  cv::putText(*image, y_label, {area.x + 5, top - 10}, font, 0.45, black, 1, cv::LINE_AA);
+  int i = 0;
+  for (const auto& [arm, points] : series) {
+    const cv::Scalar colour = kPlotColours[i % 8];
+    for (int curve = 0; curve < (with_second ? 2 : 1); ++curve) {
+      std::optional<cv::Point> previous;
+      for (const auto& [m, p] : points) {
+        const double y = value(p, curve);
+        if (std::isnan(y)) {
+          previous.reset();
+          continue;
+        }
+        const cv::Point here = px(m, y);
+        cv::circle(*image, here, curve == 0 ? 4 : 3, colour, curve == 0 ? cv::FILLED : 1, cv::LINE_AA);
+        if (previous) cv::line(*image, *previous, here, colour, curve == 0 ? 2 : 1, cv::LINE_AA);
+        previous = here;
+      }
+    }
+    ++i;
+  }
+}
+
+}  // namespace
+
+std::vector<std::string> plot_campaign(const std::string& tsv_text, const std::string& dir) {
+  // group -> (unit, series)
+  std::map<std::string, std::pair<std::string, PlotSeries>> groups;
+  std::istringstream in(tsv_text);
+  std::string line;
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::stringstream fields(line);
+    for (std::string field; std::getline(fields, field, '\t');) f.push_back(field);
+    if (f.size() < 13 || f[0] == "arm" || f[3].empty() || f[5] != "1") continue;  // sized faults
+    auto& [unit, series] = groups[f[1]];
+    unit = f[3];
+    PlotPoint& p = series[f[0]][std::stod(f[2])];
+    ++p.runs;
+    if (f[6] == "1") {
+      ++p.detected;
+      p.latency_ms.push_back(std::stod(f[9]));
+    }
+  }
+  fs::create_directories(dir);
+  std::vector<std::string> written;
+  for (auto& [group, unit_series] : groups) {
+    auto& [unit, series] = unit_series;
+    double latency_max = 0;
+    for (auto& [arm, points] : series)
+      for (auto& [m, p] : points) {
+        std::sort(p.latency_ms.begin(), p.latency_ms.end());
+        if (!p.latency_ms.empty()) latency_max = std::max(latency_max, quantile(p.latency_ms, 0.99));
+      }
+    const int legend_h = 22 * static_cast<int>(series.size()) + 20;
+    cv::Mat image(640 + legend_h, 1000, CV_8UC3, cv::Scalar(255, 255, 255));
+    const std::string x_label = group + " (" + unit + ")";
+    draw_panel(&image, {0, 0, 500, 640}, series, "detection rate: " + group, x_label, 100,
+               "% of runs stopped", [](const PlotPoint& p, int) { return 100.0 * p.detected / p.runs; });
+    draw_panel(
+        &image, {500, 0, 500, 640}, series, "latency from onset (median filled, p99 open)", x_label,
+        latency_max * 1.1, "ms",
+        [](const PlotPoint& p, int curve) {
+          if (p.latency_ms.empty()) return std::nan("");
+          return quantile(p.latency_ms, curve == 0 ? 0.5 : 0.99);
+        },
+        /*with_second=*/true);
+    int i = 0;
+    for (const auto& [arm, points] : series) {
+      const int y = 650 + 22 * i;
+      cv::line(image, {30, y}, {70, y}, kPlotColours[i % 8], 2, cv::LINE_AA);
+      cv::putText(image, arm, {80, y + 5}, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 1,
+                  cv::LINE_AA);
+      ++i;
+    }
+    std::string name = group;
+    std::replace(name.begin(), name.end(), ' ', '-');
+    const std::string path = dir + "/detection-" + name + ".png";
+    if (!cv::imwrite(path, image)) throw std::runtime_error(path + ": cannot write the plot");
+    written.push_back(path);
+  }
+  return written;
 }
 
 }  // namespace tofguard::test

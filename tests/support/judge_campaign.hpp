@@ -49,10 +49,27 @@ std::optional<CampaignArm> iiwa14_campaign_arm(const std::string& shared_dir, co
 std::optional<CampaignArm> kinova_gen3_campaign_arm(const std::string& shared_dir,
                                                     const std::string& scene_dir);
 
+// `arm` watched by a camera at `rate_hz` (camera.rate_hz: the evidence
+// tests' threshold and the protective field's response time follow it).
+CampaignArm with_camera_rate(const CampaignArm& arm, double rate_hz);
+// `arm` watched from a second placement: its camera pose turned by
+// `turn_deg` about the world's vertical (z) axis through the robot's root
+// (the world origin), so the camera sees the arm from another side.
+CampaignArm with_camera_turned(const CampaignArm& arm, double turn_deg);
+
 // A fault from frame `onset_frame` on (none: kind kNone).
 struct CampaignFault {
-  enum class Kind { kNone, kJointOffset, kCameraPose, kObject };
+  // kFrozenImage: from the onset the camera repeats the image before it,
+  // byte for byte (a frozen driver), while the joints go on moving.
+  // kCameraStall / kJointStall: from the onset no depth frame / no joint
+  // state arrives (the monitor's input deadlines; the frames judged are
+  // the ones still arriving).
+  enum class Kind { kNone, kJointOffset, kCameraPose, kObject, kFrozenImage, kCameraStall, kJointStall };
   Kind kind = Kind::kNone;
+  // The fault's kind and size for the report and the plots (e.g. "joint
+  // offset", 5 (deg); "camera translation", 2 (cm)); size 0: no size.
+  std::string group;
+  double magnitude = 0;
   // kJointOffset: the joint reports `offset` (rad; m prismatic) more than
   // its true position.
   std::string joint;
@@ -91,12 +108,18 @@ struct CampaignRun {
 // What happened in one run.
 struct CampaignResult {
   std::string label;
+  std::string group;  // CampaignFault::group, magnitude
+  double magnitude = 0;
   // A DANGEROUS verdict before the onset (a false stop), its detail.
   bool false_stop = false;
   std::string false_stop_detail;
   // The first DANGEROUS verdict at or after the onset.
   bool stopped = false;
   int stop_frames = 0;  // frames from onset to the stop, the onset frame counted as 1
+  // Time from the onset (the capture time of the first faulty frame, or
+  // the time the first missing message was due) to the stop's verdict, on
+  // the campaign's clock (one frame period a frame; no transport).
+  double stop_latency_s = 0;
   int8_t cause = 0;
   std::string suspect;
   std::string detail;
@@ -150,11 +173,20 @@ struct CampaignResult {
 // Throws std::runtime_error when the scene cannot be loaded or rendered.
 std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vector<CampaignRun>& runs);
 
-// The fault set of issue 14's targets on `arm`: every actuated joint at
-// each of `joint_offsets_deg` (signs alternating), the camera moved by 2 cm
-// along x, y, z and 3 cm along z, and turned 1 degree about x, y, z.
-std::vector<CampaignRun> standard_fault_runs(const CampaignArm& arm,
-                                             const std::vector<double>& joint_offsets_deg);
+// Issue 15's matrix: every actuated joint at each of `joint_offsets_deg`;
+// the camera moved by each of `camera_translations_cm` along its optical
+// x, y and z (the optical axis) and turned by each of
+// `camera_rotations_deg` about x, y and z (signs alternating).
+struct FaultMagnitudes {
+  std::vector<double> joint_offsets_deg;
+  std::vector<double> camera_translations_cm;
+  std::vector<double> camera_rotations_deg;
+};
+std::vector<CampaignRun> fault_runs(const CampaignArm& arm, const FaultMagnitudes& magnitudes);
+
+// Streams that stop or freeze: the camera repeating its image, the camera
+// stream stalled and the joint stream stalled, `runs_each` runs each.
+std::vector<CampaignRun> stream_fault_runs(int runs_each);
 
 // Issue 15's objects on `arm`: a 10 cm cube held still beside the arm at
 // each of `distances_m`; a hand-sized box (10 x 10 x 20 cm) approaching
@@ -164,8 +196,14 @@ std::vector<CampaignRun> standard_fault_runs(const CampaignArm& arm,
 std::vector<CampaignRun> object_runs(const CampaignArm& arm, const std::vector<double>& distances_m,
                                      double beyond_m);
 
-// Nominal: `seconds` of frames without a fault, split into runs of `run_s`.
-std::vector<CampaignRun> nominal_runs(double seconds, double run_s, uint64_t seed);
+// Nominal: `seconds` of frames at `rate_hz` without a fault, split into
+// runs of `run_s`.
+std::vector<CampaignRun> nominal_runs(double seconds, double run_s, double rate_hz, uint64_t seed);
+
+// People and carts walking past beyond the warning field of the arm at
+// rest, one after another, for `seconds` in all (issue 15's false-stop
+// target: they may warn, never stop).
+std::vector<CampaignRun> passer_runs(const CampaignArm& arm, double seconds, uint64_t seed);
 
 // A markdown table of the object runs of `results` per kind (issue 15):
 // runs, the object's pixels and distances, detection, latency, the
@@ -177,8 +215,20 @@ std::string object_report(const std::string& arm, const std::vector<CampaignResu
                           const deployment::Config& config);
 
 // A markdown table of `results` (object runs left out) per fault kind and a
-// line per run that missed a target.
+// line per run that missed a target; "" when there are none.
 std::string campaign_report(const std::string& arm, const std::vector<CampaignResult>& results,
                             double frame_period_s);
+
+// One tab-separated line per run (arm with its rate and placement, group,
+// magnitude, unit, label, expected stop, stopped, right cause, right
+// suspect, latency from onset in ms, false stop, frames judged, pixels the
+// fault changed), after a header line when `header`.
+std::string campaign_tsv(const std::string& arm, const std::vector<CampaignResult>& results, bool header);
+
+// PNG plots from campaign_tsv's lines: per fault group, the detection rate
+// and the median and p99 latency (ms) against the magnitude, one curve per
+// arm (and rate and placement). Writes <dir>/detection-<group>.png and
+// returns the paths. Throws std::runtime_error when a file cannot be written.
+std::vector<std::string> plot_campaign(const std::string& csv_text, const std::string& dir);
 
 }  // namespace tofguard::test

@@ -10,10 +10,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <iostream>
+
+#include <opencv2/imgcodecs.hpp>
 
 #include "judge_campaign.hpp"
 #include "test_support.hpp"
+#include "tofguard/risk/risk_settings.hpp"
 #include "tofguard/risk_t.hpp"
 
 namespace tofguard::test {
@@ -23,7 +27,7 @@ int sim_config_debounce_frames() { return default_campaign_arm().config.risk.deb
 
 std::vector<CampaignRun> short_runs(const CampaignArm& arm) {
   std::vector<CampaignRun> runs;
-  for (CampaignRun& run : standard_fault_runs(arm, {5})) {
+  for (CampaignRun& run : fault_runs(arm, {{5}, {2}, {1}})) {
     const std::string& label = run.fault.label;
     // The joints, and three of the camera cases.
     if (run.fault.kind == CampaignFault::Kind::kCameraPose && label != "camera 2 cm along z (optical axis)" &&
@@ -112,6 +116,78 @@ void expect_targets(const CampaignArm& arm) {
 }
 
 TEST(JudgeCampaign, DefaultArm) { expect_targets(default_campaign_arm()); }
+
+// Frozen and stalled streams (arm-independent: the default arm): each
+// stopped as a sensor fault naming its stream, a stall within its
+// deadline (config/sim.yaml risk.deadlines_ms) of the first missing
+// message, a frozen image once frozen_repeat_frames repeats are debounced.
+TEST(JudgeCampaign, FrozenAndStalledStreams) {
+  const CampaignArm arm = default_campaign_arm();
+  const risk::RiskSettings& r = arm.config.risk;
+  const double period_s = 1.0 / arm.config.camera.rate_hz;
+  const std::vector<CampaignResult> results = run_campaign(arm, stream_fault_runs(2));
+  std::cout << campaign_report(arm.name, results, period_s);
+  ASSERT_EQ(results.size(), 6u);
+  for (const CampaignResult& res : results) {
+    SCOPED_TRACE(res.label);
+    EXPECT_FALSE(res.false_stop) << res.false_stop_detail;
+    ASSERT_TRUE(res.stopped);
+    EXPECT_TRUE(res.right_cause) << res.detail;
+    EXPECT_TRUE(res.right_suspect) << res.suspect << ": " << res.detail;
+    EXPECT_EQ(res.safe_after_stop, 0);
+    if (res.group == "joint stream stalled") {
+      // From the last state's arrival: the deadline; from when the next
+      // was due: one period less (1 ms checks).
+      EXPECT_LE(res.stop_latency_s, 1e-6 * static_cast<double>(r.joint_state_deadline_us) - period_s + 1e-3);
+      EXPECT_GT(res.stop_latency_s, 1e-6 * static_cast<double>(r.joint_state_deadline_us) - period_s - 2e-3);
+    } else if (res.group == "camera stream stalled") {
+      EXPECT_LE(res.stop_latency_s, 1e-6 * static_cast<double>(r.depth_deadline_us) - period_s + 1e-3);
+      EXPECT_GT(res.stop_latency_s, 1e-6 * static_cast<double>(r.depth_deadline_us) - period_s - 2e-3);
+    } else {
+      // The first repeat is the onset frame; frozen_repeat_frames repeats
+      // make it a finding, debounced over sensor_debounce_frames.
+      EXPECT_EQ(res.stop_frames, r.frozen_repeat_frames + r.sensor_debounce_frames - 1) << res.detail;
+    }
+  }
+}
+
+// The plots: a PNG per sized fault kind, from the runs' lines.
+TEST(JudgeCampaign, PlotsFromRunLines) {
+  auto result = [](const std::string& group, double magnitude, bool stopped, double latency_s) {
+    CampaignResult r;
+    r.group = group;
+    r.magnitude = magnitude;
+    r.label = group;
+    r.expected_stop = true;
+    r.stopped = stopped;
+    r.stop_latency_s = latency_s;
+    return r;
+  };
+  const std::string tsv =
+      campaign_tsv("arm A",
+                   {result("joint offset", 2, false, 0), result("joint offset", 5, true, 0.033),
+                    result("camera rotation", 1, true, 0.033)},
+                   true) +
+      campaign_tsv("arm B",
+                   {result("joint offset", 2, true, 0.1), result("camera stream stalled", 0, true, 0.1)},
+                   false);
+  EXPECT_EQ(std::count(tsv.begin(), tsv.end(), '\n'), 6);
+  const std::string dir = output_dir() + "/judge_campaign_plots";
+  std::filesystem::remove_all(dir);
+  const std::vector<std::string> paths = plot_campaign(tsv, dir);
+  // Two sized kinds; the stall has no magnitude to plot against.
+  ASSERT_EQ(paths.size(), 2u);
+  for (const std::string& path : paths) {
+    SCOPED_TRACE(path);
+    const cv::Mat image = cv::imread(path);
+    ASSERT_FALSE(image.empty());
+    EXPECT_EQ(image.cols, 1000);
+    // Not blank: the curves and the text.
+    EXPECT_LT(cv::mean(image)[0], 254.0);
+  }
+  EXPECT_NE(paths[0].find("detection-camera-rotation.png"), std::string::npos);
+  EXPECT_NE(paths[1].find("detection-joint-offset.png"), std::string::npos);
+}
 
 TEST(JudgeCampaign, Iiwa14) {
   const std::optional<CampaignArm> arm = iiwa14_campaign_arm(shared_dir(), output_dir() + "/judge_campaign");
