@@ -4,7 +4,8 @@
 // skipped when absent): issue 14's targets on a short campaign (every joint
 // 5 degrees off, the camera moved 2 cm along its optical axis and sideways
 // and turned 1 degree), and issue 15's objects (a cube inside the protective
-// field, a person and a cart beyond the warning field).
+// field, a person and a cart beyond the warning field), the iiwa14 also at
+// 25 Hz from a second camera placement, and frozen and stalled streams.
 // tofguard-judge-campaign runs the long ones (docs/safety-chain.md,
 // "Measured"; docs/detection.md).
 #include <gtest/gtest.h>
@@ -194,6 +195,18 @@ TEST(JudgeCampaign, Iiwa14) {
   if (!arm)
     GTEST_SKIP() << "the iiwa14 is not under ../shared/robots (shared_dir() '" << shared_dir() << "')";
   expect_targets(*arm);
+}
+
+// Another camera rate and placement (issue 15: nothing tuned to one
+// camera): the iiwa14 at 25 Hz, its camera turned 40 degrees about the
+// vertical through the robot's root.
+TEST(JudgeCampaign, Iiwa14At25HzFromASecondPlacement) {
+  const std::optional<CampaignArm> arm = iiwa14_campaign_arm(shared_dir(), output_dir() + "/judge_campaign");
+  if (!arm)
+    GTEST_SKIP() << "the iiwa14 is not under ../shared/robots (shared_dir() '" << shared_dir() << "')";
+  const CampaignArm moved = with_camera_rate(with_camera_turned(*arm, 40), 25);
+  ASSERT_EQ(moved.config.camera.rate_hz, 25);
+  expect_targets(moved);
 }
 
 TEST(JudgeCampaign, KinovaGen3) {
