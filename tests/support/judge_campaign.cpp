@@ -1,6 +1,7 @@
 #include "judge_campaign.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -1042,8 +1043,9 @@ void draw_panel(cv::Mat* image, const cv::Rect& area, const PlotSeries& series, 
 }  // namespace
 
 std::vector<std::string> plot_campaign(const std::string& tsv_text, const std::string& dir) {
-  // group -> (unit, series)
-  std::map<std::string, std::pair<std::string, PlotSeries>> groups;
+  // (group, robot) -> (unit, series by the rest of the arm's name: its
+  // rate and placement). The robot is the arm's name before ", ".
+  std::map<std::pair<std::string, std::string>, std::pair<std::string, PlotSeries>> plots;
   std::istringstream in(tsv_text);
   std::string line;
   while (std::getline(in, line)) {
@@ -1051,49 +1053,69 @@ std::vector<std::string> plot_campaign(const std::string& tsv_text, const std::s
     std::stringstream fields(line);
     for (std::string field; std::getline(fields, field, '\t');) f.push_back(field);
     if (f.size() < 13 || f[0] == "arm" || f[3].empty() || f[5] != "1") continue;  // sized faults
-    auto& [unit, series] = groups[f[1]];
+    const size_t comma = f[0].find(", ");
+    const std::string robot = f[0].substr(0, comma);
+    const std::string variant = comma == std::string::npos ? "as configured" : f[0].substr(comma + 2);
+    auto& [unit, series] = plots[{f[1], robot}];
     unit = f[3];
-    PlotPoint& p = series[f[0]][std::stod(f[2])];
+    PlotPoint& p = series[variant][std::stod(f[2])];
     ++p.runs;
     if (f[6] == "1") {
       ++p.detected;
       p.latency_ms.push_back(std::stod(f[9]));
     }
   }
+  // A file name of `text`: lower-case letters and digits, '-' between.
+  const auto slug = [](const std::string& text) {
+    std::string out;
+    for (char c : text) {
+      if (std::isalnum(static_cast<unsigned char>(c)) != 0) {
+        out += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      } else if (!out.empty() && out.back() != '-') {
+        out += '-';
+      }
+    }
+    while (!out.empty() && out.back() == '-') out.pop_back();
+    return out;
+  };
   fs::create_directories(dir);
   std::vector<std::string> written;
-  for (auto& [group, unit_series] : groups) {
+  for (auto& [key, unit_series] : plots) {
+    const auto& [group, robot] = key;
     auto& [unit, series] = unit_series;
     double latency_max = 0;
-    for (auto& [arm, points] : series)
+    for (auto& [variant, points] : series)
       for (auto& [m, p] : points) {
         std::sort(p.latency_ms.begin(), p.latency_ms.end());
         if (!p.latency_ms.empty()) latency_max = std::max(latency_max, quantile(p.latency_ms, 0.99));
       }
+    // The latency axis up to a round number: 1, 2 or 5 times a power of 10.
+    double latency_axis = 1;
+    while (latency_axis < 1.05 * latency_max) {
+      latency_axis *= (std::to_string(static_cast<long>(latency_axis))[0] == '2') ? 2.5 : 2;
+    }
     const int legend_h = 22 * static_cast<int>(series.size()) + 20;
-    cv::Mat image(640 + legend_h, 1000, CV_8UC3, cv::Scalar(255, 255, 255));
+    cv::Mat image(560 + legend_h, 900, CV_8UC3, cv::Scalar(255, 255, 255));
     const std::string x_label = group + " (" + unit + ")";
-    draw_panel(&image, {0, 0, 500, 640}, series, "detection rate: " + group, x_label, 100,
+    draw_panel(&image, {0, 0, 450, 560}, series, robot + ": detection rate", x_label, 100,
                "% of runs stopped", [](const PlotPoint& p, int) { return 100.0 * p.detected / p.runs; });
     draw_panel(
-        &image, {500, 0, 500, 640}, series, "latency from onset (median filled, p99 open)", x_label,
-        latency_max * 1.1, "ms",
+        &image, {450, 0, 450, 560}, series, "latency from onset (median filled, p99 open)", x_label,
+        latency_axis, "ms",
         [](const PlotPoint& p, int curve) {
           if (p.latency_ms.empty()) return std::nan("");
           return quantile(p.latency_ms, curve == 0 ? 0.5 : 0.99);
         },
         /*with_second=*/true);
     int i = 0;
-    for (const auto& [arm, points] : series) {
-      const int y = 650 + 22 * i;
+    for (const auto& [variant, points] : series) {
+      const int y = 570 + 22 * i;
       cv::line(image, {30, y}, {70, y}, kPlotColours[i % 8], 2, cv::LINE_AA);
-      cv::putText(image, arm, {80, y + 5}, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 1,
-                  cv::LINE_AA);
+      cv::putText(image, robot + ", " + variant, {80, y + 5}, cv::FONT_HERSHEY_SIMPLEX, 0.45,
+                  cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
       ++i;
     }
-    std::string name = group;
-    std::replace(name.begin(), name.end(), ' ', '-');
-    const std::string path = dir + "/detection-" + name + ".png";
+    const std::string path = dir + "/detection-" + slug(group) + "-" + slug(robot) + ".png";
     if (!cv::imwrite(path, image)) throw std::runtime_error(path + ": cannot write the plot");
     written.push_back(path);
   }

@@ -225,10 +225,11 @@ std::string campaign_report(const std::string& arm, const std::vector<CampaignRe
 // fault changed), after a header line when `header`.
 std::string campaign_tsv(const std::string& arm, const std::vector<CampaignResult>& results, bool header);
 
-// PNG plots from campaign_tsv's lines: per fault group, the detection rate
-// and the median and p99 latency (ms) against the magnitude, one curve per
-// arm (and rate and placement). Writes <dir>/detection-<group>.png and
-// returns the paths. Throws std::runtime_error when a file cannot be written.
+// PNG plots from campaign_tsv's lines: per fault group with a magnitude and
+// robot (the arm's name before ", "), the detection rate and the median and
+// p99 latency (ms) against the magnitude, a curve per rate and placement.
+// Writes <dir>/detection-<group>-<robot>.png (lower case, '-' for spaces)
+// and returns the paths. Throws std::runtime_error when a file cannot be written.
 std::vector<std::string> plot_campaign(const std::string& csv_text, const std::string& dir);
 
 }  // namespace tofguard::test

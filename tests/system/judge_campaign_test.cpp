@@ -152,7 +152,7 @@ TEST(JudgeCampaign, FrozenAndStalledStreams) {
   }
 }
 
-// The plots: a PNG per sized fault kind, from the runs' lines.
+// The plots: a PNG per sized fault kind and robot, from the runs' lines.
 TEST(JudgeCampaign, PlotsFromRunLines) {
   auto result = [](const std::string& group, double magnitude, bool stopped, double latency_s) {
     CampaignResult r;
@@ -165,29 +165,32 @@ TEST(JudgeCampaign, PlotsFromRunLines) {
     return r;
   };
   const std::string tsv =
-      campaign_tsv("arm A",
+      campaign_tsv("arm A, 25 Hz",
                    {result("joint offset", 2, false, 0), result("joint offset", 5, true, 0.033),
                     result("camera rotation", 1, true, 0.033)},
                    true) +
+      campaign_tsv("arm A, 30 Hz", {result("joint offset", 2, true, 0.1)}, false) +
       campaign_tsv("arm B",
                    {result("joint offset", 2, true, 0.1), result("camera stream stalled", 0, true, 0.1)},
                    false);
-  EXPECT_EQ(std::count(tsv.begin(), tsv.end(), '\n'), 6);
+  EXPECT_EQ(std::count(tsv.begin(), tsv.end(), '\n'), 7);
   const std::string dir = output_dir() + "/judge_campaign_plots";
   std::filesystem::remove_all(dir);
   const std::vector<std::string> paths = plot_campaign(tsv, dir);
-  // Two sized kinds; the stall has no magnitude to plot against.
-  ASSERT_EQ(paths.size(), 2u);
+  // A plot per sized kind and robot (arm A's two rates in one); the stall
+  // has no magnitude to plot against.
+  ASSERT_EQ(paths.size(), 3u);
   for (const std::string& path : paths) {
     SCOPED_TRACE(path);
     const cv::Mat image = cv::imread(path);
     ASSERT_FALSE(image.empty());
-    EXPECT_EQ(image.cols, 1000);
+    EXPECT_EQ(image.cols, 900);
     // Not blank: the curves and the text.
     EXPECT_LT(cv::mean(image)[0], 254.0);
   }
-  EXPECT_NE(paths[0].find("detection-camera-rotation.png"), std::string::npos);
-  EXPECT_NE(paths[1].find("detection-joint-offset.png"), std::string::npos);
+  EXPECT_NE(paths[0].find("detection-camera-rotation-arm-a.png"), std::string::npos);
+  EXPECT_NE(paths[1].find("detection-joint-offset-arm-a.png"), std::string::npos);
+  EXPECT_NE(paths[2].find("detection-joint-offset-arm-b.png"), std::string::npos);
 }
 
 TEST(JudgeCampaign, Iiwa14) {
