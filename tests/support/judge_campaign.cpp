@@ -134,7 +134,7 @@ std::string magnitude_text(const std::string& group, double magnitude) {
   return s.str();
 }
 
-// The value of nearest rank `q` (0..1) of sorted `v`.
+// The value of nearest rank `q` (0..1) of `sorted` (ascending).
 double quantile(const std::vector<double>& sorted, double q) {
   const size_t rank = static_cast<size_t>(std::ceil(q * static_cast<double>(sorted.size())));
   return sorted[std::clamp<size_t>(rank, 1, sorted.size()) - 1];
