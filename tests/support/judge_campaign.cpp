@@ -409,7 +409,7 @@ std::vector<CampaignRun> passer_runs(const CampaignArm& arm, double seconds, uin
     CampaignRun run;
     const bool cart = runs.size() % 2 == 1;
     run.fault = passer(at_rest, 0.1, cart, side);
-    if (runs.size() % 2 == 1) side = -side;
+    if (cart) side = -side;
     // It starts where its path comes nearest the arm and walks on across
     // the view, on alternating sides of the image.
     run.onset_frame = static_cast<int>(std::lround(rate_hz));
@@ -638,7 +638,7 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
               ? last_depth_m
               : truth.capture(true_joints, true_pose, intrinsics,
                               run.noise_seed * 100000 + static_cast<uint64_t>(k), objects);
-      last_depth_m = depth_m;
+      if (kind == Kind::kFrozenImage) last_depth_m = depth_m;
       const depth_image_t camera =
           make_depth_image(config.camera.id, intrinsics, state.utime, k, /*calibrated=*/true, depth_m);
 
@@ -733,9 +733,8 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
       // A sensor fault naming the stream that froze or stopped (a stalled
       // camera starves the discrepancy stream too: either is right).
       result.right_cause = result.stopped && result.cause == risk_t::CAUSE_SENSOR_FAULT;
-      const std::string& c = config.channels.joint_state;
       const bool names_stream = kind == Kind::kJointStall
-                                    ? result.suspect == c
+                                    ? result.suspect == config.channels.joint_state
                                     : result.suspect == config.channels.depth ||
                                           (stall && result.suspect == config.channels.discrepancy);
       result.right_suspect = result.right_cause && names_stream;
