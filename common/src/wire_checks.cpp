@@ -239,6 +239,21 @@ std::string check_evidence(const discrepancy_t& d) {
   if (!(std::isfinite(d.static_chi2) && d.static_chi2 >= 0)) {
     return expected("static_chi2", "a finite sum >= 0", d.static_chi2);
   }
+  for (int r = 0; r < 4; ++r) {
+    if (d.camera_region_fit_pixels[r] < 0) {
+      return expected("camera_region_fit_pixels[" + std::to_string(r) + "]", "a count >= 0",
+                      d.camera_region_fit_pixels[r]);
+    }
+  }
+  if (auto p = finite_array(d.camera_region_score, 24, "camera_region_score"); !p.empty()) return p;
+  if (auto p = finite_array(d.camera_region_information, 24, "camera_region_information"); !p.empty())
+    return p;
+  for (int k = 0; k < 24; ++k) {
+    if (d.camera_region_information[k] < 0) {
+      return expected("camera_region_information[" + std::to_string(k) + "]", "an information >= 0",
+                      d.camera_region_information[k]);
+    }
+  }
   if (auto p = check_count(d.num_joints, d.joint_name, "joint_name", "num_joints"); !p.empty()) return p;
   if (auto p = check_count(d.num_joints, d.joint_fit_pixels, "joint_fit_pixels", "num_joints"); !p.empty())
     return p;

@@ -144,6 +144,9 @@ void clear_evidence(discrepancy_t* s) {
   std::fill(s->camera_information, s->camera_information + 36, 0.0);
   std::fill(s->camera_correction, s->camera_correction + 6, 0.0);
   s->static_chi2 = 0;
+  std::fill(s->camera_region_fit_pixels, s->camera_region_fit_pixels + 4, 0);
+  std::fill(s->camera_region_score, s->camera_region_score + 24, 0.0);
+  std::fill(s->camera_region_information, s->camera_region_information + 24, 0.0);
   s->num_joints = 0;
   s->joint_name.clear();
   s->joint_fit_pixels.clear();
@@ -193,6 +196,8 @@ void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered
   const int16_t* gen = rendered.depth_mm.data();
   const double model_var = parameters.model_sigma_mm * parameters.model_sigma_mm;
   const double inv_pps = 1.0 / parameters.pixels_per_sample;
+  const int half_width = camera.width / 2;
+  const int half_height = camera.height / 2;
   for (int i = 0; i < num_pixels; ++i) {
     const int t = tof[i];
     if (t <= 0 || gen[i] <= 0 || silhouette[i]) continue;
@@ -233,11 +238,18 @@ void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered
       // judge that; in the camera fit it would pull the pose.
       if (!in_naming_fit) continue;
       ++s.camera_fit_pixels;
+      // The image quadrant (discrepancy_t.camera_region_*).
+      const int region = (i % camera.width >= half_width ? 1 : 0) + (i / camera.width >= half_height ? 2 : 0);
+      ++s.camera_region_fit_pixels[region];
+      double* region_score = s.camera_region_score + 6 * region;
+      double* region_information = s.camera_region_information + 6 * region;
       // The upper triangle by hand: Eigen's rankUpdate on a 6x6
       // selfadjoint view costs more than the rest of the pixel.
       for (int a = 0; a < 6; ++a) {
         const double wj = w * camera_row[a];
         camera_score[a] -= wj * r;
+        region_score[a] -= wj * r;
+        region_information[a] += wj * camera_row[a];
         for (int b = a; b < 6; ++b) camera_information(a, b) += wj * camera_row[b];
       }
     }

@@ -18,18 +18,74 @@ double joint_llr(double score, double information, double delta) {
   return log_cosh(delta * score) - delta * delta * information / 2;
 }
 
-double camera_llr(const std::array<double, 6>& score, const std::array<double, 36>& information,
-                  const std::array<double, 6>& delta) {
+namespace {
+
+// camera_llr on the information's diagonal.
+double camera_llr_diagonal(const double* score, const double* information_diagonal,
+                           const std::array<double, 6>& delta) {
   std::array<double, 6> terms{};
   double largest = -std::numeric_limits<double>::infinity();
   for (int a = 0; a < 6; ++a) {
-    terms[a] = log_cosh(delta[a] * score[a]) - delta[a] * delta[a] * information[a * 6 + a] / 2;
+    terms[a] = log_cosh(delta[a] * score[a]) - delta[a] * delta[a] * information_diagonal[a] / 2;
     largest = std::max(largest, terms[a]);
   }
   if (!std::isfinite(largest)) return largest;
   double sum = 0;
   for (double t : terms) sum += std::exp(t - largest);
   return largest + std::log(sum / 6);
+}
+
+}  // namespace
+
+double camera_llr(const std::array<double, 6>& score, const std::array<double, 36>& information,
+                  const std::array<double, 6>& delta) {
+  const std::array<double, 6> diagonal = {information[0],  information[7],  information[14],
+                                          information[21], information[28], information[35]};
+  return camera_llr_diagonal(score.data(), diagonal.data(), delta);
+}
+
+bool camera_region_votes(const double* information_diagonal, const std::array<double, 6>& delta) {
+  double divergence = 0;
+  for (int a = 0; a < 6; ++a) {
+    divergence = std::max(divergence, delta[a] * delta[a] * information_diagonal[a] / 2);
+  }
+  return divergence >= kCameraRegionVoteNats;
+}
+
+CameraRegionRatio camera_region_llr(const discrepancy_t& f, const std::array<double, 6>& delta) {
+  std::array<double, 4> ratios{};
+  int voters = 0;
+  for (int r = 0; r < 4; ++r) {
+    const double* information = f.camera_region_information + 6 * r;
+    if (!camera_region_votes(information, delta)) continue;
+    ratios[voters++] = camera_llr_diagonal(f.camera_region_score + 6 * r, information, delta);
+  }
+  CameraRegionRatio result;
+  result.voters = voters;
+  if (voters == 0) {
+    // No region carries a nat at delta (a frame without regions, from an
+    // older tofguard-discrepancy, or a scene with hardly any static
+    // surface): the whole image's ratio.
+    std::array<double, 6> score{};
+    std::array<double, 36> information{};
+    std::copy(f.camera_score, f.camera_score + 6, score.begin());
+    std::copy(f.camera_information, f.camera_information + 36, information.begin());
+    result.llr = camera_llr(score, information, delta);
+    return result;
+  }
+  // The m-th largest of the n voters' ratios, m = min(n, 3): with
+  // n = 4, three must agree. exp of it is at most the mean of the m
+  // largest exp(LLR_r), so E_0[exp] <= n / m: subtracting log(n / m)
+  // keeps E_0[LR] <= 1 (docs/safety-chain.md).
+  const int agree = std::min(voters, 3);
+  // Ascending, by insertion (at most four; std::sort on a partial
+  // std::array trips GCC 12's -Warray-bounds).
+  for (int i = 1; i < voters; ++i) {
+    for (int j = i; j > 0 && ratios[j - 1] > ratios[j]; --j) std::swap(ratios[j - 1], ratios[j]);
+  }
+  result.agree = agree;
+  result.llr = ratios[voters - agree] - std::log(static_cast<double>(voters) / agree);
+  return result;
 }
 
 double cusum_threshold(int hypotheses, double rate_hz, double false_stop_period_h) {
@@ -159,11 +215,7 @@ EvidenceStep SequentialEvidence::update(const discrepancy_t& f) {
   // rule names that fault).
   if (f.evidence_available && f.repeat_count == 0) {
     result.updated = true;
-    std::array<double, 6> score{};
-    std::array<double, 36> information{};
-    std::copy(f.camera_score, f.camera_score + 6, score.begin());
-    std::copy(f.camera_information, f.camera_information + 36, information.begin());
-    camera_cusum_ = step(camera_cusum_, camera_llr(score, information, camera_delta_), h_);
+    camera_cusum_ = step(camera_cusum_, camera_region_llr(f, camera_delta_).llr, h_);
     for (int i = 0; i < f.num_joints; ++i) {
       const auto it = joint_cusum_.find(f.joint_name[i]);
       if (it == joint_cusum_.end()) continue;  // not a moving joint of the robot: not a hypothesis

@@ -82,6 +82,10 @@ discrepancy_t discrepancy_with_evidence() {
   d.camera_fit_pixels = 20;
   for (int k = 0; k < 6; ++k) d.camera_information[7 * k] = 1e6;
   d.static_chi2 = 18;
+  for (int r = 0; r < 4; ++r) {
+    d.camera_region_fit_pixels[r] = 5;
+    for (int a = 0; a < 6; ++a) d.camera_region_information[6 * r + a] = 2.5e5;
+  }
   d.num_joints = 2;
   d.joint_name = {"a1", "a2"};
   d.joint_fit_pixels = {10, 4};
@@ -123,6 +127,15 @@ TEST(WireChecks, DiscrepancyEvidence) {
   d = discrepancy_with_evidence();
   d.static_chi2 = -1;
   EXPECT_EQ(field_of(d), "static_chi2");
+  d = discrepancy_with_evidence();
+  d.camera_region_fit_pixels[3] = -1;
+  EXPECT_EQ(field_of(d), "camera_region_fit_pixels[3]");
+  d = discrepancy_with_evidence();
+  d.camera_region_score[23] = kNaN;
+  EXPECT_EQ(field_of(d), "camera_region_score[23]");
+  d = discrepancy_with_evidence();
+  d.camera_region_information[7] = -1;
+  EXPECT_EQ(field_of(d), "camera_region_information[7]");
   d = discrepancy_with_evidence();
   d.joint_score.resize(1);
   EXPECT_EQ(field_of(d), "joint_score");

@@ -415,6 +415,33 @@ TEST_F(EvidenceTest, NominalFramesFitNothing) {
   EXPECT_GT(s.static_chi2 / s.camera_fit_pixels, 0.3);
 }
 
+// The camera fit by image quadrant (discrepancy_t.camera_region_*): the
+// four partition the fit pixels, and their scores and information sum to
+// the whole image's; each quadrant of this scene sees static surfaces.
+TEST_F(EvidenceTest, TheCameraRegionsPartitionTheCameraFit) {
+  const JointPositions q = estimator::test::side_reach_pose();
+  const discrepancy_t s = evidence_of(frames_, *config_, q, camera(), q, camera(), 78);
+  ASSERT_TRUE(s.evidence_available);
+  int pixels = 0;
+  for (int r = 0; r < 4; ++r) {
+    std::cout << "region " << r << ": " << s.camera_region_fit_pixels[r] << " fit pixels\n";
+    EXPECT_GT(s.camera_region_fit_pixels[r], 0) << r;
+    pixels += s.camera_region_fit_pixels[r];
+  }
+  EXPECT_EQ(pixels, s.camera_fit_pixels);
+  for (int a = 0; a < 6; ++a) {
+    double score = 0;
+    double information = 0;
+    for (int r = 0; r < 4; ++r) {
+      score += s.camera_region_score[6 * r + a];
+      information += s.camera_region_information[6 * r + a];
+    }
+    const double scale = std::sqrt(s.camera_information[7 * a]);
+    EXPECT_NEAR(score, s.camera_score[a], 1e-9 * scale + 1e-9) << a;
+    EXPECT_NEAR(information, s.camera_information[7 * a], 1e-9 * s.camera_information[7 * a]) << a;
+  }
+}
+
 TEST_F(EvidenceTest, AStillArmShowsNoJointOffsetFromOneMixedPixel) {
   // The default arm halted where safety_chain_e2e_test's arm once stopped
   // (JOINT_STATE of the run): a pixel of link7 lies beside a scene step of

@@ -153,6 +153,10 @@ void discrepancies() {
   m.link_bias_sigma_mm = {0.5f, 0.5f};
   m.camera_fit_pixels = 10;
   for (int k = 0; k < 6; ++k) m.camera_information[7 * k] = 1;
+  for (int r = 0; r < 4; ++r) {
+    m.camera_region_fit_pixels[r] = 2;
+    for (int a = 0; a < 6; ++a) m.camera_region_information[6 * r + a] = 0.25;
+  }
   m.num_joints = 3;
   m.joint_name = kJoints;
   m.joint_fit_pixels = {3, 3, 4};

@@ -48,7 +48,9 @@ const std::vector<std::string> kJoints = {"a1", "a2", "a3", "a4", "a5", "a6", "a
 // 52 sigma in one frame) to hardly seen (a7: 0.03 sigma).
 const std::map<std::string, double> kJointInformation = {{"a1", 1e6}, {"a2", 1e5}, {"a3", 1e4}, {"a4", 3e3},
                                                          {"a5", 1e3}, {"a6", 1e2}, {"a7", 1.0}};
-// Camera information, diagonal: translation 1/m^2, rotation 1/rad^2.
+// Camera information per image region (discrepancy_t.camera_region_*),
+// diagonal: translation 1/m^2, rotation 1/rad^2. The whole image has four
+// times as much.
 const std::array<double, 6> kCameraInformation = {3e5, 3e4, 1e3, 1e4, 1e3, 10};
 
 // A usable frame whose evidence fields hold the given scores (all zero by
@@ -66,7 +68,12 @@ discrepancy_t evidence_frame(int64_t seq) {
   d.num_match = d.num_pixels;
   d.num_compared = d.num_pixels;
   d.evidence_available = true;
-  for (int a = 0; a < 6; ++a) d.camera_information[a * 6 + a] = kCameraInformation[a];
+  for (int a = 0; a < 6; ++a) {
+    d.camera_information[a * 6 + a] = 4 * kCameraInformation[a];
+    for (int r = 0; r < 4; ++r) d.camera_region_information[6 * r + a] = kCameraInformation[a];
+  }
+  d.camera_fit_pixels = 4000;
+  std::fill(d.camera_region_fit_pixels, d.camera_region_fit_pixels + 4, 1000);
   d.num_joints = static_cast<int>(kJoints.size());
   for (const std::string& j : kJoints) {
     d.joint_name.push_back(j);
@@ -88,8 +95,12 @@ int joint_index(const std::string& joint) {
 class ScoreSource {
  public:
   explicit ScoreSource(uint32_t seed) : random_(seed) {}
+  // camera_offset: the pose error, seen in every region; region_offset
+  // (when given) replaces it in region `region` alone (an object flush with
+  // a modelled surface there).
   discrepancy_t frame(int64_t seq, const std::map<std::string, double>& joint_offsets = {},
-                      const std::array<double, 6>& camera_offset = {}) {
+                      const std::array<double, 6>& camera_offset = {}, int region = -1,
+                      const std::array<double, 6>& region_offset = {}) {
     discrepancy_t d = evidence_frame(seq);
     for (int i = 0; i < d.num_joints; ++i) {
       const double information = d.joint_information[i];
@@ -98,9 +109,14 @@ class ScoreSource {
       d.joint_score[i] = information * delta + std::sqrt(information) * normal_(random_);
     }
     d.joint_naming_score = d.joint_score;
-    for (int a = 0; a < 6; ++a) {
-      const double information = kCameraInformation[a];
-      d.camera_score[a] = information * camera_offset[a] + std::sqrt(information) * normal_(random_);
+    for (int r = 0; r < 4; ++r) {
+      const std::array<double, 6>& offset = r == region ? region_offset : camera_offset;
+      for (int a = 0; a < 6; ++a) {
+        const double information = kCameraInformation[a];
+        const double score = information * offset[a] + std::sqrt(information) * normal_(random_);
+        d.camera_region_score[6 * r + a] = score;
+        d.camera_score[a] += score;
+      }
     }
     return d;
   }
@@ -151,11 +167,10 @@ TEST(EvidenceTests, NominalFramesNeverCrossAndEveryRatioDriftsDown) {
       llr_sum[d.joint_name[i]] += risk::joint_llr(d.joint_score[i], d.joint_information[i], 3 * kDeg);
       largest[d.joint_name[i]] = std::max(largest[d.joint_name[i]], evidence.joint_cusum(d.joint_name[i]));
     }
-    std::array<double, 6> score;
-    std::array<double, 36> information;
-    std::copy(d.camera_score, d.camera_score + 6, score.begin());
-    std::copy(d.camera_information, d.camera_information + 36, information.begin());
-    camera_llr_sum += risk::camera_llr(score, information, camera_delta);
+    const risk::CameraRegionRatio camera = risk::camera_region_llr(d, camera_delta);
+    ASSERT_EQ(camera.voters, 4);
+    ASSERT_EQ(camera.agree, 3);
+    camera_llr_sum += camera.llr;
     camera_largest = std::max(camera_largest, evidence.camera_cusum());
   }
   for (const auto& [joint, sum] : llr_sum) {
@@ -181,12 +196,84 @@ TEST(EvidenceTests, AGrossFaultCrossesOnItsFirstFrame) {
       << step.finding.detail;
   EXPECT_NE(step.finding.detail.find("° ± 0.1°"), std::string::npos) << step.finding.detail;
 
-  // The camera 2 cm off sideways (x, I = 3e5 / m^2: 120 in delta^2 I) at once.
+  // The camera 2 cm off sideways (x, I = 3e5 / m^2 per region: 120 in
+  // delta^2 I, each of the four regions alone crosses h) at once.
   SequentialEvidence camera(sim_config().risk, friend_arm(), kRateHz);
   const EvidenceStep moved = camera.update(source.frame(1, {}, {0.02, 0, 0, 0, 0, 0}));
   ASSERT_TRUE(moved.crossed);
   EXPECT_EQ(moved.finding.cause, risk_t::CAUSE_CALIBRATION_ERROR);
   EXPECT_EQ(moved.finding.suspect, "");
+}
+
+// An object flush with a modelled surface (within the naming gate) pulls
+// the camera fit of the region it is in: the pose error that explains it
+// there is gross (here 3 cm sideways, 270 in delta^2 I), but the other
+// regions see none. Three regions must agree: 20 000 such frames never
+// cross, while the same error in every region crosses at once.
+TEST(EvidenceTests, ACameraErrorInOneRegionAloneIsNotAPoseError) {
+  const std::array<double, 6> shifted = {0.03, 0, 0, 0, 0, 0};
+  ScoreSource source(21);
+  for (int region = 0; region < 4; ++region) {
+    SequentialEvidence evidence(sim_config().risk, friend_arm(), kRateHz);
+    double largest = 0;
+    for (int k = 0; k < 5000; ++k) {
+      const EvidenceStep step = evidence.update(source.frame(k, {}, {}, region, shifted));
+      ASSERT_FALSE(step.crossed) << "region " << region << ", frame " << k << ": " << step.finding.detail;
+      largest = std::max(largest, evidence.camera_cusum());
+    }
+    std::cout << "3 cm in region " << region << " alone: largest camera CUSUM " << largest << " of h "
+              << evidence.threshold() << "\n";
+  }
+  // Two regions with a pose error and two without: still not three.
+  discrepancy_t two = source.frame(1, {}, shifted, 0, {});
+  std::fill(two.camera_region_score, two.camera_region_score + 6, 0.0);
+  std::fill(two.camera_region_score + 6, two.camera_region_score + 12, 0.0);
+  SequentialEvidence evidence(sim_config().risk, friend_arm(), kRateHz);
+  EXPECT_FALSE(evidence.update(two).crossed);
+  EXPECT_EQ(risk::camera_region_llr(two, {0.02, 0.02, 0.02, kDeg, kDeg, kDeg}).agree, 3);
+  SequentialEvidence whole(sim_config().risk, friend_arm(), kRateHz);
+  const EvidenceStep step = whole.update(source.frame(1, {}, shifted));
+  ASSERT_TRUE(step.crossed);
+  EXPECT_EQ(step.finding.cause, risk_t::CAUSE_CALIBRATION_ERROR);
+}
+
+// Regions that cannot carry a nat at delta do not vote (a region of sky or
+// of the arm alone): with two such, the other two must both agree; with
+// none voting (a frame without regions), the whole image decides.
+TEST(EvidenceTests, RegionsWithoutEvidenceDoNotVote) {
+  const std::array<double, 6> delta = {0.02, 0.02, 0.02, kDeg, kDeg, kDeg};
+  const std::array<double, 6> shifted = {0.02, 0, 0, 0, 0, 0};
+  ScoreSource source(22);
+  discrepancy_t d = source.frame(1, {}, shifted);
+  for (int r : {1, 3}) {
+    std::fill(d.camera_region_information + 6 * r, d.camera_region_information + 6 * r + 6, 0.0);
+    std::fill(d.camera_region_score + 6 * r, d.camera_region_score + 6 * r + 6, 0.0);
+  }
+  // 1 nat at delta: 2 cm with I = 5000 / m^2 is delta^2 I / 2 = 1.
+  EXPECT_TRUE(risk::camera_region_votes(&d.camera_region_information[0], delta));
+  const std::array<double, 6> one_nat = {5000, 0, 0, 0, 0, 0};
+  const std::array<double, 6> below = {4999, 0, 0, 0, 0, 0};
+  EXPECT_TRUE(risk::camera_region_votes(one_nat.data(), delta));
+  EXPECT_FALSE(risk::camera_region_votes(below.data(), delta));
+  risk::CameraRegionRatio ratio = risk::camera_region_llr(d, delta);
+  EXPECT_EQ(ratio.voters, 2);
+  EXPECT_EQ(ratio.agree, 2);
+  SequentialEvidence evidence(sim_config().risk, friend_arm(), kRateHz);
+  EXPECT_TRUE(evidence.update(d).crossed);
+  // One of the two without the error: no.
+  std::fill(d.camera_region_score, d.camera_region_score + 6, 0.0);
+  SequentialEvidence other(sim_config().risk, friend_arm(), kRateHz);
+  EXPECT_FALSE(other.update(d).crossed);
+  // No regions at all: the whole image's ratio.
+  discrepancy_t whole = source.frame(2, {}, shifted);
+  std::fill(whole.camera_region_information, whole.camera_region_information + 24, 0.0);
+  ratio = risk::camera_region_llr(whole, delta);
+  EXPECT_EQ(ratio.voters, 0);
+  std::array<double, 6> score;
+  std::array<double, 36> information;
+  std::copy(whole.camera_score, whole.camera_score + 6, score.begin());
+  std::copy(whole.camera_information, whole.camera_information + 36, information.begin());
+  EXPECT_DOUBLE_EQ(ratio.llr, risk::camera_llr(score, information, delta));
 }
 
 // A marginal fault accumulates: a4 (I = 3e3 / rad^2) off by 3 degrees is

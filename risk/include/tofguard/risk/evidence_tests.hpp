@@ -37,6 +37,34 @@ double joint_llr(double score, double information, double delta);
 double camera_llr(const std::array<double, 6>& score, const std::array<double, 36>& information,
                   const std::array<double, 6>& delta);
 
+// A region of the camera fit (discrepancy_t.camera_region_*) votes in the
+// camera test when one frame of it alone carries at least this much
+// evidence at the test's delta, nats: max_a delta_a^2 I_aa / 2 >= 1. A
+// region with less can neither show nor rule out a pose error of the
+// test's size; its vote would only hold the others back.
+constexpr double kCameraRegionVoteNats = 1.0;
+
+// Whether a region with this information diagonal (6 entries) votes.
+bool camera_region_votes(const double* information_diagonal, const std::array<double, 6>& delta);
+
+struct CameraRegionRatio {
+  // The camera test's per-frame log-likelihood ratio.
+  double llr = 0;
+  // How many regions voted, and how many had to agree (0 when none voted
+  // and llr is the whole image's camera_llr).
+  int voters = 0;
+  int agree = 0;
+};
+
+// The camera test's per-frame ratio from the image regions: a pose error
+// moves the whole static scene, an object flush with a modelled surface
+// one region. Of the n regions that vote, the m-th largest camera_llr,
+// m = min(n, 3), minus log(n / m) (so that E_0[LR] <= 1 still holds: the
+// m-th largest LR is at most the mean of the m largest); with no region
+// voting, the whole image's camera_llr. docs/safety-chain.md, "Sequential
+// evidence and its thresholds".
+CameraRegionRatio camera_region_llr(const discrepancy_t& frame, const std::array<double, 6>& delta);
+
 // The CUSUM threshold for `hypotheses` tests on frames at `rate_hz` and at
 // most one false stop per `false_stop_period_h` hours:
 // h = ln(hypotheses * rate_hz * 3600 * false_stop_period_h).
