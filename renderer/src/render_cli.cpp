@@ -52,13 +52,15 @@ int whole(const std::string& option, double value) {
 std::string render_cli_usage() {
   return "usage: tofguard-renderer render --urdf ROBOT.urdf [--env ENV.urdf ...] [--geometry "
          "visual|collision]\n"
-         "         [--padding METRES] [--package-path DIR ...] [--joint NAME=VALUE ...]\n"
+         "         [--padding METRES] [--simplify-error-mm MM] [--package-path DIR ...] [--joint NAME=VALUE "
+         "...]\n"
          "         --camera-pose x,y,z,qw,qx,qy,qz [--frame LINK] --intrinsics W,H,fx,fy,cx,cy\n"
          "         [--near METRES] [--far METRES] --out DEPTH.png [--labels LABELS.png]\n"
          "Renders the model once. The camera pose is the optical frame's (x right, y down, z forward)\n"
          "in LINK (default: the robot's root link), metres and a unit quaternion. Joint values in\n"
          "radians or metres. DEPTH.png: 16-bit Z in millimetres, 0 = nothing. LABELS.png: 16-bit\n"
-         "labels, 0 = nothing, 1.. robot links, 1000.. environment links.\n";
+         "labels, 0 = nothing, 1.. robot links, 1000.. environment links. Meshes are exact unless\n"
+         "--simplify-error-mm is given (as renderer.simplify_error_mm in the config).\n";
 }
 
 int run_render_cli(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
@@ -87,6 +89,8 @@ int run_render_cli(const std::vector<std::string>& args, std::ostream& out, std:
         options.geometry = robot_model::parse_geometry_source(value);
       } else if (option == "--padding") {
         options.padding_m = parse_numbers(option, value, 1)[0];
+      } else if (option == "--simplify-error-mm") {
+        options.simplify_error_m = parse_numbers(option, value, 1)[0] / 1000.0;
       } else if (option == "--package-path") {
         options.package_paths.push_back(value);
       } else if (option == "--joint") {

@@ -26,6 +26,7 @@ robot_model::SceneOptions scene_options(const RendererSettings& renderer, const 
   robot_model::SceneOptions options;
   options.geometry = robot_model::parse_geometry_source(renderer.geometry);
   options.padding_m = renderer.padding_m;
+  options.simplify_error_m = renderer.simplify_error_mm / 1000.0;
   options.package_paths = robot.package_paths;
   return options;
 }

@@ -6,6 +6,9 @@ RendererSettings read_renderer_settings(YamlMap renderer) {
   RendererSettings r;
   r.geometry = renderer.choice("geometry", {"visual", "collision"});
   r.padding_m = renderer.number("padding_m", 0, 1);
+  // Optional: a config written before meshes were simplified keeps the
+  // exact meshes it was checked with.
+  r.simplify_error_mm = renderer.optional_number("simplify_error_mm", 0, 0, 10);
   r.near_m = renderer.number("near_m", 1e-3, 100);
   r.far_m = renderer.number("far_m", 1e-3, 1000);
   if (r.far_m <= r.near_m) {

@@ -9,6 +9,7 @@
 #include <assimp/config.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#include <meshoptimizer.h>
 #include <assimp/Importer.hpp>
 
 #include "tofguard/common/error_log.hpp"
@@ -32,6 +33,10 @@ class SceneBuilder {
     if (!std::isfinite(options.padding_m) || options.padding_m < 0) {
       throw ModelError("renderer padding_m must be a finite value >= 0, got " +
                        std::to_string(options.padding_m));
+    }
+    if (!std::isfinite(options.simplify_error_m) || options.simplify_error_m < 0) {
+      throw ModelError("renderer simplify_error_mm must be a finite value >= 0, got " +
+                       std::to_string(1000 * options.simplify_error_m) + " mm");
     }
     scene_.meshes.push_back(unit_box());
     scene_.meshes.push_back(unit_sphere());
@@ -177,9 +182,36 @@ class SceneBuilder {
     if (mesh.num_triangles() == 0) {
       throw ModelError(where + "mesh '" + uri + "' (" + path.string() + ") has no triangles");
     }
+    mesh.source_triangles = mesh.num_triangles();
+    if (options_.simplify_error_m > 0) simplify(mesh, options_.simplify_error_m);
     orient(mesh);
     if (options_.padding_m > 0) pad_along_normals(mesh, options_.padding_m);
     return mesh;
+  }
+
+  // Collapses edges while the surface stays within error_m of the
+  // original (meshopt_simplify's error is relative to the mesh's extent,
+  // meshopt_simplifyScale), borders locked so that an open mesh keeps its
+  // outline; then drops the vertices no triangle uses any more.
+  static void simplify(TriangleMesh& mesh, double error_m) {
+    static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float), "packed vertex positions");
+    const float* positions = mesh.vertices.front().data();
+    const size_t num_vertices = mesh.vertices.size();
+    const float scale = meshopt_simplifyScale(positions, num_vertices, sizeof(Eigen::Vector3f));
+    if (!(scale > 0)) return;  // every vertex at one point: nothing to simplify
+    std::vector<uint32_t> simplified(mesh.indices.size());
+    float relative_error = 0;
+    simplified.resize(meshopt_simplify(simplified.data(), mesh.indices.data(), mesh.indices.size(), positions,
+                                       num_vertices, sizeof(Eigen::Vector3f), 3,
+                                       static_cast<float>(error_m / scale), meshopt_SimplifyLockBorder,
+                                       &relative_error));
+    if (simplified.empty()) return;  // keep the exact mesh rather than none
+    std::vector<Eigen::Vector3f> vertices(num_vertices);
+    vertices.resize(meshopt_optimizeVertexFetch(vertices.data(), simplified.data(), simplified.size(),
+                                                mesh.vertices.data(), num_vertices, sizeof(Eigen::Vector3f)));
+    mesh.vertices = std::move(vertices);
+    mesh.indices = std::move(simplified);
+    mesh.simplify_error_m = static_cast<double>(relative_error) * scale;
   }
 
   // Sets closed_outward, flipping a closed, consistently wound mesh that is
@@ -245,6 +277,15 @@ GeometrySource parse_geometry_source(const std::string& text) {
 size_t SceneModel::num_triangles() const {
   size_t total = 0;
   for (const Shape& shape : shapes) total += meshes[shape.mesh_index].num_triangles();
+  return total;
+}
+
+size_t SceneModel::num_source_triangles() const {
+  size_t total = 0;
+  for (const Shape& shape : shapes) {
+    const TriangleMesh& mesh = meshes[shape.mesh_index];
+    total += mesh.source_triangles > 0 ? mesh.source_triangles : mesh.num_triangles();
+  }
   return total;
 }
 

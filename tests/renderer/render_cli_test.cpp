@@ -63,6 +63,17 @@ TEST(RenderCli, UsageAndModelErrors) {
                                   &out, &err),
       1);
   EXPECT_NE(err.find("/nonexistent.urdf: cannot read the URDF file"), std::string::npos) << err;
+  const std::string robot = write_test_file(
+      "cli/sphere.urdf",
+      "<robot name=\"r\"><link name=\"world\"><visual><geometry><sphere radius=\"0.1\"/></geometry></visual>"
+      "</link></robot>");
+  EXPECT_EQ(tofguard::test::run_command("render_cli_simplify",
+                                        {bin, "render", "--urdf", robot, "--simplify-error-mm", "-1",
+                                         "--camera-pose", "0,0,0,1,0,0,0", "--intrinsics", "8,8,8,8,4,4",
+                                         "--out", write_test_file("cli/simplify.png", "")},
+                                        &out, &err),
+            1);
+  EXPECT_NE(err.find("simplify_error_mm must be a finite value >= 0, got -1.0"), std::string::npos) << err;
 }
 
 }  // namespace

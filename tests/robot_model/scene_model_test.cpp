@@ -2,10 +2,13 @@
 // and relative URIs, the real iiwa14, and bad models with their errors.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <sstream>
 #include <thread>
+#include <vector>
 
 #include "renderer_test_util.hpp"
 
@@ -469,6 +472,132 @@ TEST(SceneModelErrors, BadSizesAndPadding) {
       model_error(write_test_file("bad/ok.urdf", one_link_urdf("<sphere radius=\"0.1\"/>")), {}, options)
           .find("padding_m"),
       std::string::npos);
+  options.padding_m = 0;
+  options.simplify_error_m = -0.001;
+  EXPECT_NE(
+      model_error(write_test_file("bad/ok.urdf", one_link_urdf("<sphere radius=\"0.1\"/>")), {}, options)
+          .find("simplify_error_mm must be a finite value >= 0, got -1.0"),
+      std::string::npos);
+}
+
+// --- simplified meshes (SceneOptions::simplify_error_m, docs/renderer.md) ---
+
+// The iiwa14's OBJ and the Kinova Gen3's STL visual meshes simplified to
+// 1 mm: far fewer triangles, every mesh within the bound by the
+// simplifier's own measure, and the depth rendered at 640x480 from 2 m
+// (the camera's pixel is 3 mm there) against the exact meshes': the same
+// pixels show the arm (but for a few at its outline) and the depths agree
+// to the bound along the view (1 mm, plus 1 mm for the rendered depth's
+// whole millimetres, plus what a surface's slope adds along the ray).
+struct SimplifiedArm {
+  std::string name;
+  std::string urdf;
+  std::vector<std::string> package_paths;
+  CameraPose camera;
+};
+
+void expect_simplified_like_exact(const SimplifiedArm& arm) {
+  robot_model::SceneOptions exact_options;
+  exact_options.package_paths = arm.package_paths;
+  robot_model::SceneOptions simplified_options = exact_options;
+  simplified_options.simplify_error_m = 0.001;
+  const robot_model::SceneModel exact = robot_model::load_scene(arm.urdf, {}, exact_options);
+  const robot_model::SceneModel simplified = robot_model::load_scene(arm.urdf, {}, simplified_options);
+  EXPECT_EQ(simplified.num_source_triangles(), exact.num_triangles());
+  EXPECT_EQ(exact.num_source_triangles(), exact.num_triangles());
+  double largest_error_m = 0;
+  for (const robot_model::TriangleMesh& mesh : simplified.meshes) {
+    EXPECT_LE(mesh.simplify_error_m, 0.001) << mesh.source;
+    largest_error_m = std::max(largest_error_m, mesh.simplify_error_m);
+  }
+  std::cout << arm.name << ": " << exact.num_triangles() << " triangles exact, " << simplified.num_triangles()
+            << " simplified to 1 mm (largest reported error " << 1000 * largest_error_m << " mm)\n";
+  EXPECT_LT(simplified.num_triangles() * 4, exact.num_triangles()) << arm.name;
+
+  const Intrinsics vga{640, 480, 525, 525, 319.5, 239.5};
+  DepthRenderer exact_renderer(exact, 0.1, 5.0);
+  DepthRenderer simplified_renderer(simplified, 0.1, 5.0);
+  robot_model::JointPositions q;
+  for (const std::string& joint : exact.movable_joint_names) q[joint] = 0.3;
+  const RenderResult a = exact_renderer.render(q, arm.camera, vga);
+  const RenderResult b = simplified_renderer.render(q, arm.camera, vga);
+  ASSERT_TRUE(a.usable && b.usable) << a.unusable_reason << b.unusable_reason;
+  // Pixels beside a step of more than 50 mm (config/sim.yaml's
+  // discrepancy.silhouette_jump_mm: one link's outline over another or the
+  // background) are silhouettes, which the discrepancy stage does not
+  // compare: a ray there hits one surface or the other.
+  const auto beside_a_step = [&](const RenderResult& r, int i) {
+    const int u = i % r.width, v = i / r.width;
+    for (int dv = -1; dv <= 1; ++dv) {
+      for (int du = -1; du <= 1; ++du) {
+        const int un = u + du, vn = v + dv;
+        if (un < 0 || vn < 0 || un >= r.width || vn >= r.height) return true;
+        const int j = vn * r.width + un;
+        if (r.labels[j] == 0 || std::abs(r.depth_m[j] - r.depth_m[i]) > 0.05f) return true;
+      }
+    }
+    return false;
+  };
+  int both = 0, only_one = 0, silhouette = 0, beyond_3mm = 0;
+  std::vector<double> differences_mm;
+  for (size_t i = 0; i < a.depth_m.size(); ++i) {
+    const bool in_a = a.labels[i] != 0, in_b = b.labels[i] != 0;
+    if (!in_a && !in_b) continue;
+    if (in_a != in_b) {
+      ++only_one;
+      continue;
+    }
+    ++both;
+    if (beside_a_step(a, static_cast<int>(i)) || beside_a_step(b, static_cast<int>(i))) {
+      ++silhouette;
+      continue;
+    }
+    const double d = 1000.0 * std::abs(a.depth_m[i] - b.depth_m[i]);
+    differences_mm.push_back(d);
+    beyond_3mm += d > 3.0;
+  }
+  ASSERT_GT(both, 5000) << arm.name << ": the arm must fill part of the image";
+  std::sort(differences_mm.begin(), differences_mm.end());
+  const double median = differences_mm[differences_mm.size() / 2];
+  const double p99 = differences_mm[differences_mm.size() * 99 / 100];
+  std::cout << arm.name << " at 640x480: " << both << " arm pixels in both (" << silhouette
+            << " beside a step), " << only_one << " in one only; |depth difference| median " << median
+            << " mm, p99 " << p99 << " mm, max " << differences_mm.back() << " mm, beyond 3 mm " << beyond_3mm
+            << " of " << differences_mm.size() << "\n";
+  EXPECT_LE(median, 1.0) << arm.name;
+  EXPECT_LE(p99, 3.0) << arm.name;
+  EXPECT_LT(only_one, both / 100) << arm.name;
+}
+
+// The side view of Iiwa14: 2 m in front of the root on +x, looking along -x.
+CameraPose side_view_from(double height_m) {
+  Eigen::Isometry3d world_from_optical = Eigen::Isometry3d::Identity();
+  world_from_optical.translation() = Eigen::Vector3d(2.0, 0, height_m);
+  world_from_optical.linear().col(0) = Eigen::Vector3d(0, 1, 0);
+  world_from_optical.linear().col(1) = Eigen::Vector3d(0, 0, -1);
+  world_from_optical.linear().col(2) = Eigen::Vector3d(-1, 0, 0);
+  CameraPose pose = camera_pose_in("", world_from_optical);
+  return pose;
+}
+
+TEST(SimplifiedMeshes, TheIiwa14AndTheKinovaGen3RenderAsTheExactMeshesDo) {
+  if (tofguard::test::shared_dir().empty())
+    GTEST_SKIP() << "../shared is absent: the iiwa14 and Kinova Gen3 models are not available";
+  const std::string robots = tofguard::test::shared_dir() + "/robots";
+  SimplifiedArm iiwa{
+      "iiwa14", robots + "/iiwa14/urdf/iiwa14_no_collision_relative.urdf", {}, side_view_from(0.65)};
+  iiwa.camera.frame_id = "base";
+  SimplifiedArm kinova{"Kinova Gen3",
+                       robots +
+                           "/kinova_gen3/kortex_description/arms/gen3/7dof/urdf/"
+                           "GEN3-7DOF-NOVISION_FOR_URDF_ARM_V12.urdf",
+                       {robots + "/kinova_gen3"},
+                       side_view_from(0.55)};
+  kinova.camera.frame_id = "base_link";
+  for (const SimplifiedArm& arm : {iiwa, kinova}) {
+    if (!fs::exists(arm.urdf)) GTEST_SKIP() << arm.urdf << " is absent";
+    expect_simplified_like_exact(arm);
+  }
 }
 
 }  // namespace

@@ -18,6 +18,11 @@ struct RendererSettings {
   std::string geometry;
   // padding_m: every shape is inflated by this much, metres.
   double padding_m = 0;
+  // simplify_error_mm (optional; absent: 0, the exact meshes): mesh files
+  // are simplified at load until the surface would move by more than this,
+  // millimetres (robot_model::SceneOptions::simplify_error_m,
+  // docs/renderer.md "Simplified meshes").
+  double simplify_error_mm = 0;
   // near_m, far_m: clip distances along the optical axis, metres.
   double near_m = 0;
   double far_m = 0;

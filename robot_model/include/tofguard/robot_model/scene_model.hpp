@@ -37,6 +37,14 @@ struct SceneOptions {
   // Folders searched for package://NAME/rest URIs: NAME is looked up as a
   // sub-folder of each, in order.
   std::vector<std::string> package_paths;
+  // Mesh files are simplified at load (meshoptimizer's meshopt_simplify,
+  // borders locked) until a further edge collapse would move the surface
+  // by more than this, metres (its quadric error: the distance of the
+  // simplified surface from the planes of the original triangles it
+  // replaced), measured after the URDF's scale and before padding. 0: the
+  // exact meshes. Primitives (boxes, spheres, cylinders) are never
+  // simplified. docs/renderer.md, "Simplified meshes".
+  double simplify_error_m = 0;
 };
 
 // Parses "visual" / "collision"; throws ModelError for anything else.
@@ -49,6 +57,11 @@ struct TriangleMesh {
   std::string source;
   std::vector<Eigen::Vector3f> vertices;
   std::vector<uint32_t> indices;  // 3 per triangle
+  // The file's triangles before simplification (SceneOptions::
+  // simplify_error_m; num_triangles() when not simplified), and the error
+  // the simplifier reports for the result, metres (0 when not simplified).
+  size_t source_triangles = 0;
+  double simplify_error_m = 0;
   // True when the triangles form closed surfaces, every edge shared by
   // exactly two triangles that run it in opposite directions, wound
   // counter-clockwise seen from outside. Only then may the renderer skip
@@ -84,6 +97,8 @@ struct SceneModel : KinematicTree {
   // Triangles drawn per render (every shape, scaled meshes counted once per
   // shape that uses them).
   size_t num_triangles() const;
+  // The same count with every mesh file's triangles before simplification.
+  size_t num_source_triangles() const;
 };
 
 // Loads the robot and the environments. Mesh URIs: package://NAME/rest
