@@ -151,6 +151,36 @@ TEST(Discrepancy, ObjectFarFromTheArmIsNotNearTheArm) {
   EXPECT_NEAR(s.unexplained_area_within_m2[149], 400 * pixel_m2, 1e-6);
 }
 
+// A box 0.5 m in front of the arm's plane, beside it in the image, with
+// its left edge mixed with the floor behind it (a ToF camera's flying
+// pixels: 1500 mm, half way between the box at 1000 and the floor at 2000).
+// Back-projected at their own depth they would float in the arm's plane
+// 0.23 m from link2; they are placed at the box's depth instead, so that
+// nothing is nearer the arm than the box itself (0.52 m).
+TEST(Discrepancy, MixedPixelsAtAnObjectsEdgeStandAtTheObject) {
+  const SyntheticImage model = draw(default_arm());
+  std::vector<Box> scene = default_arm();
+  scene.push_back({130, 60, 150, 80, 1000, 0});
+  SyntheticImage seen = draw(scene);
+  for (int v = 60; v < 80; ++v) seen.depth_mm[v * kWidth + 129] = 1500;
+  const discrepancy_t s = compare(model, seen.depth_mm).summary;
+  EXPECT_EQ(s.num_unexpected_surface, 420);
+  EXPECT_EQ(s.near_arm_pixels, 0);
+  // The box's nearest point (u 130, v 79 at 1.0 m) is 0.52 m from link2's
+  // nearest (u 99, v 60..79 at 1.5 m): nothing within 0.45 m.
+  EXPECT_FLOAT_EQ(s.unexplained_area_within_m2[44], 0);
+  EXPECT_GT(s.unexplained_area_within_m2[60], 0);
+  // Without the neighbours' evidence (the same pixels, nothing beside
+  // them nearer): they stay where they are, in the arm's plane 0.23 m away.
+  SyntheticImage alone = draw(default_arm());
+  for (int v = 60; v < 80; ++v) {
+    for (int u = 127; u < 130; ++u) alone.depth_mm[v * kWidth + u] = 1500;
+  }
+  const discrepancy_t t = compare(model, alone.depth_mm).summary;
+  EXPECT_EQ(t.num_unexpected_surface, 60);
+  EXPECT_GT(t.unexplained_area_within_m2[25], 0);  // within 0.26 m
+}
+
 TEST(Discrepancy, ThinSilhouetteSliversAreNotBlobs) {
   const SyntheticImage model = draw(default_arm());
   // The camera's link2 one pixel wider: a one-pixel column of nearer
