@@ -19,6 +19,7 @@
 #include "tofguard/common/risk_names.hpp"
 #include "tofguard/discrepancy/discrepancy_image.hpp"
 #include "tofguard/renderer/rendered_kinematics.hpp"
+#include "tofguard/renderer/renderer_process.hpp"
 #include "tofguard/risk/protective_field.hpp"
 #include "tofguard/risk/risk_monitor.hpp"
 #include "tofguard/risk_t.hpp"
@@ -509,14 +510,11 @@ ObjectPath place_object(const CampaignFault& fault, const robot_model::PlacedArm
 std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vector<CampaignRun>& runs) {
   const deployment::Config& config = arm.config;
   SimulatedFrames truth(config);
-  // The model as tofguard-renderer loads it (the config's geometry and
-  // padding), and the tree tofguard-risk loads.
-  robot_model::SceneOptions options;
-  options.geometry = robot_model::parse_geometry_source(config.renderer.geometry);
-  options.padding_m = config.renderer.padding_m;
-  options.package_paths = config.robot.package_paths;
+  // The model as tofguard-renderer loads it (the config's geometry,
+  // padding and mesh simplification), and the tree tofguard-risk loads.
   const robot_model::SceneModel model_scene =
-      robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths, options);
+      robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths,
+                              renderer::scene_options(config.renderer, config.robot));
   renderer::DepthRenderer model(model_scene, config.renderer.near_m, config.renderer.far_m);
   const robot_model::ArmSpheres arm_cover =
       robot_model::cover_arm_with_spheres(model_scene, config.renderer.arm_cover_cell_m);
