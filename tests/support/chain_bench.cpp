@@ -1,0 +1,866 @@
+#include "chain_bench.hpp"
+
+#include <poll.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <memory>
+#include <mutex>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+#include <unordered_map>
+
+#include <lcm/lcm-cpp.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "proc_stats.hpp"
+#include "simulated_frames.hpp"
+#include "test_support.hpp"
+#include "tofguard/common/clock.hpp"
+#include "tofguard/common/depth_frame.hpp"
+#include "tofguard/deployment/config.hpp"
+#include "tofguard/discrepancy_t.hpp"
+#include "tofguard/joint_state_t.hpp"
+#include "tofguard/renderer/renderer_process.hpp"
+#include "tofguard/risk_t.hpp"
+#include "tofguard/robot_model/scene_model.hpp"
+
+namespace tofguard::test {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kPi = 3.141592653589793;
+
+// The observer chain, the judge first so that it listens before its inputs
+// speak (as LiveChain starts it).
+const std::vector<std::string> kChainProcesses = {"tofguard-intervene", "tofguard-risk",
+                                                  "tofguard-discrepancy", "tofguard-renderer"};
+const std::string kBenchProcess = "tofguard-bench";
+
+// At most this many distinct frames are prepared per step; longer steps play
+// them forwards and backwards (the arm reverses), so memory stays bounded at
+// 640x480 and high rates while every frame differs from the one before.
+constexpr int kMaxPreparedFrames = 150;
+// Joint states between frames at this period at least (the arm driver's
+// 100 Hz of config/sim.yaml), besides one at each frame's utime.
+constexpr int64_t kJointStatePeriodUs = 10000;
+// Frames in a row that must come through before the measured step starts.
+constexpr int kWarmupFrames = 5;
+// The chain's start (EGL, mesh loading, the arm's cover of spheres) may
+// take this long on a loaded 2-core machine with the iiwa14's meshes.
+constexpr auto kStartDeadline = std::chrono::seconds(90);
+
+std::string fixed_text(double value, int decimals) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(decimals);
+  s << value;
+  return s.str();
+}
+
+std::string number_text(double value) {
+  std::ostringstream s;
+  s << std::setprecision(12) << value;
+  return s.str();
+}
+
+std::string size_text(int width, int height) { return std::to_string(width) + "x" + std::to_string(height); }
+
+// The value of nearest rank `q` (0..1) of `sorted` (ascending).
+double quantile(const std::vector<double>& sorted, double q) {
+  const size_t rank = static_cast<size_t>(std::ceil(q * static_cast<double>(sorted.size())));
+  return sorted[std::clamp<size_t>(rank, 1, sorted.size()) - 1];
+}
+
+LatencySummary summarise(std::vector<double> latency_ms) {
+  LatencySummary s;
+  s.count = static_cast<int>(latency_ms.size());
+  if (latency_ms.empty()) return s;
+  std::sort(latency_ms.begin(), latency_ms.end());
+  s.p50_ms = quantile(latency_ms, 0.5);
+  s.p99_ms = quantile(latency_ms, 0.99);
+  s.max_ms = latency_ms.back();
+  return s;
+}
+
+// LCM's encoding is big-endian.
+void put_int64_be(uint8_t* at, int64_t value) {
+  for (int i = 7; i >= 0; --i) {
+    at[i] = static_cast<uint8_t>(value & 0xff);
+    value >>= 8;
+  }
+}
+int64_t get_int64_be(const uint8_t* at) {
+  uint64_t value = 0;
+  for (int i = 0; i < 8; ++i) value = (value << 8) | at[i];
+  return static_cast<int64_t>(value);
+}
+
+// depth_image_t, discrepancy_t and risk_t all begin with the type's hash,
+// then utime and seq (lcmtypes/). The bench reads only those, so that it
+// does not spend the 2 cores decoding 640x480 images the chain needs.
+constexpr size_t kHashUtimeSeqBytes = 24;
+constexpr size_t kSeqOffset = 16;
+constexpr size_t kUtimeOffset = 8;
+
+// When each stage's message of a frame arrived (monotonic us, 0: not yet).
+struct FrameArrivals {
+  int64_t sent_us = 0;
+  int64_t rendered_us = 0;
+  int64_t discrepancy_us = 0;
+  int64_t risk_us = 0;
+};
+
+// Receives TOF_RENDERED, SAFETY_DISCREPANCY and SAFETY_RISK on its own
+// thread and LCM sockets, so that the publisher's pacing does not delay the
+// time stamps; records the first arrival of each per frame seq.
+class ArrivalRecorder {
+ public:
+  explicit ArrivalRecorder(const deployment::Config& config)
+      : safety_(config.lcm.url), images_(config.lcm.image_url) {
+    if (!safety_.good() || !images_.good())
+      throw std::runtime_error("cannot open LCM (" + config.lcm.url + ", " + config.lcm.image_url + ")");
+    images_.subscribe(config.channels.rendered, &ArrivalRecorder::on_rendered, this);
+    safety_.subscribe(config.channels.discrepancy, &ArrivalRecorder::on_discrepancy, this);
+    safety_.subscribe(config.channels.risk, &ArrivalRecorder::on_risk, this);
+    thread_ = std::thread([this] { receive(); });
+  }
+  ~ArrivalRecorder() {
+    stop_ = true;
+    thread_.join();
+  }
+  ArrivalRecorder(const ArrivalRecorder&) = delete;
+  ArrivalRecorder& operator=(const ArrivalRecorder&) = delete;
+
+  void sent(int64_t seq, int64_t at_us) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    frames_[seq].sent_us = at_us;
+  }
+  FrameArrivals arrivals(int64_t seq) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = frames_.find(seq);
+    return it == frames_.end() ? FrameArrivals{} : it->second;
+  }
+  // Waits until every frame of [first_seq, last_seq] has its SAFETY_RISK,
+  // or until `deadline_us` (monotonic). Returns whether all came.
+  bool wait_for_verdicts(int64_t first_seq, int64_t last_seq, int64_t deadline_us) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    // The frames before `unjudged` have their verdicts: each wake-up scans
+    // on from there.
+    int64_t unjudged = first_seq;
+    const auto all_judged = [&] {
+      for (; unjudged <= last_seq; ++unjudged) {
+        const auto it = frames_.find(unjudged);
+        if (it == frames_.end() || it->second.risk_us == 0) return false;
+      }
+      return true;
+    };
+    while (!all_judged()) {
+      const int64_t left_us = deadline_us - monotonic_us();
+      if (left_us <= 0) return false;
+      verdict_.wait_for(lock, std::chrono::microseconds(std::min<int64_t>(left_us, 20000)));
+    }
+    return true;
+  }
+  void forget_before(int64_t seq) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (auto it = frames_.begin(); it != frames_.end();) it = it->first < seq ? frames_.erase(it) : ++it;
+  }
+
+ private:
+  enum class Stage { kRendered, kDiscrepancy, kRisk };
+
+  void receive() {
+    pollfd fds[2] = {{safety_.getFileno(), POLLIN, 0}, {images_.getFileno(), POLLIN, 0}};
+    while (!stop_) {
+      if (poll(fds, 2, 20) <= 0) continue;
+      if (fds[0].revents & POLLIN) safety_.handleTimeout(0);
+      if (fds[1].revents & POLLIN) images_.handleTimeout(0);
+    }
+  }
+  void record(const lcm::ReceiveBuffer* buffer, int64_t hash, Stage stage) {
+    const int64_t now_us = monotonic_us();
+    if (buffer->data_size < kHashUtimeSeqBytes) return;
+    const auto* bytes = static_cast<const uint8_t*>(buffer->data);
+    if (get_int64_be(bytes) != hash) return;
+    const int64_t seq = get_int64_be(bytes + kSeqOffset);
+    if (seq < 0) return;  // a timeout verdict, about no frame
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = frames_.find(seq);
+    if (it == frames_.end()) return;  // not a frame this bench sent (or forgotten)
+    int64_t& at = stage == Stage::kRendered      ? it->second.rendered_us
+                  : stage == Stage::kDiscrepancy ? it->second.discrepancy_us
+                                                 : it->second.risk_us;
+    if (at != 0) return;
+    at = now_us;
+    if (stage == Stage::kRisk) verdict_.notify_all();
+  }
+  void on_rendered(const lcm::ReceiveBuffer* b, const std::string&) {
+    record(b, depth_image_t::getHash(), Stage::kRendered);
+  }
+  void on_discrepancy(const lcm::ReceiveBuffer* b, const std::string&) {
+    record(b, discrepancy_t::getHash(), Stage::kDiscrepancy);
+  }
+  void on_risk(const lcm::ReceiveBuffer* b, const std::string&) {
+    record(b, risk_t::getHash(), Stage::kRisk);
+  }
+
+  lcm::LCM safety_;
+  lcm::LCM images_;
+  mutable std::mutex mutex_;
+  std::condition_variable verdict_;
+  std::unordered_map<int64_t, FrameArrivals> frames_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+double motion_position(const sim::JointMotion& m, double t_s) {
+  return m.center + m.amplitude * std::sin(2 * kPi * t_s / m.period_s + m.phase_rad);
+}
+double motion_velocity(const sim::JointMotion& m, double t_s) {
+  return m.amplitude * 2 * kPi / m.period_s * std::cos(2 * kPi * t_s / m.period_s + m.phase_rad);
+}
+
+// The arm's path for a step: `prepared` frames taken 1/rate apart in motion
+// time, played forwards then backwards. Real time t maps to motion time
+// path_s(t), a triangle wave, so frame k (at t = k / rate) shows the pose
+// of prepared frame index(k), and a joint state at any t lies on the same
+// smooth path (continuous position; the velocity reverses at the ends).
+struct ArmPath {
+  double rate_hz = 30;
+  int prepared = 1;
+  double start_s = 0;  // motion time of prepared frame 0
+
+  double span_s() const { return (prepared - 1) / rate_hz; }
+  int index(int64_t k) const {
+    if (prepared <= 1) return 0;
+    const int64_t cycle = 2 * (prepared - 1);
+    const int64_t i = k % cycle;
+    return static_cast<int>(i < prepared ? i : cycle - i);
+  }
+  // Motion time at real time t_s after the step's start, and its direction.
+  std::pair<double, double> at(double t_s) const {
+    if (prepared <= 1) return {start_s, 0.0};
+    const double period_s = 2 * span_s();
+    const double phase_s = std::fmod(t_s, period_s);
+    return phase_s <= span_s() ? std::make_pair(start_s + phase_s, 1.0)
+                               : std::make_pair(start_s + period_s - phase_s, -1.0);
+  }
+};
+
+// One arm at one camera size: its config, the chain running on it, the
+// bench's publisher and receiver, and the simulated camera that prepares
+// the frames.
+class BenchChain {
+ public:
+  BenchChain(const std::string& arm_name, const CampaignArm& arm, const Intrinsics& intrinsics,
+             double config_rate_hz, const BenchOptions& options, std::ostream& log)
+      : arm_name_(arm_name), arm_(arm), intrinsics_(intrinsics), options_(options), log_(log) {
+    arm_.config.camera.intrinsics = intrinsics;
+    arm_.config.camera.rate_hz = config_rate_hz;
+    const std::string name = "bench-" + arm_name + "-" + size_text(intrinsics.width, intrinsics.height);
+    config_path_ = write_bench_config(arm_, intrinsics, name);
+    config_ = deployment::load_config(config_path_, nullptr);
+    frames_ = std::make_unique<SimulatedFrames>(arm_.config);
+    // What tofguard-renderer draws (its geometry, padding and mesh
+    // simplification), not the simulated camera's exact scene.
+    triangles_ = robot_model::load_scene(config_.robot.urdf_path, config_.environment.urdf_paths,
+                                         renderer::scene_options(config_.renderer, config_.robot))
+                     .num_triangles();
+    for (const std::string& joint : frames_->scene().actuated_joint_names) joint_names_.push_back(joint);
+    recorder_ = std::make_unique<ArrivalRecorder>(config_);
+    safety_ = std::make_unique<lcm::LCM>(config_.lcm.url);
+    images_ = std::make_unique<lcm::LCM>(config_.lcm.image_url);
+    if (!safety_->good() || !images_->good()) throw std::runtime_error("cannot open LCM for publishing");
+    for (const std::string& p : kChainProcesses) {
+      processes_[p] = std::make_unique<Subprocess>(
+          name + "-" + p, std::vector<std::string>{bin_dir() + "/" + p, "--config", config_path_});
+    }
+  }
+
+  size_t triangles() const { return triangles_; }
+
+  // Runs `rate_hz` for `seconds` (after a warm-up on the first call) and
+  // measures it.
+  BenchStep run_step(double rate_hz, double seconds) {
+    const int64_t frames = std::max<int64_t>(1, std::llround(rate_hz * seconds));
+    const ArmPath path = prepare(rate_hz, static_cast<int>(std::min<int64_t>(frames, kMaxPreparedFrames)));
+    if (!warm_) warm_up(path);
+    BenchStep step;
+    step.arm = arm_name_;
+    step.width = intrinsics_.width;
+    step.height = intrinsics_.height;
+    step.triangles = triangles();
+    step.rate_hz = rate_hz;
+    std::map<std::string, ProcSample> cpu_before;
+    for (const auto& [name, p] : processes_) cpu_before[name] = sample_proc(p->pid());
+    cpu_before[kBenchProcess] = sample_proc(getpid());
+    const int64_t start_us = monotonic_us();
+    const int64_t first_seq = next_seq_;
+    publish(path, 0, frames);
+    const int64_t sent_us = monotonic_us();
+    const int64_t last_seq = next_seq_ - 1;
+    recorder_->wait_for_verdicts(first_seq, last_seq, last_send_us_ + options_.result_timeout_us);
+    const int64_t end_us = monotonic_us();
+    for (const auto& [name, p] : processes_) {
+      const ProcSample after = sample_proc(p->pid());
+      if (!after.alive) throw std::runtime_error(name + " died during the step\n" + stderr_of_all());
+      step.cpu_percent[name] = 100.0 * (after.cpu_s - cpu_before[name].cpu_s) / ((end_us - start_us) * 1e-6);
+    }
+    step.cpu_percent[kBenchProcess] = 100.0 *
+                                      (sample_proc(getpid()).cpu_s - cpu_before[kBenchProcess].cpu_s) /
+                                      ((end_us - start_us) * 1e-6);
+    step.frames_sent = static_cast<int>(frames);
+    step.sent_rate_hz = frames > 1 ? (frames - 1) / ((sent_us - start_us) * 1e-6) : rate_hz;
+    std::vector<double> render_ms, discrepancy_ms, risk_ms, end_to_end_ms;
+    for (int64_t seq = first_seq; seq <= last_seq; ++seq) {
+      const FrameArrivals a = recorder_->arrivals(seq);
+      if (a.rendered_us) {
+        ++step.frames_rendered;
+        render_ms.push_back((a.rendered_us - a.sent_us) * 1e-3);
+      }
+      if (a.discrepancy_us) {
+        ++step.frames_judged;
+        if (a.rendered_us) discrepancy_ms.push_back((a.discrepancy_us - a.rendered_us) * 1e-3);
+      }
+      if (a.risk_us) {
+        ++step.frames_verdict;
+        if (a.discrepancy_us) risk_ms.push_back((a.risk_us - a.discrepancy_us) * 1e-3);
+        end_to_end_ms.push_back((a.risk_us - a.sent_us) * 1e-3);
+      }
+      if (a.risk_us == 0 || a.risk_us - a.sent_us > options_.result_timeout_us) ++step.frames_dropped;
+    }
+    step.render = summarise(render_ms);
+    step.discrepancy = summarise(discrepancy_ms);
+    step.risk = summarise(risk_ms);
+    step.end_to_end = summarise(end_to_end_ms);
+    recorder_->forget_before(next_seq_);
+    return step;
+  }
+
+  std::string stderr_of_all() {
+    std::string text;
+    for (auto& [name, p] : processes_) {
+      const std::string err = p->stderr_text();
+      text += "--- " + name + ":\n" + (err.size() > 2000 ? err.substr(err.size() - 2000) : err);
+    }
+    return text;
+  }
+
+ private:
+  // Renders the step's frames before it starts, so that the publisher only
+  // publishes: the simulated ToF camera's pipeline (scene at the arm's pose,
+  // noise, mixed and invalid pixels, distance calibration), encoded once.
+  ArmPath prepare(double rate_hz, int count) {
+    ArmPath path;
+    path.rate_hz = rate_hz;
+    path.prepared = count;
+    path.start_s = motion_start_s_;
+    // The next step starts elsewhere on the arm's path.
+    motion_start_s_ += 1.7;
+    encoded_.clear();
+    const Eigen::Isometry3d world_from_optical = arm_.config.camera.pose.frame_from_optical();
+    for (int i = 0; i < count; ++i) {
+      const std::vector<float> depth_m = frames_->capture(joints_at(path.start_s + i / rate_hz),
+                                                          world_from_optical, intrinsics_, ++noise_index_);
+      const depth_image_t image =
+          make_depth_image(config_.camera.id, intrinsics_, 0, 0, /*calibrated=*/true, depth_m);
+      std::vector<uint8_t> bytes(static_cast<size_t>(image.getEncodedSize()));
+      if (image.encode(bytes.data(), 0, static_cast<int>(bytes.size())) < 0)
+        throw std::runtime_error("cannot encode a depth frame");
+      encoded_.push_back(std::move(bytes));
+    }
+    return path;
+  }
+
+  robot_model::JointPositions joints_at(double motion_s) const {
+    robot_model::JointPositions joints;
+    for (const std::string& j : joint_names_) joints[j] = 0;
+    for (const sim::JointMotion& m : arm_.config.joints_sim.motion)
+      joints[m.joint] = motion_position(m, motion_s);
+    return joints;
+  }
+
+  joint_state_t joint_state(const ArmPath& path, double t_s, int64_t utime) const {
+    const auto [motion_s, direction] = path.at(t_s);
+    joint_state_t s;
+    s.utime = utime;
+    s.robot_id = config_.robot.id;
+    for (const std::string& j : joint_names_) {
+      double position = 0, velocity = 0;
+      for (const sim::JointMotion& m : arm_.config.joints_sim.motion) {
+        if (m.joint != j) continue;
+        position = motion_position(m, motion_s);
+        velocity = direction * motion_velocity(m, motion_s);
+      }
+      s.name.push_back(j);
+      s.position.push_back(position);
+      s.velocity.push_back(velocity);
+    }
+    s.num_joints = static_cast<int32_t>(s.name.size());
+    return s;
+  }
+
+  // Publishes `frames` frames at path.rate_hz on the monotonic clock: before
+  // frame k the joint states since the last frame (every 10 ms) and one at
+  // the frame's own utime, so that the renderer interpolates, never
+  // extrapolates (docs/renderer.md). `first_k`: the first frame's index on
+  // the path (the warm-up goes on along it one frame per call).
+  void publish(const ArmPath& path, int64_t first_k, int64_t frames) {
+    const int64_t period_us = std::llround(1e6 / path.rate_hz);
+    const int64_t start_mono_us = monotonic_us() + 2000;
+    // utimes continue the wall clock (capture time = the time it is sent),
+    // and always rise across steps.
+    const int64_t start_utime = std::max(wall_utime(), last_utime_ + 1000) + 2000;
+    const auto at = [&](int64_t offset_us) {
+      std::this_thread::sleep_until(
+          std::chrono::steady_clock::time_point(std::chrono::microseconds(start_mono_us + offset_us)));
+    };
+    for (int64_t k = 0; k < frames; ++k) {
+      const int64_t frame_us = k * period_us;
+      if (k > 0) {
+        for (int64_t j = frame_us - period_us + kJointStatePeriodUs; j < frame_us - 1000;
+             j += kJointStatePeriodUs) {
+          at(j);
+          const joint_state_t s = joint_state(path, (first_k * period_us + j) * 1e-6, start_utime + j);
+          safety_->publish(config_.channels.joint_state, &s);
+        }
+      }
+      at(frame_us);
+      const int64_t utime = start_utime + frame_us;
+      const joint_state_t s = joint_state(path, (first_k * period_us + frame_us) * 1e-6, utime);
+      safety_->publish(config_.channels.joint_state, &s);
+      std::vector<uint8_t>& bytes = encoded_[static_cast<size_t>(path.index(first_k + k))];
+      put_int64_be(bytes.data() + kUtimeOffset, utime);
+      put_int64_be(bytes.data() + kSeqOffset, next_seq_);
+      recorder_->sent(next_seq_, monotonic_us());
+      images_->publish(config_.channels.depth, bytes.data(), static_cast<unsigned int>(bytes.size()));
+      last_send_us_ = monotonic_us();
+      last_utime_ = utime;
+      ++next_seq_;
+    }
+  }
+
+  // Publishes until kWarmupFrames frames in a row have come through the
+  // whole chain (the processes loaded their models and paired their first
+  // inputs), then lets the rest drain.
+  void warm_up(const ArmPath& path) {
+    log_ << "  starting the chain (" << arm_name_ << ", " << size_text(intrinsics_.width, intrinsics_.height)
+         << ", " << triangles() << " triangles)..." << std::endl;
+    const int64_t first_seq = next_seq_;
+    const int64_t deadline_us =
+        monotonic_us() + std::chrono::duration_cast<std::chrono::microseconds>(kStartDeadline).count();
+    // One frame at a time: each waits for its verdict (or 1 s), so that the
+    // chain is not flooded while it starts.
+    int in_a_row = 0;
+    while (in_a_row < kWarmupFrames) {
+      if (monotonic_us() > deadline_us)
+        throw std::runtime_error("the chain did not judge " + std::to_string(kWarmupFrames) +
+                                 " frames in a row within " + std::to_string(kStartDeadline.count()) +
+                                 " s\n" + stderr_of_all());
+      for (auto& [name, p] : processes_) {
+        if (!p->running()) throw std::runtime_error(name + " exited at start\n" + stderr_of_all());
+      }
+      publish(path, next_seq_ - first_seq, 1);
+      const int64_t seq = next_seq_ - 1;
+      in_a_row = recorder_->wait_for_verdicts(seq, seq, monotonic_us() + options_.result_timeout_us)
+                     ? in_a_row + 1
+                     : 0;
+    }
+    recorder_->forget_before(next_seq_);
+    log_ << "  chain up after " << next_seq_ - first_seq << " frames" << std::endl;
+    warm_ = true;
+  }
+
+  std::string arm_name_;
+  CampaignArm arm_;
+  Intrinsics intrinsics_;
+  BenchOptions options_;
+  std::ostream& log_;
+  std::string config_path_;
+  deployment::Config config_;
+  std::unique_ptr<SimulatedFrames> frames_;
+  std::vector<std::string> joint_names_;
+  size_t triangles_ = 0;
+  std::unique_ptr<ArrivalRecorder> recorder_;
+  std::unique_ptr<lcm::LCM> safety_;
+  std::unique_ptr<lcm::LCM> images_;
+  std::map<std::string, std::unique_ptr<Subprocess>> processes_;
+  std::vector<std::vector<uint8_t>> encoded_;
+  int64_t next_seq_ = 1;
+  int64_t last_send_us_ = 0;
+  int64_t last_utime_ = 0;
+  uint64_t noise_index_ = 0;
+  double motion_start_s_ = 0;
+  bool warm_ = false;
+};
+
+std::string machine_text() {
+  std::string model = "unknown CPU";
+  std::ifstream cpuinfo("/proc/cpuinfo");
+  for (std::string line; std::getline(cpuinfo, line);) {
+    if (line.rfind("model name", 0) == 0 && line.find(':') != std::string::npos) {
+      model = line.substr(line.find(':') + 2);
+      break;
+    }
+  }
+  std::ifstream loadavg("/proc/loadavg");
+  std::string load_1, load_5, load_15;
+  loadavg >> load_1 >> load_5 >> load_15;
+  return "nproc " + std::to_string(sysconf(_SC_NPROCESSORS_ONLN)) + ", " + model + ", load average " +
+         load_1 + " " + load_5 + " " + load_15 + " at the start";
+}
+
+std::string date_text() {
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char text[64];
+  std::strftime(text, sizeof text, "%Y-%m-%d %H:%M UTC", &utc);
+  return text;
+}
+
+// Why `step` does not sustain its rate, "" when it does.
+std::string not_sustained_because(const BenchStep& step) {
+  const double period_ms = 1000.0 / step.rate_hz;
+  if (step.frames_dropped > 0) return std::to_string(step.frames_dropped) + " frames dropped";
+  if (step.sent_rate_hz < 0.95 * step.rate_hz)
+    return "the bench published only " + fixed_text(step.sent_rate_hz, 0) + " Hz";
+  const std::pair<const char*, const LatencySummary*> stages[] = {
+      {"render", &step.render}, {"discrepancy", &step.discrepancy}, {"risk", &step.risk}};
+  for (const auto& [name, s] : stages) {
+    if (s->p99_ms > period_ms)
+      return std::string(name) + " p99 " + fixed_text(s->p99_ms, 1) + " ms > period " +
+             fixed_text(period_ms, 1) + " ms";
+  }
+  return "";
+}
+
+}  // namespace
+
+std::optional<CampaignArm> bench_arm(const std::string& name, const std::string& shared_dir,
+                                     const std::string& scene_dir) {
+  if (name == "default") return default_campaign_arm();
+  if (name == "iiwa14") return iiwa14_campaign_arm(shared_dir, scene_dir);
+  if (name == "kinova") return kinova_gen3_campaign_arm(shared_dir, scene_dir);
+  throw std::invalid_argument("--arms: expected default, iiwa14 or kinova, got '" + name + "'");
+}
+
+Intrinsics scaled_intrinsics(const Intrinsics& base, int width, int height) {
+  const double sx = static_cast<double>(width) / base.width;
+  const double sy = static_cast<double>(height) / base.height;
+  // A pixel's centre is at (u, v); its edges at +-0.5: the image's edges
+  // stay at the same rays when (c + 0.5) scales with the size.
+  return Intrinsics(width, height, base.fx * sx, base.fy * sy, (base.cx + 0.5) * sx - 0.5,
+                    (base.cy + 0.5) * sy - 0.5);
+}
+
+std::string write_bench_config(const CampaignArm& arm, const Intrinsics& intrinsics,
+                               const std::string& name) {
+  const deployment::Config& c = arm.config;
+  std::string robot = "urdf: " + c.robot.urdf_path;
+  if (!c.robot.package_paths.empty()) {
+    robot += "\n  package_paths: [";
+    for (size_t i = 0; i < c.robot.package_paths.size(); ++i)
+      robot += (i ? ", " : "") + c.robot.package_paths[i];
+    robot += "]";
+  }
+  std::string environment = "urdfs: [";
+  for (size_t i = 0; i < c.environment.urdf_paths.size(); ++i)
+    environment += (i ? ", " : "") + c.environment.urdf_paths[i];
+  environment += "]";
+  const CameraPose& pose = c.camera.pose;
+  const Eigen::Quaterniond q = pose.rotation;
+  return sim_config_variant(
+      name,
+      {{"urdf: models/friend_arm.urdf", robot},
+       {"urdfs: [models/wheelchair_environment.urdf]", environment},
+       {"rate_hz: 30\n  intrinsics: {width: 176, height: 144, fx: 221.0, fy: 220.5, cx: 87.3, cy: 71.8}",
+        "rate_hz: " + number_text(c.camera.rate_hz) + "\n  intrinsics: {width: " +
+            std::to_string(intrinsics.width) + ", height: " + std::to_string(intrinsics.height) +
+            ", fx: " + number_text(intrinsics.fx) + ", fy: " + number_text(intrinsics.fy) +
+            ", cx: " + number_text(intrinsics.cx) + ", cy: " + number_text(intrinsics.cy) + "}"},
+       {"frame: world\n    translation_m: [-0.90, -0.20, 1.80]\n    rotation_wxyz: [0.302934347, "
+        "-0.581931466, "
+        "0.669435574, -0.348486102]",
+        "frame: " + pose.frame_id + "\n    translation_m: [" + number_text(pose.translation_m.x()) + ", " +
+            number_text(pose.translation_m.y()) + ", " + number_text(pose.translation_m.z()) +
+            "]\n    rotation_wxyz: [" + number_text(q.w()) + ", " + number_text(q.x()) + ", " +
+            number_text(q.y()) + ", " + number_text(q.z()) + "]"},
+       // The bench stands in for tofguard-camera (it publishes the frames,
+       // not a heartbeat), and no tofguard-estimator runs: the observer
+       // chain alone, judged by its rules.
+       {"required_heartbeats: [tofguard-camera, tofguard-renderer, tofguard-discrepancy]",
+        "required_heartbeats: [tofguard-renderer, tofguard-discrepancy]"},
+       {"estimate:\n    enabled: true", "estimate:\n    enabled: false"}});
+}
+
+BenchReport run_bench(const BenchOptions& options, std::ostream& log) {
+  BenchReport report;
+  report.machine = machine_text();
+  report.date = date_text();
+  const std::string scene_dir = options.work_dir.empty() ? output_dir() + "/bench" : options.work_dir;
+  for (const std::string& arm_name : options.arms) {
+    const std::optional<CampaignArm> arm = bench_arm(arm_name, options.shared_dir, scene_dir);
+    if (!arm) {
+      report.skipped.push_back(
+          arm_name + ": skipped, its URDF is not under " +
+          (options.shared_dir.empty() ? std::string("../shared (absent)") : options.shared_dir + "/robots"));
+      log << report.skipped.back() << std::endl;
+      continue;
+    }
+    for (const auto& [width, height] : options.resolutions) {
+      const Intrinsics intrinsics = scaled_intrinsics(arm->config.camera.intrinsics, width, height);
+      log << arm_name << " " << size_text(width, height) << std::endl;
+      BenchChain chain(arm_name, *arm, intrinsics, options.ramp ? options.ramp_start_hz : options.rate_hz,
+                       options, log);
+      if (!options.ramp) {
+        report.steps.push_back(chain.run_step(options.rate_hz, options.seconds));
+        continue;
+      }
+      BenchRamp ramp;
+      ramp.arm = arm_name;
+      ramp.width = width;
+      ramp.height = height;
+      ramp.triangles = chain.triangles();
+      for (double rate = options.ramp_start_hz; rate <= options.ramp_max_hz; rate *= 2) {
+        log << "  " << fixed_text(rate, 0) << " Hz for " << options.ramp_step_s << " s" << std::endl;
+        ramp.steps.push_back(chain.run_step(rate, options.ramp_step_s));
+        const std::string why = not_sustained_because(ramp.steps.back());
+        if (!why.empty()) {
+          ramp.stopped_because = fixed_text(rate, 0) + " Hz: " + why;
+          break;
+        }
+        ramp.sustained_hz = rate;
+      }
+      if (ramp.stopped_because.empty())
+        ramp.stopped_because = "none up to " + fixed_text(options.ramp_max_hz, 0) + " Hz (the ramp's end)";
+      report.ramps.push_back(std::move(ramp));
+    }
+  }
+  return report;
+}
+
+namespace {
+
+std::string latency_cell(const LatencySummary& s) {
+  if (s.count == 0) return "-";
+  return fixed_text(s.p50_ms, 1) + " / " + fixed_text(s.p99_ms, 1) + " / " + fixed_text(s.max_ms, 1);
+}
+
+std::string steps_table(const std::vector<BenchStep>& steps) {
+  const deployment::Config config = deployment::load_config(source_dir() + "/config/sim.yaml", nullptr);
+  const ChannelNames& ch = config.channels;
+  std::ostringstream t;
+  t << "| arm | triangles | size | rate (Hz) | sent | dropped | " << ch.depth << " → " << ch.rendered << " | "
+    << ch.rendered << " → " << ch.discrepancy << " | " << ch.discrepancy << " → " << ch.risk << " | "
+    << ch.depth << " → " << ch.risk
+    << " (end to end) | CPU % renderer / discrepancy / risk / intervene / bench |\n";
+  t << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+  for (const BenchStep& s : steps) {
+    const auto cpu = [&](const std::string& p) {
+      const auto it = s.cpu_percent.find(p);
+      return it == s.cpu_percent.end() ? std::string("-") : fixed_text(it->second, 0);
+    };
+    t << "| " << s.arm << " | " << s.triangles << " | " << size_text(s.width, s.height) << " | "
+      << fixed_text(s.rate_hz, 0) << " | " << s.frames_sent << " | " << s.frames_dropped << " | "
+      << latency_cell(s.render) << " | " << latency_cell(s.discrepancy) << " | " << latency_cell(s.risk)
+      << " | " << latency_cell(s.end_to_end) << " | " << cpu("tofguard-renderer") << " / "
+      << cpu("tofguard-discrepancy") << " / " << cpu("tofguard-risk") << " / " << cpu("tofguard-intervene")
+      << " / " << cpu(kBenchProcess) << " |\n";
+  }
+  return t.str();
+}
+
+}  // namespace
+
+std::string bench_markdown(const BenchReport& report) {
+  std::ostringstream md;
+  md << "tofguard-bench, " << report.date << "; machine: " << report.machine << "\n\n";
+  md << "Latencies p50 / p99 / max in ms, each the bench's receive time of the stage's message for the "
+        "frame's "
+        "seq minus the previous stage's (the first: the time the bench sent the frame); CPU: % of one core "
+        "over "
+        "the step; dropped: no verdict within 1 s.\n\n";
+  if (!report.steps.empty()) md << steps_table(report.steps);
+  if (!report.ramps.empty()) {
+    md << "| arm | triangles | size | highest rate sustained (Hz) | stopped at |\n";
+    md << "| --- | --- | --- | --- | --- |\n";
+    std::vector<BenchStep> all;
+    for (const BenchRamp& r : report.ramps) {
+      md << "| " << r.arm << " | " << r.triangles << " | " << size_text(r.width, r.height) << " | "
+         << (r.sustained_hz > 0 ? fixed_text(r.sustained_hz, 0) : std::string("none")) << " | "
+         << r.stopped_because << " |\n";
+      all.insert(all.end(), r.steps.begin(), r.steps.end());
+    }
+    md << "\nEvery step of the ramps:\n\n" << steps_table(all);
+  }
+  for (const std::string& s : report.skipped) md << "\n" << s << "\n";
+  return md.str();
+}
+
+namespace {
+
+const cv::Scalar kColours[] = {{200, 60, 30}, {30, 120, 220}, {40, 160, 40}, {160, 40, 160},
+                               {0, 160, 200}, {90, 90, 90},   {220, 140, 0}, {120, 60, 0}};
+
+// One curve of a panel: (x, y) points, joined, filled or open circles.
+struct Curve {
+  std::string label;
+  std::vector<std::pair<double, double>> points;
+  int colour = 0;
+  bool filled = true;
+};
+
+// The axis's end: 1, 2 or 5 times a power of 10, above `value`.
+double round_axis(double value) {
+  double axis = 1e-3;
+  while (axis < 1.05 * value) axis *= (std::to_string(axis * 1e3).substr(0, 1) == "2") ? 2.5 : 2;
+  return axis;
+}
+
+// `tick_labels`: the text under an x value (else the value itself).
+void draw_panel(cv::Mat* image, const cv::Rect& area, const std::string& title, const std::string& x_label,
+                const std::string& y_label, const std::vector<Curve>& curves,
+                const std::map<double, std::string>& tick_labels = {}) {
+  const cv::Scalar black(0, 0, 0), grey(200, 200, 200);
+  double x_max = 0, y_max = 0;
+  std::vector<double> ticks;
+  for (const Curve& c : curves)
+    for (const auto& [x, y] : c.points) {
+      x_max = std::max(x_max, x);
+      y_max = std::max(y_max, y);
+      if (std::find(ticks.begin(), ticks.end(), x) == ticks.end()) ticks.push_back(x);
+    }
+  x_max = x_max > 0 ? 1.08 * x_max : 1;
+  y_max = round_axis(y_max > 0 ? y_max : 1);
+  const int left = area.x + 70, right = area.x + area.width - 20, top = area.y + 50,
+            bottom = area.y + area.height - 50;
+  auto px = [&](double x, double y) {
+    return cv::Point(left + static_cast<int>((right - left) * x / x_max),
+                     bottom - static_cast<int>((bottom - top) * std::min(y, y_max) / y_max));
+  };
+  const int font = cv::FONT_HERSHEY_SIMPLEX;
+  cv::putText(*image, title, {area.x + 10, area.y + 25}, font, 0.55, black, 1, cv::LINE_AA);
+  for (int i = 0; i <= 4; ++i) {
+    const double y = y_max * i / 4;
+    cv::line(*image, px(0, y), px(x_max, y), grey, 1);
+    cv::putText(*image, fixed_text(y, y_max < 10 ? 1 : 0), {area.x + 5, px(0, y).y + 5}, font, 0.4, black, 1,
+                cv::LINE_AA);
+  }
+  for (double x : ticks) {
+    cv::line(*image, px(x, 0), px(x, 0) + cv::Point(0, 5), black, 1);
+    std::ostringstream l;
+    l << x;
+    const auto label = tick_labels.find(x);
+    cv::putText(*image, label == tick_labels.end() ? l.str() : label->second, px(x, 0) + cv::Point(-20, 20),
+                font, 0.4, black, 1, cv::LINE_AA);
+  }
+  cv::line(*image, px(0, 0), px(x_max, 0), black, 1);
+  cv::line(*image, px(0, 0), px(0, y_max), black, 1);
+  cv::putText(*image, x_label, {(left + right) / 2 - 60, bottom + 40}, font, 0.45, black, 1, cv::LINE_AA);
+  cv::putText(*image, y_label, {area.x + 5, top - 10}, font, 0.45, black, 1, cv::LINE_AA);
+  for (const Curve& c : curves) {
+    const cv::Scalar colour = kColours[c.colour % 8];
+    std::vector<std::pair<double, double>> points = c.points;
+    std::sort(points.begin(), points.end());
+    for (size_t i = 0; i < points.size(); ++i) {
+      const cv::Point here = px(points[i].first, points[i].second);
+      cv::circle(*image, here, c.filled ? 4 : 3, colour, c.filled ? cv::FILLED : 1, cv::LINE_AA);
+      if (i > 0)
+        cv::line(*image, px(points[i - 1].first, points[i - 1].second), here, colour, c.filled ? 2 : 1,
+                 cv::LINE_AA);
+    }
+  }
+}
+
+}  // namespace
+
+void plot_bench(const BenchReport& report, const std::string& path) {
+  // Latency: the plain steps, or each ramp's first (slowest) rate.
+  std::vector<BenchStep> steps = report.steps;
+  for (const BenchRamp& r : report.ramps)
+    if (!r.steps.empty()) steps.push_back(r.steps.front());
+  std::vector<std::string> arms;
+  for (const BenchStep& s : steps)
+    if (std::find(arms.begin(), arms.end(), s.arm) == arms.end()) arms.push_back(s.arm);
+  const char* const stage_names[] = {"render", "discrepancy", "risk", "end to end"};
+  const int panel_w = 450, panel_h = 420, legend_h = 70;
+  const int panels = static_cast<int>(arms.size()) + 1;
+  cv::Mat image(panel_h + legend_h, panel_w * panels, CV_8UC3, cv::Scalar(255, 255, 255));
+  std::map<double, std::string> size_labels;
+  for (const BenchStep& s : steps) size_labels[s.width * s.height / 1000.0] = size_text(s.width, s.height);
+  for (size_t a = 0; a < arms.size(); ++a) {
+    std::vector<Curve> curves;
+    for (int stage = 0; stage < 4; ++stage) {
+      for (const bool p99 : {false, true}) {
+        Curve c;
+        c.colour = stage;
+        c.filled = !p99;
+        for (const BenchStep& s : steps) {
+          if (s.arm != arms[a]) continue;
+          const LatencySummary& l = stage == 0   ? s.render
+                                    : stage == 1 ? s.discrepancy
+                                    : stage == 2 ? s.risk
+                                                 : s.end_to_end;
+          if (l.count > 0) c.points.push_back({s.width * s.height / 1000.0, p99 ? l.p99_ms : l.p50_ms});
+        }
+        curves.push_back(c);
+      }
+    }
+    draw_panel(&image, {panel_w * static_cast<int>(a), 0, panel_w, panel_h},
+               arms[a] + ": latency per stage (p50 filled, p99 open)", "camera size (kilopixels)", "ms",
+               curves, size_labels);
+  }
+  // Throughput against the scene's triangles, a curve per camera size.
+  std::map<std::string, Curve> by_size;
+  const auto add_point = [&](int width, int height, size_t triangles, double rate_hz) {
+    Curve& c = by_size[size_text(width, height)];
+    c.label = size_text(width, height);
+    c.points.push_back({static_cast<double>(triangles), rate_hz});
+  };
+  for (const BenchRamp& r : report.ramps) add_point(r.width, r.height, r.triangles, r.sustained_hz);
+  for (const BenchStep& s : report.steps) {
+    // Without a ramp: the rate of verdicts delivered (frames not dropped).
+    const double delivered = s.frames_sent > 0 ? s.rate_hz * (s.frames_sent - s.frames_dropped) /
+                                                     static_cast<double>(s.frames_sent)
+                                               : 0;
+    add_point(s.width, s.height, s.triangles, delivered);
+  }
+  std::vector<Curve> throughput;
+  int colour = 4;
+  for (auto& [size, c] : by_size) {
+    c.colour = colour++;
+    throughput.push_back(c);
+  }
+  draw_panel(&image, {panel_w * (panels - 1), 0, panel_w, panel_h},
+             report.ramps.empty() ? "rate delivered (no drops)" : "highest rate sustained", "triangles", "Hz",
+             throughput);
+  const int font = cv::FONT_HERSHEY_SIMPLEX;
+  for (int stage = 0; stage < 4; ++stage) {
+    const int x = 20 + 150 * stage, y = panel_h + 20;
+    cv::line(image, {x, y}, {x + 30, y}, kColours[stage], 2, cv::LINE_AA);
+    cv::putText(image, stage_names[stage], {x + 35, y + 5}, font, 0.45, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+  }
+  int i = 0;
+  for (const Curve& c : throughput) {
+    const int x = 20 + 150 * i++, y = panel_h + 50;
+    cv::line(image, {x, y}, {x + 30, y}, kColours[c.colour % 8], 2, cv::LINE_AA);
+    cv::putText(image, c.label, {x + 35, y + 5}, font, 0.45, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+  }
+  const fs::path parent = fs::path(path).parent_path();
+  if (!parent.empty()) fs::create_directories(parent);
+  if (!cv::imwrite(path, image)) throw std::runtime_error(path + ": cannot write the plot");
+}
+
+}  // namespace tofguard::test

@@ -1,0 +1,132 @@
+#pragma once
+// The observer chain's speed as processes (issue 17 point 1): tofguard-renderer,
+// -discrepancy, -risk and -intervene started from build/bin with a config
+// made for the arm and camera size, fed over real LCM by the bench's own
+// publisher with depth frames prepared beforehand (the simulated ToF camera's
+// pipeline: the scene rendered at the arm's pose, its error model and the
+// distance calibration) and joint states along a smooth path. Per frame the
+// bench records, on its own monotonic clock, when it sent TOF_DEPTH and
+// when TOF_RENDERED, SAFETY_DISCREPANCY and SAFETY_RISK for that frame's seq
+// arrived; from that the latency of each stage, frames dropped, CPU per
+// process (/proc) and, ramping the rate, the highest rate sustained.
+//
+// A measuring tool, not a test of timing: LCM must run in a private network
+// namespace (scripts/bench, tests/netns/run-in-netns).
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "judge_campaign.hpp"
+#include "tofguard/common/camera_geometry.hpp"
+
+namespace tofguard::test {
+
+struct BenchOptions {
+  // default, iiwa14, kinova (the last two from `shared_dir`/robots).
+  std::vector<std::string> arms = {"default"};
+  // Camera sizes; the config's intrinsics scaled to each (same field of view).
+  std::vector<std::pair<int, int>> resolutions = {{176, 144}};
+  double rate_hz = 30;
+  double seconds = 10;
+  // Ramp: rates ramp_start_hz, twice that, ... up to ramp_max_hz, each for
+  // ramp_step_s, stopping at the first rate with a dropped frame, a stage's
+  // p99 above the frame period, or a publisher that could not keep the rate.
+  bool ramp = false;
+  double ramp_start_hz = 30;
+  double ramp_max_hz = 1920;
+  double ramp_step_s = 3;
+  // A TOF_DEPTH whose SAFETY_RISK has not come this long after it was sent
+  // is dropped.
+  int64_t result_timeout_us = 1000000;
+  std::string shared_dir;
+  // Configs, scenes and the processes' output files.
+  std::string work_dir;
+};
+
+// p50 / p99 / max of one stage's latencies (nearest rank), ms; count 0:
+// no frame reached the stage.
+struct LatencySummary {
+  int count = 0;
+  double p50_ms = 0;
+  double p99_ms = 0;
+  double max_ms = 0;
+};
+
+// One rate held for a while on one arm and camera size.
+struct BenchStep {
+  std::string arm;
+  int width = 0;
+  int height = 0;
+  size_t triangles = 0;  // the scene's (arm and environment) per render
+  double rate_hz = 0;
+  double sent_rate_hz = 0;  // what the publisher achieved (frames / time taken)
+  int frames_sent = 0;
+  int frames_rendered = 0;  // TOF_RENDERED arrived
+  int frames_judged = 0;    // SAFETY_DISCREPANCY arrived
+  int frames_verdict = 0;   // SAFETY_RISK arrived (at any time)
+  int frames_dropped = 0;   // no SAFETY_RISK within result_timeout_us
+  // TOF_DEPTH sent -> TOF_RENDERED -> SAFETY_DISCREPANCY -> SAFETY_RISK, and
+  // TOF_DEPTH sent -> SAFETY_RISK.
+  LatencySummary render;
+  LatencySummary discrepancy;
+  LatencySummary risk;
+  LatencySummary end_to_end;
+  // Process name -> CPU time over the step / its wall time, percent of one
+  // core; "tofguard-bench" is this process (publisher and receiver).
+  std::map<std::string, double> cpu_percent;
+};
+
+// A ramp on one arm and camera size: the rates tried, the highest one
+// sustained (0: not even the first) and why the next one was not.
+struct BenchRamp {
+  std::string arm;
+  int width = 0;
+  int height = 0;
+  size_t triangles = 0;
+  double sustained_hz = 0;
+  std::string stopped_because;
+  std::vector<BenchStep> steps;
+};
+
+struct BenchReport {
+  std::string machine;               // nproc, CPU model, load
+  std::string date;                  // UTC
+  std::vector<BenchStep> steps;      // without --ramp: one per arm and size
+  std::vector<BenchRamp> ramps;      // with --ramp
+  std::vector<std::string> skipped;  // arms skipped, with why
+};
+
+// The campaign arm `name` (default, iiwa14, kinova; judge_campaign.hpp's
+// scenes), nothing when its URDF is not under `shared_dir`. Throws
+// std::invalid_argument for another name.
+std::optional<CampaignArm> bench_arm(const std::string& name, const std::string& shared_dir,
+                                     const std::string& scene_dir);
+
+// `base` scaled to width x height: the same field of view (fx, cx with the
+// width; fy, cy with the height; pixel centres stay at the same rays).
+Intrinsics scaled_intrinsics(const Intrinsics& base, int width, int height);
+
+// config/sim.yaml for `arm` at `intrinsics` (its robot, environment,
+// camera pose and rate), as the bench's chain runs it, written to
+// output_dir()/<name>.yaml; returns the path.
+std::string write_bench_config(const CampaignArm& arm, const Intrinsics& intrinsics, const std::string& name);
+
+// Runs every arm and size of `options`; progress lines go to `log`. Throws
+// std::runtime_error when a chain does not come up or a scene cannot be
+// rendered.
+BenchReport run_bench(const BenchOptions& options, std::ostream& log);
+
+// The report as Markdown: machine and date, a row per step (latencies per
+// stage, drops, CPU per process) and, for ramps, the rate sustained.
+std::string bench_markdown(const BenchReport& report);
+
+// A PNG: p50 and p99 latency per stage against the camera's pixels (a
+// panel per arm), and the rate sustained (with --ramp; else the rate
+// delivered) against the scene's triangles. Throws std::runtime_error when
+// it cannot be written.
+void plot_bench(const BenchReport& report, const std::string& path);
+
+}  // namespace tofguard::test

@@ -1,0 +1,113 @@
+// tofguard-bench: the observer chain's speed as real processes over real LCM
+// (issue 17 point 1; tests/support/chain_bench.hpp): latency per stage,
+// frames dropped and CPU per process, per arm and camera size, at one rate or
+// ramping. Run it through scripts/bench (a private network namespace).
+//
+//   tofguard-bench [--arms default,iiwa14,kinova] [--resolutions 176x144,320x240,640x480]
+//                  [--rate-hz 30] [--seconds 10] [--ramp] [--ramp-step-s 3] [--ramp-max-hz 1920]
+//                  [--shared DIR] [--markdown FILE] [--plot FILE.png]
+//
+// --ramp: 30, 60, 120 ... Hz, --ramp-step-s each, up to the first rate with
+// a dropped frame, a stage's p99 above the frame period or a publisher that
+// could not keep the rate; reports the highest rate sustained.
+//
+// Prints the Markdown table (with the machine and the date) to stdout.
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "chain_bench.hpp"
+#include "test_support.hpp"
+
+namespace {
+
+std::vector<std::string> split(const std::string& text) {
+  std::vector<std::string> parts;
+  std::stringstream s(text);
+  for (std::string part; std::getline(s, part, ',');)
+    if (!part.empty()) parts.push_back(part);
+  return parts;
+}
+
+int usage(const std::string& why) {
+  std::cerr
+      << "tofguard-bench: " << why
+      << "\nusage: tofguard-bench [--arms default,iiwa14,kinova] [--resolutions 176x144,320x240,640x480] "
+         "[--rate-hz 30] [--seconds 10] [--ramp] [--ramp-step-s 3] [--ramp-max-hz 1920] [--shared DIR] "
+         "[--markdown FILE] [--plot FILE.png]\n";
+  return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace tofguard::test;
+  BenchOptions options;
+  options.shared_dir = shared_dir();
+  std::string markdown_path;
+  std::string plot_path;
+  for (int i = 1; i < argc; ++i) {
+    const std::string option = argv[i];
+    if (option == "--ramp") {
+      options.ramp = true;
+      continue;
+    }
+    if (option == "-h" || option == "--help") return usage("the observer chain's speed");
+    if (i + 1 >= argc) return usage(option + ": expected a value");
+    const std::string value = argv[++i];
+    try {
+      if (option == "--arms") {
+        options.arms = split(value);
+      } else if (option == "--resolutions") {
+        options.resolutions.clear();
+        for (const std::string& r : split(value)) {
+          const size_t x = r.find('x');
+          if (x == std::string::npos) return usage("--resolutions: expected WIDTHxHEIGHT, got '" + r + "'");
+          options.resolutions.emplace_back(std::stoi(r.substr(0, x)), std::stoi(r.substr(x + 1)));
+        }
+      } else if (option == "--rate-hz") {
+        options.rate_hz = std::stod(value);
+      } else if (option == "--seconds") {
+        options.seconds = std::stod(value);
+      } else if (option == "--ramp-step-s") {
+        options.ramp_step_s = std::stod(value);
+      } else if (option == "--ramp-max-hz") {
+        options.ramp_max_hz = std::stod(value);
+      } else if (option == "--shared") {
+        options.shared_dir = value;
+      } else if (option == "--markdown") {
+        markdown_path = value;
+      } else if (option == "--plot") {
+        plot_path = value;
+      } else {
+        return usage("unknown option " + option);
+      }
+    } catch (const std::exception&) {
+      return usage(option + ": expected a number, got '" + value + "'");
+    }
+  }
+  if (!(options.rate_hz > 0) || !(options.seconds > 0) || !(options.ramp_step_s > 0))
+    return usage("--rate-hz, --seconds and --ramp-step-s must be positive");
+  for (const auto& [w, h] : options.resolutions)
+    if (w <= 0 || h <= 0) return usage("--resolutions: sizes must be positive");
+  try {
+    const BenchReport report = run_bench(options, std::cerr);
+    const std::string markdown = bench_markdown(report);
+    std::cout << markdown << std::flush;
+    if (!markdown_path.empty()) {
+      std::ofstream out(markdown_path);
+      out << markdown;
+      if (!out) throw std::runtime_error(markdown_path + ": cannot write the table");
+    }
+    if (!plot_path.empty()) {
+      plot_bench(report, plot_path);
+      std::cerr << "plot: " << plot_path << "\n";
+    }
+  } catch (const std::exception& e) {
+    std::cerr << "tofguard-bench: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
