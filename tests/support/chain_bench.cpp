@@ -119,6 +119,7 @@ struct FrameArrivals {
   int64_t rendered_us = 0;
   int64_t discrepancy_us = 0;
   int64_t risk_us = 0;
+  int8_t level = -1;  // the verdict's risk_t level
 };
 
 // Receives TOF_RENDERED, SAFETY_DISCREPANCY and SAFETY_RISK on its own
@@ -203,7 +204,11 @@ class ArrivalRecorder {
                                                  : it->second.risk_us;
     if (at != 0) return;
     at = now_us;
-    if (stage == Stage::kRisk) verdict_.notify_all();
+    if (stage != Stage::kRisk) return;
+    // risk_t's level follows its seq.
+    if (buffer->data_size > kHashUtimeSeqBytes)
+      it->second.level = static_cast<int8_t>(bytes[kHashUtimeSeqBytes]);
+    verdict_.notify_all();
   }
   void on_rendered(const lcm::ReceiveBuffer* b, const std::string&) {
     record(b, depth_image_t::getHash(), Stage::kRendered);
@@ -268,10 +273,20 @@ class BenchChain {
       : arm_name_(arm_name), arm_(arm), intrinsics_(intrinsics), options_(options), log_(log) {
     arm_.config.camera.intrinsics = intrinsics;
     arm_.config.camera.rate_hz = config_rate_hz;
+    frames_ = std::make_unique<SimulatedFrames>(arm_.config);
+    // The campaign's generic scenes place the camera in "world", which the
+    // campaign resolves itself; tofguard-renderer needs a link of the model:
+    // the robot's root link is the world frame (docs/architecture.md).
+    const robot_model::SceneModel& scene = frames_->scene();
+    const CameraPose& pose = arm_.config.camera.pose;
+    if (std::none_of(scene.links.begin(), scene.links.end(),
+                     [&](const robot_model::Link& l) { return l.name == pose.frame_id; })) {
+      arm_.config.camera.pose =
+          CameraPose(scene.links.front().name, pose.translation_m, UnitQuaternion(pose.rotation));
+    }
     const std::string name = "bench-" + arm_name + "-" + size_text(intrinsics.width, intrinsics.height);
     config_path_ = write_bench_config(arm_, intrinsics, name);
     config_ = deployment::load_config(config_path_, nullptr);
-    frames_ = std::make_unique<SimulatedFrames>(arm_.config);
     // What tofguard-renderer draws (its geometry, padding and mesh
     // simplification), not the simulated camera's exact scene.
     triangles_ = robot_model::load_scene(config_.robot.urdf_path, config_.environment.urdf_paths,
@@ -337,6 +352,7 @@ class BenchChain {
         ++step.frames_verdict;
         if (a.discrepancy_us) risk_ms.push_back((a.risk_us - a.discrepancy_us) * 1e-3);
         end_to_end_ms.push_back((a.risk_us - a.sent_us) * 1e-3);
+        if (a.level == risk_t::SAFE) ++step.frames_safe;
       }
       if (a.risk_us == 0 || a.risk_us - a.sent_us > options_.result_timeout_us) ++step.frames_dropped;
     }
@@ -662,11 +678,11 @@ std::string steps_table(const std::vector<BenchStep>& steps) {
   const deployment::Config config = deployment::load_config(source_dir() + "/config/sim.yaml", nullptr);
   const ChannelNames& ch = config.channels;
   std::ostringstream t;
-  t << "| arm | triangles | size | rate (Hz) | sent | dropped | " << ch.depth << " → " << ch.rendered << " | "
-    << ch.rendered << " → " << ch.discrepancy << " | " << ch.discrepancy << " → " << ch.risk << " | "
+  t << "| arm | triangles | size | rate (Hz) | sent | dropped | SAFE | " << ch.depth << " → " << ch.rendered
+    << " | " << ch.rendered << " → " << ch.discrepancy << " | " << ch.discrepancy << " → " << ch.risk << " | "
     << ch.depth << " → " << ch.risk
     << " (end to end) | CPU % renderer / discrepancy / risk / intervene / bench |\n";
-  t << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+  t << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
   for (const BenchStep& s : steps) {
     const auto cpu = [&](const std::string& p) {
       const auto it = s.cpu_percent.find(p);
@@ -674,10 +690,10 @@ std::string steps_table(const std::vector<BenchStep>& steps) {
     };
     t << "| " << s.arm << " | " << s.triangles << " | " << size_text(s.width, s.height) << " | "
       << fixed_text(s.rate_hz, 0) << " | " << s.frames_sent << " | " << s.frames_dropped << " | "
-      << latency_cell(s.render) << " | " << latency_cell(s.discrepancy) << " | " << latency_cell(s.risk)
-      << " | " << latency_cell(s.end_to_end) << " | " << cpu("tofguard-renderer") << " / "
-      << cpu("tofguard-discrepancy") << " / " << cpu("tofguard-risk") << " / " << cpu("tofguard-intervene")
-      << " / " << cpu(kBenchProcess) << " |\n";
+      << s.frames_safe << " | " << latency_cell(s.render) << " | " << latency_cell(s.discrepancy) << " | "
+      << latency_cell(s.risk) << " | " << latency_cell(s.end_to_end) << " | " << cpu("tofguard-renderer")
+      << " / " << cpu("tofguard-discrepancy") << " / " << cpu("tofguard-risk") << " / "
+      << cpu("tofguard-intervene") << " / " << cpu(kBenchProcess) << " |\n";
   }
   return t.str();
 }
@@ -691,7 +707,9 @@ std::string bench_markdown(const BenchReport& report) {
         "frame's "
         "seq minus the previous stage's (the first: the time the bench sent the frame); CPU: % of one core "
         "over "
-        "the step; dropped: no verdict within 1 s.\n\n";
+        "the step; dropped: no verdict within 1 s; SAFE: verdicts SAFE (the chain is judging the nominal "
+        "frames, not "
+        "stopping).\n\n";
   if (!report.steps.empty()) md << steps_table(report.steps);
   if (!report.ramps.empty()) {
     md << "| arm | triangles | size | highest rate sustained (Hz) | stopped at |\n";

@@ -68,6 +68,7 @@ struct BenchStep {
   int frames_judged = 0;    // SAFETY_DISCREPANCY arrived
   int frames_verdict = 0;   // SAFETY_RISK arrived (at any time)
   int frames_dropped = 0;   // no SAFETY_RISK within result_timeout_us
+  int frames_safe = 0;      // SAFETY_RISK arrived with level SAFE
   // TOF_DEPTH sent -> TOF_RENDERED -> SAFETY_DISCREPANCY -> SAFETY_RISK, and
   // TOF_DEPTH sent -> SAFETY_RISK.
   LatencySummary render;

@@ -40,7 +40,7 @@ TEST(BenchSmoke, FramesGoThroughEveryStageAtTenHertz) {
                              "SAFETY_DISCREPANCY → SAFETY_RISK", "TOF_DEPTH → SAFETY_RISK", "CPU %"})
     EXPECT_NE(markdown.find(column), std::string::npos) << column;
   EXPECT_NE(markdown.find("| default | "), std::string::npos);
-  EXPECT_NE(markdown.find("| 176x144 | 10 | 30 | 0 |"), std::string::npos) << markdown;
+  EXPECT_NE(markdown.find("| 176x144 | 10 | 30 | 0 | "), std::string::npos) << markdown;
   EXPECT_NE(markdown.find("nproc"), std::string::npos);
 
   const std::string plot = output_dir() + "/bench_smoke/bench.png";
