@@ -29,10 +29,14 @@
 #include "tofguard/common/clock.hpp"
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/deployment/config.hpp"
+#include "tofguard/discrepancy/discrepancy_image.hpp"
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/joint_state_t.hpp"
+#include "tofguard/renderer/depth_renderer.hpp"
+#include "tofguard/renderer/rendered_kinematics.hpp"
 #include "tofguard/renderer/renderer_process.hpp"
 #include "tofguard/risk_t.hpp"
+#include "tofguard/robot_model/arm_spheres.hpp"
 #include "tofguard/robot_model/scene_model.hpp"
 
 namespace tofguard::test {
@@ -177,10 +181,15 @@ class ArrivalRecorder {
     std::lock_guard<std::mutex> lock(mutex_);
     for (auto it = frames_.begin(); it != frames_.end();) it = it->first < seq ? frames_.erase(it) : ++it;
   }
+  // The largest TOF_RENDERED, SAFETY_DISCREPANCY and SAFETY_RISK received
+  // for the bench's frames, bytes (0: none came).
+  enum class Stage { kRendered, kDiscrepancy, kRisk };
+  size_t largest_message(Stage stage) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return largest_[static_cast<int>(stage)];
+  }
 
  private:
-  enum class Stage { kRendered, kDiscrepancy, kRisk };
-
   void receive() {
     pollfd fds[2] = {{safety_.getFileno(), POLLIN, 0}, {images_.getFileno(), POLLIN, 0}};
     while (!stop_) {
@@ -199,6 +208,8 @@ class ArrivalRecorder {
     std::lock_guard<std::mutex> lock(mutex_);
     const auto it = frames_.find(seq);
     if (it == frames_.end()) return;  // not a frame this bench sent (or forgotten)
+    size_t& largest = largest_[static_cast<int>(stage)];
+    largest = std::max(largest, static_cast<size_t>(buffer->data_size));
     int64_t& at = stage == Stage::kRendered      ? it->second.rendered_us
                   : stage == Stage::kDiscrepancy ? it->second.discrepancy_us
                                                  : it->second.risk_us;
@@ -225,6 +236,67 @@ class ArrivalRecorder {
   mutable std::mutex mutex_;
   std::condition_variable verdict_;
   std::unordered_map<int64_t, FrameArrivals> frames_;
+  size_t largest_[3] = {0, 0, 0};
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+// The LCM hop floor's receiver: its own thread and LCM instances on the
+// chain's two URLs, subscribed to the scratch channels; each message
+// carries the monotonic time it was published at.
+const std::string kHopChannels[3] = {"TOFGUARD_BENCH_HOP_IMAGE", "TOFGUARD_BENCH_HOP_DISCREPANCY",
+                                     "TOFGUARD_BENCH_HOP_RISK"};
+constexpr size_t kHopHeaderBytes = 16;  // kind, sent_us (big-endian int64)
+
+class HopReceiver {
+ public:
+  HopReceiver(const std::string& safety_url, const std::string& image_url)
+      : safety_(safety_url), images_(image_url) {
+    if (!safety_.good() || !images_.good())
+      throw std::runtime_error("cannot open LCM (" + safety_url + ", " + image_url + ")");
+    images_.subscribe(kHopChannels[0], &HopReceiver::on_message, this);
+    safety_.subscribe(kHopChannels[1], &HopReceiver::on_message, this);
+    safety_.subscribe(kHopChannels[2], &HopReceiver::on_message, this);
+    thread_ = std::thread([this] {
+      pollfd fds[2] = {{safety_.getFileno(), POLLIN, 0}, {images_.getFileno(), POLLIN, 0}};
+      while (!stop_) {
+        if (poll(fds, 2, 20) <= 0) continue;
+        if (fds[0].revents & POLLIN) safety_.handleTimeout(0);
+        if (fds[1].revents & POLLIN) images_.handleTimeout(0);
+      }
+    });
+  }
+  ~HopReceiver() {
+    stop_ = true;
+    thread_.join();
+  }
+  HopReceiver(const HopReceiver&) = delete;
+  HopReceiver& operator=(const HopReceiver&) = delete;
+
+  size_t received() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return latency_ms_[0].size() + latency_ms_[1].size() + latency_ms_[2].size();
+  }
+  std::vector<double> latency_ms(int kind) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return latency_ms_[kind];
+  }
+
+ private:
+  void on_message(const lcm::ReceiveBuffer* buffer, const std::string&) {
+    const int64_t now_us = monotonic_us();
+    if (buffer->data_size < kHopHeaderBytes) return;
+    const auto* bytes = static_cast<const uint8_t*>(buffer->data);
+    const int64_t kind = get_int64_be(bytes);
+    if (kind < 0 || kind > 2) return;
+    std::lock_guard<std::mutex> lock(mutex_);
+    latency_ms_[kind].push_back((now_us - get_int64_be(bytes + 8)) * 1e-3);
+  }
+
+  lcm::LCM safety_;
+  lcm::LCM images_;
+  mutable std::mutex mutex_;
+  std::vector<double> latency_ms_[3];
   std::atomic<bool> stop_{false};
   std::thread thread_;
 };
@@ -289,9 +361,9 @@ class BenchChain {
     config_ = deployment::load_config(config_path_, nullptr);
     // What tofguard-renderer draws (its geometry, padding and mesh
     // simplification), not the simulated camera's exact scene.
-    triangles_ = robot_model::load_scene(config_.robot.urdf_path, config_.environment.urdf_paths,
-                                         renderer::scene_options(config_.renderer, config_.robot))
-                     .num_triangles();
+    scene_ = robot_model::load_scene(config_.robot.urdf_path, config_.environment.urdf_paths,
+                                     renderer::scene_options(config_.renderer, config_.robot));
+    triangles_ = scene_.num_triangles();
     for (const std::string& joint : frames_->scene().actuated_joint_names) joint_names_.push_back(joint);
     recorder_ = std::make_unique<ArrivalRecorder>(config_);
     safety_ = std::make_unique<lcm::LCM>(config_.lcm.url);
@@ -308,6 +380,7 @@ class BenchChain {
   // Runs `rate_hz` for `seconds` (after a warm-up on the first call) and
   // measures it.
   BenchStep run_step(double rate_hz, double seconds) {
+    if (!recorder_) throw std::logic_error("run_step after measure_floors stopped the chain");
     const int64_t frames = std::max<int64_t>(1, std::llround(rate_hz * seconds));
     const ArmPath path = prepare(rate_hz, static_cast<int>(std::min<int64_t>(frames, kMaxPreparedFrames)));
     if (!warm_) warm_up(path);
@@ -364,6 +437,34 @@ class BenchChain {
     return step;
   }
 
+  // Stops the chain (its processes and the bench's receiver) and measures
+  // the floors alone (BenchFloors): renders and compute_discrepancy along
+  // the last step's path, then `hops` messages of each size at `rate_hz`.
+  BenchFloors measure_floors(double rate_hz, int hops) {
+    BenchFloors f;
+    f.arm = arm_name_;
+    f.width = intrinsics_.width;
+    f.height = intrinsics_.height;
+    f.rate_hz = rate_hz;
+    f.image_hop.bytes = encoded_.empty() ? 0 : encoded_.front().size();
+    f.discrepancy_hop.bytes = recorder_->largest_message(ArrivalRecorder::Stage::kDiscrepancy);
+    f.risk_hop.bytes = recorder_->largest_message(ArrivalRecorder::Stage::kRisk);
+    const size_t rendered_bytes = recorder_->largest_message(ArrivalRecorder::Stage::kRendered);
+    processes_.clear();
+    recorder_.reset();
+    log_ << "  floors: chain stopped; " << options_.floor_frames << " renders and compute_discrepancy, then "
+         << hops << " LCM hops of each size at " << fixed_text(rate_hz, 0) << " Hz" << std::endl;
+    measure_compute_floors(&f);
+    if (rendered_bytes != 0 && rendered_bytes != f.image_hop.bytes)
+      log_ << "  floors: TOF_RENDERED was " << rendered_bytes << " bytes, TOF_DEPTH " << f.image_hop.bytes
+           << "; the image hop uses TOF_DEPTH's size" << std::endl;
+    // Without a verdict in the run: the size of the model's own message.
+    if (f.discrepancy_hop.bytes == 0) f.discrepancy_hop.bytes = discrepancy_bytes_;
+    if (f.risk_hop.bytes == 0) f.risk_hop.bytes = static_cast<size_t>(risk_t{}.getEncodedSize());
+    measure_hops(rate_hz, hops, &f);
+    return f;
+  }
+
   std::string stderr_of_all() {
     std::string text;
     for (auto& [name, p] : processes_) {
@@ -386,6 +487,7 @@ class BenchChain {
     motion_start_s_ += 1.7;
     encoded_.clear();
     const Eigen::Isometry3d world_from_optical = arm_.config.camera.pose.frame_from_optical();
+    last_path_ = path;
     for (int i = 0; i < count; ++i) {
       const std::vector<float> depth_m = frames_->capture(joints_at(path.start_s + i / rate_hz),
                                                           world_from_optical, intrinsics_, ++noise_index_);
@@ -498,6 +600,90 @@ class BenchChain {
     warm_ = true;
   }
 
+  void measure_compute_floors(BenchFloors* f) {
+    if (encoded_.empty()) return;
+    renderer::DepthRenderer renderer(scene_, config_.renderer.near_m, config_.renderer.far_m);
+    const CameraPose& pose = config_.camera.pose;
+    const auto joints = [&](int i) {
+      return joints_at(last_path_.start_s + last_path_.index(i) / last_path_.rate_hz);
+    };
+    const int n = std::max(1, options_.floor_frames);
+    // Untimed: the first renders (shaders, buffers).
+    for (int i = 0; i < 3; ++i) renderer.render(joints(i), pose, intrinsics_);
+    std::vector<double> render_ms;
+    for (int i = 0; i < n; ++i) {
+      const robot_model::JointPositions j = joints(i);
+      const int64_t start_us = monotonic_us();
+      const renderer::RenderResult result = renderer.render(j, pose, intrinsics_);
+      const int64_t end_us = monotonic_us();
+      if (!result.usable)
+        throw std::runtime_error("floors: the scene cannot be rendered: " + result.unusable_reason);
+      render_ms.push_back((end_us - start_us) * 1e-3);
+    }
+    f->render = summarise(render_ms);
+    // compute_discrepancy on each prepared camera frame and the model at
+    // its joints, as tofguard-renderer makes TOF_RENDERED and TOF_LABELS.
+    const robot_model::ArmSpheres cover =
+        robot_model::cover_arm_with_spheres(scene_, config_.renderer.arm_cover_cell_m);
+    const discrepancy::Parameters parameters = discrepancy::parameters_from(config_.discrepancy);
+    std::vector<double> compute_ms;
+    for (int i = 0; i < n; ++i) {
+      const std::vector<uint8_t>& bytes = encoded_[static_cast<size_t>(last_path_.index(i))];
+      depth_image_t camera;
+      if (camera.decode(bytes.data(), 0, static_cast<int>(bytes.size())) < 0)
+        throw std::runtime_error("floors: cannot decode a prepared frame");
+      const renderer::RenderResult result = renderer.render(joints(i), pose, intrinsics_);
+      const depth_image_t rendered = make_depth_image(camera.camera_id, intrinsics_of(camera), camera.utime,
+                                                      camera.seq, /*calibrated=*/true, result.depth_m);
+      const link_labels_t labels = renderer::make_rendered_link_labels(camera, result, scene_, cover);
+      const int64_t start_us = monotonic_us();
+      const discrepancy::DiscrepancyFrame frame =
+          discrepancy::compute_discrepancy(camera, rendered, labels, parameters);
+      const int64_t end_us = monotonic_us();
+      if (!frame.summary.usable) {
+        log_ << "  floors: compute_discrepancy: unusable: " << frame.summary.unusable_reason << std::endl;
+        continue;
+      }
+      discrepancy_bytes_ = std::max(discrepancy_bytes_, static_cast<size_t>(frame.summary.getEncodedSize()));
+      compute_ms.push_back((end_us - start_us) * 1e-3);
+    }
+    f->discrepancy_compute = summarise(compute_ms);
+  }
+
+  // Each period: an image-sized message on the image URL, a third of a
+  // period later a discrepancy_t-sized one and two thirds later a
+  // risk_t-sized one on the safety URL, through the publishers the chain's
+  // frames went through.
+  void measure_hops(double rate_hz, int hops, BenchFloors* f) {
+    HopReceiver receiver(config_.lcm.url, config_.lcm.image_url);
+    HopFloor* floors[3] = {&f->image_hop, &f->discrepancy_hop, &f->risk_hop};
+    lcm::LCM* urls[3] = {images_.get(), safety_.get(), safety_.get()};
+    std::vector<uint8_t> messages[3];
+    for (int kind = 0; kind < 3; ++kind) {
+      messages[kind].assign(std::max(floors[kind]->bytes, kHopHeaderBytes), 0);
+      floors[kind]->bytes = messages[kind].size();
+      put_int64_be(messages[kind].data(), kind);
+    }
+    // The receiver's sockets are open once it is constructed; let it settle.
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    const int64_t period_us = std::llround(1e6 / rate_hz);
+    const int64_t start_mono_us = monotonic_us() + 2000;
+    for (int k = 0; k < hops; ++k) {
+      for (int kind = 0; kind < 3; ++kind) {
+        std::this_thread::sleep_until(std::chrono::steady_clock::time_point(
+            std::chrono::microseconds(start_mono_us + k * period_us + kind * period_us / 3)));
+        std::vector<uint8_t>& m = messages[kind];
+        put_int64_be(m.data() + 8, monotonic_us());
+        urls[kind]->publish(kHopChannels[kind], m.data(), static_cast<unsigned int>(m.size()));
+        ++floors[kind]->sent;
+      }
+    }
+    const int64_t deadline_us = monotonic_us() + options_.result_timeout_us;
+    while (receiver.received() < static_cast<size_t>(3 * hops) && monotonic_us() < deadline_us)
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    for (int kind = 0; kind < 3; ++kind) floors[kind]->latency = summarise(receiver.latency_ms(kind));
+  }
+
   std::string arm_name_;
   CampaignArm arm_;
   Intrinsics intrinsics_;
@@ -508,6 +694,10 @@ class BenchChain {
   std::unique_ptr<SimulatedFrames> frames_;
   std::vector<std::string> joint_names_;
   size_t triangles_ = 0;
+  // What tofguard-renderer loads (the floors render it).
+  robot_model::SceneModel scene_;
+  ArmPath last_path_;
+  size_t discrepancy_bytes_ = 0;
   std::unique_ptr<ArrivalRecorder> recorder_;
   std::unique_ptr<lcm::LCM> safety_;
   std::unique_ptr<lcm::LCM> images_;
@@ -640,8 +830,15 @@ BenchReport run_bench(const BenchOptions& options, std::ostream& log) {
       log << arm_name << " " << size_text(width, height) << std::endl;
       BenchChain chain(arm_name, *arm, intrinsics, options.ramp ? options.ramp_start_hz : options.rate_hz,
                        options, log);
+      // The floors' hops: as many as the run's frames (30 to 300) at its rate.
+      const auto floor_hops = [](double rate_hz, double seconds) {
+        return static_cast<int>(std::clamp<int64_t>(std::llround(rate_hz * seconds), 30, 300));
+      };
       if (!options.ramp) {
         report.steps.push_back(chain.run_step(options.rate_hz, options.seconds));
+        if (options.floors)
+          report.floors.push_back(
+              chain.measure_floors(options.rate_hz, floor_hops(options.rate_hz, options.seconds)));
         continue;
       }
       BenchRamp ramp;
@@ -662,6 +859,9 @@ BenchReport run_bench(const BenchOptions& options, std::ostream& log) {
       if (ramp.stopped_because.empty())
         ramp.stopped_because = "none up to " + fixed_text(options.ramp_max_hz, 0) + " Hz (the ramp's end)";
       report.ramps.push_back(std::move(ramp));
+      if (options.floors)
+        report.floors.push_back(chain.measure_floors(options.ramp_start_hz,
+                                                     floor_hops(options.ramp_start_hz, options.ramp_step_s)));
     }
   }
   return report;
@@ -669,9 +869,10 @@ BenchReport run_bench(const BenchOptions& options, std::ostream& log) {
 
 namespace {
 
-std::string latency_cell(const LatencySummary& s) {
+std::string latency_cell(const LatencySummary& s, int decimals = 1) {
   if (s.count == 0) return "-";
-  return fixed_text(s.p50_ms, 1) + " / " + fixed_text(s.p99_ms, 1) + " / " + fixed_text(s.max_ms, 1);
+  return fixed_text(s.p50_ms, decimals) + " / " + fixed_text(s.p99_ms, decimals) + " / " +
+         fixed_text(s.max_ms, decimals);
 }
 
 std::string steps_table(const std::vector<BenchStep>& steps) {
@@ -698,7 +899,73 @@ std::string steps_table(const std::vector<BenchStep>& steps) {
   return t.str();
 }
 
+std::string hop_cell(const HopFloor& h) {
+  std::string cell = latency_cell(h.latency, 2) + " (" + std::to_string(h.bytes) + " B";
+  if (h.latency.count != h.sent)
+    cell += ", " + std::to_string(h.latency.count) + " of " + std::to_string(h.sent) + " arrived";
+  return cell + ")";
+}
+
+// "1.4× (4.1 / 2.9 ms)": the stage's p50 over its floor.
+std::string ratio_cell(const LatencySummary& stage, double floor_ms) {
+  if (stage.count == 0 || !(floor_ms > 0)) return "-";
+  return fixed_text(stage.p50_ms / floor_ms, 1) + "× (" + fixed_text(stage.p50_ms, 2) + " / " +
+         fixed_text(floor_ms, 2) + " ms)";
+}
+
+std::string floors_table(const BenchReport& report) {
+  const deployment::Config config = deployment::load_config(source_dir() + "/config/sim.yaml", nullptr);
+  const ChannelNames& ch = config.channels;
+  std::ostringstream t;
+  t << "\nFloors (issue 17: each stage within 2× of its floor), measured by the bench alone after the "
+       "chain's processes were stopped. Render floor: DepthRenderer::render (render, read-back, "
+       "conversion) in the bench, the scene tofguard-renderer loads, the run's intrinsics and the last "
+       "step's joint path, back to back. Compute: compute_discrepancy on the prepared frames and the model "
+       "at their joints. LCM hop floor: a message of the size of "
+    << ch.depth << " / " << ch.rendered << " (lcm.image_url), " << ch.discrepancy << " and " << ch.risk
+    << " (lcm.url) on a scratch channel at the run's rate, sent → received by the bench's own thread. "
+       "p50 / p99 / max ms. Stage floors (p50s summed): render = image hop + render + image hop ("
+    << ch.depth << " in, " << ch.rendered << " out); discrepancy = compute + " << ch.discrepancy
+    << " hop; risk = " << ch.risk << " hop (the risk monitor's work not measured).\n\n";
+  t << "| arm | size | rate (Hz) | render floor p50 / p99 / max | compute_discrepancy p50 / p99 / max | "
+       "LCM hop floor p50 / p99 / max, "
+    << ch.depth << " / " << ch.rendered << " | LCM hop floor, " << ch.discrepancy << " | LCM hop floor, "
+    << ch.risk << " | render p50 / floor | discrepancy p50 / floor | risk p50 / floor |\n";
+  t << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+  for (const BenchFloors& f : report.floors) {
+    // The step at the floors' rate: the plain step, or the ramp's first.
+    const BenchStep* step = nullptr;
+    for (const BenchStep& s : report.steps)
+      if (s.arm == f.arm && s.width == f.width && s.height == f.height) step = &s;
+    for (const BenchRamp& r : report.ramps)
+      if (r.arm == f.arm && r.width == f.width && r.height == f.height && !r.steps.empty())
+        step = &r.steps.front();
+    const BenchStep none;
+    const BenchStep& s = step ? *step : none;
+    t << "| " << f.arm << " | " << size_text(f.width, f.height) << " | " << fixed_text(f.rate_hz, 0) << " | "
+      << latency_cell(f.render, 2) << " (" << f.render.count << ") | "
+      << latency_cell(f.discrepancy_compute, 2) << " (" << f.discrepancy_compute.count << ") | "
+      << hop_cell(f.image_hop) << " | " << hop_cell(f.discrepancy_hop) << " | " << hop_cell(f.risk_hop)
+      << " | " << ratio_cell(s.render, render_stage_floor_ms(f)) << " | "
+      << ratio_cell(s.discrepancy, discrepancy_stage_floor_ms(f)) << " | "
+      << ratio_cell(s.risk, risk_stage_floor_ms(f)) << " |\n";
+  }
+  return t.str();
+}
+
 }  // namespace
+
+double render_stage_floor_ms(const BenchFloors& f) {
+  if (f.render.count == 0 || f.image_hop.latency.count == 0) return 0;
+  return f.render.p50_ms + 2 * f.image_hop.latency.p50_ms;
+}
+double discrepancy_stage_floor_ms(const BenchFloors& f) {
+  if (f.discrepancy_compute.count == 0 || f.discrepancy_hop.latency.count == 0) return 0;
+  return f.discrepancy_compute.p50_ms + f.discrepancy_hop.latency.p50_ms;
+}
+double risk_stage_floor_ms(const BenchFloors& f) {
+  return f.risk_hop.latency.count == 0 ? 0 : f.risk_hop.latency.p50_ms;
+}
 
 std::string bench_markdown(const BenchReport& report) {
   std::ostringstream md;
@@ -723,6 +990,7 @@ std::string bench_markdown(const BenchReport& report) {
     }
     md << "\nEvery step of the ramps:\n\n" << steps_table(all);
   }
+  if (!report.floors.empty()) md << floors_table(report);
   for (const std::string& s : report.skipped) md << "\n" << s << "\n";
   return md.str();
 }

@@ -10,6 +10,13 @@
 // arrived; from that the latency of each stage, frames dropped, CPU per
 // process (/proc) and, ramping the rate, the highest rate sustained.
 //
+// Beside each arm and size, the floors the stages are held against (issue
+// 17: each stage within 2x of its floor), measured by the bench itself after
+// the chain's processes are stopped: the renderer's scene rendered in this
+// process along the same joint path at the same intrinsics, compute_discrepancy
+// on the prepared frames, and one LCM hop of each stage's message size on a
+// scratch channel of the chain's URL at the run's rate (BenchFloors).
+//
 // A measuring tool, not a test of timing: LCM must run in a private network
 // namespace (scripts/bench, tests/netns/run-in-netns).
 #include <cstdint>
@@ -41,6 +48,10 @@ struct BenchOptions {
   // A TOF_DEPTH whose SAFETY_RISK has not come this long after it was sent
   // is dropped.
   int64_t result_timeout_us = 1000000;
+  // Measure the floors (BenchFloors) after each arm and size's run;
+  // floor_frames renders (and compute_discrepancy calls) back to back.
+  bool floors = true;
+  int floor_frames = 100;
   std::string shared_dir;
   // Configs, scenes and the processes' output files.
   std::string work_dir;
@@ -92,11 +103,58 @@ struct BenchRamp {
   std::vector<BenchStep> steps;
 };
 
+// One LCM hop: messages of `bytes` bytes published by the bench on a
+// scratch channel of one of the chain's URLs at the run's rate, each
+// timestamped (monotonic) just before publish() as the bench stamps
+// TOF_DEPTH, and on arrival by the bench's own receiver thread. latency.count:
+// the messages that arrived (of `sent`).
+struct HopFloor {
+  size_t bytes = 0;
+  int sent = 0;
+  LatencySummary latency;
+};
+
+// The floors of one arm and camera size, measured by the bench alone (the
+// chain's processes stopped, no chain process involved).
+struct BenchFloors {
+  std::string arm;
+  int width = 0;
+  int height = 0;
+  double rate_hz = 0;  // the hops' rate: the run's (with --ramp, its first)
+  // DepthRenderer::render (render, read-back, conversion to metres) in this
+  // process: the scene tofguard-renderer loads (robot_model::load_scene with
+  // renderer::scene_options), its near and far, the camera pose and
+  // intrinsics of the run, the last step's joint path; floor_frames back to
+  // back after 3 untimed.
+  LatencySummary render;
+  // discrepancy::compute_discrepancy on each prepared camera frame with its
+  // model frame (TOF_RENDERED and TOF_LABELS as the renderer makes them at
+  // the same joints), the config's parameters; count 0 when unusable.
+  LatencySummary discrepancy_compute;
+  // TOF_DEPTH / TOF_RENDERED (depth_image_t of the size) on lcm.image_url,
+  // SAFETY_DISCREPANCY (discrepancy_t) and SAFETY_RISK (risk_t) on lcm.url,
+  // each of the size the chain's messages had in the run.
+  HopFloor image_hop;
+  HopFloor discrepancy_hop;
+  HopFloor risk_hop;
+};
+
+// The floor of each stage (p50s summed), ms, and what it is made of: render
+// = image hop (TOF_DEPTH to the renderer) + render + image hop (TOF_RENDERED
+// back); discrepancy = compute_discrepancy + discrepancy_t hop (the bench
+// and tofguard-discrepancy receive TOF_RENDERED at the same time, so that
+// hop is not in the stage); risk = risk_t hop (the risk monitor's own work
+// is not measured). 0 when a part is missing.
+double render_stage_floor_ms(const BenchFloors& floors);
+double discrepancy_stage_floor_ms(const BenchFloors& floors);
+double risk_stage_floor_ms(const BenchFloors& floors);
+
 struct BenchReport {
   std::string machine;               // nproc, CPU model, load
   std::string date;                  // UTC
   std::vector<BenchStep> steps;      // without --ramp: one per arm and size
   std::vector<BenchRamp> ramps;      // with --ramp
+  std::vector<BenchFloors> floors;   // one per arm and size (unless --no-floors)
   std::vector<std::string> skipped;  // arms skipped, with why
 };
 
@@ -121,7 +179,9 @@ std::string write_bench_config(const CampaignArm& arm, const Intrinsics& intrins
 BenchReport run_bench(const BenchOptions& options, std::ostream& log);
 
 // The report as Markdown: machine and date, a row per step (latencies per
-// stage, drops, CPU per process) and, for ramps, the rate sustained.
+// stage, drops, CPU per process), for ramps the rate sustained, and the
+// floors with each stage's p50 over its floor (a ramp's: its first step's,
+// at the floors' rate).
 std::string bench_markdown(const BenchReport& report);
 
 // A PNG: p50 and p99 latency per stage against the camera's pixels (a

@@ -5,11 +5,17 @@
 //
 //   tofguard-bench [--arms default,iiwa14,kinova] [--resolutions 176x144,320x240,640x480]
 //                  [--rate-hz 30] [--seconds 10] [--ramp] [--ramp-step-s 3] [--ramp-max-hz 1920]
-//                  [--shared DIR] [--markdown FILE] [--plot FILE.png]
+//                  [--shared DIR] [--markdown FILE] [--plot FILE.png] [--no-floors]
 //
 // --ramp: 30, 60, 120 ... Hz, --ramp-step-s each, up to the first rate with
 // a dropped frame, a stage's p99 above the frame period or a publisher that
 // could not keep the rate; reports the highest rate sustained.
+//
+// After each arm and size, with its chain stopped, the floors (BenchFloors):
+// DepthRenderer::render and compute_discrepancy in this process along the
+// same joint path, and one LCM hop of each stage's message size on a scratch
+// channel of the chain's URL at the run's rate; a table of them with each
+// stage's p50 over its floor. --no-floors skips them.
 //
 // Prints the Markdown table (with the machine and the date) to stdout.
 #include <fstream>
@@ -36,7 +42,7 @@ int usage(const std::string& why) {
       << "tofguard-bench: " << why
       << "\nusage: tofguard-bench [--arms default,iiwa14,kinova] [--resolutions 176x144,320x240,640x480] "
          "[--rate-hz 30] [--seconds 10] [--ramp] [--ramp-step-s 3] [--ramp-max-hz 1920] [--shared DIR] "
-         "[--markdown FILE] [--plot FILE.png]\n";
+         "[--markdown FILE] [--plot FILE.png] [--no-floors]\n";
   return 2;
 }
 
@@ -52,6 +58,10 @@ int main(int argc, char** argv) {
     const std::string option = argv[i];
     if (option == "--ramp") {
       options.ramp = true;
+      continue;
+    }
+    if (option == "--no-floors") {
+      options.floors = false;
       continue;
     }
     if (option == "-h" || option == "--help") return usage("the observer chain's speed");

@@ -1,8 +1,9 @@
 // tofguard-bench's logic, short (tests/support/chain_bench.hpp): the
 // default arm at 176x144 and 10 Hz for 3 s through the real observer chain.
 // Asserts that every frame went through every stage, none was dropped, and
-// the report has its rows; never a wall-clock latency (the machine may be
-// loaded).
+// the report has its rows, the floors' included (renders, compute_discrepancy
+// calls and LCM hops counted); never a wall-clock latency (the machine may
+// be loaded).
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -42,6 +43,28 @@ TEST(BenchSmoke, FramesGoThroughEveryStageAtTenHertz) {
   EXPECT_NE(markdown.find("| default | "), std::string::npos);
   EXPECT_NE(markdown.find("| 176x144 | 10 | 30 | 0 | "), std::string::npos) << markdown;
   EXPECT_NE(markdown.find("nproc"), std::string::npos);
+
+  // The floors: measured with the chain stopped, a row per arm and size.
+  ASSERT_EQ(report.floors.size(), 1u);
+  const BenchFloors& floors = report.floors.front();
+  EXPECT_EQ(floors.arm, "default");
+  EXPECT_EQ(floors.width, 176);
+  EXPECT_EQ(floors.height, 144);
+  EXPECT_EQ(floors.render.count, options.floor_frames);
+  EXPECT_GT(floors.discrepancy_compute.count, 0);
+  for (const HopFloor* hop : {&floors.image_hop, &floors.discrepancy_hop, &floors.risk_hop}) {
+    EXPECT_EQ(hop->sent, 30);
+    EXPECT_GT(hop->latency.count, 0);
+    EXPECT_GT(hop->bytes, 0u);
+  }
+  // A depth_image_t of 176x144 int16 pixels.
+  EXPECT_GT(floors.image_hop.bytes, 176u * 144u * 2u);
+  for (const char* column :
+       {"render floor p50 / p99 / max", "compute_discrepancy p50 / p99 / max",
+        "LCM hop floor p50 / p99 / max, TOF_DEPTH / TOF_RENDERED", "LCM hop floor, SAFETY_DISCREPANCY",
+        "LCM hop floor, SAFETY_RISK", "render p50 / floor", "discrepancy p50 / floor", "risk p50 / floor"})
+    EXPECT_NE(markdown.find(column), std::string::npos) << column;
+  EXPECT_NE(markdown.find("| default | 176x144 | 10 | "), std::string::npos) << markdown;
 
   const std::string plot = output_dir() + "/bench_smoke/bench.png";
   plot_bench(report, plot);
