@@ -314,20 +314,23 @@ void largest_blob(const cv::Mat1b& mismatch_mask, int opening_radius_px, const P
   s->largest_blob_area_m2 = static_cast<float>(area);
 }
 
-// The depth (mm) at which pixel i of `tof` stands for a surface: a mixed
-// ("flying") pixel, whose return mixes two surfaces at a step, reads a depth
-// between them where there is nothing. It is recognised by its neighbours:
-// along some direction (horizontal, vertical or either diagonal) one is
-// nearer and the opposite one farther, each by more than jump_mm. It is
-// placed at the nearer neighbour's depth: the part of its ray that hits
-// something real there (a cart's edge before the wall) is at the front
-// surface, and the back one is what the model explains. Any other pixel
-// keeps its own depth.
-int surface_depth_mm(const int16_t* tof, int i, int width, int height, double jump_mm) {
+// The depth (mm) at which pixel i of `tof`, an unexplained nearer surface,
+// stands for one. A mixed ("flying") pixel, whose return mixes two surfaces
+// at a step, reads a depth between them where there is nothing. It is
+// recognised by its neighbours: along some direction (horizontal, vertical
+// or either diagonal) one is nearer and the opposite one farther, each by
+// more than jump_mm. Its unexplained part is the neighbour that is itself
+// an unexplained surface (`unexplained`): a cart's edge before the modelled
+// wall is placed at the cart's depth (the nearer), a person passing behind
+// the arm's edge at the person's (the farther), not on the arm. When both
+// are, the nearer; when neither is (two explained surfaces mixed), and for
+// any other pixel, its own depth.
+int surface_depth_mm(const int16_t* tof, const uint8_t* unexplained, int i, int width, int height,
+                     double jump_mm) {
   const int d = tof[i];
   const int u = i % width;
   const int v = i / width;
-  int nearest = d;
+  int placed = std::numeric_limits<int>::max();
   constexpr int kAxes[4][2] = {{1, 0}, {0, 1}, {1, 1}, {1, -1}};
   for (const auto& axis : kAxes) {
     const int ua = u + axis[0], va = v + axis[1];
@@ -335,19 +338,23 @@ int surface_depth_mm(const int16_t* tof, int i, int width, int height, double ju
     if (ua < 0 || ub < 0 || ua >= width || ub >= width || va < 0 || vb < 0 || va >= height || vb >= height) {
       continue;
     }
-    const int a = tof[va * width + ua];
-    const int b = tof[vb * width + ub];
-    if (a <= 0 || b <= 0) continue;
-    const int nearer = std::min(a, b);
-    const int farther = std::max(a, b);
-    if (d - nearer > jump_mm && farther - d > jump_mm) nearest = std::min(nearest, nearer);
+    int nearer = va * width + ua;
+    int farther = vb * width + ub;
+    if (tof[nearer] <= 0 || tof[farther] <= 0) continue;
+    if (tof[nearer] > tof[farther]) std::swap(nearer, farther);
+    if (!(d - tof[nearer] > jump_mm && tof[farther] - d > jump_mm)) continue;
+    if (unexplained[nearer] != 0) {
+      placed = std::min(placed, static_cast<int>(tof[nearer]));
+    } else if (unexplained[farther] != 0) {
+      placed = std::min(placed, static_cast<int>(tof[farther]));
+    }
   }
-  return nearest;
+  return placed == std::numeric_limits<int>::max() ? d : placed;
 }
 
 // Stage 6, unexplained nearer surfaces and the protective fields: every
 // occluded or unexpected-surface pixel (after the same opening)
-// back-projected at the camera's depth (a mixed pixel at its nearer
+// back-projected at the camera's depth (a mixed pixel at its unexplained
 // neighbour's, surface_depth_mm), and its distance to the arm: 0 for
 // an occluded pixel (it hides part of the arm, and what cannot be seen is
 // occupied), else the distance to the arm's cover (arm_distance.hpp; 0 for
@@ -378,8 +385,8 @@ void unexplained_surfaces(const depth_image_t& camera, const link_labels_t& labe
     double distance_m = 0;
     if (s->field_available && pixel_class[i] != discrepancy_t::PIXEL_OCCLUDED) {
       // The camera-frame point (optical frame, m) of pixel i at its depth.
-      const double z =
-          metres_from_mm(surface_depth_mm(tof, i, width, camera.height, parameters.silhouette_jump_mm));
+      const double z = metres_from_mm(
+          surface_depth_mm(tof, candidate, i, width, camera.height, parameters.silhouette_jump_mm));
       const Eigen::Vector3d point((i % width - camera.cx) * z / camera.fx,
                                   (i / width - camera.cy) * z / camera.fy, z);
       distance_m = arm.distance_m(point, up_to_m);

@@ -181,6 +181,23 @@ TEST(Discrepancy, MixedPixelsAtAnObjectsEdgeStandAtTheObject) {
   EXPECT_GT(t.unexplained_area_within_m2[25], 0);  // within 0.26 m
 }
 
+// A person 0.3 m behind link2, beside it in the image, with the link's edge
+// mixed with the person (1650 mm, between the link at 1500 and the person at
+// 1800). The mixed pixels' unexplained part is the person, not the link:
+// they are placed at the person's depth, 0.3 m from the arm, not on it.
+TEST(Discrepancy, MixedPixelsBetweenTheArmAndSomethingBehindItStandBehind) {
+  const SyntheticImage model = draw(default_arm());
+  std::vector<Box> scene = default_arm();
+  scene.push_back({100, 55, 130, 85, 1800, 0});
+  SyntheticImage seen = draw(scene);
+  for (int v = 60; v < 80; ++v) seen.depth_mm[v * kWidth + 100] = 1650;
+  const discrepancy_t s = compare(model, seen.depth_mm).summary;
+  EXPECT_EQ(s.num_unexpected_surface, 900);
+  EXPECT_EQ(s.near_arm_pixels, 0);
+  EXPECT_FLOAT_EQ(s.unexplained_area_within_m2[25], 0);  // nothing within 0.26 m
+  EXPECT_GT(s.unexplained_area_within_m2[40], 0);        // the person, 0.3 m behind
+}
+
 TEST(Discrepancy, ThinSilhouetteSliversAreNotBlobs) {
   const SyntheticImage model = draw(default_arm());
   // The camera's link2 one pixel wider: a one-pixel column of nearer
