@@ -23,7 +23,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "joint_motion.hpp"
+#include "plot_panel.hpp"
 #include "proc_stats.hpp"
+#include "report_format.hpp"
 #include "simulated_frames.hpp"
 #include "test_support.hpp"
 #include "tofguard/common/clock.hpp"
@@ -43,7 +46,6 @@ namespace tofguard::test {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kPi = 3.141592653589793;
 
 // The observer chain, the judge first so that it listens before its inputs
 // speak (as LiveChain starts it).
@@ -64,14 +66,6 @@ constexpr int kWarmupFrames = 5;
 // take this long on a loaded 2-core machine with the iiwa14's meshes.
 constexpr auto kStartDeadline = std::chrono::seconds(90);
 
-std::string fixed_text(double value, int decimals) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(decimals);
-  s << value;
-  return s.str();
-}
-
 std::string number_text(double value) {
   std::ostringstream s;
   s << std::setprecision(12) << value;
@@ -79,12 +73,6 @@ std::string number_text(double value) {
 }
 
 std::string size_text(int width, int height) { return std::to_string(width) + "x" + std::to_string(height); }
-
-// The value of nearest rank `q` (0..1) of `sorted` (ascending).
-double quantile(const std::vector<double>& sorted, double q) {
-  const size_t rank = static_cast<size_t>(std::ceil(q * static_cast<double>(sorted.size())));
-  return sorted[std::clamp<size_t>(rank, 1, sorted.size()) - 1];
-}
 
 LatencySummary summarise(std::vector<double> latency_ms) {
   LatencySummary s;
@@ -301,13 +289,6 @@ class HopReceiver {
   std::thread thread_;
 };
 
-double motion_position(const sim::JointMotion& m, double t_s) {
-  return m.center + m.amplitude * std::sin(2 * kPi * t_s / m.period_s + m.phase_rad);
-}
-double motion_velocity(const sim::JointMotion& m, double t_s) {
-  return m.amplitude * 2 * kPi / m.period_s * std::cos(2 * kPi * t_s / m.period_s + m.phase_rad);
-}
-
 // The arm's path for a step: `prepared` frames taken 1/rate apart in motion
 // time, played forwards then backwards. Real time t maps to motion time
 // path_s(t), a triangle wave, so frame k (at t = k / rate) shows the pose
@@ -505,7 +486,7 @@ class BenchChain {
     robot_model::JointPositions joints;
     for (const std::string& j : joint_names_) joints[j] = 0;
     for (const sim::JointMotion& m : arm_.config.joints_sim.motion)
-      joints[m.joint] = motion_position(m, motion_s);
+      joints[m.joint] = joint_position(m, motion_s);
     return joints;
   }
 
@@ -518,8 +499,8 @@ class BenchChain {
       double position = 0, velocity = 0;
       for (const sim::JointMotion& m : arm_.config.joints_sim.motion) {
         if (m.joint != j) continue;
-        position = motion_position(m, motion_s);
-        velocity = direction * motion_velocity(m, motion_s);
+        position = joint_position(m, motion_s);
+        velocity = direction * joint_velocity(m, motion_s);
       }
       s.name.push_back(j);
       s.position.push_back(position);
@@ -997,9 +978,6 @@ std::string bench_markdown(const BenchReport& report) {
 
 namespace {
 
-const cv::Scalar kColours[] = {{200, 60, 30}, {30, 120, 220}, {40, 160, 40}, {160, 40, 160},
-                               {0, 160, 200}, {90, 90, 90},   {220, 140, 0}, {120, 60, 0}};
-
 // One curve of a panel: (x, y) points, joined, filled or open circles.
 struct Curve {
   std::string label;
@@ -1008,18 +986,10 @@ struct Curve {
   bool filled = true;
 };
 
-// The axis's end: 1, 2 or 5 times a power of 10, above `value`.
-double round_axis(double value) {
-  double axis = 1e-3;
-  while (axis < 1.05 * value) axis *= (std::to_string(axis * 1e3).substr(0, 1) == "2") ? 2.5 : 2;
-  return axis;
-}
-
 // `tick_labels`: the text under an x value (else the value itself).
 void draw_panel(cv::Mat* image, const cv::Rect& area, const std::string& title, const std::string& x_label,
                 const std::string& y_label, const std::vector<Curve>& curves,
                 const std::map<double, std::string>& tick_labels = {}) {
-  const cv::Scalar black(0, 0, 0), grey(200, 200, 200);
   double x_max = 0, y_max = 0;
   std::vector<double> ticks;
   for (const Curve& c : curves)
@@ -1029,44 +999,13 @@ void draw_panel(cv::Mat* image, const cv::Rect& area, const std::string& title, 
       if (std::find(ticks.begin(), ticks.end(), x) == ticks.end()) ticks.push_back(x);
     }
   x_max = x_max > 0 ? 1.08 * x_max : 1;
-  y_max = round_axis(y_max > 0 ? y_max : 1);
-  const int left = area.x + 70, right = area.x + area.width - 20, top = area.y + 50,
-            bottom = area.y + area.height - 50;
-  auto px = [&](double x, double y) {
-    return cv::Point(left + static_cast<int>((right - left) * x / x_max),
-                     bottom - static_cast<int>((bottom - top) * std::min(y, y_max) / y_max));
-  };
-  const int font = cv::FONT_HERSHEY_SIMPLEX;
-  cv::putText(*image, title, {area.x + 10, area.y + 25}, font, 0.55, black, 1, cv::LINE_AA);
-  for (int i = 0; i <= 4; ++i) {
-    const double y = y_max * i / 4;
-    cv::line(*image, px(0, y), px(x_max, y), grey, 1);
-    cv::putText(*image, fixed_text(y, y_max < 10 ? 1 : 0), {area.x + 5, px(0, y).y + 5}, font, 0.4, black, 1,
-                cv::LINE_AA);
-  }
-  for (double x : ticks) {
-    cv::line(*image, px(x, 0), px(x, 0) + cv::Point(0, 5), black, 1);
-    std::ostringstream l;
-    l << x;
-    const auto label = tick_labels.find(x);
-    cv::putText(*image, label == tick_labels.end() ? l.str() : label->second, px(x, 0) + cv::Point(-20, 20),
-                font, 0.4, black, 1, cv::LINE_AA);
-  }
-  cv::line(*image, px(0, 0), px(x_max, 0), black, 1);
-  cv::line(*image, px(0, 0), px(0, y_max), black, 1);
-  cv::putText(*image, x_label, {(left + right) / 2 - 60, bottom + 40}, font, 0.45, black, 1, cv::LINE_AA);
-  cv::putText(*image, y_label, {area.x + 5, top - 10}, font, 0.45, black, 1, cv::LINE_AA);
+  y_max = round_axis(y_max > 0 ? y_max : 1, 1e-3);
+  const PanelArea panel =
+      draw_panel_frame(image, area, PanelStyle{}, title, x_label, y_label, x_max, y_max, ticks, tick_labels);
   for (const Curve& c : curves) {
-    const cv::Scalar colour = kColours[c.colour % 8];
     std::vector<std::pair<double, double>> points = c.points;
     std::sort(points.begin(), points.end());
-    for (size_t i = 0; i < points.size(); ++i) {
-      const cv::Point here = px(points[i].first, points[i].second);
-      cv::circle(*image, here, c.filled ? 4 : 3, colour, c.filled ? cv::FILLED : 1, cv::LINE_AA);
-      if (i > 0)
-        cv::line(*image, px(points[i - 1].first, points[i - 1].second), here, colour, c.filled ? 2 : 1,
-                 cv::LINE_AA);
-    }
+    draw_curve(image, panel, points, plot_colour(c.colour), c.filled);
   }
 }
 
@@ -1132,18 +1071,12 @@ void plot_bench(const BenchReport& report, const std::string& path) {
   draw_panel(&image, {panel_w * (panels - 1), 0, panel_w, panel_h},
              report.ramps.empty() ? "rate delivered (no drops)" : "highest rate sustained", "triangles", "Hz",
              throughput);
-  const int font = cv::FONT_HERSHEY_SIMPLEX;
-  for (int stage = 0; stage < 4; ++stage) {
-    const int x = 20 + 150 * stage, y = panel_h + 20;
-    cv::line(image, {x, y}, {x + 30, y}, kColours[stage], 2, cv::LINE_AA);
-    cv::putText(image, stage_names[stage], {x + 35, y + 5}, font, 0.45, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-  }
+  for (int stage = 0; stage < 4; ++stage)
+    draw_legend_entry(&image, {20 + 150 * stage, panel_h + 20}, 30, 35, plot_colour(stage),
+                      stage_names[stage]);
   int i = 0;
-  for (const Curve& c : throughput) {
-    const int x = 20 + 150 * i++, y = panel_h + 50;
-    cv::line(image, {x, y}, {x + 30, y}, kColours[c.colour % 8], 2, cv::LINE_AA);
-    cv::putText(image, c.label, {x + 35, y + 5}, font, 0.45, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-  }
+  for (const Curve& c : throughput)
+    draw_legend_entry(&image, {20 + 150 * i++, panel_h + 50}, 30, 35, plot_colour(c.colour), c.label);
   const fs::path parent = fs::path(path).parent_path();
   if (!parent.empty()) fs::create_directories(parent);
   if (!cv::imwrite(path, image)) throw std::runtime_error(path + ": cannot write the plot");

@@ -14,6 +14,9 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "joint_motion.hpp"
+#include "plot_panel.hpp"
+#include "report_format.hpp"
 #include "simulated_frames.hpp"
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/common/risk_names.hpp"
@@ -80,13 +83,6 @@ void judge_frames_only(deployment::Config* config) {
   config->risk.camera_pose_required = false;
 }
 
-double joint_position(const sim::JointMotion& m, double t_s) {
-  return m.center + m.amplitude * std::sin(2 * kPi * t_s / m.period_s + m.phase_rad);
-}
-double joint_velocity(const sim::JointMotion& m, double t_s) {
-  return m.amplitude * 2 * kPi / m.period_s * std::cos(2 * kPi * t_s / m.period_s + m.phase_rad);
-}
-
 // Pixels whose noise-free depth differs by more than 3 sigma(d) between the
 // model at the true joints and pose and `reported_depth_m` (or that one
 // has a surface and the other none).
@@ -111,14 +107,6 @@ int changed_pixels(renderer::DepthRenderer& model, const robot_model::SceneModel
   return changed;
 }
 
-std::string fixed_text(double value, int decimals) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(decimals);
-  s << value;
-  return s.str();
-}
-
 // The unit of a fault group's magnitude, "" for groups without one.
 std::string magnitude_unit(const std::string& group) {
   if (group == "joint offset" || group == "camera rotation") return "deg";
@@ -133,12 +121,6 @@ std::string magnitude_text(const std::string& group, double magnitude) {
   std::ostringstream s;
   s << " " << magnitude << " " << unit;
   return s.str();
-}
-
-// The value of nearest rank `q` (0..1) of `sorted` (ascending).
-double quantile(const std::vector<double>& sorted, double q) {
-  const size_t rank = static_cast<size_t>(std::ceil(q * static_cast<double>(sorted.size())));
-  return sorted[std::clamp<size_t>(rank, 1, sorted.size()) - 1];
 }
 
 // "median / p99 / max" of latencies in seconds, as ms; "-" when none.
@@ -965,9 +947,6 @@ std::string campaign_tsv(const std::string& arm, const std::vector<CampaignResul
 
 namespace {
 
-const cv::Scalar kPlotColours[] = {{200, 60, 30}, {30, 120, 220}, {40, 160, 40}, {160, 40, 160},
-                                   {0, 160, 200}, {90, 90, 90},   {220, 140, 0}, {120, 60, 0}};
-
 struct PlotPoint {
   int runs = 0, detected = 0;
   std::vector<double> latency_ms;
@@ -982,7 +961,6 @@ template <typename Value>
 void draw_panel(cv::Mat* image, const cv::Rect& area, const PlotSeries& series, const std::string& title,
                 const std::string& x_label, double y_max, const std::string& y_label, Value value,
                 bool with_second = false) {
-  const cv::Scalar black(0, 0, 0), grey(200, 200, 200);
   double x_max = 0;
   std::vector<double> ticks;
   for (const auto& [arm, points] : series)
@@ -992,46 +970,18 @@ void draw_panel(cv::Mat* image, const cv::Rect& area, const PlotSeries& series, 
     }
   x_max *= 1.08;
   if (!(y_max > 0)) y_max = 1;
-  const int left = area.x + 70, right = area.x + area.width - 20, top = area.y + 70,
-            bottom = area.y + area.height - 50;
-  auto px = [&](double x, double y) {
-    return cv::Point(left + static_cast<int>((right - left) * x / x_max),
-                     bottom - static_cast<int>((bottom - top) * std::min(y, y_max) / y_max));
-  };
-  const int font = cv::FONT_HERSHEY_SIMPLEX;
-  cv::putText(*image, title, {area.x + 10, area.y + 25}, font, 0.6, black, 1, cv::LINE_AA);
-  for (int i = 0; i <= 4; ++i) {
-    const double y = y_max * i / 4;
-    cv::line(*image, px(0, y), px(x_max, y), grey, 1);
-    cv::putText(*image, fixed_text(y, y_max < 10 ? 1 : 0), {area.x + 5, px(0, y).y + 5}, font, 0.4, black, 1,
-                cv::LINE_AA);
-  }
-  for (double t : ticks) {
-    cv::line(*image, px(t, 0), px(t, 0) + cv::Point(0, 5), black, 1);
-    std::ostringstream l;
-    l << t;
-    cv::putText(*image, l.str(), px(t, 0) + cv::Point(-8, 20), font, 0.4, black, 1, cv::LINE_AA);
-  }
-  cv::line(*image, px(0, 0), px(x_max, 0), black, 1);
-  cv::line(*image, px(0, 0), px(0, y_max), black, 1);
-  cv::putText(*image, x_label, {(left + right) / 2 - 40, bottom + 40}, font, 0.45, black, 1, cv::LINE_AA);
-  cv::putText(*image, y_label, {area.x + 5, top - 10}, font, 0.45, black, 1, cv::LINE_AA);
+  PanelStyle style;
+  style.top = 70;
+  style.title_scale = 0.6;
+  style.tick_label_dx = -8;
+  style.x_label_dx = -40;
+  const PanelArea panel = draw_panel_frame(image, area, style, title, x_label, y_label, x_max, y_max, ticks);
   int i = 0;
   for (const auto& [arm, points] : series) {
-    const cv::Scalar colour = kPlotColours[i % 8];
     for (int curve = 0; curve < (with_second ? 2 : 1); ++curve) {
-      std::optional<cv::Point> previous;
-      for (const auto& [m, p] : points) {
-        const double y = value(p, curve);
-        if (std::isnan(y)) {
-          previous.reset();
-          continue;
-        }
-        const cv::Point here = px(m, y);
-        cv::circle(*image, here, curve == 0 ? 4 : 3, colour, curve == 0 ? cv::FILLED : 1, cv::LINE_AA);
-        if (previous) cv::line(*image, *previous, here, colour, curve == 0 ? 2 : 1, cv::LINE_AA);
-        previous = here;
-      }
+      std::vector<std::pair<double, double>> xy;
+      for (const auto& [m, p] : points) xy.push_back({m, value(p, curve)});
+      draw_curve(image, panel, xy, plot_colour(i), curve == 0);
     }
     ++i;
   }
@@ -1087,10 +1037,7 @@ std::vector<std::string> plot_campaign(const std::string& tsv_text, const std::s
         if (!p.latency_ms.empty()) latency_max = std::max(latency_max, quantile(p.latency_ms, 0.99));
       }
     // The latency axis up to a round number: 1, 2 or 5 times a power of 10.
-    double latency_axis = 1;
-    while (latency_axis < 1.05 * latency_max) {
-      latency_axis *= (std::to_string(static_cast<long>(latency_axis))[0] == '2') ? 2.5 : 2;
-    }
+    const double latency_axis = round_axis(latency_max, 1);
     const int legend_h = 22 * static_cast<int>(series.size()) + 20;
     cv::Mat image(560 + legend_h, 900, CV_8UC3, cv::Scalar(255, 255, 255));
     const std::string x_label = group + " (" + unit + ")";
@@ -1106,10 +1053,7 @@ std::vector<std::string> plot_campaign(const std::string& tsv_text, const std::s
         /*with_second=*/true);
     int i = 0;
     for (const auto& [variant, points] : series) {
-      const int y = 570 + 22 * i;
-      cv::line(image, {30, y}, {70, y}, kPlotColours[i % 8], 2, cv::LINE_AA);
-      cv::putText(image, robot + ", " + variant, {80, y + 5}, cv::FONT_HERSHEY_SIMPLEX, 0.45,
-                  cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+      draw_legend_entry(&image, {30, 570 + 22 * i}, 40, 50, plot_colour(i), robot + ", " + variant);
       ++i;
     }
     const std::string path = dir + "/detection-" + slug(group) + "-" + slug(robot) + ".png";

@@ -20,22 +20,14 @@
 // Prints the Markdown table (with the machine and the date) to stdout.
 #include <fstream>
 #include <iostream>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "chain_bench.hpp"
+#include "report_format.hpp"
 #include "test_support.hpp"
 
 namespace {
-
-std::vector<std::string> split(const std::string& text) {
-  std::vector<std::string> parts;
-  std::stringstream s(text);
-  for (std::string part; std::getline(s, part, ',');)
-    if (!part.empty()) parts.push_back(part);
-  return parts;
-}
 
 int usage(const std::string& why) {
   std::cerr
@@ -69,10 +61,10 @@ int main(int argc, char** argv) {
     const std::string value = argv[++i];
     try {
       if (option == "--arms") {
-        options.arms = split(value);
+        options.arms = split_list(value);
       } else if (option == "--resolutions") {
         options.resolutions.clear();
-        for (const std::string& r : split(value)) {
+        for (const std::string& r : split_list(value)) {
           const size_t x = r.find('x');
           if (x == std::string::npos) return usage("--resolutions: expected WIDTHxHEIGHT, got '" + r + "'");
           options.resolutions.emplace_back(std::stoi(r.substr(0, x)), std::stoi(r.substr(x + 1)));

@@ -35,28 +35,14 @@
 #include <fstream>
 #include <iostream>
 #include <iterator>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "judge_campaign.hpp"
+#include "report_format.hpp"
 #include "test_support.hpp"
 
 namespace {
-
-std::vector<std::string> split(const std::string& text) {
-  std::vector<std::string> parts;
-  std::stringstream s(text);
-  for (std::string part; std::getline(s, part, ',');)
-    if (!part.empty()) parts.push_back(part);
-  return parts;
-}
-
-std::vector<double> numbers(const std::string& text) {
-  std::vector<double> values;
-  for (const std::string& v : split(text)) values.push_back(std::stod(v));
-  return values;
-}
 
 int usage(const std::string& why) {
   std::cerr
@@ -96,13 +82,13 @@ int main(int argc, char** argv) {
     const std::string value = argv[++i];
     try {
       if (option == "--arms") {
-        arms = split(value);
+        arms = split_list(value);
       } else if (option == "--offsets-deg") {
-        magnitudes.joint_offsets_deg = numbers(value);
+        magnitudes.joint_offsets_deg = number_list(value);
       } else if (option == "--camera-cm") {
-        magnitudes.camera_translations_cm = numbers(value);
+        magnitudes.camera_translations_cm = number_list(value);
       } else if (option == "--camera-deg") {
-        magnitudes.camera_rotations_deg = numbers(value);
+        magnitudes.camera_rotations_deg = number_list(value);
       } else if (option == "--streams") {
         streams = std::stoi(value);
       } else if (option == "--nominal-s") {
@@ -110,13 +96,13 @@ int main(int argc, char** argv) {
       } else if (option == "--passers-s") {
         passers_s = std::stod(value);
       } else if (option == "--objects-cm") {
-        for (double cm : numbers(value)) objects_m.push_back(cm / 100);
+        for (double cm : number_list(value)) objects_m.push_back(cm / 100);
       } else if (option == "--beyond-cm") {
         beyond_m = std::stod(value) / 100;
       } else if (option == "--rates-hz") {
-        rates_hz = numbers(value);
+        rates_hz = number_list(value);
       } else if (option == "--turns-deg") {
-        turns_deg = numbers(value);
+        turns_deg = number_list(value);
       } else if (option == "--shared") {
         shared = value;
       } else if (option == "--tsv") {
