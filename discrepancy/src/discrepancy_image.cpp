@@ -96,6 +96,61 @@ cv::Mat1b opened(const cv::Mat1b& mask, int radius_px) {
   return out;
 }
 
+// The opening of `mask` (a square of radius_px) in which neighbours belong
+// together only on one surface: a pixel survives the erosion when every
+// pixel of its square is in the mask and within jump_mm of its depth, and
+// the dilation gives back the mask's pixels within jump_mm of a survivor in
+// their square. A sliver of the arm's own edge seen a pixel or two wider
+// than modelled, or a row of mixed pixels, touching a larger unexplained
+// surface at another depth (a cart passing behind the arm) goes, as it
+// would with nothing beside it; the surface itself stays. jump_mm <= 0:
+// the plain opening.
+cv::Mat1b opened_on_surfaces(const cv::Mat1b& mask, const int16_t* depth_mm, int radius_px, double jump_mm) {
+  // No jump (silhouettes off, silhouette_jump_mm <= 0): the plain opening.
+  if (radius_px <= 0 || jump_mm <= 0) return opened(mask, radius_px);
+  const int width = mask.cols;
+  const int height = mask.rows;
+  const uint8_t* in = mask.ptr<uint8_t>();
+  const auto same_surface = [&](int i, int j) {
+    return in[j] != 0 && std::abs(depth_mm[j] - depth_mm[i]) <= jump_mm;
+  };
+  cv::Mat1b core(height, width, uint8_t{0});
+  uint8_t* survivor = core.ptr<uint8_t>();
+  for (int v = radius_px; v < height - radius_px; ++v) {
+    for (int u = radius_px; u < width - radius_px; ++u) {
+      const int i = v * width + u;
+      if (in[i] == 0) continue;
+      bool whole = true;
+      for (int dv = -radius_px; dv <= radius_px && whole; ++dv) {
+        for (int du = -radius_px; du <= radius_px && whole; ++du)
+          whole = same_surface(i, i + dv * width + du);
+      }
+      survivor[i] = whole ? 255 : 0;
+    }
+  }
+  cv::Mat1b out(height, width, uint8_t{0});
+  uint8_t* kept = out.ptr<uint8_t>();
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      const int i = v * width + u;
+      if (in[i] == 0) continue;
+      bool near_survivor = false;
+      for (int dv = -radius_px; dv <= radius_px && !near_survivor; ++dv) {
+        const int vn = v + dv;
+        if (vn < 0 || vn >= height) continue;
+        for (int du = -radius_px; du <= radius_px && !near_survivor; ++du) {
+          const int un = u + du;
+          if (un < 0 || un >= width) continue;
+          const int j = vn * width + un;
+          near_survivor = survivor[j] != 0 && std::abs(depth_mm[j] - depth_mm[i]) <= jump_mm;
+        }
+      }
+      kept[i] = near_survivor ? 255 : 0;
+    }
+  }
+  return out;
+}
+
 // ---- The stages of compute_discrepancy, in order ----
 
 // Stage 1, label decoding: "" when every label value names a link or
@@ -353,7 +408,8 @@ int surface_depth_mm(const int16_t* tof, const uint8_t* unexplained, int i, int 
 }
 
 // Stage 6, unexplained nearer surfaces and the protective fields: every
-// occluded or unexpected-surface pixel (after the same opening)
+// occluded or unexpected-surface pixel (after the opening, on surfaces:
+// opened_on_surfaces)
 // back-projected at the camera's depth (a mixed pixel at its unexplained
 // neighbour's, surface_depth_mm), and its distance to the arm: 0 for
 // an occluded pixel (it hides part of the arm, and what cannot be seen is
@@ -370,7 +426,9 @@ void unexplained_surfaces(const depth_image_t& camera, const link_labels_t& labe
   s->field_bin_m = static_cast<float>(parameters.field_bin_m);
   s->num_field_bins = num_bins;
   std::vector<double> area_in_bin(num_bins, 0.0);
-  const cv::Mat1b candidates = opened(classes.nearer_mask, parameters.opening_radius_px);
+  const cv::Mat1b candidates =
+      opened_on_surfaces(classes.nearer_mask, camera.depth_mm.data(), parameters.opening_radius_px,
+                         parameters.silhouette_jump_mm);
   const ArmDistance arm(labels);
   const int width = camera.width;
   const int num_pixels = width * camera.height;
