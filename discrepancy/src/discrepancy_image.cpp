@@ -547,7 +547,8 @@ discrepancy_t unusable_summary(const depth_image_t& camera, int8_t kind, const s
 }
 
 DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_image_t& rendered,
-                                     const link_labels_t& labels, const Parameters& parameters) {
+                                     const link_labels_t& labels, const Parameters& parameters,
+                                     WorkerPool* workers) {
   DiscrepancyFrame frame;
   if (!labels.usable) {
     frame.summary =
@@ -617,7 +618,7 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
   unexplained_surfaces(camera, labels, frame, classes, parameters, footprint, &s);
   // Stage 7, evidence (evidence.hpp).
   compute_evidence(camera, rendered, labels, silhouette, parameters.silhouette_jump_mm,
-                   parameters.tolerance.noise, parameters.evidence, &s);
+                   parameters.tolerance.noise, parameters.evidence, &s, workers);
   joint_reach(labels, &s);
   return frame;
 }

@@ -23,6 +23,7 @@ int run_discrepancy(const DiscrepancyProcessSettings& settings) {
   const Parameters parameters = parameters_from(dc);
   FramePairer pairer(dc.pair_timeout_us, dc.max_pending_frames);
   RepeatCounter repeats;
+  WorkerPool workers(dc.worker_threads);
   int64_t judged = 0;
   int64_t unusable = 0;
 
@@ -41,7 +42,7 @@ int run_discrepancy(const DiscrepancyProcessSettings& settings) {
       const int64_t start_us = monotonic_us();
       const depth_image_t empty{};
       DiscrepancyFrame frame = compute_discrepancy(pair.camera.image, pair.rendered ? *pair.rendered : empty,
-                                                   pair.labels, parameters);
+                                                   pair.labels, parameters, &workers);
       frame.summary.depth_hash = pair.camera.depth_hash;
       frame.summary.repeat_count = pair.camera.repeat_count;
       frame.summary.compute_us = static_cast<int32_t>(monotonic_us() - start_us);

@@ -57,6 +57,8 @@ DiscrepancySettings read_discrepancy_settings(YamlMap map) {
     }
     evidence.finish();
   }
+  if (map.optional("worker_threads"))
+    d.worker_threads = static_cast<int>(map.integer("worker_threads", 1, 64));
   map.finish();
   return d;
 }

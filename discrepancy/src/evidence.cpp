@@ -161,9 +161,71 @@ void clear_evidence(discrepancy_t* s) {
   s->joint_search_gain.clear();
 }
 
+namespace {
+
+// compute_evidence's bands of rows: a fixed number, so that the sums do not
+// depend on how many threads run them.
+constexpr int kEvidenceBands = 8;
+
+// One band's sums of the evidence fits (the discrepancy_t fields of the
+// same names; link_sum_* per link: sum of w r and of w).
+struct EvidenceSums {
+  EvidenceSums(int num_links, int num_joints)
+      : link_sum_wr(num_links, 0.0),
+        link_sum_w(num_links, 0.0),
+        joint_fit_pixels(num_joints, 0),
+        joint_score(num_joints, 0.0),
+        joint_information(num_joints, 0.0),
+        joint_naming_score(num_joints, 0.0),
+        joint_naming_information(num_joints, 0.0) {}
+  void add(const EvidenceSums& o) {
+    for (size_t l = 0; l < link_sum_wr.size(); ++l) {
+      link_sum_wr[l] += o.link_sum_wr[l];
+      link_sum_w[l] += o.link_sum_w[l];
+    }
+    robot_fit_pixels += o.robot_fit_pixels;
+    robot_chi2 += o.robot_chi2;
+    for (size_t j = 0; j < joint_score.size(); ++j) {
+      joint_fit_pixels[j] += o.joint_fit_pixels[j];
+      joint_score[j] += o.joint_score[j];
+      joint_information[j] += o.joint_information[j];
+      joint_naming_score[j] += o.joint_naming_score[j];
+      joint_naming_information[j] += o.joint_naming_information[j];
+    }
+    static_chi2 += o.static_chi2;
+    camera_fit_pixels += o.camera_fit_pixels;
+    camera_score += o.camera_score;
+    camera_information += o.camera_information;
+    for (int k = 0; k < 4; ++k) camera_region_fit_pixels[k] += o.camera_region_fit_pixels[k];
+    for (int k = 0; k < 24; ++k) {
+      camera_region_score[k] += o.camera_region_score[k];
+      camera_region_information[k] += o.camera_region_information[k];
+    }
+  }
+  std::vector<double> link_sum_wr;
+  std::vector<double> link_sum_w;
+  int32_t robot_fit_pixels = 0;
+  double robot_chi2 = 0;
+  std::vector<int32_t> joint_fit_pixels;
+  std::vector<double> joint_score;
+  std::vector<double> joint_information;
+  std::vector<double> joint_naming_score;
+  std::vector<double> joint_naming_information;
+  double static_chi2 = 0;
+  int32_t camera_fit_pixels = 0;
+  Eigen::Matrix<double, 6, 1> camera_score = Eigen::Matrix<double, 6, 1>::Zero();
+  Eigen::Matrix<double, 6, 6> camera_information = Eigen::Matrix<double, 6, 6>::Zero();  // upper triangle
+  int32_t camera_region_fit_pixels[4] = {0, 0, 0, 0};
+  double camera_region_score[24] = {};
+  double camera_region_information[24] = {};
+};
+
+}  // namespace
+
 void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered, const link_labels_t& labels,
                       const std::vector<uint8_t>& silhouette, double silhouette_jump_mm,
-                      const DepthNoise& noise, const EvidenceParameters& parameters, discrepancy_t* summary) {
+                      const DepthNoise& noise, const EvidenceParameters& parameters, discrepancy_t* summary,
+                      WorkerPool* workers) {
   discrepancy_t& s = *summary;
   clear_evidence(&s);
   const EvidenceJacobian jacobian(rendered, labels, silhouette_jump_mm);
@@ -177,83 +239,108 @@ void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered
   // evidence, not the camera's, and stay out of the camera fit.
   std::vector<uint8_t> explained_static;
   search_joint_offsets(camera, rendered, labels, jacobian.kinematics(), noise, parameters, &s,
-                       &explained_static);
+                       &explained_static, workers);
   const bool have_explained = explained_static.size() == static_cast<size_t>(num_pixels);
   const int num_links = labels.num_links;
   const int num_joints = jacobian.num_joints();
-  std::vector<double> link_sum_wr(num_links, 0.0);
-  std::vector<double> link_sum_w(num_links, 0.0);
-  std::vector<double> joint_row(num_joints, 0.0);
-  s.joint_fit_pixels.assign(num_joints, 0);
-  s.joint_score.assign(num_joints, 0.0);
-  s.joint_information.assign(num_joints, 0.0);
-  s.joint_naming_score.assign(num_joints, 0.0);
-  s.joint_naming_information.assign(num_joints, 0.0);
-  Eigen::Matrix<double, 6, 1> camera_score = Eigen::Matrix<double, 6, 1>::Zero();
-  Eigen::Matrix<double, 6, 6> camera_information = Eigen::Matrix<double, 6, 6>::Zero();
-  double camera_row[6];
   const int16_t* tof = camera.depth_mm.data();
   const int16_t* gen = rendered.depth_mm.data();
   const double model_var = parameters.model_sigma_mm * parameters.model_sigma_mm;
   const double inv_pps = 1.0 / parameters.pixels_per_sample;
   const int half_width = camera.width / 2;
   const int half_height = camera.height / 2;
-  for (int i = 0; i < num_pixels; ++i) {
-    const int t = tof[i];
-    if (t <= 0 || gen[i] <= 0 || silhouette[i]) continue;
-    bool moved = false;
-    int link = -1;
-    if (!jacobian.at(i, camera_row, joint_row.data(), &moved, &link)) continue;
-    if (!moved && have_explained && explained_static[i]) continue;
-    const double sigma_d = noise.sigma_mm(t);
-    const double var = sigma_d * sigma_d + model_var;
-    const double limit = parameters.clip_sigmas * std::sqrt(var);
-    const double raw_r = static_cast<double>(gen[i] - t);
-    const double r = std::clamp(raw_r, -limit, limit);
-    const bool in_naming_fit = std::abs(raw_r) <= parameters.naming_gate_sigmas * std::sqrt(var);
-    const double w = inv_pps / var;
-    link_sum_wr[link] += w * r;
-    link_sum_w[link] += w;
-    if (moved) {
-      ++s.robot_fit_pixels;
-      s.robot_chi2 += w * r * r;
-      for (int j = 0; j < num_joints; ++j) {
-        const double jj = joint_row[j];
-        if (jj == 0.0) continue;
-        ++s.joint_fit_pixels[j];
-        s.joint_score[j] -= w * jj * r;
-        s.joint_information[j] += w * jj * jj;
+  // The image in kEvidenceBands bands of rows, each summed on its own (a
+  // WorkerPool task when `workers` is given) and the bands added in order:
+  // the sums are the same whichever threads run them.
+  std::vector<EvidenceSums> bands(kEvidenceBands, EvidenceSums(num_links, num_joints));
+  const auto sum_band = [&](int band) {
+    EvidenceSums& b = bands[static_cast<size_t>(band)];
+    std::vector<double> joint_row(num_joints, 0.0);
+    double camera_row[6];
+    const int first = static_cast<int>(static_cast<int64_t>(num_pixels) * band / kEvidenceBands);
+    const int last = static_cast<int>(static_cast<int64_t>(num_pixels) * (band + 1) / kEvidenceBands);
+    for (int i = first; i < last; ++i) {
+      const int t = tof[i];
+      if (t <= 0 || gen[i] <= 0 || silhouette[i]) continue;
+      bool moved = false;
+      int link = -1;
+      if (!jacobian.at(i, camera_row, joint_row.data(), &moved, &link)) continue;
+      if (!moved && have_explained && explained_static[i]) continue;
+      const double sigma_d = noise.sigma_mm(t);
+      const double var = sigma_d * sigma_d + model_var;
+      const double limit = parameters.clip_sigmas * std::sqrt(var);
+      const double raw_r = static_cast<double>(gen[i] - t);
+      const double r = std::clamp(raw_r, -limit, limit);
+      const bool in_naming_fit = std::abs(raw_r) <= parameters.naming_gate_sigmas * std::sqrt(var);
+      const double w = inv_pps / var;
+      b.link_sum_wr[link] += w * r;
+      b.link_sum_w[link] += w;
+      if (moved) {
+        ++b.robot_fit_pixels;
+        b.robot_chi2 += w * r * r;
+        for (int j = 0; j < num_joints; ++j) {
+          const double jj = joint_row[j];
+          if (jj == 0.0) continue;
+          ++b.joint_fit_pixels[j];
+          b.joint_score[j] -= w * jj * r;
+          b.joint_information[j] += w * jj * jj;
+          if (!in_naming_fit) continue;
+          b.joint_naming_score[j] -= w * jj * r;
+          b.joint_naming_information[j] += w * jj * jj;
+        }
+      } else {
+        b.static_chi2 += w * r * r;
+        // A static pixel beyond the gate is outside the camera's linear model
+        // as the naming fit's are outside the joints': a pose off by the
+        // test's delta (2 cm, 1 degree) moves smooth static surfaces by a few
+        // sigma, while an object in front of them (a person walking past
+        // the wall) differs by tens of centimetres. Its clipped residual
+        // would say only that something is there, and the protective fields
+        // judge that; in the camera fit it would pull the pose.
         if (!in_naming_fit) continue;
-        s.joint_naming_score[j] -= w * jj * r;
-        s.joint_naming_information[j] += w * jj * jj;
-      }
-    } else {
-      s.static_chi2 += w * r * r;
-      // A static pixel beyond the gate is outside the camera's linear model
-      // as the naming fit's are outside the joints': a pose off by the
-      // test's delta (2 cm, 1 degree) moves smooth static surfaces by a few
-      // sigma, while an object in front of them (a person walking past
-      // the wall) differs by tens of centimetres. Its clipped residual
-      // would say only that something is there, and the protective fields
-      // judge that; in the camera fit it would pull the pose.
-      if (!in_naming_fit) continue;
-      ++s.camera_fit_pixels;
-      // The image quadrant (discrepancy_t.camera_region_*).
-      const int region = (i % camera.width >= half_width ? 1 : 0) + (i / camera.width >= half_height ? 2 : 0);
-      ++s.camera_region_fit_pixels[region];
-      double* region_score = s.camera_region_score + 6 * region;
-      double* region_information = s.camera_region_information + 6 * region;
-      // The upper triangle by hand: Eigen's rankUpdate on a 6x6
-      // selfadjoint view costs more than the rest of the pixel.
-      for (int a = 0; a < 6; ++a) {
-        const double wj = w * camera_row[a];
-        camera_score[a] -= wj * r;
-        region_score[a] -= wj * r;
-        region_information[a] += wj * camera_row[a];
-        for (int b = a; b < 6; ++b) camera_information(a, b) += wj * camera_row[b];
+        ++b.camera_fit_pixels;
+        // The image quadrant (discrepancy_t.camera_region_*).
+        const int region =
+            (i % camera.width >= half_width ? 1 : 0) + (i / camera.width >= half_height ? 2 : 0);
+        ++b.camera_region_fit_pixels[region];
+        double* region_score = b.camera_region_score + 6 * region;
+        double* region_information = b.camera_region_information + 6 * region;
+        // The upper triangle by hand: Eigen's rankUpdate on a 6x6
+        // selfadjoint view costs more than the rest of the pixel.
+        for (int a = 0; a < 6; ++a) {
+          const double wj = w * camera_row[a];
+          b.camera_score[a] -= wj * r;
+          region_score[a] -= wj * r;
+          region_information[a] += wj * camera_row[a];
+          for (int c = a; c < 6; ++c) b.camera_information(a, c) += wj * camera_row[c];
+        }
       }
     }
+  };
+  if (workers != nullptr) {
+    workers->run(kEvidenceBands, sum_band);
+  } else {
+    for (int band = 0; band < kEvidenceBands; ++band) sum_band(band);
   }
+  EvidenceSums total(num_links, num_joints);
+  for (const EvidenceSums& b : bands) total.add(b);
+  s.robot_fit_pixels = total.robot_fit_pixels;
+  s.robot_chi2 = total.robot_chi2;
+  s.static_chi2 = total.static_chi2;
+  s.camera_fit_pixels = total.camera_fit_pixels;
+  s.joint_fit_pixels = total.joint_fit_pixels;
+  s.joint_score = total.joint_score;
+  s.joint_information = total.joint_information;
+  s.joint_naming_score = total.joint_naming_score;
+  s.joint_naming_information = total.joint_naming_information;
+  std::copy(total.camera_region_fit_pixels, total.camera_region_fit_pixels + 4, s.camera_region_fit_pixels);
+  std::copy(total.camera_region_score, total.camera_region_score + 24, s.camera_region_score);
+  std::copy(total.camera_region_information, total.camera_region_information + 24,
+            s.camera_region_information);
+  const std::vector<double>& link_sum_wr = total.link_sum_wr;
+  const std::vector<double>& link_sum_w = total.link_sum_w;
+  Eigen::Matrix<double, 6, 1> camera_score = total.camera_score;
+  Eigen::Matrix<double, 6, 6> camera_information = total.camera_information;
   camera_information = camera_information.selfadjointView<Eigen::Upper>();
   Eigen::Matrix<double, 6, 1> correction = Eigen::Matrix<double, 6, 1>::Zero();
   if (s.camera_fit_pixels > 0) {

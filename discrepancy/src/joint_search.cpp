@@ -20,6 +20,29 @@ struct SearchPoint {
   double inv_sigma;
 };
 
+// A rigid motion (optical frame, mm) as 12 plain numbers, applied inline:
+// Eigen's Isometry3d * Vector3d is a call per point in the search's inner
+// loop. The sums run in Eigen's order ((r0 p0 + r1 p1) + r2 p2) + t, so the
+// moved points are the same to the last bit (the bench's digest,
+// docs/benchmarks.md, "The hot paths").
+struct RigidMotion {
+  explicit RigidMotion(const Eigen::Isometry3d& m) {
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) rotation[3 * r + c] = m.linear()(r, c);
+      translation[r] = m.translation()[r];
+    }
+  }
+  double x(const Eigen::Vector3d& p) const { return apply(0, p); }
+  double y(const Eigen::Vector3d& p) const { return apply(1, p); }
+  double z(const Eigen::Vector3d& p) const { return apply(2, p); }
+  double apply(int r, const Eigen::Vector3d& p) const {
+    const double* row = rotation + 3 * r;
+    return ((row[0] * p.x() + row[1] * p.y()) + row[2] * p.z()) + translation[r];
+  }
+  double rotation[9];
+  double translation[3];
+};
+
 // What the points of some links cost against the measured depth when moved
 // by one rigid motion.
 class PointCost {
@@ -42,13 +65,14 @@ class PointCost {
   void mark_matches(const std::vector<SearchPoint>& points, const Eigen::Isometry3d& motion, int block,
                     const IsStatic& is_static, std::vector<uint8_t>* mask) const {
     const double clip = std::sqrt(clip2_);
+    const RigidMotion m(motion);
     for (const SearchPoint& point : points) {
-      const Eigen::Vector3d q = motion * point.p_mm;
+      const double qz = m.z(point.p_mm);
       int u = 0;
       int v = 0;
-      if (!lands(q, &u, &v)) continue;
+      if (!lands(m.x(point.p_mm), m.y(point.p_mm), qz, &u, &v)) continue;
       const int measured = tof_[v * width_ + u];
-      if (measured <= 0 || std::abs(q.z() - measured) * point.inv_sigma > clip) continue;
+      if (measured <= 0 || std::abs(qz - measured) * point.inv_sigma > clip) continue;
       const int u0 = std::max(0, u - block / 2);
       const int v0 = std::max(0, v - block / 2);
       for (int y = v0; y < std::min(height_, v0 + block); ++y) {
@@ -64,30 +88,32 @@ class PointCost {
   double operator()(const std::vector<SearchPoint>& points, const Eigen::Isometry3d& motion,
                     size_t every) const {
     double sum = 0;
+    const RigidMotion m(motion);
     for (size_t n = 0; n < points.size(); n += every) {
-      const Eigen::Vector3d q = motion * points[n].p_mm;
+      const Eigen::Vector3d& p = points[n].p_mm;
+      const double qz = m.z(p);
       int u = 0;
       int v = 0;
-      const int measured = lands(q, &u, &v) ? tof_[v * width_ + u] : 0;
+      const int measured = lands(m.x(p), m.y(p), qz, &u, &v) ? tof_[v * width_ + u] : 0;
       if (measured <= 0) {
         sum += clip2_;
         continue;
       }
-      const double x = (q.z() - measured) * points[n].inv_sigma;
+      const double x = (qz - measured) * points[n].inv_sigma;
       sum += std::min(x * x, clip2_);
     }
     return weight_ * static_cast<double>(every) * sum;
   }
 
  private:
-  // The pixel (u, v) nearest to where point q (optical frame, mm) projects;
-  // false when it is behind the camera or off the image. Rounds by +0.5
-  // and truncation (both >= 0 once in range).
-  bool lands(const Eigen::Vector3d& q, int* u, int* v) const {
-    if (!(q.z() > 1.0)) return false;
-    const double inv_z = 1.0 / q.z();
-    const double uf = fx_ * q.x() * inv_z + cx_ + 0.5;
-    const double vf = fy_ * q.y() * inv_z + cy_ + 0.5;
+  // The pixel (u, v) nearest to where point (qx, qy, qz) (optical frame,
+  // mm) projects; false when it is behind the camera or off the image.
+  // Rounds by +0.5 and truncation (both >= 0 once in range).
+  bool lands(double qx, double qy, double qz, int* u, int* v) const {
+    if (!(qz > 1.0)) return false;
+    const double inv_z = 1.0 / qz;
+    const double uf = fx_ * qx * inv_z + cx_ + 0.5;
+    const double vf = fy_ * qy * inv_z + cy_ + 0.5;
     if (!(uf >= 0 && vf >= 0 && uf < width_ && vf < height_)) return false;
     *u = static_cast<int>(uf);
     *v = static_cast<int>(vf);
@@ -120,7 +146,7 @@ Eigen::Isometry3d axis_motion(const LabelAxis& axis, double amount) {
 void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rendered,
                           const link_labels_t& labels, const LabelKinematics& k, const DepthNoise& noise,
                           const EvidenceParameters& parameters, discrepancy_t* summary,
-                          std::vector<uint8_t>* explained_static) {
+                          std::vector<uint8_t>* explained_static, WorkerPool* workers) {
   if (explained_static != nullptr) explained_static->clear();
   discrepancy_t& s = *summary;
   s.search_points = 0;
@@ -197,10 +223,11 @@ void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rend
     return motion;
   };
 
-  for (int j = 0; j < k.num_joints; ++j) {
+  // One joint's search: writes only joint j's offset and gain.
+  const auto search_joint = [&](int j) {
     bool prismatic = false;
     const std::vector<MovedLink> moved = moved_links(j, &prismatic);
-    if (moved.empty()) continue;
+    if (moved.empty()) return;
     // The coarse trials take every `coarse_every`-th point of each link
     // (about kCoarsePoints of the joint's points in all): they only pick the
     // basin; the gain and the refinement use every point.
@@ -239,6 +266,11 @@ void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rend
     }
     s.joint_search_offset[j] = best_offset;
     s.joint_search_gain[j] = std::max(0.0, none - best);
+  };
+  if (workers != nullptr) {
+    workers->run(k.num_joints, search_joint);
+  } else {
+    for (int j = 0; j < k.num_joints; ++j) search_joint(j);
   }
 
   // The static pixels the best joint's offset explains: where its moved

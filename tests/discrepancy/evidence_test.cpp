@@ -264,6 +264,62 @@ discrepancy_t evidence_of(test::SimulatedFrames* frames, const deployment::Confi
   return f.summary;
 }
 
+// The encoded summary, utime and compute_us aside.
+std::vector<uint8_t> encoded(discrepancy_t s) {
+  s.utime = 0;
+  s.compute_us = 0;
+  std::vector<uint8_t> bytes(static_cast<size_t>(s.getEncodedSize()));
+  s.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  return bytes;
+}
+
+// compute_discrepancy shares the naming search's joints and the evidence
+// sums' bands among a WorkerPool's threads (discrepancy.worker_threads): the
+// summary must be the same to the last bit on 1, 2 or 4 threads, with and
+// without a pool, for a nominal frame, an encoder offset the search finds
+// and a moved camera.
+TEST_F(EvidenceTest, TheSummaryDoesNotDependOnTheWorkerThreads) {
+  const JointPositions truth = estimator::test::side_reach_pose();
+  const Intrinsics& in = config_->camera.intrinsics;
+  const std::string joint = frames_->scene().actuated_joint_names[1];
+  JointPositions offset = truth;
+  offset[joint] += 10 * kDeg;
+  const Eigen::Isometry3d moved_camera = camera() * Eigen::Translation3d(0.03, 0, 0);
+  struct Case {
+    const char* what;
+    JointPositions reported;
+    Eigen::Isometry3d seen_from;
+  };
+  const Case cases[] = {{"nominal", truth, camera()},
+                        {"encoder 10 deg off", offset, camera()},
+                        {"camera 3 cm off", truth, moved_camera}};
+  WorkerPool two(2);
+  WorkerPool four(4);
+  uint64_t index = 70;
+  for (const Case& c : cases) {
+    const std::vector<float> seen = frames_->capture(truth, c.seen_from, in, ++index);
+    const depth_image_t cam = make_depth_image("cam", in, 1, 1, true, seen);
+    const Frame model = render_frame(&frames_->renderer(), frames_->scene(), c.reported, camera(), in);
+    const DiscrepancyFrame alone = compute_discrepancy(cam, model.depth, model.labels, parameters(*config_));
+    ASSERT_TRUE(alone.summary.evidence_available) << c.what;
+    const std::vector<uint8_t> expected = encoded(alone.summary);
+    for (WorkerPool* pool : {&two, &four}) {
+      const DiscrepancyFrame shared =
+          compute_discrepancy(cam, model.depth, model.labels, parameters(*config_), pool);
+      EXPECT_TRUE(encoded(shared.summary) == expected) << c.what << ", " << pool->num_threads() << " threads";
+    }
+    if (std::string(c.what) == "encoder 10 deg off") {
+      // The search found the offset: the test compares a search that ran.
+      double best_gain = 0;
+      for (double g : alone.summary.joint_search_gain) best_gain = std::max(best_gain, g);
+      EXPECT_GT(best_gain, 20.0);
+    }
+    if (std::string(c.what) == "camera 3 cm off") {
+      EXPECT_GT(alone.summary.camera_fit_pixels, 1000);
+    }
+  }
+}
+
 TEST_F(EvidenceTest, AnEncoderOffsetIsBestExplainedByItsOwnJoint) {
   const JointPositions truth = estimator::test::side_reach_pose();
   uint64_t index = 10;

@@ -14,6 +14,7 @@
 #include <opencv2/core.hpp>
 
 #include "tofguard/common/depth_frame.hpp"
+#include "tofguard/common/worker_pool.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/discrepancy/discrepancy_settings.hpp"
 #include "tofguard/discrepancy/evidence.hpp"
@@ -72,8 +73,13 @@ struct DiscrepancyFrame {
 // do not fit each other (size, intrinsics, camera, label values), the
 // summary is unusable and says why; `rendered` is not read when the labels
 // are unusable.
+//
+// workers (optional): the threads the naming search shares its joints
+// among (joint_search.hpp); nullptr runs it on the caller's thread. The
+// summary is the same either way.
 DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_image_t& rendered,
-                                     const link_labels_t& labels, const Parameters& parameters);
+                                     const link_labels_t& labels, const Parameters& parameters,
+                                     WorkerPool* workers = nullptr);
 
 // compute_discrepancy's silhouette mask (row-major, 1 = beside a
 // silhouette): the pixels beside a rendered depth step larger than

@@ -74,6 +74,11 @@ struct DiscrepancySettings {
   double evidence_search_range_m = 0;
   double evidence_search_step_m = 0;
   int evidence_search_max_points = 0;
+  // worker_threads (optional, default 1): the threads compute_discrepancy's
+  // naming search shares its joints among, the process's own included
+  // (WorkerPool; docs/benchmarks.md, "The hot paths"). A speed setting
+  // only: the summary is the same for any value. 1: no worker thread.
+  int worker_threads = 1;
 };
 
 // Reads (and finishes) the `discrepancy` section.

@@ -28,6 +28,7 @@
 #include <Eigen/Core>
 
 #include "tofguard/common/depth_frame.hpp"
+#include "tofguard/common/worker_pool.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/link_labels_t.hpp"
@@ -152,9 +153,11 @@ class EvidenceJacobian {
 // beside a silhouette), `silhouette_jump_mm` its threshold (no slope is
 // taken across a larger rendered step). Leaves them zero
 // (evidence_available false) when the labels carry no kinematics.
+// `workers` as compute_discrepancy's.
 void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered, const link_labels_t& labels,
                       const std::vector<uint8_t>& silhouette, double silhouette_jump_mm,
-                      const DepthNoise& noise, const EvidenceParameters& parameters, discrepancy_t* summary);
+                      const DepthNoise& noise, const EvidenceParameters& parameters, discrepancy_t* summary,
+                      WorkerPool* workers = nullptr);
 
 // Clears the evidence fields (evidence_available false, everything zero).
 void clear_evidence(discrepancy_t* summary);

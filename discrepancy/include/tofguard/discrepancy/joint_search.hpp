@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "tofguard/common/worker_pool.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/discrepancy/evidence.hpp"
 #include "tofguard/discrepancy_t.hpp"
@@ -38,9 +39,15 @@ namespace tofguard::discrepancy {
 // matches the measured depth there: a static pixel that the arm, where the
 // search sees it, explains (the camera fit leaves it out). All 0 when no
 // joint's offset helps; empty when the search could not run.
+//
+// workers (optional): each joint's search is one task (WorkerPool); they
+// share nothing but read-only inputs, and each writes its own joint's
+// entries, so the result does not depend on the threads. nullptr: all on
+// the caller's thread.
 void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rendered,
                           const link_labels_t& labels, const LabelKinematics& kinematics,
                           const DepthNoise& noise, const EvidenceParameters& parameters,
-                          discrepancy_t* summary, std::vector<uint8_t>* explained_static = nullptr);
+                          discrepancy_t* summary, std::vector<uint8_t>* explained_static = nullptr,
+                          WorkerPool* workers = nullptr);
 
 }  // namespace tofguard::discrepancy
