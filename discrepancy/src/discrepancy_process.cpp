@@ -1,9 +1,11 @@
 #include "tofguard/discrepancy/discrepancy_process.hpp"
 
 #include <algorithm>
+#include <cstdio>
 
 #include "tofguard/common/clock.hpp"
 #include "tofguard/common/lcm_node.hpp"
+#include "tofguard/common/resident_heap.hpp"
 #include "tofguard/common/wire_checks.hpp"
 #include "tofguard/discrepancy/discrepancy_image.hpp"
 #include "tofguard/discrepancy/frame_pairer.hpp"
@@ -18,6 +20,8 @@ ProcessInfo process_info() {
 }
 
 int run_discrepancy(const DiscrepancyProcessSettings& settings) {
+  if (!keep_heap_resident())
+    std::fprintf(stderr, "tofguard-discrepancy: warning: mallopt refused keep_heap_resident's settings\n");
   LcmNode node(settings.lcm, settings.channels, process_info().name);
   const DiscrepancySettings& dc = settings.discrepancy;
   const Parameters parameters = parameters_from(dc);

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <stdexcept>
 #include <vector>
@@ -10,6 +11,7 @@
 #include "tofguard/common/config_error.hpp"
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/common/lcm_node.hpp"
+#include "tofguard/common/resident_heap.hpp"
 #include "tofguard/common/wire_checks.hpp"
 
 namespace tofguard::renderer {
@@ -222,6 +224,8 @@ RenderedFrame RendererService::make_output(const depth_image_t& frame, RenderRes
 }
 
 int run_renderer(const RendererProcessSettings& settings) {
+  if (!keep_heap_resident())
+    std::fprintf(stderr, "tofguard-renderer: warning: mallopt refused keep_heap_resident's settings\n");
   const std::string name = process_info().name;
   std::unique_ptr<RendererService> service;
   try {

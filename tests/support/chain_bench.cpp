@@ -589,6 +589,7 @@ class BenchChain {
       return joints_at(last_path_.start_s + last_path_.index(i) / last_path_.rate_hz);
     };
     const int n = std::max(1, options_.floor_frames);
+    log_ << "  floors: rendering with " << renderer.description() << std::endl;
     // Untimed: the first renders (shaders, buffers).
     for (int i = 0; i < 3; ++i) renderer.render(joints(i), pose, intrinsics_);
     std::vector<double> render_ms;

@@ -26,6 +26,7 @@
 #include "chain_bench.hpp"
 #include "report_format.hpp"
 #include "test_support.hpp"
+#include "tofguard/common/resident_heap.hpp"
 
 namespace {
 
@@ -42,6 +43,8 @@ int usage(const std::string& why) {
 
 int main(int argc, char** argv) {
   using namespace tofguard::test;
+  // As the renderer and discrepancy processes (the floors run in here).
+  tofguard::keep_heap_resident();
   BenchOptions options;
   options.shared_dir = shared_dir();
   std::string markdown_path;
