@@ -20,6 +20,11 @@ double joint_llr(double score, double information, double delta) {
 
 namespace {
 
+// The diagonal of a row-major 6x6 information matrix.
+std::array<double, 6> diagonal_of(const double* information) {
+  return {information[0], information[7], information[14], information[21], information[28], information[35]};
+}
+
 // camera_llr on the information's diagonal.
 double camera_llr_diagonal(const double* score, const double* information_diagonal,
                            const std::array<double, 6>& delta) {
@@ -39,9 +44,7 @@ double camera_llr_diagonal(const double* score, const double* information_diagon
 
 double camera_llr(const std::array<double, 6>& score, const std::array<double, 36>& information,
                   const std::array<double, 6>& delta) {
-  const std::array<double, 6> diagonal = {information[0],  information[7],  information[14],
-                                          information[21], information[28], information[35]};
-  return camera_llr_diagonal(score.data(), diagonal.data(), delta);
+  return camera_llr_diagonal(score.data(), diagonal_of(information.data()).data(), delta);
 }
 
 bool camera_region_votes(const double* information_diagonal, const std::array<double, 6>& delta) {
@@ -65,12 +68,8 @@ CameraRegionRatio camera_region_llr(const discrepancy_t& f, const std::array<dou
   if (voters == 0) {
     // No region carries a nat at delta (a frame without regions, from an
     // older tofguard-discrepancy, or a scene with hardly any static
-    // surface): the whole image's ratio.
-    std::array<double, 6> score{};
-    std::array<double, 36> information{};
-    std::copy(f.camera_score, f.camera_score + 6, score.begin());
-    std::copy(f.camera_information, f.camera_information + 36, information.begin());
-    result.llr = camera_llr(score, information, delta);
+    // surface): the whole image's ratio, on its information's diagonal.
+    result.llr = camera_llr_diagonal(f.camera_score, diagonal_of(f.camera_information).data(), delta);
     return result;
   }
   // The m-th largest of the n voters' ratios, m = min(n, 3): with
