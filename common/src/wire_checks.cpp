@@ -137,45 +137,6 @@ std::string check_kinematics(const link_labels_t& l) {
   return "";
 }
 
-// link_labels_t's arm cover (arm_cover_max_radius_m .. arm_sphere_radius_m).
-std::string check_arm_cover(const link_labels_t& l) {
-  if (auto p = check_count(l.num_arm_spheres, l.arm_sphere_link, "arm_sphere_link", "num_arm_spheres");
-      !p.empty())
-    return p;
-  if (auto p =
-          check_count(l.num_arm_spheres, l.arm_sphere_center_m, "arm_sphere_center_m", "num_arm_spheres");
-      !p.empty())
-    return p;
-  if (auto p =
-          check_count(l.num_arm_spheres, l.arm_sphere_radius_m, "arm_sphere_radius_m", "num_arm_spheres");
-      !p.empty())
-    return p;
-  if (!std::isfinite(l.arm_cover_max_radius_m) || l.arm_cover_max_radius_m < 0) {
-    return expected("arm_cover_max_radius_m", "a finite radius >= 0 (m)", l.arm_cover_max_radius_m);
-  }
-  for (int k = 0; k < l.num_arm_spheres; ++k) {
-    const std::string at = "[" + std::to_string(k) + "]";
-    if (l.arm_sphere_link[k] < 0 || l.arm_sphere_link[k] >= l.num_robot_links) {
-      return expected("arm_sphere_link" + at,
-                      "a robot link index 0..num_robot_links-1 = " + std::to_string(l.num_robot_links - 1),
-                      l.arm_sphere_link[k]);
-    }
-    if (l.arm_sphere_center_m[k].size() != 3) return "arm_sphere_center_m" + at + ": expected 3 coordinates";
-    for (int c = 0; c < 3; ++c) {
-      if (!std::isfinite(l.arm_sphere_center_m[k][c])) {
-        return expected("arm_sphere_center_m" + at, "finite coordinates (m)", l.arm_sphere_center_m[k][c]);
-      }
-    }
-    const double r = l.arm_sphere_radius_m[k];
-    // (float radii against a double maximum: one float rounding allowed)
-    if (!std::isfinite(r) || r < 0 || r > l.arm_cover_max_radius_m * (1 + 1e-6)) {
-      return expected("arm_sphere_radius_m" + at,
-                      "a radius 0..arm_cover_max_radius_m = " + std::to_string(l.arm_cover_max_radius_m), r);
-    }
-  }
-  return "";
-}
-
 // discrepancy_t's protective-field fields (field_bin_m ..
 // unexplained_area_within_m2).
 std::string check_field(const discrepancy_t& d) {
@@ -283,6 +244,44 @@ std::string check_evidence(const discrepancy_t& d) {
 }
 
 }  // namespace
+
+std::string check_arm_cover(const link_labels_t& l) {
+  if (auto p = check_count(l.num_arm_spheres, l.arm_sphere_link, "arm_sphere_link", "num_arm_spheres");
+      !p.empty())
+    return p;
+  if (auto p =
+          check_count(l.num_arm_spheres, l.arm_sphere_center_m, "arm_sphere_center_m", "num_arm_spheres");
+      !p.empty())
+    return p;
+  if (auto p =
+          check_count(l.num_arm_spheres, l.arm_sphere_radius_m, "arm_sphere_radius_m", "num_arm_spheres");
+      !p.empty())
+    return p;
+  if (!std::isfinite(l.arm_cover_max_radius_m) || l.arm_cover_max_radius_m < 0) {
+    return expected("arm_cover_max_radius_m", "a finite radius >= 0 (m)", l.arm_cover_max_radius_m);
+  }
+  for (int k = 0; k < l.num_arm_spheres; ++k) {
+    const std::string at = "[" + std::to_string(k) + "]";
+    if (l.arm_sphere_link[k] < 0 || l.arm_sphere_link[k] >= l.num_robot_links) {
+      return expected("arm_sphere_link" + at,
+                      "a robot link index 0..num_robot_links-1 = " + std::to_string(l.num_robot_links - 1),
+                      l.arm_sphere_link[k]);
+    }
+    if (l.arm_sphere_center_m[k].size() != 3) return "arm_sphere_center_m" + at + ": expected 3 coordinates";
+    for (int c = 0; c < 3; ++c) {
+      if (!std::isfinite(l.arm_sphere_center_m[k][c])) {
+        return expected("arm_sphere_center_m" + at, "finite coordinates (m)", l.arm_sphere_center_m[k][c]);
+      }
+    }
+    const double r = l.arm_sphere_radius_m[k];
+    // (float radii against a double maximum: one float rounding allowed)
+    if (!std::isfinite(r) || r < 0 || r > l.arm_cover_max_radius_m * (1 + 1e-6)) {
+      return expected("arm_sphere_radius_m" + at,
+                      "a radius 0..arm_cover_max_radius_m = " + std::to_string(l.arm_cover_max_radius_m), r);
+    }
+  }
+  return "";
+}
 
 std::string check_depth_image(const depth_image_t& image) {
   if (image.camera_id.empty()) return "camera_id: expected a camera name, got an empty string";

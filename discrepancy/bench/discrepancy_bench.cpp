@@ -37,7 +37,7 @@ Frames make_frames(int width, int height) {
       }
     }
   };
-  Frames f;
+  Frames f{};  // value-initialised: the generated types leave their scalars uninitialised
   for (depth_image_t* m : {&f.camera, &f.rendered}) {
     m->utime = 1;
     m->seq = 1;
@@ -84,6 +84,13 @@ Frames make_frames(int width, int height) {
   f.labels.axis_parent = {-1, 0};
   f.labels.num_link_axes = 3;
   f.labels.link_axis = {-1, 0, 1};
+  // The arm cover (so that the protective fields run): a sphere of 0.12 m
+  // at each link box's centre (optical frame, m; fx = 200 px at 176 wide).
+  f.labels.arm_cover_max_radius_m = 0.15;
+  f.labels.num_arm_spheres = 3;
+  f.labels.arm_sphere_link = {0, 1, 2};
+  f.labels.arm_sphere_center_m = {{-0.285f, 0.36f, 1.5f}, {-0.285f, 0.06f, 1.5f}, {-0.06f, -0.015f, 1.5f}};
+  f.labels.arm_sphere_radius_m = {0.12f, 0.12f, 0.12f};
   std::mt19937 rng(1);
   std::normal_distribution<double> unit(0, 1);
   for (int16_t& d : f.camera.depth_mm) {

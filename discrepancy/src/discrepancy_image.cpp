@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "tofguard/common/demand.hpp"
+#include "tofguard/common/wire_checks.hpp"
 #include "tofguard/discrepancy/arm_distance.hpp"
 
 namespace tofguard::discrepancy {
@@ -171,7 +172,9 @@ std::string check_labels(const link_labels_t& labels) {
         << kLabelEnvironmentFirst + (num_links - num_robot_links) - 1 << ", got " << l;
     return why.str();
   }
-  return "";
+  // The arm cover indexes links and spheres by what it carries
+  // (ArmDistance).
+  return check_arm_cover(labels);
 }
 
 // What the pixel classes leave for the later stages.

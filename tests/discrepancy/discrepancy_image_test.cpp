@@ -336,6 +336,23 @@ TEST(Discrepancy, FramesThatDoNotFitAreUnusableAndSayWhy) {
   s = compute_discrepancy(camera, depth_frame(model.depth_mm, 4), bad_label, sim_parameters()).summary;
   EXPECT_FALSE(s.usable);
   EXPECT_EQ(s.unusable_reason, "label[179]: expected 0, 1..3 or 1000..1000, got 500");
+
+  // An arm cover that does not fit its own counts or links (an in-process
+  // caller that skipped the wire checks): unusable, not read out of range.
+  link_labels_t bad_cover = labels;
+  bad_cover.arm_cover_max_radius_m = 0.1;
+  bad_cover.num_arm_spheres = 2;
+  bad_cover.arm_sphere_link = {0, 7};
+  bad_cover.arm_sphere_center_m = {{0.f, 0.f, 1.f}, {0.f, 0.f, 1.f}};
+  bad_cover.arm_sphere_radius_m = {0.05f, 0.05f};
+  s = compute_discrepancy(camera, depth_frame(model.depth_mm, 4), bad_cover, sim_parameters()).summary;
+  EXPECT_FALSE(s.usable);
+  EXPECT_EQ(s.unusable_kind, discrepancy_t::UNUSABLE_MISMATCHED);
+  EXPECT_NE(s.unusable_reason.find("arm_sphere_link[1]"), std::string::npos) << s.unusable_reason;
+  bad_cover.num_arm_spheres = 3;
+  s = compute_discrepancy(camera, depth_frame(model.depth_mm, 4), bad_cover, sim_parameters()).summary;
+  EXPECT_FALSE(s.usable);
+  EXPECT_NE(s.unusable_reason.find("num_arm_spheres"), std::string::npos) << s.unusable_reason;
 }
 
 TEST(Discrepancy, ColourImageIsRedForNearerBlueForFartherBlackForMatch) {

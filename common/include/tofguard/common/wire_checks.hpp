@@ -30,6 +30,11 @@ std::string check_joint_state(const joint_state_t& state);
 // 1e-3, normalised by from_camera_pose_message).
 std::string check_camera_pose(const camera_pose_t& pose);
 std::string check_link_labels(const link_labels_t& labels);
+// link_labels_t's arm cover alone (arm_cover_max_radius_m ..
+// arm_sphere_radius_m: counts, links in range, finite centres, radii up to
+// the maximum); part of check_link_labels, and what compute_discrepancy
+// checks itself before it reads the cover.
+std::string check_arm_cover(const link_labels_t& labels);
 // level and cause must be one of risk_t's constants.
 std::string check_risk(const risk_t& risk);
 // stop and cause must be one of the constants.
