@@ -102,14 +102,20 @@ Frames make_frames(int width, int height) {
 
 void BM_ComputeDiscrepancy(benchmark::State& state) {
   const Frames f = make_frames(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
-  const tofguard::discrepancy::Parameters parameters;
+  // The third argument: evidence.max_pixels (0: every pixel).
+  tofguard::discrepancy::Parameters parameters;
+  parameters.evidence.max_pixels = static_cast<int>(state.range(2));
   for (auto _ : state) {
     auto frame = tofguard::discrepancy::compute_discrepancy(f.camera, f.rendered, f.labels, parameters);
     benchmark::DoNotOptimize(frame.summary.num_match);
   }
   state.SetItemsProcessed(state.iterations() * state.range(0) * state.range(1));
 }
-BENCHMARK(BM_ComputeDiscrepancy)->Args({176, 144})->Args({640, 480})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ComputeDiscrepancy)
+    ->Args({176, 144, 0})
+    ->Args({640, 480, 0})
+    ->Args({640, 480, 80000})
+    ->Unit(benchmark::kMicrosecond);
 
 // The naming search alone (joint_search.hpp) on the same frame: two
 // joints, their links' points.

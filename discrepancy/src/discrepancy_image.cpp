@@ -523,6 +523,7 @@ Parameters parameters_from(const DiscrepancySettings& config) {
   p.evidence.clip_sigmas = config.evidence_clip_sigmas;
   p.evidence.naming_gate_sigmas = config.evidence_naming_gate_sigmas;
   p.evidence.pixels_per_sample = config.evidence_pixels_per_sample;
+  p.evidence.max_pixels = config.evidence_max_pixels;
   p.evidence.search_range_rad = config.evidence_search_range_rad;
   p.evidence.search_step_rad = config.evidence_search_step_rad;
   p.evidence.search_range_m = config.evidence_search_range_m;

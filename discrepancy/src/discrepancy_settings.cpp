@@ -41,6 +41,8 @@ DiscrepancySettings read_discrepancy_settings(YamlMap map) {
     d.evidence_clip_sigmas = evidence.number("clip_sigmas", 0.5, 100);
     d.evidence_pixels_per_sample = evidence.number("pixels_per_sample", 1, 10000);
     d.evidence_naming_gate_sigmas = evidence.number("naming_gate_sigmas", 1, 100);
+    if (evidence.optional("max_pixels"))
+      d.evidence_max_pixels = static_cast<int>(evidence.integer("max_pixels", 1000, 100000000));
     {
       YamlMap search = evidence.map("search");
       constexpr double kRad = M_PI / 180.0;

@@ -67,39 +67,51 @@ EvidenceJacobian::EvidenceJacobian(const depth_image_t& rendered, const link_lab
 }
 
 bool EvidenceJacobian::at(int i, double camera[6], double* joints, bool* moved, int* link_out) const {
+  if (!available_ || i < 0 || i >= width_ * height_) return false;
+  return at(i % width_, i / width_, camera, joints, moved, link_out);
+}
+
+bool EvidenceJacobian::at(int u, int v, double camera[6], double* joints, bool* moved, int* link_out) const {
   if (!available_) return false;
+  const int i = v * width_ + u;
   const int z_mm = depth_[i];
   if (z_mm <= 0) return false;
   const int l = label_[i];
   const int link = link_of_label(l, kinematics_.num_robot_links, kinematics_.num_links);
   if (link < 0) return false;
-  const int u = i % width_;
-  const int v = i / width_;
   // The slope of the rendered surface, mm per pixel: central differences
   // over the neighbours on the same link and surface, one-sided with one.
   const auto qualifies = [&](int n) {
     const int d = depth_[n];
     return d > 0 && label_[n] == l && !silhouette_step(d, z_mm, jump_mm_);
   };
-  const auto slope = [&](bool has_minus, int minus, bool has_plus, int plus, double* g) {
-    const bool a = has_minus && qualifies(minus);
-    const bool b = has_plus && qualifies(plus);
+  double gu = 0;
+  {
+    const bool a = u > 0 && qualifies(i - 1);
+    const bool b = u + 1 < width_ && qualifies(i + 1);
     if (a && b) {
-      *g = 0.5 * (depth_[plus] - depth_[minus]);
+      gu = 0.5 * (depth_[i + 1] - depth_[i - 1]);
     } else if (b) {
-      *g = depth_[plus] - z_mm;
+      gu = depth_[i + 1] - z_mm;
     } else if (a) {
-      *g = z_mm - depth_[minus];
+      gu = z_mm - depth_[i - 1];
     } else {
       return false;
     }
-    return true;
-  };
-  double gu = 0;
+  }
   double gv = 0;
-  if (!slope(u > 0, i - 1, u + 1 < width_, i + 1, &gu) ||
-      !slope(v > 0, i - width_, v + 1 < height_, i + width_, &gv)) {
-    return false;
+  {
+    const bool a = v > 0 && qualifies(i - width_);
+    const bool b = v + 1 < height_ && qualifies(i + width_);
+    if (a && b) {
+      gv = 0.5 * (depth_[i + width_] - depth_[i - width_]);
+    } else if (b) {
+      gv = depth_[i + width_] - z_mm;
+    } else if (a) {
+      gv = z_mm - depth_[i - width_];
+    } else {
+      return false;
+    }
   }
   const double z = z_mm;
   const Eigen::Vector3d p((u - cx_) * z / fx_, (v - cy_) * z / fy_, z);
@@ -132,6 +144,16 @@ bool EvidenceJacobian::at(int i, double camera[6], double* joints, bool* moved, 
     camera[5] = gxp.z();
   }
   return true;
+}
+
+int evidence_stride(int width, int height, int max_pixels) {
+  if (max_pixels <= 0 || width <= 0 || height <= 0) return 1;
+  int k = 1;
+  const auto sampled = [&](int stride) {
+    return int64_t{(width + stride - 1) / stride} * int64_t{(height + stride - 1) / stride};
+  };
+  while (sampled(k) > max_pixels && k < std::max(width, height)) ++k;
+  return k;
 }
 
 void clear_evidence(discrepancy_t* s) {
@@ -246,7 +268,10 @@ void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered
   const int16_t* tof = camera.depth_mm.data();
   const int16_t* gen = rendered.depth_mm.data();
   const double model_var = parameters.model_sigma_mm * parameters.model_sigma_mm;
-  const double inv_pps = 1.0 / parameters.pixels_per_sample;
+  // Every stride-th pixel in u and v (EvidenceParameters::max_pixels), each
+  // weighted for the noise correlation left between the sampled pixels.
+  const int stride = evidence_stride(camera.width, camera.height, parameters.max_pixels);
+  const double inv_pps = 1.0 / sampled_pixels_per_sample(parameters.pixels_per_sample, stride);
   const int half_width = camera.width / 2;
   const int half_height = camera.height / 2;
   // The image in kEvidenceBands bands of rows, each summed on its own (a
@@ -259,60 +284,70 @@ void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered
     double camera_row[6];
     const int first = static_cast<int>(static_cast<int64_t>(num_pixels) * band / kEvidenceBands);
     const int last = static_cast<int>(static_cast<int64_t>(num_pixels) * (band + 1) / kEvidenceBands);
-    for (int i = first; i < last; ++i) {
-      const int t = tof[i];
-      if (t <= 0 || gen[i] <= 0 || silhouette[i]) continue;
-      bool moved = false;
-      int link = -1;
-      if (!jacobian.at(i, camera_row, joint_row.data(), &moved, &link)) continue;
-      if (!moved && have_explained && explained_static[i]) continue;
-      const double sigma_d = noise.sigma_mm(t);
-      const double var = sigma_d * sigma_d + model_var;
-      const double limit = parameters.clip_sigmas * std::sqrt(var);
-      const double raw_r = static_cast<double>(gen[i] - t);
-      const double r = std::clamp(raw_r, -limit, limit);
-      const bool in_naming_fit = std::abs(raw_r) <= parameters.naming_gate_sigmas * std::sqrt(var);
-      const double w = inv_pps / var;
-      b.link_sum_wr[link] += w * r;
-      b.link_sum_w[link] += w;
-      if (moved) {
-        ++b.robot_fit_pixels;
-        b.robot_chi2 += w * r * r;
-        for (int j = 0; j < num_joints; ++j) {
-          const double jj = joint_row[j];
-          if (jj == 0.0) continue;
-          ++b.joint_fit_pixels[j];
-          b.joint_score[j] -= w * jj * r;
-          b.joint_information[j] += w * jj * jj;
+    if (first >= last) return;
+    const int width = camera.width;
+    // The band's rows, each from the band's first pixel (first row) to its
+    // last (last row); with a sampling stride k every k-th row and column.
+    for (int v = first / width; v <= (last - 1) / width; ++v) {
+      if (v % stride != 0) continue;
+      const int row = v * width;
+      const int u_first = std::max(first - row, 0);
+      const int u_end = std::min(last - row, width);
+      for (int u = (u_first + stride - 1) / stride * stride; u < u_end; u += stride) {
+        const int i = row + u;
+        const int t = tof[i];
+        if (t <= 0 || gen[i] <= 0 || silhouette[i]) continue;
+        bool moved = false;
+        int link = -1;
+        if (!jacobian.at(u, v, camera_row, joint_row.data(), &moved, &link)) continue;
+        if (!moved && have_explained && explained_static[i]) continue;
+        const double sigma_d = noise.sigma_mm(t);
+        const double var = sigma_d * sigma_d + model_var;
+        const double limit = parameters.clip_sigmas * std::sqrt(var);
+        const double raw_r = static_cast<double>(gen[i] - t);
+        const double r = std::clamp(raw_r, -limit, limit);
+        const bool in_naming_fit = std::abs(raw_r) <= parameters.naming_gate_sigmas * std::sqrt(var);
+        const double w = inv_pps / var;
+        b.link_sum_wr[link] += w * r;
+        b.link_sum_w[link] += w;
+        if (moved) {
+          ++b.robot_fit_pixels;
+          b.robot_chi2 += w * r * r;
+          for (int j = 0; j < num_joints; ++j) {
+            const double jj = joint_row[j];
+            if (jj == 0.0) continue;
+            ++b.joint_fit_pixels[j];
+            b.joint_score[j] -= w * jj * r;
+            b.joint_information[j] += w * jj * jj;
+            if (!in_naming_fit) continue;
+            b.joint_naming_score[j] -= w * jj * r;
+            b.joint_naming_information[j] += w * jj * jj;
+          }
+        } else {
+          b.static_chi2 += w * r * r;
+          // A static pixel beyond the gate is outside the camera's linear model
+          // as the naming fit's are outside the joints': a pose off by the
+          // test's delta (2 cm, 1 degree) moves smooth static surfaces by a few
+          // sigma, while an object in front of them (a person walking past
+          // the wall) differs by tens of centimetres. Its clipped residual
+          // would say only that something is there, and the protective fields
+          // judge that; in the camera fit it would pull the pose.
           if (!in_naming_fit) continue;
-          b.joint_naming_score[j] -= w * jj * r;
-          b.joint_naming_information[j] += w * jj * jj;
-        }
-      } else {
-        b.static_chi2 += w * r * r;
-        // A static pixel beyond the gate is outside the camera's linear model
-        // as the naming fit's are outside the joints': a pose off by the
-        // test's delta (2 cm, 1 degree) moves smooth static surfaces by a few
-        // sigma, while an object in front of them (a person walking past
-        // the wall) differs by tens of centimetres. Its clipped residual
-        // would say only that something is there, and the protective fields
-        // judge that; in the camera fit it would pull the pose.
-        if (!in_naming_fit) continue;
-        ++b.camera_fit_pixels;
-        // The image quadrant (discrepancy_t.camera_region_*).
-        const int region =
-            (i % camera.width >= half_width ? 1 : 0) + (i / camera.width >= half_height ? 2 : 0);
-        ++b.camera_region_fit_pixels[region];
-        double* region_score = b.camera_region_score + 6 * region;
-        double* region_information = b.camera_region_information + 6 * region;
-        // The upper triangle by hand: Eigen's rankUpdate on a 6x6
-        // selfadjoint view costs more than the rest of the pixel.
-        for (int a = 0; a < 6; ++a) {
-          const double wj = w * camera_row[a];
-          b.camera_score[a] -= wj * r;
-          region_score[a] -= wj * r;
-          region_information[a] += wj * camera_row[a];
-          for (int c = a; c < 6; ++c) b.camera_information(a, c) += wj * camera_row[c];
+          ++b.camera_fit_pixels;
+          // The image quadrant (discrepancy_t.camera_region_*).
+          const int region = (u >= half_width ? 1 : 0) + (v >= half_height ? 2 : 0);
+          ++b.camera_region_fit_pixels[region];
+          double* region_score = b.camera_region_score + 6 * region;
+          double* region_information = b.camera_region_information + 6 * region;
+          // The upper triangle by hand: Eigen's rankUpdate on a 6x6
+          // selfadjoint view costs more than the rest of the pixel.
+          for (int a = 0; a < 6; ++a) {
+            const double wj = w * camera_row[a];
+            b.camera_score[a] -= wj * r;
+            region_score[a] -= wj * r;
+            region_information[a] += wj * camera_row[a];
+            for (int c = a; c < 6; ++c) b.camera_information(a, c) += wj * camera_row[c];
+          }
         }
       }
     }

@@ -320,6 +320,127 @@ TEST_F(EvidenceTest, TheSummaryDoesNotDependOnTheWorkerThreads) {
   }
 }
 
+// The sampling stride (EvidenceParameters::max_pixels) and the weight the
+// sampled pixels keep.
+TEST(EvidenceSampling, TheStrideIsTheSmallestThatKeepsToMaxPixels) {
+  EXPECT_EQ(evidence_stride(176, 144, 0), 1);
+  EXPECT_EQ(evidence_stride(176, 144, 80000), 1);
+  EXPECT_EQ(evidence_stride(320, 240, 80000), 1);  // 76 800 pixels
+  EXPECT_EQ(evidence_stride(640, 480, 80000), 2);  // 320 x 240 sampled
+  EXPECT_EQ(evidence_stride(528, 432, 80000), 2);
+  EXPECT_EQ(evidence_stride(1280, 960, 80000), 4);
+  EXPECT_EQ(evidence_stride(641, 481, 76800), 3);  // ceil(641/2) * ceil(481/2) = 321 * 241 > 76 800
+  // Independent noise: sampling leaves the weight as it was. A 3x3
+  // filter's footprint (9 pixels): samples 2 apart share 9/4 of it, 3 apart
+  // none.
+  EXPECT_DOUBLE_EQ(sampled_pixels_per_sample(1, 2), 1.0);
+  EXPECT_DOUBLE_EQ(sampled_pixels_per_sample(9, 1), 9.0);
+  EXPECT_DOUBLE_EQ(sampled_pixels_per_sample(9, 2), 2.25);
+  EXPECT_DOUBLE_EQ(sampled_pixels_per_sample(9, 3), 1.0);
+}
+
+// A frame three times the sim camera's size (528x432, 228 096 pixels),
+// sampled with max_pixels 80 000 (every second pixel in u and v), against
+// the same frames summed over every pixel:
+// - a quarter of the pixels and of the information;
+// - under no fault the joints' scores in units of their own standard
+//   deviation (z = score / sqrt(information)) vary from frame to frame as
+//   the full frame's do, about 1 (measured 0.99 every pixel, 1.03 every
+//   2nd): the sampled pixels keep their weights, so the risk's thresholds
+//   keep their false-stop rate (weighting them by k^2 = 4 would make it
+//   about 4 and fail this); the mean z^2, with the scene's fixed part, is
+//   no larger (2.6 every pixel, 1.4 every 2nd);
+// - an encoder offset of 10 degrees is still named and sized by the search,
+//   and its score stands far above the noise.
+TEST_F(EvidenceTest, ASampledLargeFrameKeepsTheFalseStopRateAndFindsAnOffset) {
+  const Intrinsics small = config_->camera.intrinsics;
+  const Intrinsics in{3 * small.width, 3 * small.height, 3 * small.fx,
+                      3 * small.fy,    3 * small.cx + 1, 3 * small.cy + 1};
+  Parameters full = parameters(*config_);
+  full.evidence.max_pixels = 0;
+  Parameters sampled = full;
+  sampled.evidence.max_pixels = 80000;
+  ASSERT_EQ(evidence_stride(in.width, in.height, sampled.evidence.max_pixels), 2);
+  ASSERT_GT(frames_->scene().actuated_joint_names.size(), 3u);
+  const JointPositions truth = estimator::test::side_reach_pose();
+  const Frame model = render_frame(&frames_->renderer(), frames_->scene(), truth, camera(), in);
+  // Per joint, its z over the frames (every pixel, every 2nd pixel).
+  std::vector<std::vector<double>> z_full(model.labels.num_joints);
+  std::vector<std::vector<double>> z_sampled(model.labels.num_joints);
+  for (uint64_t index = 200; index < 212; ++index) {
+    const depth_image_t cam =
+        make_depth_image("cam", in, 1, 1, true, frames_->capture(truth, camera(), in, index));
+    const discrepancy_t f = compute_discrepancy(cam, model.depth, model.labels, full).summary;
+    const discrepancy_t s = compute_discrepancy(cam, model.depth, model.labels, sampled).summary;
+    ASSERT_TRUE(f.evidence_available && s.evidence_available);
+    const double pixel_ratio = static_cast<double>(f.camera_fit_pixels) / s.camera_fit_pixels;
+    EXPECT_NEAR(pixel_ratio, 4.0, 0.4) << index;
+    for (int j = 0; j < f.num_joints; ++j) {
+      if (!(f.joint_information[j] > 0) || !(s.joint_information[j] > 0)) continue;
+      EXPECT_NEAR(f.joint_information[j] / s.joint_information[j], 4.0, 0.8) << f.joint_name[j];
+      z_full[j].push_back(f.joint_score[j] / std::sqrt(f.joint_information[j]));
+      z_sampled[j].push_back(s.joint_score[j] / std::sqrt(s.joint_information[j]));
+    }
+  }
+  // Pooled over the joints: the frame-to-frame variance of z (the noise:
+  // what the risk's thresholds are derived from, docs/safety-chain.md
+  // "Sequential evidence") and the mean of z^2 (noise and the scene's
+  // fixed part).
+  const auto spread = [](const std::vector<std::vector<double>>& z, double* mean_z2) {
+    double sum_var = 0;
+    double sum_z2 = 0;
+    int n = 0;
+    int joints = 0;
+    for (const std::vector<double>& zj : z) {
+      if (zj.size() < 2) continue;
+      double mean = 0;
+      for (double v : zj) mean += v / zj.size();
+      double var = 0;
+      for (double v : zj) {
+        var += (v - mean) * (v - mean) / (zj.size() - 1);
+        sum_z2 += v * v;
+        ++n;
+      }
+      sum_var += var;
+      ++joints;
+    }
+    *mean_z2 = n > 0 ? sum_z2 / n : 0;
+    return joints > 0 ? sum_var / joints : 0;
+  };
+  double z2_full = 0;
+  double z2_sampled = 0;
+  const double var_full = spread(z_full, &z2_full);
+  const double var_sampled = spread(z_sampled, &z2_sampled);
+  std::cout << "528x432, no fault, joint z over 12 frames: frame-to-frame variance every pixel " << var_full
+            << ", every 2nd pixel " << var_sampled << "; mean z^2 " << z2_full << ", " << z2_sampled << "\n";
+  EXPECT_GT(var_sampled, 0.3);
+  EXPECT_LT(var_sampled, 2.0);
+  EXPECT_LT(var_sampled, 1.5 * var_full + 0.1);
+  EXPECT_LT(z2_sampled, 1.5 * z2_full + 0.1);
+
+  const std::string joint = frames_->scene().actuated_joint_names[1];
+  JointPositions reported = truth;
+  reported[joint] += 10 * kDeg;
+  const Frame offset_model = render_frame(&frames_->renderer(), frames_->scene(), reported, camera(), in);
+  const depth_image_t cam =
+      make_depth_image("cam", in, 1, 1, true, frames_->capture(truth, camera(), in, 300));
+  const discrepancy_t s = compute_discrepancy(cam, offset_model.depth, offset_model.labels, sampled).summary;
+  ASSERT_TRUE(s.evidence_available);
+  int best = 0;
+  int own = -1;
+  for (int j = 0; j < s.num_joints; ++j) {
+    if (s.joint_search_gain[j] > s.joint_search_gain[best]) best = j;
+    if (s.joint_name[j] == joint) own = j;
+  }
+  ASSERT_GE(own, 0);
+  EXPECT_EQ(s.joint_name[best], joint);
+  EXPECT_NEAR(s.joint_search_offset[own] / kDeg, -10.0, 1.0);
+  const double z_own = std::abs(s.joint_score[own]) / std::sqrt(s.joint_information[own]);
+  std::cout << "528x432, " << joint << " 10 deg off, every 2nd pixel: |z| " << z_own << ", search gain "
+            << s.joint_search_gain[own] << "\n";
+  EXPECT_GT(z_own, 10.0);
+}
+
 TEST_F(EvidenceTest, AnEncoderOffsetIsBestExplainedByItsOwnJoint) {
   const JointPositions truth = estimator::test::side_reach_pose();
   uint64_t index = 10;

@@ -64,6 +64,11 @@ struct DiscrepancySettings {
   // evidence.naming_gate_sigmas: the naming fit's gate in sigmas (the
   // suspect joint is named from the pixels within it).
   double evidence_naming_gate_sigmas = 0;
+  // evidence.max_pixels (optional; absent: 0, every pixel): at most this
+  // many pixels in the evidence sums, every k-th in u and v above it
+  // (EvidenceParameters::max_pixels: less information, the same false-stop
+  // rate).
+  int evidence_max_pixels = 0;
   // evidence.search.{range_deg, step_deg, range_mm, step_mm, max_points}:
   // the naming search (joint_search.hpp): trial offsets of each revolute
   // joint within +-range_deg in steps of step_deg (prismatic: range_mm,

@@ -20,6 +20,7 @@
 //
 // Pure computation: no LCM, no clocks; one pass over the pixels, nothing
 // allocated per pixel.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -46,6 +47,14 @@ struct EvidenceParameters {
   // camera with spatial filtering: its filter's footprint): w_i =
   // 1 / (pixels_per_sample * sigma_i^2).
   double pixels_per_sample = 1.0;
+  // At most this many pixels enter the evidence sums: above it every k-th
+  // pixel in u and v, k the smallest that keeps to it (evidence_stride);
+  // 0: every pixel. The sampled pixels keep their own weight (see
+  // evidence_pixels_per_sample), so the scores stay N(0, information)
+  // under no fault and the risk's thresholds hold unchanged: a sampled
+  // frame has less information (detection power) than the full one, never
+  // a higher false-stop rate.
+  int max_pixels = 0;
   // The naming fit (discrepancy_t.joint_naming_*) takes the robot's pixels
   // whose residual is within naming_gate_sigmas * sigma_i.
   double naming_gate_sigmas = 6.0;
@@ -74,6 +83,21 @@ struct DepthNoise {
     return sigma_at_0m_mm + sigma_per_m2_mm * d_m * d_m;
   }
 };
+
+// compute_evidence's sampling stride k >= 1 for a width x height frame: the
+// smallest k with ceil(width / k) * ceil(height / k) <= max_pixels (1 when
+// max_pixels <= 0).
+int evidence_stride(int width, int height, int max_pixels);
+
+// The pixels per independent noise sample among the pixels of a stride-k
+// grid: a camera whose noise is correlated over `pixels_per_sample` pixels
+// (a filter's footprint) has samples k pixels apart correlated over
+// pixels_per_sample / k^2 of them, and never fewer than 1 (independent).
+// Weights are 1 / (this * sigma_i^2): with independent noise (1) sampling
+// leaves each pixel's weight as it was.
+inline double sampled_pixels_per_sample(double pixels_per_sample, int stride) {
+  return std::max(1.0, pixels_per_sample / (static_cast<double>(stride) * stride));
+}
 
 // One moving axis of link_labels_t's kinematics (optical frame, mm).
 struct LabelAxis {
@@ -136,6 +160,9 @@ class EvidenceJacobian {
   // written) when the pixel takes no part: no rendered depth, no link, or
   // no slope (no qualifying neighbour in u or in v).
   bool at(int i, double camera[6], double* joints, bool* moved, int* link) const;
+  // The same for the pixel in column u, row v (i = v * width + u; both in
+  // range): compute_evidence's loop, which knows them.
+  bool at(int u, int v, double camera[6], double* joints, bool* moved, int* link) const;
 
  private:
   bool available_ = false;
