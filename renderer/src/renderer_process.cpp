@@ -1,4 +1,5 @@
 #include "tofguard/renderer/renderer_process.hpp"
+#include "tofguard/renderer/llvmpipe_threads.hpp"
 #include "tofguard/renderer/rendered_kinematics.hpp"
 
 #include <algorithm>
@@ -227,6 +228,8 @@ int run_renderer(const RendererProcessSettings& settings) {
   if (!keep_heap_resident())
     std::fprintf(stderr, "tofguard-renderer: warning: mallopt refused keep_heap_resident's settings\n");
   const std::string name = process_info().name;
+  // Before the service opens its EGL display (llvmpipe reads it then).
+  std::cerr << name << ": " << choose_llvmpipe_threads(settings.camera.intrinsics) << "\n";
   std::unique_ptr<RendererService> service;
   try {
     service = std::make_unique<RendererService>(settings);
