@@ -511,9 +511,9 @@ class BenchChain {
   }
 
   // Publishes `frames` frames at path.rate_hz on the monotonic clock: before
-  // frame k the joint states since the last frame (every 10 ms) and one at
-  // the frame's own utime, so that the renderer interpolates, never
-  // extrapolates (docs/renderer.md). `first_k`: the first frame's index on
+  // frame k the joint states since the last frame (every 10 ms) and, 1 ms
+  // before the frame, one at the frame's own utime, so that the renderer
+  // interpolates, never extrapolates (docs/renderer.md). `first_k`: the first frame's index on
   // the path (the warm-up goes on along it one frame per call).
   void publish(const ArmPath& path, int64_t first_k, int64_t frames) {
     const int64_t period_us = std::llround(1e6 / path.rate_hz);
@@ -535,10 +535,19 @@ class BenchChain {
           safety_->publish(config_.channels.joint_state, &s);
         }
       }
-      at(frame_us);
+      // The frame's own joint state 1 ms before the frame: JOINT_STATE
+      // (safety URL) and TOF_DEPTH (image URL) arrive on separate sockets,
+      // and a frame that came first would be rendered at joints
+      // extrapolated from the states before it. In the warm-up (one frame a
+      // call, no states in between, the path a period ahead per frame
+      // whatever the clock) that extrapolation was off by degrees: an
+      // encoder error the risk's sequential test then carried into the
+      // measured step's first frames (270-290 SAFE of 300 in some runs).
+      at(frame_us - 1000);
       const int64_t utime = start_utime + frame_us;
       const joint_state_t s = joint_state(path, (first_k * period_us + frame_us) * 1e-6, utime);
       safety_->publish(config_.channels.joint_state, &s);
+      at(frame_us);
       std::vector<uint8_t>& bytes = encoded_[static_cast<size_t>(path.index(first_k + k))];
       put_int64_be(bytes.data() + kUtimeOffset, utime);
       put_int64_be(bytes.data() + kSeqOffset, next_seq_);
