@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <iostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "estimator_test_support.hpp"
@@ -148,6 +149,18 @@ void expect_joint_jacobians_match(const robot_model::SceneModel& scene, const Jo
     ++checked;
   }
   EXPECT_GE(checked, 3) << arm;
+}
+
+// The joint whose naming search gained most, and `joint`'s own index (-1
+// when the summary has no such joint).
+std::pair<int, int> searched_best_and_own(const discrepancy_t& s, const std::string& joint) {
+  int best = 0;
+  int own = -1;
+  for (int j = 0; j < s.num_joints; ++j) {
+    if (s.joint_search_gain[j] > s.joint_search_gain[best]) best = j;
+    if (s.joint_name[j] == joint) own = j;
+  }
+  return {best, own};
 }
 
 class EvidenceTest : public ::testing::Test {
@@ -426,12 +439,7 @@ TEST_F(EvidenceTest, ASampledLargeFrameKeepsTheFalseStopRateAndFindsAnOffset) {
       make_depth_image("cam", in, 1, 1, true, frames_->capture(truth, camera(), in, 300));
   const discrepancy_t s = compute_discrepancy(cam, offset_model.depth, offset_model.labels, sampled).summary;
   ASSERT_TRUE(s.evidence_available);
-  int best = 0;
-  int own = -1;
-  for (int j = 0; j < s.num_joints; ++j) {
-    if (s.joint_search_gain[j] > s.joint_search_gain[best]) best = j;
-    if (s.joint_name[j] == joint) own = j;
-  }
+  const auto [best, own] = searched_best_and_own(s, joint);
   ASSERT_GE(own, 0);
   EXPECT_EQ(s.joint_name[best], joint);
   EXPECT_NEAR(s.joint_search_offset[own] / kDeg, -10.0, 1.0);
@@ -495,12 +503,7 @@ TEST_F(EvidenceTest, TheNamingSearchNamesAndSizesAnEncoderOffset) {
       ASSERT_EQ(s.joint_search_gain.size(), static_cast<size_t>(s.num_joints));
       EXPECT_GT(s.search_points, 100);
       EXPECT_LE(s.search_points, parameters(*config_).evidence.search_max_points);
-      int best = 0;
-      int own = -1;
-      for (int j = 0; j < s.num_joints; ++j) {
-        if (s.joint_search_gain[j] > s.joint_search_gain[best]) best = j;
-        if (s.joint_name[j] == joint) own = j;
-      }
+      const auto [best, own] = searched_best_and_own(s, joint);
       ASSERT_GE(own, 0);
       const double found_deg = s.joint_search_offset[own] / kDeg;
       std::cout << joint << " " << offset_deg << " deg: best " << s.joint_name[best] << " (gain "
