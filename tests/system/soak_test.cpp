@@ -6,7 +6,8 @@
 //
 // Here (ctest): 2 minutes, asserting zero false stops, RSS growth of each
 // process from the first sample after warm-up to the last below
-// kRssGrowthBoundKb, and no fd growth. scripts/soak runs the same for 30
+// kRssGrowthBoundKb and no steady RSS growth (below), and no fd growth.
+// scripts/soak runs the same for 30
 // minutes (environment: TOFGUARD_SOAK_S, TOFGUARD_SOAK_SAMPLE_S,
 // TOFGUARD_SOAK_OUT) and keeps the Markdown table and the CSV.
 #include <gtest/gtest.h>
@@ -25,12 +26,20 @@
 namespace tofguard::test {
 namespace {
 
-// Each process may grow by at most 2 MiB between the first sample after
-// warm-up and the last: a leak of one small allocation per frame (100 B at
-// 30 Hz) would grow 300 kB a minute and one per message of the 100 Hz joint
-// state more; allocator caches and lazily touched pages settle during the
-// warm-up.
-constexpr int64_t kRssGrowthBoundKb = 2048;
+// Two bounds on each process's RSS after the warm-up (allocator caches and
+// lazily touched pages settle during it):
+// - A leak grows steadily: one small allocation per frame (100 B at 30 Hz)
+//   is 15 kB per 5-s sample, a new highest RSS at nearly every sample. So a
+//   new highest RSS may come at most at half of the samples after warm-up.
+// - One-off growth, such as a heap that keeps its freed memory
+//   (keep_heap_resident in tofguard-renderer and -discrepancy: RSS is the
+//   heap's high-water mark) reaching a new mark when a rarer event first
+//   happens, or llvmpipe compiling a shader variant: at most 4 MiB in all.
+//   Measured: tofguard-renderer +0.8-1.0 MB at about 50 s in 3 of 3 runs
+//   (llvmpipe on 0 or 2 threads), flat before and after; once a second
+//   step at 115 s, 2056 kB in all, over the 2 MiB this bound was before.
+//   The most new highs of any process in those runs: 6 of 18 samples.
+constexpr int64_t kRssGrowthBoundKb = 4096;
 
 double env_seconds(const char* name, double fallback) {
   const char* v = std::getenv(name);
@@ -60,6 +69,10 @@ TEST(Soak, NominalRunHasNoFalseStopsAndNoResourceGrowth) {
   };
   std::vector<Row> rows;
   std::map<std::string, ProcSample> first_after_warmup, last;
+  // Per process, after warm-up: samples taken, and how many set a new
+  // highest RSS.
+  std::map<std::string, int> samples_after_warmup, rss_highs;
+  std::map<std::string, int64_t> highest_rss_kb;
   std::map<std::string, double> cpu_at_warmup;
   double warmup_t = -1;
   const int64_t start_us = monotonic_us();
@@ -87,7 +100,14 @@ TEST(Soak, NominalRunHasNoFalseStopsAndNoResourceGrowth) {
                 << s.rss_kb << "," << s.fds << "," << std::setprecision(2) << s.cpu_s << "\n";
             if (t >= warmup_s && !first_after_warmup.count(n)) {
               first_after_warmup[n] = s;
+              highest_rss_kb[n] = s.rss_kb;
               warmup_t = t;
+            } else if (first_after_warmup.count(n)) {
+              ++samples_after_warmup[n];
+              if (s.rss_kb > highest_rss_kb[n]) {
+                ++rss_highs[n];
+                highest_rss_kb[n] = s.rss_kb;
+              }
             }
             last[n] = s;
           }
@@ -107,16 +127,16 @@ TEST(Soak, NominalRunHasNoFalseStopsAndNoResourceGrowth) {
      << " s of warm-up, at " << warmup_t << " s, to the last).\n\n"
      << "- false stops: " << false_stops << "\n"
      << "- frame verdicts: " << verdicts << " (" << std::setprecision(1) << verdicts / run_s << " /s)\n\n"
-     << "| process | RSS after warm-up (kB) | RSS last (kB) | RSS growth (kB) | fds after warm-up | fds last "
-        "| CPU "
-        "(% of a core, after warm-up) |\n"
-     << "| --- | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+     << "| process | RSS after warm-up (kB) | RSS last (kB) | RSS growth (kB) | new RSS highs (of samples) "
+        "| fds after warm-up | fds last | CPU (% of a core, after warm-up) |\n"
+     << "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
   for (const std::string& n : chain_process_names()) {
     const ProcSample& a = first_after_warmup[n];
     const ProcSample& b = last[n];
     const double cpu = (b.cpu_s - a.cpu_s) / std::max(1e-9, run_s - warmup_t) * 100;
     md << "| " << n << " | " << a.rss_kb << " | " << b.rss_kb << " | " << b.rss_kb - a.rss_kb << " | "
-       << a.fds << " | " << b.fds << " | " << std::setprecision(1) << cpu << " |\n";
+       << rss_highs[n] << " of " << samples_after_warmup[n] << " | " << a.fds << " | " << b.fds << " | "
+       << std::setprecision(1) << cpu << " |\n";
   }
   for (const std::string& r : stop_reasons) md << "\nfalse stop at " << r << "\n";
   std::ofstream(out_dir + "/soak.md") << md.str();
@@ -128,6 +148,9 @@ TEST(Soak, NominalRunHasNoFalseStopsAndNoResourceGrowth) {
   for (const std::string& n : chain_process_names()) {
     EXPECT_TRUE(last[n].alive) << n;
     EXPECT_LE(last[n].rss_kb - first_after_warmup[n].rss_kb, kRssGrowthBoundKb) << n;
+    EXPECT_GE(samples_after_warmup[n], 4) << n;
+    EXPECT_LE(2 * rss_highs[n], samples_after_warmup[n])
+        << n << ": a new highest RSS at " << rss_highs[n] << " of " << samples_after_warmup[n] << " samples";
     EXPECT_LE(last[n].fds, first_after_warmup[n].fds) << n;
   }
 }
