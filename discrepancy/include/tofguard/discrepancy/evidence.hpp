@@ -50,7 +50,7 @@ struct EvidenceParameters {
   // At most this many pixels enter the evidence sums: above it every k-th
   // pixel in u and v, k the smallest that keeps to it (evidence_stride);
   // 0: every pixel. The sampled pixels keep their own weight (see
-  // evidence_pixels_per_sample), so the scores stay N(0, information)
+  // sampled_pixels_per_sample), so the scores stay N(0, information)
   // under no fault and the risk's thresholds hold unchanged: a sampled
   // frame has less information (detection power) than the full one, never
   // a higher false-stop rate.

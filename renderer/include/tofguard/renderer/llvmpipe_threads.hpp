@@ -6,8 +6,8 @@
 // thread), and every frame is handed to the threads and collected back.
 // On a small frame the hand-over costs more than the threads save, and the
 // threads compete with tofguard-discrepancy's for the same cores; on a
-// large one they shorten the render (docs/benchmarks.md, "llvmpipe's
-// threads"). A GPU driver ignores the variable.
+// large one they shorten the render (docs/benchmarks.md, "Sampling the evidence, and
+// llvmpipe's threads"). A GPU driver ignores the variable.
 #include <cstdint>
 #include <string>
 
@@ -17,7 +17,8 @@ namespace tofguard::renderer {
 
 // Frames of at most this many pixels (half of 320x240) are rasterised in
 // the calling thread. Measured with tofguard-bench on the 2-core VM
-// (docs/benchmarks.md, "llvmpipe's threads"): at 176x144 (25 344 pixels)
+// (docs/benchmarks.md, "Sampling the evidence, and llvmpipe's threads"):
+// at 176x144 (25 344 pixels)
 // the calling thread takes the chain's end-to-end p99 from 15.4 to 8.9 ms
 // with the same render floor; at 320x240 the chain is the same either way
 // and the threads shorten the Kinova Gen3's render floor (10.7 against
