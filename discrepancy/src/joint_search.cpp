@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -223,54 +224,110 @@ void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rend
     return motion;
   };
 
-  // One joint's search: writes only joint j's offset and gain.
-  const auto search_joint = [&](int j) {
+  // Each joint's search: the coarse trials (every `coarse_every`-th point
+  // of each link the joint moves, about kCoarsePoints of the joint's points
+  // in all: they only pick the basin) over +-range in steps, then every
+  // point at no offset and, when a trial beat no offset, at the best trial
+  // and a quarter and a half step either side of it. The trials of all
+  // joints are one list of tasks (WorkerPool), each writing its own cost:
+  // a base joint's trials move every robot point and a wrist's a few, so
+  // tasks per joint left one thread with most of the work. The choices
+  // below read the costs in a fixed order, so nothing depends on the
+  // threads.
+  struct JointTrials {
+    std::vector<MovedLink> moved;
+    size_t coarse_every = 1;
+    double step = 0;
+    int steps = 0;
+    size_t first_coarse = 0;  // index of its first coarse cost (offset 0)
+    size_t first_fine = 0;    // index of its first fine cost (none, then kFine)
+  };
+  // The fine trials about the coarse trials' best, in steps.
+  static constexpr double kFine[] = {0.0, -0.5, -0.25, 0.25, 0.5};
+  struct Trial {
+    int joint;
+    double offset;
+    size_t every;
+  };
+  std::vector<JointTrials> trials_of(k.num_joints);
+  std::vector<Trial> coarse;
+  for (int j = 0; j < k.num_joints; ++j) {
+    JointTrials& t = trials_of[j];
     bool prismatic = false;
-    const std::vector<MovedLink> moved = moved_links(j, &prismatic);
-    if (moved.empty()) return;
-    // The coarse trials take every `coarse_every`-th point of each link
-    // (about kCoarsePoints of the joint's points in all): they only pick the
-    // basin; the gain and the refinement use every point.
+    t.moved = moved_links(j, &prismatic);
+    if (t.moved.empty()) continue;
     size_t moved_points = 0;
-    for (const MovedLink& m : moved) moved_points += m.points->size();
-    const size_t coarse_every = std::max<size_t>(1, moved_points / kCoarsePoints);
-    const auto total_cost = [&](double offset, size_t every) {
-      double sum = 0;
-      for (const MovedLink& m : moved) sum += cost(*m.points, motion_of(m, offset), every);
-      return sum;
-    };
+    for (const MovedLink& m : t.moved) moved_points += m.points->size();
+    t.coarse_every = std::max<size_t>(1, moved_points / kCoarsePoints);
     const double range = prismatic ? parameters.search_range_m : parameters.search_range_rad;
-    const double step = prismatic ? parameters.search_step_m : parameters.search_step_rad;
-    const int steps = static_cast<int>(std::floor(range / step + 1e-9));
-    double coarse_best = total_cost(0.0, coarse_every);
+    t.step = prismatic ? parameters.search_step_m : parameters.search_step_rad;
+    t.steps = static_cast<int>(std::floor(range / t.step + 1e-9));
+    t.first_coarse = coarse.size();
+    coarse.push_back(Trial{j, 0.0, t.coarse_every});
+    for (int g = -t.steps; g <= t.steps; ++g) {
+      if (g != 0) coarse.push_back(Trial{j, g * t.step, t.coarse_every});
+    }
+  }
+  const auto run_trials = [&](const std::vector<Trial>& trials, std::vector<double>* costs) {
+    costs->assign(trials.size(), 0.0);
+    const auto one = [&](int n) {
+      const Trial& trial = trials[static_cast<size_t>(n)];
+      double sum = 0;
+      for (const MovedLink& m : trials_of[trial.joint].moved)
+        sum += cost(*m.points, motion_of(m, trial.offset), trial.every);
+      (*costs)[static_cast<size_t>(n)] = sum;
+    };
+    if (workers != nullptr) {
+      workers->run(static_cast<int>(trials.size()), one);
+    } else {
+      for (size_t n = 0; n < trials.size(); ++n) one(static_cast<int>(n));
+    }
+  };
+  std::vector<double> coarse_cost;
+  run_trials(coarse, &coarse_cost);
+  // Per joint, the coarse trials' best (0: none beat no offset), then
+  // the fine trials.
+  std::vector<double> centre_of(k.num_joints, 0.0);
+  std::vector<Trial> fine;
+  for (int j = 0; j < k.num_joints; ++j) {
+    JointTrials& t = trials_of[j];
+    if (t.moved.empty()) continue;
+    size_t n = t.first_coarse;
+    double coarse_best = coarse_cost[n++];
     double centre = 0;
-    for (int g = -steps; g <= steps; ++g) {
+    for (int g = -t.steps; g <= t.steps; ++g) {
       if (g == 0) continue;
-      const double c = total_cost(g * step, coarse_every);
+      const double c = coarse_cost[n++];
       if (c < coarse_best) {
         coarse_best = c;
-        centre = g * step;
+        centre = g * t.step;
       }
     }
-    const double none = total_cost(0.0, 1);
+    centre_of[j] = centre;
+    t.first_fine = fine.size();
+    fine.push_back(Trial{j, 0.0, 1});
+    if (centre == 0) continue;
+    for (double f : kFine) fine.push_back(Trial{j, centre + f * t.step, 1});
+  }
+  std::vector<double> fine_cost;
+  run_trials(fine, &fine_cost);
+  for (int j = 0; j < k.num_joints; ++j) {
+    const JointTrials& t = trials_of[j];
+    if (t.moved.empty()) continue;
+    const double none = fine_cost[t.first_fine];
     double best = none;
     double best_offset = 0;
-    if (centre != 0) {
-      for (double f : {0.0, -0.5, -0.25, 0.25, 0.5}) {
-        const double c = total_cost(centre + f * step, 1);
+    if (centre_of[j] != 0) {
+      for (size_t f = 0; f < std::size(kFine); ++f) {
+        const double c = fine_cost[t.first_fine + 1 + f];
         if (c < best) {
           best = c;
-          best_offset = centre + f * step;
+          best_offset = centre_of[j] + kFine[f] * t.step;
         }
       }
     }
     s.joint_search_offset[j] = best_offset;
     s.joint_search_gain[j] = std::max(0.0, none - best);
-  };
-  if (workers != nullptr) {
-    workers->run(k.num_joints, search_joint);
-  } else {
-    for (int j = 0; j < k.num_joints; ++j) search_joint(j);
   }
 
   // The static pixels the best joint's offset explains: where its moved
@@ -284,10 +341,8 @@ void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rend
       best_joint = j;
   }
   if (best_joint < 0) return;
-  bool prismatic = false;
-  const std::vector<MovedLink> moved = moved_links(best_joint, &prismatic);
   const auto is_static = [&](int i) { return moved_link(static_cast<size_t>(i)) < 0; };
-  for (const MovedLink& m : moved) {
+  for (const MovedLink& m : trials_of[best_joint].moved) {
     cost.mark_matches(*m.points, motion_of(m, s.joint_search_offset[best_joint]), stride, is_static,
                       explained_static);
   }

@@ -40,10 +40,11 @@ namespace tofguard::discrepancy {
 // search sees it, explains (the camera fit leaves it out). All 0 when no
 // joint's offset helps; empty when the search could not run.
 //
-// workers (optional): each joint's search is one task (WorkerPool); they
-// share nothing but read-only inputs, and each writes its own joint's
-// entries, so the result does not depend on the threads. nullptr: all on
-// the caller's thread.
+// workers (optional): each trial offset of each joint is one task
+// (WorkerPool); they share nothing but read-only inputs, each writes its
+// own cost, and the offsets are chosen from the costs in a fixed order, so
+// the result does not depend on the threads. nullptr: all on the caller's
+// thread.
 void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rendered,
                           const link_labels_t& labels, const LabelKinematics& kinematics,
                           const DepthNoise& noise, const EvidenceParameters& parameters,
