@@ -592,37 +592,43 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
   s.link_invalid.assign(num_links, 0);
   s.link_median_dis_mm.assign(num_links, 0.0f);
 
-  // The images first, then the per-frame scratch, in this order: it keeps
-  // the heap's layout (and its page faults) as they were when this was one
-  // function.
-  frame.pixel_class.create(camera.height, camera.width);
-  frame.dis_mm.create(camera.height, camera.width);
-  PixelClasses classes(camera.height, camera.width);
   const std::vector<uint8_t> silhouette = silhouette_mask(rendered, parameters.silhouette_jump_mm);
-  classify_pixels(camera, rendered, labels, silhouette, parameters.tolerance, &frame, &classes);
+  // Stages 3 to 6 need nothing from the evidence, nor it from them (they
+  // write other fields of the summary): they run as one more task beside
+  // the naming search's trials (SideTask), so that a thread the trials
+  // leave free does them. The histograms stay until the frame is done
+  // (DisHistograms).
+  DisHistograms histograms;
+  SideTask pixel_stages([&] {
+    frame.pixel_class.create(camera.height, camera.width);
+    frame.dis_mm.create(camera.height, camera.width);
+    PixelClasses classes(camera.height, camera.width);
+    classify_pixels(camera, rendered, labels, silhouette, parameters.tolerance, &frame, &classes);
 
-  // The seed's score and the class counts.
-  s.num_match = classes.count[discrepancy_t::PIXEL_MATCH];
-  s.num_robot_missing = classes.count[discrepancy_t::PIXEL_ROBOT_MISSING];
-  s.num_occluded = classes.count[discrepancy_t::PIXEL_OCCLUDED];
-  s.num_unexpected_surface = classes.count[discrepancy_t::PIXEL_UNEXPECTED_SURFACE];
-  s.num_environment_missing = classes.count[discrepancy_t::PIXEL_ENVIRONMENT_MISSING];
-  s.num_invalid = classes.count[discrepancy_t::PIXEL_INVALID];
-  s.invalid_fraction = static_cast<float>(s.num_invalid) / static_cast<float>(num_pixels);
-  s.num_compared = classes.num_compared;
-  s.sum_abs_dis_mm = classes.sum_abs_dis_mm;
-  s.normalized_sum_abs_dis =
-      s.num_compared > 0 ? classes.sum_abs_dis_mm / (s.num_compared * parameters.max_depth_mm) : 0.0;
-  s.mismatch_fraction =
-      s.num_compared > 0 ? static_cast<float>(s.num_compared - s.num_match) / s.num_compared : 0.0f;
+    // The seed's score and the class counts.
+    s.num_match = classes.count[discrepancy_t::PIXEL_MATCH];
+    s.num_robot_missing = classes.count[discrepancy_t::PIXEL_ROBOT_MISSING];
+    s.num_occluded = classes.count[discrepancy_t::PIXEL_OCCLUDED];
+    s.num_unexpected_surface = classes.count[discrepancy_t::PIXEL_UNEXPECTED_SURFACE];
+    s.num_environment_missing = classes.count[discrepancy_t::PIXEL_ENVIRONMENT_MISSING];
+    s.num_invalid = classes.count[discrepancy_t::PIXEL_INVALID];
+    s.invalid_fraction = static_cast<float>(s.num_invalid) / static_cast<float>(num_pixels);
+    s.num_compared = classes.num_compared;
+    s.sum_abs_dis_mm = classes.sum_abs_dis_mm;
+    s.normalized_sum_abs_dis =
+        s.num_compared > 0 ? classes.sum_abs_dis_mm / (s.num_compared * parameters.max_depth_mm) : 0.0;
+    s.mismatch_fraction =
+        s.num_compared > 0 ? static_cast<float>(s.num_compared - s.num_match) / s.num_compared : 0.0f;
 
-  const DisHistograms histograms = per_link_statistics(frame, camera, rendered, labels, silhouette, &s);
-  const PixelFootprint footprint(camera, rendered);
-  largest_blob(classes.mismatch_mask, parameters.opening_radius_px, footprint, &s);
-  unexplained_surfaces(camera, labels, frame, classes, parameters, footprint, &s);
+    histograms = per_link_statistics(frame, camera, rendered, labels, silhouette, &s);
+    const PixelFootprint footprint(camera, rendered);
+    largest_blob(classes.mismatch_mask, parameters.opening_radius_px, footprint, &s);
+    unexplained_surfaces(camera, labels, frame, classes, parameters, footprint, &s);
+  });
   // Stage 7, evidence (evidence.hpp).
   compute_evidence(camera, rendered, labels, silhouette, parameters.silhouette_jump_mm,
-                   parameters.tolerance.noise, parameters.evidence, &s, workers);
+                   parameters.tolerance.noise, parameters.evidence, &s, workers, &pixel_stages);
+  pixel_stages.run_once();
   joint_reach(labels, &s);
   return frame;
 }

@@ -247,7 +247,7 @@ struct EvidenceSums {
 void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered, const link_labels_t& labels,
                       const std::vector<uint8_t>& silhouette, double silhouette_jump_mm,
                       const DepthNoise& noise, const EvidenceParameters& parameters, discrepancy_t* summary,
-                      WorkerPool* workers) {
+                      WorkerPool* workers, SideTask* beside) {
   discrepancy_t& s = *summary;
   clear_evidence(&s);
   const EvidenceJacobian jacobian(rendered, labels, silhouette_jump_mm);
@@ -261,7 +261,7 @@ void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered
   // evidence, not the camera's, and stay out of the camera fit.
   std::vector<uint8_t> explained_static;
   search_joint_offsets(camera, rendered, labels, jacobian.kinematics(), noise, parameters, &s,
-                       &explained_static, workers);
+                       &explained_static, workers, beside);
   const bool have_explained = explained_static.size() == static_cast<size_t>(num_pixels);
   const int num_links = labels.num_links;
   const int num_joints = jacobian.num_joints();

@@ -147,7 +147,7 @@ Eigen::Isometry3d axis_motion(const LabelAxis& axis, double amount) {
 void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rendered,
                           const link_labels_t& labels, const LabelKinematics& k, const DepthNoise& noise,
                           const EvidenceParameters& parameters, discrepancy_t* summary,
-                          std::vector<uint8_t>* explained_static, WorkerPool* workers) {
+                          std::vector<uint8_t>* explained_static, WorkerPool* workers, SideTask* beside) {
   if (explained_static != nullptr) explained_static->clear();
   discrepancy_t& s = *summary;
   s.search_points = 0;
@@ -268,23 +268,32 @@ void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rend
       if (g != 0) coarse.push_back(Trial{j, g * t.step, t.coarse_every});
     }
   }
-  const auto run_trials = [&](const std::vector<Trial>& trials, std::vector<double>* costs) {
+  // `side` (optional) runs as task 0, the trials as 1.. (the longest task
+  // first).
+  const auto run_trials = [&](const std::vector<Trial>& trials, std::vector<double>* costs, SideTask* side) {
     costs->assign(trials.size(), 0.0);
-    const auto one = [&](int n) {
+    const int first = side != nullptr ? 1 : 0;
+    const auto one = [&](int task) {
+      if (task < first) {
+        side->run_once();
+        return;
+      }
+      const int n = task - first;
       const Trial& trial = trials[static_cast<size_t>(n)];
       double sum = 0;
       for (const MovedLink& m : trials_of[trial.joint].moved)
         sum += cost(*m.points, motion_of(m, trial.offset), trial.every);
       (*costs)[static_cast<size_t>(n)] = sum;
     };
+    const int tasks = first + static_cast<int>(trials.size());
     if (workers != nullptr) {
-      workers->run(static_cast<int>(trials.size()), one);
+      workers->run(tasks, one);
     } else {
-      for (size_t n = 0; n < trials.size(); ++n) one(static_cast<int>(n));
+      for (int task = 0; task < tasks; ++task) one(task);
     }
   };
   std::vector<double> coarse_cost;
-  run_trials(coarse, &coarse_cost);
+  run_trials(coarse, &coarse_cost, beside);
   // Per joint, the coarse trials' best (0: none beat no offset), then
   // the fine trials.
   std::vector<double> centre_of(k.num_joints, 0.0);
@@ -310,7 +319,7 @@ void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rend
     for (double f : kFine) fine.push_back(Trial{j, centre + f * t.step, 1});
   }
   std::vector<double> fine_cost;
-  run_trials(fine, &fine_cost);
+  run_trials(fine, &fine_cost, nullptr);
   for (int j = 0; j < k.num_joints; ++j) {
     const JointTrials& t = trials_of[j];
     if (t.moved.empty()) continue;

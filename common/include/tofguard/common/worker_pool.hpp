@@ -15,6 +15,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <exception>
+#include <functional>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -59,6 +60,27 @@ class WorkerPool {
   uint64_t generation_ = 0;
   bool stopping_ = false;
   std::exception_ptr error_;
+};
+
+// Work of a caller's that needs nothing from a later WorkerPool call and
+// may share its threads as one more task (compute_discrepancy's pixel
+// stages beside the naming search's trials), else runs where its owner
+// calls run_once() after the call: either way exactly once. Not thread-safe
+// by itself: run_once() is called by one task of one run, or by the owner
+// after that run has returned (run's return orders the two).
+class SideTask {
+ public:
+  explicit SideTask(std::function<void()> work) : work_(std::move(work)) {}
+  void run_once() {
+    if (done_) return;
+    done_ = true;
+    work_();
+  }
+  bool done() const { return done_; }
+
+ private:
+  std::function<void()> work_;
+  bool done_ = false;
 };
 
 }  // namespace tofguard

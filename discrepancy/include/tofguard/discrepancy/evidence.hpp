@@ -180,11 +180,13 @@ class EvidenceJacobian {
 // beside a silhouette), `silhouette_jump_mm` its threshold (no slope is
 // taken across a larger rendered step). Leaves them zero
 // (evidence_available false) when the labels carry no kinematics.
-// `workers` as compute_discrepancy's.
+// `workers` as compute_discrepancy's; `beside` (optional) as
+// search_joint_offsets': it may run during the call, and the caller runs it
+// after it (SideTask::run_once) when it did not.
 void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered, const link_labels_t& labels,
                       const std::vector<uint8_t>& silhouette, double silhouette_jump_mm,
                       const DepthNoise& noise, const EvidenceParameters& parameters, discrepancy_t* summary,
-                      WorkerPool* workers = nullptr);
+                      WorkerPool* workers = nullptr, SideTask* beside = nullptr);
 
 // Clears the evidence fields (evidence_available false, everything zero).
 void clear_evidence(discrepancy_t* summary);

@@ -45,10 +45,15 @@ namespace tofguard::discrepancy {
 // own cost, and the offsets are chosen from the costs in a fixed order, so
 // the result does not depend on the threads. nullptr: all on the caller's
 // thread.
+//
+// beside (optional): the caller's own work, run as one more task of the
+// coarse trials (on the caller's thread when `workers` is nullptr). It
+// does not run when the search stops early (no kinematics, no point): the
+// caller then runs it (SideTask::run_once).
 void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rendered,
                           const link_labels_t& labels, const LabelKinematics& kinematics,
                           const DepthNoise& noise, const EvidenceParameters& parameters,
                           discrepancy_t* summary, std::vector<uint8_t>* explained_static = nullptr,
-                          WorkerPool* workers = nullptr);
+                          WorkerPool* workers = nullptr, SideTask* beside = nullptr);
 
 }  // namespace tofguard::discrepancy
