@@ -69,6 +69,35 @@ TEST(WorkerPool, ATaskExceptionReachesTheCallerAfterTheOtherTasks) {
   EXPECT_EQ(again, std::vector<int>(4, 1));
 }
 
+TEST(SideTask, RunsOnceBesideARunOrAfterIt) {
+  WorkerPool pool(2);
+  for (int call = 0; call < 100; ++call) {
+    // Beside a run: task 0 runs it, the owner's run_once after the call
+    // does nothing.
+    int side_runs = 0;
+    std::vector<int> runs(8, 0);
+    SideTask side([&] { ++side_runs; });
+    pool.run(9, [&](int i) {
+      if (i == 0) {
+        side.run_once();
+      } else {
+        runs[static_cast<size_t>(i - 1)] += 1;
+      }
+    });
+    EXPECT_TRUE(side.done());
+    side.run_once();
+    ASSERT_EQ(side_runs, 1);
+    for (int r : runs) ASSERT_EQ(r, 1);
+  }
+  // No run took it: the owner's run_once runs it, once.
+  int side_runs = 0;
+  SideTask side([&] { ++side_runs; });
+  EXPECT_FALSE(side.done());
+  side.run_once();
+  side.run_once();
+  EXPECT_EQ(side_runs, 1);
+}
+
 TEST(WorkerPool, RefusesNoThreads) { EXPECT_DEATH(WorkerPool(0), "num_threads"); }
 
 }  // namespace

@@ -278,6 +278,18 @@ discrepancy_t evidence_of(test::SimulatedFrames* frames, const deployment::Confi
 }
 
 // The encoded summary, utime and compute_us aside.
+// `labels` without their kinematics (num_axes 0, as from a renderer that
+// sends none): the evidence is off.
+void strip_kinematics(link_labels_t* labels) {
+  labels->num_axes = 0;
+  labels->axis_joint.clear();
+  labels->axis_multiplier.clear();
+  labels->axis_prismatic.clear();
+  labels->axis_origin_m.clear();
+  labels->axis_direction.clear();
+  labels->axis_parent.clear();
+}
+
 std::vector<uint8_t> encoded(discrepancy_t s) {
   s.utime = 0;
   s.compute_us = 0;
@@ -303,23 +315,37 @@ TEST_F(EvidenceTest, TheSummaryDoesNotDependOnTheWorkerThreads) {
     JointPositions reported;
     Eigen::Isometry3d seen_from;
   };
+  // The last case's labels carry no kinematics: the search stops at once,
+  // and the pixel stages (compute_discrepancy's side task) run after it.
   const Case cases[] = {{"nominal", truth, camera()},
                         {"encoder 10 deg off", offset, camera()},
-                        {"camera 3 cm off", truth, moved_camera}};
+                        {"camera 3 cm off", truth, moved_camera},
+                        {"no kinematics", offset, camera()}};
   WorkerPool two(2);
   WorkerPool four(4);
   uint64_t index = 70;
   for (const Case& c : cases) {
     const std::vector<float> seen = frames_->capture(truth, c.seen_from, in, ++index);
     const depth_image_t cam = make_depth_image("cam", in, 1, 1, true, seen);
-    const Frame model = render_frame(&frames_->renderer(), frames_->scene(), c.reported, camera(), in);
+    Frame model = render_frame(&frames_->renderer(), frames_->scene(), c.reported, camera(), in);
+    const bool without_kinematics = std::string(c.what) == "no kinematics";
+    if (without_kinematics) strip_kinematics(&model.labels);
     const DiscrepancyFrame alone = compute_discrepancy(cam, model.depth, model.labels, parameters(*config_));
-    ASSERT_TRUE(alone.summary.evidence_available) << c.what;
+    ASSERT_TRUE(alone.summary.usable) << c.what;
+    ASSERT_EQ(alone.summary.evidence_available, !without_kinematics) << c.what;
+    // The pixel stages ran: the offset leaves pixels that do not match.
+    ASSERT_GT(alone.summary.num_compared, 1000) << c.what;
+    if (c.what != std::string("nominal")) {
+      EXPECT_GT(alone.summary.num_compared - alone.summary.num_match, 50) << c.what;
+    }
     const std::vector<uint8_t> expected = encoded(alone.summary);
     for (WorkerPool* pool : {&two, &four}) {
       const DiscrepancyFrame shared =
           compute_discrepancy(cam, model.depth, model.labels, parameters(*config_), pool);
       EXPECT_TRUE(encoded(shared.summary) == expected) << c.what << ", " << pool->num_threads() << " threads";
+      // The images too (the pixel stages write them).
+      EXPECT_EQ(cv::countNonZero(shared.pixel_class != alone.pixel_class), 0) << c.what;
+      EXPECT_EQ(cv::countNonZero(shared.dis_mm != alone.dis_mm), 0) << c.what;
     }
     if (std::string(c.what) == "encoder 10 deg off") {
       // The search found the offset: the test compares a search that ran.
