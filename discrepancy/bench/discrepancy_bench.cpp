@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 
+#include "synthetic_frames.hpp"
 #include "tofguard/discrepancy/discrepancy_image.hpp"
 #include "tofguard/discrepancy/joint_search.hpp"
 
@@ -70,20 +71,9 @@ Frames make_frames(int width, int height) {
   box(&f.camera.depth_mm, nullptr, 40, 60, 60, 100, 1500, 0);
   box(&f.camera.depth_mm, nullptr, 70, 60, 110, 80, 1500, 0);
   box(&f.camera.depth_mm, nullptr, 30, 110, 50, 130, 1400, 0);
-  // The kinematics as rendered (so that the evidence stage runs): link1
-  // turns about a vertical axis through the base, link2 about a horizontal
-  // one at link1's top.
-  f.labels.num_joints = 2;
-  f.labels.joint_name = {"a1", "a2"};
-  f.labels.num_axes = 2;
-  f.labels.axis_joint = {0, 1};
-  f.labels.axis_multiplier = {1, 1};
-  f.labels.axis_prismatic = {false, false};
-  f.labels.axis_origin_m = {{-0.3, 0.3, 1.5}, {-0.3, -0.1, 1.5}};
-  f.labels.axis_direction = {{0, -1, 0}, {0, 0, 1}};
-  f.labels.axis_parent = {-1, 0};
-  f.labels.num_link_axes = 3;
-  f.labels.link_axis = {-1, 0, 1};
+  // The kinematics as rendered, so that the evidence stage runs (the
+  // boxes are tests/support's default arm, scaled).
+  tofguard::test::add_default_arm_kinematics(&f.labels);
   // The arm cover (so that the protective fields run): a sphere of 0.12 m
   // at each link box's centre (optical frame, m; fx = 200 px at 176 wide).
   f.labels.arm_cover_max_radius_m = 0.15;

@@ -1,7 +1,12 @@
 // The discrepancy image on synthetic frames whose every count is known.
 #include <gtest/gtest.h>
 
+#include <vector>
+
+#include <opencv2/core.hpp>
+
 #include "synthetic_frames.hpp"
+#include "tofguard/common/worker_pool.hpp"
 #include "tofguard/discrepancy/discrepancy_image.hpp"
 
 namespace tofguard::test {
@@ -10,6 +15,17 @@ namespace {
 using discrepancy::compute_discrepancy;
 using discrepancy::DiscrepancyFrame;
 using discrepancy::Parameters;
+
+// OpenCV's own parallel loops (the blob stage's morphology and connected
+// components) run on the calling thread in this test: OpenCV otherwise
+// starts TBB threads, whose synchronisation TSan cannot see (TBB is not
+// instrumented), and reports its scratch buffers, allocated on a TBB thread
+// and freed on the caller's, as races. Under TSan (scripts/sanitize) every
+// thread is then tofguard's own (the WorkerPool's).
+const bool kOpenCvOnTheCallersThread = [] {
+  cv::setNumThreads(0);
+  return true;
+}();
 
 // The simulated camera's noise, 4 sigma + 15 mm, 3x3 opening, 0.2 m.
 Parameters sim_parameters() { return Parameters{}; }
@@ -104,6 +120,44 @@ TEST(Discrepancy, ShiftedLinkIsMissingWhereModelledAndUnexpectedBesideIt) {
   EXPECT_EQ(f.pixel_class(70, 105), discrepancy_t::PIXEL_UNEXPECTED_SURFACE);
   EXPECT_EQ(f.dis_mm(70, 65), -500);
   EXPECT_EQ(f.dis_mm(70, 105), 500);
+}
+
+// compute_discrepancy shares its work among a WorkerPool's threads (the
+// naming search's trials, the evidence's bands, and the pixel stages beside
+// the trials): whatever the threads, the same summary and images. Also run
+// under TSan (scripts/sanitize): the pixel stages and the search write the
+// same summary from two threads.
+TEST(Discrepancy, TheSummaryAndImagesDoNotDependOnTheWorkerThreads) {
+  const SyntheticImage model = draw(default_arm());
+  link_labels_t labels = labels_frame(model.label, 7);
+  add_pixel_cover(&labels, model.depth_mm);
+  add_default_arm_kinematics(&labels);
+  // link2 seen 4 px to the right of where it is modelled, and a box in
+  // front of the arm: every stage has something to find.
+  std::vector<Box> scene = default_arm(4);
+  scene.push_back({30, 110, 50, 130, 1400, 0});
+  const depth_image_t camera = depth_frame(with_noise(draw(scene).depth_mm, 5), 7);
+  const depth_image_t rendered = depth_frame(model.depth_mm, 7);
+  const DiscrepancyFrame alone = compute_discrepancy(camera, rendered, labels, sim_parameters());
+  const discrepancy_t& a = alone.summary;
+  ASSERT_TRUE(a.usable && a.evidence_available);
+  ASSERT_GT(a.search_points, 500);
+  ASSERT_EQ(a.num_robot_missing, 4 * 20);  // link2 (20 rows) uncovered where modelled
+  ASSERT_EQ(a.num_occluded, 200);
+  const auto encoded = [](const discrepancy_t& d) {
+    std::vector<uint8_t> bytes(static_cast<size_t>(d.getEncodedSize()));
+    d.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+    return bytes;
+  };
+  for (int threads : {2, 4}) {
+    WorkerPool pool(threads);
+    for (int call = 0; call < 5; ++call) {
+      const DiscrepancyFrame shared = compute_discrepancy(camera, rendered, labels, sim_parameters(), &pool);
+      EXPECT_TRUE(encoded(shared.summary) == encoded(a)) << threads << " threads, call " << call;
+      EXPECT_EQ(cv::countNonZero(shared.pixel_class != alone.pixel_class), 0) << threads << " threads";
+      EXPECT_EQ(cv::countNonZero(shared.dis_mm != alone.dis_mm), 0) << threads << " threads";
+    }
+  }
 }
 
 TEST(Discrepancy, ObjectInFrontOfTheArmIsOccludedAndNearTheArm) {

@@ -99,6 +99,26 @@ inline link_labels_t labels_frame(const std::vector<int16_t>& label, int64_t seq
   return m;
 }
 
+// Gives `labels` the default arm's kinematics as rendered (link_labels_t's
+// axes, optical frame, m), so that the evidence stage runs: link1 turns
+// about a vertical axis through the base (joint a1), link2 about a
+// horizontal one at link1's top (a2); base_link is fixed. The axes sit at
+// default_arm()'s boxes for fx = fy = 200 px per 176 columns (any size
+// whose focal length scales with its width).
+inline void add_default_arm_kinematics(link_labels_t* labels) {
+  labels->num_joints = 2;
+  labels->joint_name = {"a1", "a2"};
+  labels->num_axes = 2;
+  labels->axis_joint = {0, 1};
+  labels->axis_multiplier = {1, 1};
+  labels->axis_prismatic = {false, false};
+  labels->axis_origin_m = {{-0.3, 0.3, 1.5}, {-0.3, -0.1, 1.5}};
+  labels->axis_direction = {{0, -1, 0}, {0, 0, 1}};
+  labels->axis_parent = {-1, 0};
+  labels->num_link_axes = 3;
+  labels->link_axis = {-1, 0, 1};
+}
+
 // Gives `labels` a cover of the model's robot surface (link_labels_t.arm_*):
 // one sphere per robot pixel of the model, at the pixel's ray
 // back-projected to its depth `model_depth_mm` (optical frame, fx = fy =
