@@ -5,6 +5,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "sample_messages.hpp"
 #include "synthetic_frames.hpp"
 #include "tofguard/common/worker_pool.hpp"
 #include "tofguard/discrepancy/discrepancy_image.hpp"
@@ -144,11 +145,6 @@ TEST(Discrepancy, TheSummaryAndImagesDoNotDependOnTheWorkerThreads) {
   ASSERT_GT(a.search_points, 500);
   ASSERT_EQ(a.num_robot_missing, 4 * 20);  // link2 (20 rows) uncovered where modelled
   ASSERT_EQ(a.num_occluded, 200);
-  const auto encoded = [](const discrepancy_t& d) {
-    std::vector<uint8_t> bytes(static_cast<size_t>(d.getEncodedSize()));
-    d.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-    return bytes;
-  };
   for (int threads : {2, 4}) {
     WorkerPool pool(threads);
     for (int call = 0; call < 5; ++call) {
