@@ -2,14 +2,38 @@
 // (compute_discrepancy) at 176x144 and 640x480, on a frame with a shifted
 // link and an object in front of the arm (so blobs and near-arm distances
 // are exercised) and with the simulated camera's noise.
+//
+// BM_ComputeDiscrepancySimulatedArm: the same on frames of the embedded
+// default (config/sim.yaml) as the chain sees them: the simulated ToF
+// camera's frame of the default arm along its path (tests/support's
+// SimulatedFrames) against the renderer's frame and labels at the same
+// joints, with config/sim.yaml's discrepancy settings. It prints a digest
+// of the summaries of its frames (stderr): a change made for speed alone
+// leaves it as it was.
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <memory>
 #include <random>
+#include <string>
+#include <utility>
+#include <vector>
 
+#include "joint_motion.hpp"
+#include "simulated_frames.hpp"
 #include "synthetic_frames.hpp"
+#include "tofguard/common/depth_frame.hpp"
+#include "tofguard/common/worker_pool.hpp"
+#include "tofguard/deployment/config.hpp"
 #include "tofguard/discrepancy/discrepancy_image.hpp"
 #include "tofguard/discrepancy/joint_search.hpp"
+#include "tofguard/renderer/depth_renderer.hpp"
+#include "tofguard/renderer/rendered_kinematics.hpp"
+#include "tofguard/renderer/renderer_process.hpp"
+#include "tofguard/robot_model/arm_spheres.hpp"
 
 namespace {
 
@@ -126,6 +150,105 @@ void BM_SearchJointOffsets(benchmark::State& state) {
   state.counters["points"] = summary.search_points;
 }
 BENCHMARK(BM_SearchJointOffsets)->Args({176, 144})->Args({640, 480})->Unit(benchmark::kMicrosecond);
+
+// The default arm's frames at width x height (config/sim.yaml's camera,
+// the same field of view): 10 frames along its path at 30 Hz.
+struct SimulatedArmFrames {
+  tofguard::deployment::Config config;
+  std::vector<Frames> frames;
+};
+
+SimulatedArmFrames make_simulated_arm_frames(int width, int height) {
+  setenv("LP_NUM_THREADS", "0", /*overwrite=*/0);  // as tofguard-renderer at 176x144
+  SimulatedArmFrames out;
+  out.config =
+      tofguard::deployment::load_config(std::string(TOFGUARD_SOURCE_DIR) + "/config/sim.yaml", nullptr);
+  const tofguard::deployment::Config& config = out.config;
+  tofguard::test::SimulatedFrames camera_frames(config);
+  const tofguard::robot_model::SceneModel scene =
+      tofguard::robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths,
+                                        tofguard::renderer::scene_options(config.renderer, config.robot));
+  tofguard::renderer::DepthRenderer renderer(scene, config.renderer.near_m, config.renderer.far_m);
+  const tofguard::robot_model::ArmSpheres cover =
+      tofguard::robot_model::cover_arm_with_spheres(scene, config.renderer.arm_cover_cell_m);
+  tofguard::Intrinsics intrinsics = config.camera.intrinsics;
+  const double sx = static_cast<double>(width) / intrinsics.width;
+  const double sy = static_cast<double>(height) / intrinsics.height;
+  intrinsics.width = width;
+  intrinsics.height = height;
+  intrinsics.fx *= sx;
+  intrinsics.fy *= sy;
+  intrinsics.cx = (intrinsics.cx + 0.5) * sx - 0.5;
+  intrinsics.cy = (intrinsics.cy + 0.5) * sy - 0.5;
+  const Eigen::Isometry3d world_from_optical = config.camera.pose.frame_from_optical();
+  for (int i = 0; i < 10; ++i) {
+    tofguard::robot_model::JointPositions joints;
+    for (const std::string& j : camera_frames.scene().actuated_joint_names) joints[j] = 0;
+    for (const tofguard::sim::JointMotion& m : config.joints_sim.motion)
+      joints[m.joint] = tofguard::test::joint_position(m, i / 30.0);
+    Frames f;
+    f.camera =
+        tofguard::make_depth_image(config.camera.id, intrinsics, i + 1, i + 1, /*calibrated=*/true,
+                                   camera_frames.capture(joints, world_from_optical, intrinsics, i + 1));
+    const tofguard::renderer::RenderResult result = renderer.render(joints, config.camera.pose, intrinsics);
+    f.rendered = tofguard::make_depth_image(config.camera.id, intrinsics, i + 1, i + 1, /*calibrated=*/true,
+                                            result.depth_m);
+    f.labels = tofguard::renderer::make_rendered_link_labels(f.camera, result, scene, cover);
+    out.frames.push_back(std::move(f));
+  }
+  return out;
+}
+
+// state.range(2): discrepancy.worker_threads (0: none, all on the caller's
+// thread).
+void BM_ComputeDiscrepancySimulatedArm(benchmark::State& state) {
+  // Made once per size (Google Benchmark calls this several times).
+  static std::map<std::pair<int64_t, int64_t>, SimulatedArmFrames> made;
+  const auto size = std::make_pair(state.range(0), state.range(1));
+  if (made.count(size) == 0) {
+    made[size] = make_simulated_arm_frames(static_cast<int>(size.first), static_cast<int>(size.second));
+  }
+  const SimulatedArmFrames& sim = made[size];
+  const tofguard::discrepancy::Parameters parameters =
+      tofguard::discrepancy::parameters_from(sim.config.discrepancy);
+  std::unique_ptr<tofguard::WorkerPool> workers;
+  if (state.range(2) > 0) workers = std::make_unique<tofguard::WorkerPool>(static_cast<int>(state.range(2)));
+  // FNV-1a over the encoded summaries, utime and compute_us aside (as
+  // tofguard-bench's floors).
+  uint64_t digest = 0xcbf29ce484222325ULL;
+  for (const Frames& f : sim.frames) {
+    tofguard::discrepancy_t summary =
+        tofguard::discrepancy::compute_discrepancy(f.camera, f.rendered, f.labels, parameters, workers.get())
+            .summary;
+    summary.utime = 0;
+    summary.compute_us = 0;
+    std::vector<uint8_t> encoded(static_cast<size_t>(summary.getEncodedSize()));
+    summary.encode(encoded.data(), 0, static_cast<int>(encoded.size()));
+    for (uint8_t byte : encoded) digest = (digest ^ byte) * 0x100000001b3ULL;
+  }
+  static std::map<std::vector<int64_t>, uint64_t> printed;
+  const std::vector<int64_t> run = {state.range(0), state.range(1), state.range(2)};
+  if (printed.count(run) == 0) {
+    printed[run] = digest;
+    std::fprintf(stderr, "BM_ComputeDiscrepancySimulatedArm/%d/%d/%d: digest of the summaries %016llx\n",
+                 static_cast<int>(run[0]), static_cast<int>(run[1]), static_cast<int>(run[2]),
+                 static_cast<unsigned long long>(digest));
+  }
+  size_t k = 0;
+  for (auto _ : state) {
+    const Frames& f = sim.frames[k++ % sim.frames.size()];
+    auto frame =
+        tofguard::discrepancy::compute_discrepancy(f.camera, f.rendered, f.labels, parameters, workers.get());
+    benchmark::DoNotOptimize(frame.summary.num_match);
+  }
+  state.SetItemsProcessed(state.iterations() * state.range(0) * state.range(1));
+}
+BENCHMARK(BM_ComputeDiscrepancySimulatedArm)
+    ->ArgNames({"width", "height", "threads"})
+    ->Args({176, 144, 0})
+    ->Args({176, 144, 2})
+    ->Args({640, 480, 0})
+    ->Unit(benchmark::kMicrosecond);
 
 void BM_DepthHash(benchmark::State& state) {
   const Frames f = make_frames(176, 144);

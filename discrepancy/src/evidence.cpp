@@ -6,6 +6,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 
+#include "double2.hpp"
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/discrepancy/joint_search.hpp"
 
@@ -58,7 +59,7 @@ EvidenceJacobian::EvidenceJacobian(const depth_image_t& rendered, const link_lab
       fy_(rendered.fy),
       cx_(rendered.cx),
       cy_(rendered.cy),
-      jump_mm_(silhouette_jump_mm > 0 ? silhouette_jump_mm : 1e9),
+      jump_limit_mm_(silhouette_step_limit_mm(silhouette_jump_mm > 0 ? silhouette_jump_mm : 1e9)),
       depth_(rendered.depth_mm.data()),
       label_(labels.label.data()) {
   const size_t pixels = static_cast<size_t>(std::max(width_, 0)) * static_cast<size_t>(std::max(height_, 0));
@@ -66,13 +67,8 @@ EvidenceJacobian::EvidenceJacobian(const depth_image_t& rendered, const link_lab
   available_ = read_label_kinematics(labels, pixels, &kinematics_);
 }
 
-bool EvidenceJacobian::at(int i, double camera[6], double* joints, bool* moved, int* link_out) const {
-  if (!available_ || i < 0 || i >= width_ * height_) return false;
-  return at(i % width_, i / width_, camera, joints, moved, link_out);
-}
-
-bool EvidenceJacobian::at(int u, int v, double camera[6], double* joints, bool* moved, int* link_out) const {
-  if (!available_) return false;
+[[gnu::always_inline]] inline bool EvidenceJacobian::at_pixel(int u, int v, double camera[6], double* joints,
+                                                              bool* moved, int* link_out) const {
   const int i = v * width_ + u;
   const int z_mm = depth_[i];
   if (z_mm <= 0) return false;
@@ -83,7 +79,7 @@ bool EvidenceJacobian::at(int u, int v, double camera[6], double* joints, bool* 
   // over the neighbours on the same link and surface, one-sided with one.
   const auto qualifies = [&](int n) {
     const int d = depth_[n];
-    return d > 0 && label_[n] == l && !silhouette_step(d, z_mm, jump_mm_);
+    return d > 0 && label_[n] == l && std::abs(d - z_mm) <= jump_limit_mm_;
   };
   double gu = 0;
   {
@@ -118,10 +114,10 @@ bool EvidenceJacobian::at(int u, int v, double camera[6], double* joints, bool* 
   const Eigen::Vector3d g(-gu * fx_ / z, -gv * fy_ / z,
                           1.0 + (gu * fx_ * p.x() + gv * fy_ * p.y()) / (z * z));
   *link_out = link;
-  std::fill(joints, joints + kinematics_.num_joints, 0.0);
   const int first_axis = link < kinematics_.num_robot_links ? kinematics_.link_axis[link] : -1;
   *moved = first_axis >= 0;
   if (*moved) {
+    std::fill(joints, joints + kinematics_.num_joints, 0.0);
     for (int m = first_axis; m >= 0; m = kinematics_.axes[m].parent) {
       const LabelAxis& a = kinematics_.axes[m];
       // Revolute: v = direction x (p - origin) (mm per rad); prismatic:
@@ -129,7 +125,6 @@ bool EvidenceJacobian::at(int u, int v, double camera[6], double* joints, bool* 
       const double j = a.prismatic ? 1000.0 * g.dot(a.direction) : g.dot(a.direction.cross(p - a.origin_mm));
       joints[a.joint] += a.multiplier * j;
     }
-    std::fill(camera, camera + 6, 0.0);
   } else {
     // A static point seen from the optical frame moved by (t, w): its
     // coordinates change by -t - w x p.
@@ -142,6 +137,27 @@ bool EvidenceJacobian::at(int u, int v, double camera[6], double* joints, bool* 
     camera[3] = gxp.x();
     camera[4] = gxp.y();
     camera[5] = gxp.z();
+  }
+  return true;
+}
+
+bool EvidenceJacobian::at(int i, double camera[6], double* joints, bool* moved, int* link_out) const {
+  if (!available_ || i < 0 || i >= width_ * height_) return false;
+  return at_zeroing_the_other(i % width_, i / width_, camera, joints, moved, link_out);
+}
+
+bool EvidenceJacobian::at(int u, int v, double camera[6], double* joints, bool* moved, int* link_out) const {
+  if (!available_) return false;
+  return at_zeroing_the_other(u, v, camera, joints, moved, link_out);
+}
+
+bool EvidenceJacobian::at_zeroing_the_other(int u, int v, double camera[6], double* joints, bool* moved,
+                                            int* link_out) const {
+  if (!at_pixel(u, v, camera, joints, moved, link_out)) return false;
+  if (*moved) {
+    std::fill(camera, camera + 6, 0.0);
+  } else {
+    std::fill(joints, joints + kinematics_.num_joints, 0.0);
   }
   return true;
 }
@@ -242,6 +258,80 @@ struct EvidenceSums {
   double camera_region_information[24] = {};
 };
 
+// The camera fit's sums over one row's static pixels n_first .. n_end - 1
+// (their Jacobians 6 to a pixel in `jacobian`, weights w, clipped residuals
+// r), all in one image quadrant: score[a] and region_score[a] -= w J_a r,
+// region_information[a] += w J_a J_a, information(a, c) += w J_a J_c for
+// c >= a (the upper triangle of Eigen's column-major 6x6). Each sum takes
+// the pixels in order, as the loop one pixel at a time did: the same
+// numbers to the last bit (bench digest, docs/benchmarks.md).
+void add_camera_fit(const double* jacobian, const double* weight, const double* residual, int n_first,
+                    int n_end, double* score, double* information, double* region_score,
+                    double* region_information) {
+  if (n_first >= n_end) return;
+  // The scores and the region's diagonal, parameters (0, 1), (2, 3), (4, 5).
+  Double2 s[3], rs[3], ri[3];
+#pragma GCC unroll 3
+  for (int k = 0; k < 3; ++k) {
+    s[k] = load2(score + 2 * k);
+    rs[k] = load2(region_score + 2 * k);
+    ri[k] = load2(region_information + 2 * k);
+  }
+  for (int n = n_first; n < n_end; ++n) {
+    const double* j = jacobian + 6 * n;
+    const Double2 w = {weight[n], weight[n]};
+    const Double2 r = {residual[n], residual[n]};
+#pragma GCC unroll 3
+    for (int k = 0; k < 3; ++k) {
+      const Double2 jk = load2(j + 2 * k);
+      const Double2 wj = w * jk;
+      s[k] -= wj * r;
+      rs[k] -= wj * r;
+      ri[k] += wj * jk;
+    }
+  }
+#pragma GCC unroll 3
+  for (int k = 0; k < 3; ++k) {
+    store2(score + 2 * k, s[k]);
+    store2(region_score + 2 * k, rs[k]);
+    store2(region_information + 2 * k, ri[k]);
+  }
+  // information(a, c), row a in the pairs of columns (c, c + 1) from the
+  // pair holding a: 12 pairs; a row's lane left of a (row 1's column 0,
+  // ...) is summed too and never stored.
+  constexpr int kFirstPair[6] = {0, 0, 1, 1, 2, 2};
+  constexpr int kPairIndex[6] = {0, 3, 6, 8, 10, 11};
+  Double2 m[12];
+#pragma GCC unroll 6
+  for (int a = 0; a < 6; ++a) {
+#pragma GCC unroll 3
+    for (int k = kFirstPair[a]; k < 3; ++k) {
+      m[kPairIndex[a] + k - kFirstPair[a]] =
+          Double2{information[a + 6 * (2 * k)], information[a + 6 * (2 * k + 1)]};
+    }
+  }
+  for (int n = n_first; n < n_end; ++n) {
+    const double* j = jacobian + 6 * n;
+    const Double2 jk[3] = {load2(j), load2(j + 2), load2(j + 4)};
+#pragma GCC unroll 6
+    for (int a = 0; a < 6; ++a) {
+      const double wj = weight[n] * j[a];
+      const Double2 wj2 = {wj, wj};
+#pragma GCC unroll 3
+      for (int k = kFirstPair[a]; k < 3; ++k) m[kPairIndex[a] + k - kFirstPair[a]] += wj2 * jk[k];
+    }
+  }
+#pragma GCC unroll 6
+  for (int a = 0; a < 6; ++a) {
+#pragma GCC unroll 3
+    for (int k = kFirstPair[a]; k < 3; ++k) {
+      const Double2 v = m[kPairIndex[a] + k - kFirstPair[a]];
+      if (2 * k >= a) information[a + 6 * (2 * k)] = v[0];
+      information[a + 6 * (2 * k + 1)] = v[1];
+    }
+  }
+}
+
 }  // namespace
 
 void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered, const link_labels_t& labels,
@@ -281,15 +371,33 @@ void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered
   const auto sum_band = [&](int band) {
     EvidenceSums& b = bands[static_cast<size_t>(band)];
     std::vector<double> joint_row(num_joints, 0.0);
-    double camera_row[6];
     const int first = static_cast<int>(static_cast<int64_t>(num_pixels) * band / kEvidenceBands);
     const int last = static_cast<int>(static_cast<int64_t>(num_pixels) * (band + 1) / kEvidenceBands);
     if (first >= last) return;
     const int width = camera.width;
+    // One row's static pixels in the camera fit: their Jacobians (6 to a
+    // pixel, written there by the Jacobian), weights and clipped residuals,
+    // row_left of them in the image's left half. The 6x6 sums then run
+    // over the row in registers (add_camera_fit), not through 40 sums in
+    // memory per pixel.
+    std::vector<double> row_jacobian(static_cast<size_t>(6 * (width + 1)));
+    std::vector<double> row_weight(static_cast<size_t>(width));
+    std::vector<double> row_residual(static_cast<size_t>(width));
+    int row_fit = 0;
+    int row_left = 0;
+    const auto add_row_fit = [&](int n_first, int n_end, int region) {
+      if (n_first >= n_end) return;
+      b.camera_region_fit_pixels[region] += n_end - n_first;
+      add_camera_fit(row_jacobian.data(), row_weight.data(), row_residual.data(), n_first, n_end,
+                     b.camera_score.data(), b.camera_information.data(), b.camera_region_score + 6 * region,
+                     b.camera_region_information + 6 * region);
+    };
     // The band's rows, each from the band's first pixel (first row) to its
     // last (last row); with a sampling stride k every k-th row and column.
     for (int v = first / width; v <= (last - 1) / width; ++v) {
       if (v % stride != 0) continue;
+      row_fit = 0;
+      row_left = 0;
       const int row = v * width;
       const int u_first = std::max(first - row, 0);
       const int u_end = std::min(last - row, width);
@@ -299,7 +407,10 @@ void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered
         if (t <= 0 || gen[i] <= 0 || silhouette[i]) continue;
         bool moved = false;
         int link = -1;
-        if (!jacobian.at(u, v, camera_row, joint_row.data(), &moved, &link)) continue;
+        // A static pixel's camera Jacobian goes straight into the row's
+        // next slot (kept only if the pixel enters the camera fit).
+        double* camera_row = row_jacobian.data() + 6 * row_fit;
+        if (!jacobian.at_pixel(u, v, camera_row, joint_row.data(), &moved, &link)) continue;
         if (!moved && have_explained && explained_static[i]) continue;
         const double sigma_d = noise.sigma_mm(t);
         const double var = sigma_d * sigma_d + model_var;
@@ -333,23 +444,19 @@ void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered
           // would say only that something is there, and the protective fields
           // judge that; in the camera fit it would pull the pose.
           if (!in_naming_fit) continue;
-          ++b.camera_fit_pixels;
-          // The image quadrant (discrepancy_t.camera_region_*).
-          const int region = (u >= half_width ? 1 : 0) + (v >= half_height ? 2 : 0);
-          ++b.camera_region_fit_pixels[region];
-          double* region_score = b.camera_region_score + 6 * region;
-          double* region_information = b.camera_region_information + 6 * region;
-          // The upper triangle by hand: Eigen's rankUpdate on a 6x6
-          // selfadjoint view costs more than the rest of the pixel.
-          for (int a = 0; a < 6; ++a) {
-            const double wj = w * camera_row[a];
-            b.camera_score[a] -= wj * r;
-            region_score[a] -= wj * r;
-            region_information[a] += wj * camera_row[a];
-            for (int c = a; c < 6; ++c) b.camera_information(a, c) += wj * camera_row[c];
-          }
+          // Into the row's camera fit (added at the row's end, below).
+          row_weight[static_cast<size_t>(row_fit)] = w;
+          row_residual[static_cast<size_t>(row_fit)] = r;
+          if (u < half_width) row_left = row_fit + 1;
+          ++row_fit;
         }
       }
+      b.camera_fit_pixels += row_fit;
+      // The row's static pixels in the camera fit, left half then right
+      // (the image quadrants, discrepancy_t.camera_region_*), each sum
+      // taking the pixels in the order of the row as the pixels came.
+      add_row_fit(0, row_left, v >= half_height ? 2 : 0);
+      add_row_fit(row_left, row_fit, v >= half_height ? 3 : 1);
     }
   };
   if (workers != nullptr) {

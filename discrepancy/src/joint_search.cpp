@@ -7,6 +7,7 @@
 
 #include <Eigen/Geometry>
 
+#include "double2.hpp"
 #include "tofguard/common/depth_frame.hpp"
 
 namespace tofguard::discrepancy {
@@ -40,6 +41,12 @@ struct RigidMotion {
     const double* row = rotation + 3 * r;
     return ((row[0] * p.x() + row[1] * p.y()) + row[2] * p.z()) + translation[r];
   }
+  // Row r of two points at once (x, y, z: their coordinates side by
+  // side), each lane as apply().
+  Double2 apply(int r, Double2 x, Double2 y, Double2 z) const {
+    const double* row = rotation + 3 * r;
+    return ((row[0] * x + row[1] * y) + row[2] * z) + translation[r];
+  }
   double rotation[9];
   double translation[3];
 };
@@ -51,6 +58,8 @@ class PointCost {
   PointCost(const depth_image_t& camera, const depth_image_t& rendered, double clip_sigmas, double weight)
       : width_(camera.width),
         height_(camera.height),
+        width_d_(camera.width),
+        height_d_(camera.height),
         fx_(rendered.fx),
         fy_(rendered.fy),
         cx_(rendered.cx),
@@ -86,22 +95,44 @@ class PointCost {
   }
 
   // Every `every`-th point (the coarse trials), each standing for `every`.
+  // Two points at a time (Double2: the moved points and where they land
+  // the same to the last bit as one at a time), added to the sum in order.
   double operator()(const std::vector<SearchPoint>& points, const Eigen::Isometry3d& motion,
                     size_t every) const {
     double sum = 0;
     const RigidMotion m(motion);
-    for (size_t n = 0; n < points.size(); n += every) {
+    const auto add = [&](double qz, bool landed, double uf, double vf, double inv_sigma) {
+      const int measured = landed ? tof_[static_cast<int>(vf) * width_ + static_cast<int>(uf)] : 0;
+      if (measured <= 0) {
+        sum += clip2_;
+        return;
+      }
+      const double x = (qz - measured) * inv_sigma;
+      sum += std::min(x * x, clip2_);
+    };
+    size_t n = 0;
+    for (; n + every < points.size(); n += 2 * every) {
+      const SearchPoint& a = points[n];
+      const SearchPoint& b = points[n + every];
+      const Double2 px = {a.p_mm.x(), b.p_mm.x()};
+      const Double2 py = {a.p_mm.y(), b.p_mm.y()};
+      const Double2 pz = {a.p_mm.z(), b.p_mm.z()};
+      const Double2 qz = m.apply(2, px, py, pz);
+      // lands(), both lanes (a lane behind the camera computes nonsense
+      // that the test below discards).
+      const Double2 inv_z = 1.0 / qz;
+      const Double2 uf = fx_ * m.apply(0, px, py, pz) * inv_z + cx_ + 0.5;
+      const Double2 vf = fy_ * m.apply(1, px, py, pz) * inv_z + cy_ + 0.5;
+      add(qz[0], in_image(qz[0], uf[0], vf[0]), uf[0], vf[0], a.inv_sigma);
+      add(qz[1], in_image(qz[1], uf[1], vf[1]), uf[1], vf[1], b.inv_sigma);
+    }
+    for (; n < points.size(); n += every) {
       const Eigen::Vector3d& p = points[n].p_mm;
       const double qz = m.z(p);
       int u = 0;
       int v = 0;
-      const int measured = lands(m.x(p), m.y(p), qz, &u, &v) ? tof_[v * width_ + u] : 0;
-      if (measured <= 0) {
-        sum += clip2_;
-        continue;
-      }
-      const double x = (qz - measured) * points[n].inv_sigma;
-      sum += std::min(x * x, clip2_);
+      const bool landed = lands(m.x(p), m.y(p), qz, &u, &v);
+      add(qz, landed, u, v, points[n].inv_sigma);
     }
     return weight_ * static_cast<double>(every) * sum;
   }
@@ -115,14 +146,20 @@ class PointCost {
     const double inv_z = 1.0 / qz;
     const double uf = fx_ * qx * inv_z + cx_ + 0.5;
     const double vf = fy_ * qy * inv_z + cy_ + 0.5;
-    if (!(uf >= 0 && vf >= 0 && uf < width_ && vf < height_)) return false;
+    if (!in_image(qz, uf, vf)) return false;
     *u = static_cast<int>(uf);
     *v = static_cast<int>(vf);
     return true;
   }
+  // Whether a point at depth qz (mm) whose pixel coordinates are uf, vf
+  // (+0.5, to truncate) is in front of the camera and on the image.
+  bool in_image(double qz, double uf, double vf) const {
+    return qz > 1.0 && uf >= 0 && vf >= 0 && uf < width_d_ && vf < height_d_;
+  }
 
   int width_;
   int height_;
+  double width_d_, height_d_;  // the same as doubles
   double fx_, fy_, cx_, cy_;
   double clip2_;
   double weight_;

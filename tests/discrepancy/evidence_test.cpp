@@ -648,6 +648,73 @@ TEST_F(EvidenceTest, TheCameraRegionsPartitionTheCameraFit) {
   }
 }
 
+// compute_evidence sums the camera fit a row at a time, two parameters at
+// a time (Double2): its score and information must be the plain sums over
+// the fit's pixels of w J r and w J J^T, J the Jacobian at() gives. On a
+// nominal frame (the search explains no static pixel, its gains below 20)
+// the fit's pixels are the static ones with both depths, off the
+// silhouettes, whose residual is within the naming gate.
+TEST_F(EvidenceTest, TheCameraFitIsTheSumOverItsPixels) {
+  const JointPositions q = estimator::test::side_reach_pose();
+  const Intrinsics& in = config_->camera.intrinsics;
+  const depth_image_t cam = make_depth_image("cam", in, 1, 1, true, frames_->capture(q, camera(), in, 79));
+  const Frame model = render_frame(&frames_->renderer(), frames_->scene(), q, camera(), in);
+  Parameters p = parameters(*config_);
+  p.evidence.search_range_rad = 0;
+  p.evidence.search_range_m = 0;
+  const std::vector<uint8_t> silhouette = silhouette_mask(model.depth, p.silhouette_jump_mm);
+  discrepancy_t s{};
+  compute_evidence(cam, model.depth, model.labels, silhouette, p.silhouette_jump_mm, p.tolerance.noise,
+                   p.evidence, &s);
+  ASSERT_TRUE(s.evidence_available);
+  for (int j = 0; j < s.num_joints; ++j) ASSERT_EQ(s.joint_search_gain[j], 0.0) << s.joint_name[j];
+  const EvidenceJacobian jacobian(model.depth, model.labels, p.silhouette_jump_mm);
+  std::vector<double> joints(jacobian.num_joints());
+  Eigen::Matrix<double, 6, 1> score = Eigen::Matrix<double, 6, 1>::Zero();
+  Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();
+  int pixels = 0;
+  const double model_var = p.evidence.model_sigma_mm * p.evidence.model_sigma_mm;
+  for (int i = 0; i < cam.width * cam.height; ++i) {
+    const int t = cam.depth_mm[i];
+    const int g = model.depth.depth_mm[i];
+    double jc[6];
+    bool moved = false;
+    int link = -1;
+    if (t <= 0 || g <= 0 || silhouette[i] || !jacobian.at(i, jc, joints.data(), &moved, &link) || moved)
+      continue;
+    const double sigma = p.tolerance.noise.sigma_mm(t);
+    const double var = sigma * sigma + model_var;
+    if (std::abs(g - t) > p.evidence.naming_gate_sigmas * std::sqrt(var)) continue;
+    const double limit = p.evidence.clip_sigmas * std::sqrt(var);
+    const double r = std::clamp(static_cast<double>(g - t), -limit, limit);
+    const Eigen::Map<const Eigen::Matrix<double, 6, 1>> j(jc);
+    score -= j * (r / var);
+    information += j * j.transpose() / var;
+    ++pixels;
+  }
+  EXPECT_EQ(s.camera_fit_pixels, pixels);
+  ASSERT_GT(pixels, 1000);
+  const Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>> info(s.camera_information);
+  for (int a = 0; a < 6; ++a) {
+    EXPECT_NEAR(s.camera_score[a], score[a], 1e-9 * std::sqrt(information(a, a))) << a;
+    for (int c = 0; c < 6; ++c) {
+      EXPECT_NEAR(info(a, c), information(a, c), 1e-9 * std::sqrt(information(a, a) * information(c, c)))
+          << a << ", " << c;
+    }
+  }
+}
+
+// silhouette_step_limit_mm is silhouette_step in whole millimetres, for
+// every step of two depths and jumps whole, fractional, tiny, huge and NaN.
+TEST(SilhouetteStep, TheIntegerLimitGivesTheSameSteps) {
+  for (double jump : {50.0, 50.4, 49.99, 1.0, 0.5, 0.0, -3.0, 1e9, 3e10, std::nan("")}) {
+    const int limit = silhouette_step_limit_mm(jump);
+    for (int step = 0; step <= 70000; step += (step < 200 ? 1 : 997)) {
+      EXPECT_EQ(step > limit, silhouette_step(0, step, jump)) << "jump " << jump << ", step " << step;
+    }
+  }
+}
+
 TEST_F(EvidenceTest, AStillArmShowsNoJointOffsetFromOneMixedPixel) {
   // The default arm halted where safety_chain_e2e_test's arm once stopped
   // (JOINT_STATE of the run): a pixel of link7 lies beside a scene step of

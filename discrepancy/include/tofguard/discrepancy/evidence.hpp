@@ -138,6 +138,16 @@ inline bool silhouette_step(int a_mm, int b_mm, double silhouette_jump_mm) {
   return std::abs(a_mm - b_mm) > silhouette_jump_mm - 1.0;
 }
 
+// silhouette_step's test in whole millimetres: silhouette_step(a, b, j) is
+// std::abs(a - b) > silhouette_step_limit_mm(j) (an integer is above x
+// exactly when it is above floor(x)); a NaN or huge jump never steps, a
+// jump of at most 1 mm always does.
+inline int silhouette_step_limit_mm(double silhouette_jump_mm) {
+  const double x = silhouette_jump_mm - 1.0;
+  if (!(x < 1e9)) return 1000000000;  // above any step of two int16 depths
+  return x > -1.0 ? static_cast<int>(std::floor(x)) : -1;
+}
+
 // Per-pixel Jacobians of a rendered frame and its labels' kinematics.
 // Keeps pointers into `rendered` and `labels`: they must outlive it.
 class EvidenceJacobian {
@@ -165,11 +175,21 @@ class EvidenceJacobian {
   bool at(int u, int v, double camera[6], double* joints, bool* moved, int* link) const;
 
  private:
+  // Both at()s' body, defined inline in evidence.cpp so that
+  // compute_evidence's loop has it without a call per pixel. Writes only
+  // the Jacobian that applies: camera[] for a static pixel, joints[] for
+  // a moved one (at() zeroes the other).
+  bool at_pixel(int u, int v, double camera[6], double* joints, bool* moved, int* link) const;
+  bool at_zeroing_the_other(int u, int v, double camera[6], double* joints, bool* moved, int* link) const;
+  friend void compute_evidence(const depth_image_t&, const depth_image_t&, const link_labels_t&,
+                               const std::vector<uint8_t>&, double, const DepthNoise&,
+                               const EvidenceParameters&, discrepancy_t*, WorkerPool*, SideTask*);
+
   bool available_ = false;
   int width_ = 0;
   int height_ = 0;
   double fx_ = 1, fy_ = 1, cx_ = 0, cy_ = 0;
-  double jump_mm_ = 0;
+  int jump_limit_mm_ = 0;  // silhouette_step_limit_mm of the jump
   const int16_t* depth_ = nullptr;
   const int16_t* label_ = nullptr;
   LabelKinematics kinematics_;
