@@ -13,7 +13,7 @@
 namespace tofguard::discrepancy {
 namespace {
 
-// The coarse trials' points per joint (see search_joint_offsets).
+// The coarse trials' points per joint, at most (see search_joint_offsets).
 constexpr size_t kCoarsePoints = 1500;
 
 // A rendered robot point: optical frame, mm, and 1 / sigma_i (1/mm).
@@ -262,10 +262,11 @@ void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rend
   };
 
   // Each joint's search: the coarse trials (every `coarse_every`-th point
-  // of each link the joint moves, about kCoarsePoints of the joint's points
-  // in all: they only pick the basin) over +-range in steps, then every
-  // point at no offset and, when a trial beat no offset, at the best trial
-  // and a quarter and a half step either side of it. The trials of all
+  // of each link the joint moves, no more than about kCoarsePoints of the
+  // joint's points in all: they only pick the basin) over +-range in
+  // steps, then every point at no offset and, when a trial beat no offset,
+  // at the best trial and a quarter and a half step either side of it.
+  // The trials of all
   // joints are one list of tasks (WorkerPool), each writing its own cost:
   // a base joint's trials move every robot point and a wrist's a few, so
   // tasks per joint left one thread with most of the work. The choices
@@ -295,7 +296,9 @@ void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rend
     if (t.moved.empty()) continue;
     size_t moved_points = 0;
     for (const MovedLink& m : t.moved) moved_points += m.points->size();
-    t.coarse_every = std::max<size_t>(1, moved_points / kCoarsePoints);
+    // At most kCoarsePoints (rounded up: a joint moving 2 999 points takes
+    // every second, not all of them).
+    t.coarse_every = std::max<size_t>(1, (moved_points + kCoarsePoints - 1) / kCoarsePoints);
     const double range = prismatic ? parameters.search_range_m : parameters.search_range_rad;
     t.step = prismatic ? parameters.search_step_m : parameters.search_step_rad;
     t.steps = static_cast<int>(std::floor(range / t.step + 1e-9));
