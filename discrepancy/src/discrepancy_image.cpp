@@ -489,19 +489,24 @@ std::vector<uint8_t> silhouette_mask(const depth_image_t& rendered, double silho
   const int height = rendered.height;
   const int16_t* gen = rendered.depth_mm.data();
   std::vector<uint8_t> silhouette(static_cast<size_t>(width) * height, 0);
-  for (int v = 0; v < height && silhouette_jump_mm > 0; ++v) {
+  if (!(silhouette_jump_mm > 0)) return silhouette;
+  // silhouette_step in whole millimetres; a pixel with depth beside one
+  // without is a silhouette too.
+  const int limit = silhouette_step_limit_mm(silhouette_jump_mm);
+  const auto step = [limit](int a, int b) {
+    return (a > 0) != (b > 0) || (a > 0 && std::abs(a - b) > limit);
+  };
+  uint8_t* mask = silhouette.data();
+  for (int v = 0; v < height; ++v) {
+    const int row = v * width;
+    for (int u = 0; u + 1 < width; ++u) {
+      if (step(gen[row + u], gen[row + u + 1])) mask[row + u] = mask[row + u + 1] = 1;
+    }
+  }
+  for (int v = 0; v + 1 < height; ++v) {
+    const int row = v * width;
     for (int u = 0; u < width; ++u) {
-      const int i = v * width + u;
-      const int neighbours[2] = {u + 1 < width ? i + 1 : -1, v + 1 < height ? i + width : -1};
-      for (int n : neighbours) {
-        if (n < 0) continue;
-        const int a = gen[i] > 0 ? gen[i] : 0;
-        const int b = gen[n] > 0 ? gen[n] : 0;
-        if ((a > 0) != (b > 0) || (a > 0 && silhouette_step(a, b, silhouette_jump_mm))) {
-          silhouette[i] = 1;
-          silhouette[n] = 1;
-        }
-      }
+      if (step(gen[row + u], gen[row + width + u])) mask[row + u] = mask[row + width + u] = 1;
     }
   }
   return silhouette;
