@@ -110,6 +110,10 @@ class PointCost {
       const double x = (qz - measured) * inv_sigma;
       sum += std::min(x * x, clip2_);
     };
+    const Double2 one_mm = {1.0, 1.0};
+    const Double2 zero = {0.0, 0.0};
+    const Double2 width = {width_d_, width_d_};
+    const Double2 height = {height_d_, height_d_};
     size_t n = 0;
     for (; n + every < points.size(); n += 2 * every) {
       const SearchPoint& a = points[n];
@@ -123,8 +127,10 @@ class PointCost {
       const Double2 inv_z = 1.0 / qz;
       const Double2 uf = fx_ * m.apply(0, px, py, pz) * inv_z + cx_ + 0.5;
       const Double2 vf = fy_ * m.apply(1, px, py, pz) * inv_z + cy_ + 0.5;
-      add(qz[0], in_image(qz[0], uf[0], vf[0]), uf[0], vf[0], a.inv_sigma);
-      add(qz[1], in_image(qz[1], uf[1], vf[1]), uf[1], vf[1], b.inv_sigma);
+      // in_image(), both lanes: all ones where it holds.
+      const auto landed = (qz > one_mm) & (uf >= zero) & (vf >= zero) & (uf < width) & (vf < height);
+      add(qz[0], landed[0] != 0, uf[0], vf[0], a.inv_sigma);
+      add(qz[1], landed[1] != 0, uf[1], vf[1], b.inv_sigma);
     }
     for (; n < points.size(); n += every) {
       const Eigen::Vector3d& p = points[n].p_mm;
