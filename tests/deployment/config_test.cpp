@@ -1,7 +1,9 @@
 // The deployment config: the embedded default loads, and every kind of
 // mistake gives one line naming the file, the key and what was expected.
 #include <gtest/gtest.h>
+
 #include <sys/stat.h>
+#include <algorithm>
 
 #include <string>
 
@@ -61,6 +63,19 @@ TEST(Config, EmbeddedDefaultLoads) {
   EXPECT_TRUE(config.joints_sim.publish_plan);
   EXPECT_TRUE(config.renderer.prediction_enabled);
   EXPECT_EQ(config.renderer.camera_pose_max_extrapolation_us, 40000);
+}
+
+// The embedded default's deadlines fit together (config/sim.yaml,
+// intervention.risk_deadline_ms): tofguard-risk names a stalled camera or
+// discrepancy (its deadline + its check + 10 ms) before tofguard-intervene
+// sees the verdicts stop, and a silent tofguard-risk still stops the arm
+// within 200 ms (the deadline + one status tick + 10 ms).
+TEST(Config, TheRiskMonitorNamesAStalledInputBeforeTheInterveneSeesItSilent) {
+  const deployment::Config config = deployment::load_config(sim_yaml_path(), nullptr);
+  const int64_t inputs_us = std::max(config.risk.depth_deadline_us, config.risk.discrepancy_deadline_us);
+  EXPECT_GE(config.intervention.risk_deadline_us, inputs_us + config.risk.check_period_us + 10'000);
+  const auto tick_us = static_cast<int64_t>(1e6 / config.intervention.publish_rate_hz);
+  EXPECT_LE(config.intervention.risk_deadline_us + tick_us + 10'000, 200'000);
 }
 
 // Durations are read once, rounded to the nearest microsecond: what the
