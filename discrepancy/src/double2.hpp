@@ -3,8 +3,11 @@
 // loops (GCC's and Clang's vector extension: SSE2 on x86-64, NEON on
 // arm64). Each lane's +, -, * and / are the scalar ones (IEEE), so a sum
 // or a point computed two lanes at a time is the same to the last bit as
-// one at a time: the speed changes, the numbers do not (the bench digests,
-// docs/benchmarks.md).
+// one at a time where the compiler fuses no multiply-add (x86-64 without
+// -march: the bench digests, docs/benchmarks.md). Where it may fuse
+// (arm64) the lanes and the scalar code can differ in the last bit; each
+// pixel and point still takes one fixed path, so the results never depend
+// on the worker threads.
 #include <cstring>
 
 namespace tofguard::discrepancy {
