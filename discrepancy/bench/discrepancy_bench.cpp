@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "joint_motion.hpp"
+#include "scaled_intrinsics.hpp"
 #include "simulated_frames.hpp"
 #include "synthetic_frames.hpp"
 #include "tofguard/common/depth_frame.hpp"
@@ -171,15 +172,8 @@ SimulatedArmFrames make_simulated_arm_frames(int width, int height) {
   tofguard::renderer::DepthRenderer renderer(scene, config.renderer.near_m, config.renderer.far_m);
   const tofguard::robot_model::ArmSpheres cover =
       tofguard::robot_model::cover_arm_with_spheres(scene, config.renderer.arm_cover_cell_m);
-  tofguard::Intrinsics intrinsics = config.camera.intrinsics;
-  const double sx = static_cast<double>(width) / intrinsics.width;
-  const double sy = static_cast<double>(height) / intrinsics.height;
-  intrinsics.width = width;
-  intrinsics.height = height;
-  intrinsics.fx *= sx;
-  intrinsics.fy *= sy;
-  intrinsics.cx = (intrinsics.cx + 0.5) * sx - 0.5;
-  intrinsics.cy = (intrinsics.cy + 0.5) * sy - 0.5;
+  const tofguard::Intrinsics intrinsics =
+      tofguard::test::scaled_intrinsics(config.camera.intrinsics, width, height);
   const Eigen::Isometry3d world_from_optical = config.camera.pose.frame_from_optical();
   for (int i = 0; i < 10; ++i) {
     tofguard::robot_model::JointPositions joints;

@@ -272,12 +272,11 @@ void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rend
   // joint's points in all: they only pick the basin) over +-range in
   // steps, then every point at no offset and, when a trial beat no offset,
   // at the best trial and a quarter and a half step either side of it.
-  // The trials of all
-  // joints are one list of tasks (WorkerPool), each writing its own cost:
-  // a base joint's trials move every robot point and a wrist's a few, so
-  // tasks per joint left one thread with most of the work. The choices
-  // below read the costs in a fixed order, so nothing depends on the
-  // threads.
+  // The trials of all joints are one list of tasks (WorkerPool), each
+  // writing its own cost: a base joint's trials move every robot point and
+  // a wrist's a few, so tasks per joint left one thread with most of the
+  // work. The choices below read the costs in a fixed order, so nothing
+  // depends on the threads.
   struct JointTrials {
     std::vector<MovedLink> moved;
     size_t coarse_every = 1;

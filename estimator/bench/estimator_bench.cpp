@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <vector>
 
+#include "scaled_intrinsics.hpp"
 #include "simulated_frames.hpp"
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/deployment/process_settings.hpp"
@@ -16,19 +17,6 @@
 
 namespace tofguard::estimator {
 namespace {
-
-Intrinsics scaled(const Intrinsics& in, int width, int height) {
-  Intrinsics out = in;
-  const double sx = static_cast<double>(width) / in.width;
-  const double sy = static_cast<double>(height) / in.height;
-  out.width = width;
-  out.height = height;
-  out.fx = in.fx * sx;
-  out.fy = in.fy * sy;
-  out.cx = (in.cx + 0.5) * sx - 0.5;
-  out.cy = (in.cy + 0.5) * sy - 0.5;
-  return out;
-}
 
 // state.range(0) x state.range(1) pixels; state.range(2) frames estimated
 // jointly (estimator.frames_per_estimate: the frame and the ones 33 and 67
@@ -47,8 +35,8 @@ void BM_Estimate(benchmark::State& state) {
   const robot_model::JointPositions truth = {{"a1", -0.6}, {"a2", 1.3}, {"a3", -0.4}, {"a4", 1.2},
                                              {"a5", 0.6},  {"a6", 1.0}, {"a7", -0.4}};
   const Eigen::Isometry3d camera = config.camera.pose.frame_from_optical();
-  const Intrinsics intrinsics =
-      scaled(config.camera.intrinsics, static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  const Intrinsics intrinsics = tofguard::test::scaled_intrinsics(
+      config.camera.intrinsics, static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
   uint64_t frame_index = 0;
   const std::vector<EstimatorFrame> estimated = frames.frames_with_offset(
       truth, camera, intrinsics, "a4", 10 * M_PI / 180, static_cast<int>(state.range(2)), &frame_index);

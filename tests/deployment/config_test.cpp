@@ -3,8 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <sys/stat.h>
-#include <algorithm>
 
+#include <algorithm>
 #include <string>
 
 #include "test_support.hpp"

@@ -650,10 +650,10 @@ TEST_F(EvidenceTest, TheCameraRegionsPartitionTheCameraFit) {
 
 // compute_evidence sums the camera fit a row at a time, two parameters at
 // a time (Double2): its score and information must be the plain sums over
-// the fit's pixels of w J r and w J J^T, J the Jacobian at() gives. On a
-// nominal frame (the search explains no static pixel, its gains below 20)
-// the fit's pixels are the static ones with both depths, off the
-// silhouettes, whose residual is within the naming gate.
+// the fit's pixels of w J r and w J J^T, J the Jacobian at() gives. With
+// no search range (the search then explains no static pixel) the fit's
+// pixels are the static ones with both depths, off the silhouettes, whose
+// residual is within the naming gate.
 TEST_F(EvidenceTest, TheCameraFitIsTheSumOverItsPixels) {
   const JointPositions q = estimator::test::side_reach_pose();
   const Intrinsics& in = config_->camera.intrinsics;

@@ -27,6 +27,7 @@
 #include "plot_panel.hpp"
 #include "proc_stats.hpp"
 #include "report_format.hpp"
+#include "scaled_intrinsics.hpp"
 #include "simulated_frames.hpp"
 #include "test_support.hpp"
 #include "tofguard/common/clock.hpp"
@@ -764,15 +765,6 @@ std::optional<CampaignArm> bench_arm(const std::string& name, const std::string&
   if (name == "iiwa14") return iiwa14_campaign_arm(shared_dir, scene_dir);
   if (name == "kinova") return kinova_gen3_campaign_arm(shared_dir, scene_dir);
   throw std::invalid_argument("--arms: expected default, iiwa14 or kinova, got '" + name + "'");
-}
-
-Intrinsics scaled_intrinsics(const Intrinsics& base, int width, int height) {
-  const double sx = static_cast<double>(width) / base.width;
-  const double sy = static_cast<double>(height) / base.height;
-  // A pixel's centre is at (u, v); its edges at +-0.5: the image's edges
-  // stay at the same rays when (c + 0.5) scales with the size.
-  return Intrinsics(width, height, base.fx * sx, base.fy * sy, (base.cx + 0.5) * sx - 0.5,
-                    (base.cy + 0.5) * sy - 0.5);
 }
 
 std::string write_bench_config(const CampaignArm& arm, const Intrinsics& intrinsics,

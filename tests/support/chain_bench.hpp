@@ -164,10 +164,6 @@ struct BenchReport {
 std::optional<CampaignArm> bench_arm(const std::string& name, const std::string& shared_dir,
                                      const std::string& scene_dir);
 
-// `base` scaled to width x height: the same field of view (fx, cx with the
-// width; fy, cy with the height; pixel centres stay at the same rays).
-Intrinsics scaled_intrinsics(const Intrinsics& base, int width, int height);
-
 // config/sim.yaml for `arm` at `intrinsics` (its robot, environment,
 // camera pose and rate), as the bench's chain runs it, written to
 // output_dir()/<name>.yaml; returns the path.
