@@ -2,6 +2,8 @@
 #include "tofguard/renderer/rendered_kinematics.hpp"
 
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <cstring>
 #include <stdexcept>
 
@@ -17,14 +19,29 @@ constexpr size_t kMaxExtraObjects = 1000;
 // Linear Z is computed from the optical-frame position in the vertex shader
 // and interpolated perspective-correctly, so on every (planar) triangle it
 // is the exact Z of the surface, not the non-linear depth buffer.
+//
+// What changes from draw to draw (the mesh's pose and its label) comes in
+// as per-instance vertex attributes (divisor 1, one instance per draw) from
+// a buffer written once a frame, not as uniforms: Mesa's llvmpipe copies a
+// draw's changed uniforms into a 1 MB upload buffer and takes a new one when
+// it is full, which with a heap that keeps its memory (keep_heap_resident)
+// grew tofguard-renderer's RSS by 1 MB steps (one every ~11 s at 30 Hz) as
+// the freed buffers were split by small blocks. clip_from_optical, the one
+// uniform, is set only when the intrinsics change.
+constexpr GLuint kPositionLocation = 0;
+constexpr GLuint kOpticalFromMeshLocation = 1;  // a mat4: locations 1-4, a column each
+constexpr GLuint kLabelLocation = 5;
 constexpr const char* kVertexShader = R"(#version 300 es
 layout(location = 0) in vec3 position;
-uniform mat4 optical_from_mesh;
+layout(location = 1) in mat4 optical_from_mesh;
+layout(location = 5) in int label;
 uniform mat4 clip_from_optical;
 out highp float z_optical_m;
+flat out int label_of_draw;
 void main() {
   vec4 p = optical_from_mesh * vec4(position, 1.0);
   z_optical_m = p.z;
+  label_of_draw = label;
   gl_Position = clip_from_optical * p;
 }
 )";
@@ -36,10 +53,10 @@ constexpr const char* kFragmentShader = R"(#version 300 es
 precision highp float;
 precision highp int;
 in highp float z_optical_m;
-uniform int label;
+flat in int label_of_draw;
 layout(location = 0) out uvec2 depth_bits_and_label;
 void main() {
-  depth_bits_and_label = uvec2(floatBitsToUint(z_optical_m), uint(label));
+  depth_bits_and_label = uvec2(floatBitsToUint(z_optical_m), uint(label_of_draw));
 }
 )";
 
@@ -110,6 +127,12 @@ struct DepthRenderer::Impl {
     size_t first_index_byte = 0;
     bool cull_back_faces = false;
   };
+  // One draw's per-instance attributes, as the vertex shader reads them.
+  struct DrawParams {
+    float optical_from_mesh[16];  // column-major, as GL wants
+    int32_t label;
+  };
+  static_assert(sizeof(DrawParams) == 17 * 4, "DrawParams is packed: the attribute stride");
 
   Impl(const robot_model::SceneModel& scene_in, double near, double far, EglPlatform platform)
       : scene(scene_in), context(platform), near_m(near), far_m(far) {
@@ -124,7 +147,7 @@ struct DepthRenderer::Impl {
     }
     glDeleteFramebuffers(1, &framebuffer);
     glDeleteRenderbuffers(2, renderbuffers);
-    glDeleteBuffers(2, buffers);
+    glDeleteBuffers(3, buffers);
     glDeleteVertexArrays(1, &vertex_array);
     glDeleteProgram(program);
   }
@@ -142,9 +165,7 @@ struct DepthRenderer::Impl {
     glGetProgramiv(program, GL_LINK_STATUS, &ok);
     if (!ok) throw RenderError("GL: shader program does not link");
     glUseProgram(program);
-    optical_from_mesh_location = glGetUniformLocation(program, "optical_from_mesh");
     clip_from_optical_location = glGetUniformLocation(program, "clip_from_optical");
-    label_location = glGetUniformLocation(program, "label");
 
     // Every mesh in one vertex buffer and one index buffer (ES 3.0 has no
     // base-vertex draws, so the indices are made absolute here).
@@ -159,15 +180,21 @@ struct DepthRenderer::Impl {
     }
     glGenVertexArrays(1, &vertex_array);
     glBindVertexArray(vertex_array);
-    glGenBuffers(2, buffers);
+    glGenBuffers(3, buffers);
     glBindBuffer(GL_ARRAY_BUFFER, buffers[0]);
     glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(float)), vertices.data(),
                  GL_STATIC_DRAW);
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, buffers[1]);
     glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(indices.size() * sizeof(uint32_t)),
                  indices.data(), GL_STATIC_DRAW);
-    glEnableVertexAttribArray(0);
-    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), nullptr);
+    glEnableVertexAttribArray(kPositionLocation);
+    glVertexAttribPointer(kPositionLocation, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), nullptr);
+    for (GLuint column = 0; column < 4; ++column) {
+      glEnableVertexAttribArray(kOpticalFromMeshLocation + column);
+      glVertexAttribDivisor(kOpticalFromMeshLocation + column, 1);
+    }
+    glEnableVertexAttribArray(kLabelLocation);
+    glVertexAttribDivisor(kLabelLocation, 1);
 
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
@@ -215,17 +242,44 @@ struct DepthRenderer::Impl {
     return "";
   }
 
-  void draw(int mesh_index, const Eigen::Matrix4d& optical_from_mesh, int label) {
+  void add_draw(int mesh_index, const Eigen::Matrix4d& optical_from_mesh, int label) {
+    DrawParams params{};
     const Eigen::Matrix4f m = to_float(optical_from_mesh);
-    glUniformMatrix4fv(optical_from_mesh_location, 1, GL_FALSE, m.data());  // column-major, as GL wants
-    glUniform1i(label_location, label);
-    const DrawRange& range = ranges[mesh_index];
-    if (range.cull_back_faces != culling) {
-      culling = range.cull_back_faces;
-      culling ? glEnable(GL_CULL_FACE) : glDisable(GL_CULL_FACE);
+    std::memcpy(params.optical_from_mesh, m.data(), sizeof params.optical_from_mesh);
+    params.label = label;
+    draw_meshes.push_back(mesh_index);
+    draw_params.push_back(params);
+  }
+
+  // Writes every draw's attributes into buffers[2] (grown when a frame has
+  // more draws than any before) and draws each mesh as one instance whose
+  // attributes start at its own record.
+  void draw_all() {
+    const GLsizeiptr bytes = static_cast<GLsizeiptr>(draw_params.size() * sizeof(DrawParams));
+    glBindBuffer(GL_ARRAY_BUFFER, buffers[2]);
+    if (bytes > draw_params_capacity_bytes) {
+      glBufferData(GL_ARRAY_BUFFER, bytes, draw_params.data(), GL_DYNAMIC_DRAW);
+      draw_params_capacity_bytes = bytes;
+    } else {
+      glBufferSubData(GL_ARRAY_BUFFER, 0, bytes, draw_params.data());
     }
-    glDrawElements(GL_TRIANGLES, range.index_count, GL_UNSIGNED_INT,
-                   reinterpret_cast<const void*>(range.first_index_byte));
+    constexpr GLsizei stride = sizeof(DrawParams);
+    for (size_t i = 0; i < draw_meshes.size(); ++i) {
+      const size_t record = i * sizeof(DrawParams);
+      for (GLuint column = 0; column < 4; ++column) {
+        glVertexAttribPointer(kOpticalFromMeshLocation + column, 4, GL_FLOAT, GL_FALSE, stride,
+                              reinterpret_cast<const void*>(record + column * 4 * sizeof(float)));
+      }
+      glVertexAttribIPointer(kLabelLocation, 1, GL_INT, stride,
+                             reinterpret_cast<const void*>(record + offsetof(DrawParams, label)));
+      const DrawRange& range = ranges[draw_meshes[i]];
+      if (range.cull_back_faces != culling) {
+        culling = range.cull_back_faces;
+        culling ? glEnable(GL_CULL_FACE) : glDisable(GL_CULL_FACE);
+      }
+      glDrawElementsInstanced(GL_TRIANGLES, range.index_count, GL_UNSIGNED_INT,
+                              reinterpret_cast<const void*>(range.first_index_byte), 1);
+    }
   }
 
   RenderResult render_at(const robot_model::LinkPoses& poses, const Eigen::Isometry3d& world_from_optical,
@@ -272,16 +326,22 @@ struct DepthRenderer::Impl {
     const GLfloat far_depth = 1.0f;
     glClearBufferfv(GL_DEPTH, 0, &far_depth);
     const Eigen::Matrix4f projection = to_float(clip_from_optical(intrinsics, near_m, far_m));
-    glUniformMatrix4fv(clip_from_optical_location, 1, GL_FALSE, projection.data());
+    if (!projection_set || projection != last_projection) {
+      glUniformMatrix4fv(clip_from_optical_location, 1, GL_FALSE, projection.data());
+      last_projection = projection;
+      projection_set = true;
+    }
 
     const Eigen::Isometry3d optical_from_world = world_from_optical.inverse();
+    draw_meshes.clear();
+    draw_params.clear();
     for (const robot_model::Shape& shape : scene.shapes) {
       // SceneModel::links: the robot's first, then the environment's.
       const int label = label_of_link(shape.link_index, scene.num_robot_links);
       const Eigen::Matrix4d optical_from_mesh =
           (optical_from_world * poses.world_from_link[shape.link_index] * shape.link_from_shape).matrix() *
           shape.scale.homogeneous().asDiagonal();
-      draw(shape.mesh_index, optical_from_mesh, label);
+      add_draw(shape.mesh_index, optical_from_mesh, label);
     }
     for (size_t i = 0; i < extra_objects.size(); ++i) {
       const ExtraObject& o = extra_objects[i];
@@ -290,8 +350,9 @@ struct DepthRenderer::Impl {
                                                               : robot_model::kUnitCylinder;
       const Eigen::Matrix4d optical_from_mesh =
           (optical_from_world * o.world_from_object).matrix() * o.size_m.homogeneous().asDiagonal();
-      draw(mesh, optical_from_mesh, kLabelExtraObjectFirst + static_cast<int>(i));
+      add_draw(mesh, optical_from_mesh, kLabelExtraObjectFirst + static_cast<int>(i));
     }
+    draw_all();
 
     // glReadPixels writes width * height texels of read_channels uint32 each
     // into readback: a buffer sized for another framebuffer would be a heap
@@ -325,11 +386,17 @@ struct DepthRenderer::Impl {
   double near_m;
   double far_m;
   GLuint program = 0;
-  GLint optical_from_mesh_location = -1;
   GLint clip_from_optical_location = -1;
-  GLint label_location = -1;
+  bool projection_set = false;
+  Eigen::Matrix4f last_projection;
   GLuint vertex_array = 0;
-  GLuint buffers[2] = {0, 0};
+  // The meshes' vertices, their indices, and the draws' per-instance
+  // attributes (DrawParams).
+  GLuint buffers[3] = {0, 0, 0};
+  // This frame's draws: the mesh and its attributes.
+  std::vector<int> draw_meshes;
+  std::vector<DrawParams> draw_params;
+  GLsizeiptr draw_params_capacity_bytes = 0;
   GLuint framebuffer = 0;
   GLuint renderbuffers[2] = {0, 0};
   std::vector<DrawRange> ranges;
