@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -35,10 +36,11 @@ namespace {
 //   (keep_heap_resident in tofguard-renderer and -discrepancy: RSS is the
 //   heap's high-water mark) reaching a new mark when a rarer event first
 //   happens, or llvmpipe compiling a shader variant: at most 4 MiB in all.
-//   Measured: tofguard-renderer +0.8-1.0 MB at about 50 s in 3 of 3 runs
-//   (llvmpipe on 0 or 2 threads), flat before and after; once a second
-//   step at 115 s, 2056 kB in all, over the 2 MiB this bound was before.
-//   The most new highs of any process in those runs: 6 of 18 samples.
+//   tofguard-renderer's 1 MB steps (2-4 MB in two minutes on CI, over this
+//   bound twice) were llvmpipe's 1 MB upload buffers for the uniforms set
+//   per draw, one every ~345 frames; the renderer no longer sets uniforms
+//   per draw, and renderer_heap_test counts those blocks.
+//   The most new highs of any process in the runs before: 6 of 18 samples.
 constexpr int64_t kRssGrowthBoundKb = 4096;
 
 double env_seconds(const char* name, double fallback) {
@@ -57,6 +59,40 @@ TEST(Soak, NominalRunHasNoFalseStopsAndNoResourceGrowth) {
   LiveChain chain("soak");
   chain.bring_to_motion("start of the soak");
   if (HasFatalFailure()) return;
+  // The last frame verdicts as they arrived, to show on a false stop what
+  // led to it: seq jumps (frames the camera skipped or a process lost) and
+  // gaps between arrivals (a stage or the machine stalled).
+  struct VerdictSeen {
+    int64_t arrival_us;
+    int64_t seq;
+    std::string level;
+  };
+  std::deque<VerdictSeen> recent_verdicts;
+  chain.on_frame_verdict = [&](const risk_t& r) {
+    recent_verdicts.push_back({monotonic_us(), r.seq, risk_level_name(r.level)});
+    if (recent_verdicts.size() > 30) recent_verdicts.pop_front();
+  };
+  const auto explain_stop = [&](int64_t stop_us) {
+    std::ostringstream why;
+    why << "the last frame verdicts before it (arrival relative to the stop, ms; seq; gap to the one before, "
+           "ms):\n";
+    for (size_t i = 0; i < recent_verdicts.size(); ++i) {
+      const VerdictSeen& v = recent_verdicts[i];
+      why << "  " << (v.arrival_us - stop_us) / 1000.0 << "  seq " << v.seq << "  " << v.level;
+      if (i > 0) {
+        why << "  gap " << (v.arrival_us - recent_verdicts[i - 1].arrival_us) / 1000.0;
+        if (v.seq != recent_verdicts[i - 1].seq + 1)
+          why << "  (seq jumps by " << v.seq - recent_verdicts[i - 1].seq << ")";
+      }
+      why << "\n";
+    }
+    why << "heartbeats (frames in / out / dropped, status):\n";
+    for (const auto& [process, hb] : chain.heartbeats()) {
+      why << "  " << process << ": " << hb.frames_in << " / " << hb.frames_out << " / " << hb.frames_dropped
+          << ", " << hb.status << "\n";
+    }
+    return why.str() + chain.stderr_of_all();
+  };
   const int stops_at_start = chain.stops_seen();
   const int64_t verdicts_at_start = chain.frame_verdicts();
   std::vector<std::string> stop_reasons;
@@ -88,7 +124,8 @@ TEST(Soak, NominalRunHasNoFalseStopsAndNoResourceGrowth) {
           last_stops = chain.stops_seen();
           stop_reasons.push_back(std::to_string((now - start_us) / 1'000'000) +
                                  " s: " + chain.last_status().reason);
-          std::cout << "FALSE STOP at " << stop_reasons.back() << std::endl;
+          std::cout << "FALSE STOP at " << stop_reasons.back() << "\n"
+                    << explain_stop(chain.stop_arrivals_us().back()) << std::endl;
         }
         if (now >= next_sample_us) {
           next_sample_us += static_cast<int64_t>(sample_s * 1e6);
