@@ -36,6 +36,7 @@
 #endif
 #endif
 
+#ifndef TOFGUARD_ALLOCATOR_INTERCEPTED
 namespace {
 
 constexpr size_t kLargeBlockBytes = 512 * 1024;
@@ -44,7 +45,6 @@ std::atomic<int> large_aligned_blocks{0};
 
 }  // namespace
 
-#ifndef TOFGUARD_ALLOCATOR_INTERCEPTED
 extern "C" int posix_memalign(void** block, size_t alignment, size_t size) {
   using PosixMemalign = int (*)(void**, size_t, size_t);
   static const PosixMemalign next = reinterpret_cast<PosixMemalign>(dlsym(RTLD_NEXT, "posix_memalign"));
