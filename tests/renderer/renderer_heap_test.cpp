@@ -21,7 +21,7 @@
 
 #include <atomic>
 #include <cmath>
-#include <cstdlib>
+#include <cstddef>
 
 #include "estimator_test_support.hpp"
 #include "scaled_intrinsics.hpp"
@@ -64,8 +64,8 @@ TEST(RendererHeap, SteadyStateFramesTakeNoLargeBlock) {
   const robot_model::SceneModel scene = robot_model::load_scene(
       config.robot.urdf_path, config.environment.urdf_paths, scene_options(config.renderer, config.robot));
   DepthRenderer renderer(scene, config.renderer.near_m, config.renderer.far_m);
-  // Half the camera's size: the draws and their uniforms per frame are the
-  // same, the rasterising cheaper.
+  // Half the camera's size: the draws per frame are the same (what filled
+  // llvmpipe's upload buffer), the rasterising cheaper.
   const Intrinsics intrinsics = tofguard::test::scaled_intrinsics(
       config.camera.intrinsics, config.camera.intrinsics.width / 2, config.camera.intrinsics.height / 2);
   const robot_model::JointPositions centre = estimator::test::reach_pose();
