@@ -204,7 +204,10 @@ TEST(JudgeCampaign, Iiwa14) {
 // camera): the iiwa14 at 25 Hz, its camera turned 40 degrees about the
 // vertical through the robot's root.
 TEST(JudgeCampaign, Iiwa14At25HzFromASecondPlacement) {
-  const std::optional<CampaignArm> arm = iiwa14_campaign_arm(shared_dir(), output_dir() + "/judge_campaign");
+  // (A scene folder of its own: ctest runs this case beside JudgeCampaign.Iiwa14,
+  // which writes the same scene's files.)
+  const std::optional<CampaignArm> arm =
+      iiwa14_campaign_arm(shared_dir(), output_dir() + "/judge_campaign_second_placement");
   if (!arm)
     GTEST_SKIP() << "the iiwa14 is not under ../shared/robots (shared_dir() '" << shared_dir() << "')";
   const CampaignArm moved = with_camera_rate(with_camera_turned(*arm, 40), 25);
