@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "tofguard/common/clock.hpp"
 #include "tofguard/common/config_error.hpp"
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/common/lcm_node.hpp"
@@ -83,6 +84,17 @@ constexpr int kMissesBeforeProbing = 5;
 constexpr int kProbeEveryFrames = 8;
 
 }  // namespace
+
+void PredictionSchedule::rendered(int64_t duration_us) {
+  durations_us_.push_back(duration_us);
+  while (durations_us_.size() > kKeptRenders) durations_us_.pop_front();
+}
+
+int64_t PredictionSchedule::start_us(int64_t period_us) const {
+  if (period_us <= 0 || last_frame_us_ <= 0 || durations_us_.empty()) return 0;
+  const int64_t longest_us = *std::max_element(durations_us_.begin(), durations_us_.end());
+  return last_frame_us_ + period_us - (longest_us + longest_us / 4 + kMarginUs);
+}
 
 void RendererService::on_plan(const planned_trajectory_t& plan) { plan_.add(plan); }
 
@@ -270,9 +282,11 @@ int run_renderer(const RendererProcessSettings& settings) {
   node.subscribe<planned_trajectory_t>(
       node.safety(), settings.channels.planned_trajectory,
       [&](const planned_trajectory_t& plan) { service->on_plan(plan); }, check_planned_trajectory);
+  PredictionSchedule schedule;
   node.subscribe<depth_image_t>(
       node.images(), settings.channels.depth,
       [&](const depth_image_t& frame) {
+        schedule.frame_arrived(monotonic_us());
         if (service->on_depth(frame)) node.counters().frames_dropped++;
       },
       check_depth_image);
@@ -293,12 +307,23 @@ int run_renderer(const RendererProcessSettings& settings) {
                                 std::to_string(p.misses) + " misses, " + std::to_string(p.without) +
                                 " frames without one, " + std::to_string(p.rendered) + " rendered ahead");
   };
-  while (node.spin_once(service->has_pending() || service->has_prediction_to_render() ? 0 : 20)) {
+  // Idle: how long to wait for messages before the render ahead is due.
+  const auto idle_wait_ms = [&]() -> int {
+    if (!service->has_prediction_to_render()) return 20;
+    const int64_t left_us = schedule.start_us(service->frame_period_us()) - monotonic_us();
+    return left_us <= 0 ? 0 : static_cast<int>(std::min<int64_t>(20, (left_us + 999) / 1000));
+  };
+  while (node.spin_once(service->has_pending() ? 0 : idle_wait_ms())) {
     if (!service->has_pending()) {
-      // Idle: render the next frame ahead from the plan, unless a frame
-      // has come meanwhile.
+      // Idle: render the next frame ahead from the plan when it is due,
+      // unless a frame has come meanwhile.
       drain();
-      if (!service->has_pending()) service->render_prediction();
+      if (!service->has_pending() && service->has_prediction_to_render() &&
+          monotonic_us() >= schedule.start_us(service->frame_period_us())) {
+        const int64_t start_us = monotonic_us();
+        service->render_prediction();
+        schedule.rendered(monotonic_us() - start_us);
+      }
       continue;
     }
     drain();

@@ -186,5 +186,32 @@ TEST(RendererService, IgnoresOtherRobotsAndRefusesFarBeyondInt16) {
   EXPECT_THROW(RendererService{deployment::renderer_process_settings(config)}, std::invalid_argument);
 }
 
+// The render ahead starts as late as lets it finish before its frame is
+// due: the last frame's arrival + the period - (the longest of the last 8
+// renders x 1.25 + 2 ms); at once before there is a period or a render.
+TEST(PredictionSchedule, StartsAsLateAsTheLongestRecentRenderAllows) {
+  PredictionSchedule schedule;
+  EXPECT_EQ(schedule.start_us(33'333), 0);  // no frame, no render yet
+  schedule.frame_arrived(1'000'000);
+  EXPECT_EQ(schedule.start_us(33'333), 0);  // no render yet
+  schedule.rendered(900);
+  EXPECT_EQ(schedule.start_us(0), 0);  // no period learned
+  // 1 000 000 + 33 333 - (900 + 225 + 2 000)
+  EXPECT_EQ(schedule.start_us(33'333), 1'030'208);
+  // The longest of the kept renders counts: a 20 ms render leaves 8.3 ms.
+  schedule.rendered(20'000);
+  EXPECT_EQ(schedule.start_us(33'333), 1'000'000 + 33'333 - 27'000);
+  // A render longer than the period: start at once (a time already past).
+  schedule.rendered(40'000);
+  EXPECT_LT(schedule.start_us(33'333), 1'000'000);
+  // Only the last 8 renders are kept: after 8 short ones the long ones are
+  // forgotten.
+  for (int i = 0; i < 8; ++i) schedule.rendered(1'000);
+  EXPECT_EQ(schedule.start_us(33'333), 1'000'000 + 33'333 - (1'000 + 250 + 2'000));
+  // The next frame moves the schedule with it.
+  schedule.frame_arrived(1'033'333);
+  EXPECT_EQ(schedule.start_us(33'333), 1'033'333 + 33'333 - 3'250);
+}
+
 }  // namespace
 }  // namespace tofguard::renderer

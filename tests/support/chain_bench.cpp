@@ -8,12 +8,14 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <cstdio>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
@@ -35,7 +37,9 @@
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/discrepancy/discrepancy_image.hpp"
 #include "tofguard/discrepancy_t.hpp"
+#include "tofguard/heartbeat_t.hpp"
 #include "tofguard/joint_state_t.hpp"
+#include "tofguard/planned_trajectory_t.hpp"
 #include "tofguard/renderer/depth_renderer.hpp"
 #include "tofguard/renderer/rendered_kinematics.hpp"
 #include "tofguard/renderer/renderer_process.hpp"
@@ -61,6 +65,11 @@ constexpr int kMaxPreparedFrames = 150;
 // Joint states between frames at this period at least (the arm driver's
 // 100 Hz of config/sim.yaml), besides one at each frame's utime.
 constexpr int64_t kJointStatePeriodUs = 10000;
+// With BenchOptions::plan: a chunk of the plan every kPlanChunkFrames frames,
+// reaching 2 * kPlanChunkFrames frames ahead (a few kB on the safety URL,
+// whatever the step's length; each chunk replaces the plan from its first
+// point on).
+constexpr int64_t kPlanChunkFrames = 30;
 // Frames in a row that must come through before the measured step starts.
 constexpr int kWarmupFrames = 5;
 // The chain's start (EGL, mesh loading, the arm's cover of spheres) may
@@ -127,6 +136,7 @@ class ArrivalRecorder {
     images_.subscribe(config.channels.rendered, &ArrivalRecorder::on_rendered, this);
     safety_.subscribe(config.channels.discrepancy, &ArrivalRecorder::on_discrepancy, this);
     safety_.subscribe(config.channels.risk, &ArrivalRecorder::on_risk, this);
+    safety_.subscribe(config.channels.heartbeat, &ArrivalRecorder::on_heartbeat, this);
     thread_ = std::thread([this] { receive(); });
   }
   ~ArrivalRecorder() {
@@ -169,6 +179,35 @@ class ArrivalRecorder {
   void forget_before(int64_t seq) {
     std::lock_guard<std::mutex> lock(mutex_);
     for (auto it = frames_.begin(); it != frames_.end();) it = it->first < seq ? frames_.erase(it) : ++it;
+  }
+  // tofguard-renderer's prediction counts (its heartbeat's status: "...;
+  // prediction: N hits, M misses, W frames without one, ..."), from the
+  // first of its heartbeats received after `after_us` (monotonic), waiting
+  // for one until `deadline_us`; nullopt when none came or it did not say.
+  struct PredictionCounts {
+    int64_t hits = 0;
+    int64_t misses = 0;
+    int64_t without = 0;
+  };
+  std::optional<PredictionCounts> renderer_prediction(int64_t after_us, int64_t deadline_us) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    while (renderer_heartbeat_us_ <= after_us) {
+      const int64_t left_us = deadline_us - monotonic_us();
+      if (left_us <= 0) return std::nullopt;
+      heartbeat_.wait_for(lock, std::chrono::microseconds(std::min<int64_t>(left_us, 20000)));
+    }
+    const size_t at = renderer_status_.find("prediction: ");
+    if (at == std::string::npos) return std::nullopt;
+    PredictionCounts c;
+    long long hits = 0, misses = 0, without = 0;
+    if (std::sscanf(renderer_status_.c_str() + at,
+                    "prediction: %lld hits, %lld misses, %lld frames without one", &hits, &misses,
+                    &without) != 3)
+      return std::nullopt;
+    c.hits = hits;
+    c.misses = misses;
+    c.without = without;
+    return c;
   }
   // The largest TOF_RENDERED, SAFETY_DISCREPANCY and SAFETY_RISK received
   // for the bench's frames, bytes (0: none came).
@@ -219,11 +258,22 @@ class ArrivalRecorder {
   void on_risk(const lcm::ReceiveBuffer* b, const std::string&) {
     record(b, risk_t::getHash(), Stage::kRisk);
   }
+  void on_heartbeat(const lcm::ReceiveBuffer* b, const std::string&) {
+    heartbeat_t h;
+    if (h.decode(b->data, 0, static_cast<int>(b->data_size)) < 0 || h.process != "tofguard-renderer") return;
+    std::lock_guard<std::mutex> lock(mutex_);
+    renderer_status_ = h.status;
+    renderer_heartbeat_us_ = monotonic_us();
+    heartbeat_.notify_all();
+  }
 
   lcm::LCM safety_;
   lcm::LCM images_;
   mutable std::mutex mutex_;
   std::condition_variable verdict_;
+  std::condition_variable heartbeat_;
+  std::string renderer_status_;
+  int64_t renderer_heartbeat_us_ = 0;
   std::unordered_map<int64_t, FrameArrivals> frames_;
   size_t largest_[3] = {0, 0, 0};
   std::atomic<bool> stop_{false};
@@ -375,6 +425,11 @@ class BenchChain {
     std::map<std::string, ProcSample> cpu_before;
     for (const auto& [name, p] : processes_) cpu_before[name] = sample_proc(p->pid());
     cpu_before[kBenchProcess] = sample_proc(getpid());
+    // (Before the step: the renderer's counts so far, from a heartbeat
+    // after the warm-up's last verdict; its heartbeats come at 20 Hz.)
+    std::optional<ArrivalRecorder::PredictionCounts> prediction_before;
+    if (options_.plan)
+      prediction_before = recorder_->renderer_prediction(monotonic_us(), monotonic_us() + 1000000);
     const int64_t start_us = monotonic_us();
     const int64_t first_seq = next_seq_;
     publish(path, 0, frames);
@@ -410,6 +465,14 @@ class BenchChain {
         if (a.level == risk_t::SAFE) ++step.frames_safe;
       }
       if (a.risk_us == 0 || a.risk_us - a.sent_us > options_.result_timeout_us) ++step.frames_dropped;
+    }
+    if (prediction_before) {
+      const auto after = recorder_->renderer_prediction(monotonic_us(), monotonic_us() + 1000000);
+      if (after) {
+        step.prediction_hits = static_cast<int>(after->hits - prediction_before->hits);
+        step.prediction_misses = static_cast<int>(after->misses - prediction_before->misses);
+        step.frames_without_prediction = static_cast<int>(after->without - prediction_before->without);
+      }
     }
     step.render = summarise(render_ms);
     step.discrepancy = summarise(discrepancy_ms);
@@ -545,6 +608,7 @@ class BenchChain {
       // encoder error the risk's sequential test then carried into the
       // measured step's first frames (270-290 SAFE of 300 in some runs).
       at(frame_us - 1000);
+      if (options_.plan && k % kPlanChunkFrames == 0) publish_plan(path, first_k, k, frames, start_utime);
       const int64_t utime = start_utime + frame_us;
       const joint_state_t s = joint_state(path, (first_k * period_us + frame_us) * 1e-6, utime);
       safety_->publish(config_.channels.joint_state, &s);
@@ -558,6 +622,25 @@ class BenchChain {
       last_utime_ = utime;
       ++next_seq_;
     }
+  }
+
+  // The plan's chunk from frame k of a publish() call on: a point at each
+  // frame's capture time up to 2 * kPlanChunkFrames frames ahead (at most
+  // one past the call's last frame), the joints as that frame's own
+  // JOINT_STATE has them.
+  void publish_plan(const ArmPath& path, int64_t first_k, int64_t k, int64_t frames, int64_t start_utime) {
+    const int64_t period_us = std::llround(1e6 / path.rate_hz);
+    planned_trajectory_t plan;
+    plan.utime = wall_utime();
+    plan.joint_name = joint_names_;
+    plan.num_joints = static_cast<int32_t>(joint_names_.size());
+    for (int64_t i = k; i <= std::min(k + 2 * kPlanChunkFrames, frames); ++i) {
+      const int64_t utime = start_utime + i * period_us;
+      plan.point_utime.push_back(utime);
+      plan.position.push_back(joint_state(path, (first_k + i) * period_us * 1e-6, utime).position);
+    }
+    plan.num_points = static_cast<int32_t>(plan.point_utime.size());
+    safety_->publish(config_.channels.planned_trajectory, &plan);
   }
 
   // Publishes until kWarmupFrames frames in a row have come through the
@@ -895,6 +978,24 @@ std::string steps_table(const std::vector<BenchStep>& steps) {
   return t.str();
 }
 
+// With --plan: tofguard-renderer's prediction per step, a line each.
+std::string prediction_lines(const std::vector<BenchStep>& steps) {
+  std::ostringstream t;
+  for (const BenchStep& s : steps) {
+    if (s.prediction_hits < 0) continue;
+    t << "- " << s.arm << ", " << size_text(s.width, s.height) << ", " << fixed_text(s.rate_hz, 0)
+      << " Hz: tofguard-renderer rendered " << s.prediction_hits << " of " << s.frames_sent
+      << " frames ahead from the plan (hits), " << s.prediction_misses << " ahead but off the plan (misses), "
+      << s.frames_without_prediction << " without a prediction\n";
+  }
+  const std::string lines = t.str();
+  return lines.empty()
+             ? lines
+             : "\nWith the arm's path published as its plan (PLANNED_TRAJECTORY, --plan; counts from "
+               "tofguard-renderer's heartbeats before and after each step):\n\n" +
+                   lines;
+}
+
 std::string hop_cell(const HopFloor& h) {
   std::string cell = latency_cell(h.latency, 2) + " (" + std::to_string(h.bytes) + " B";
   if (h.latency.count != h.sent)
@@ -973,7 +1074,7 @@ std::string bench_markdown(const BenchReport& report) {
         "the step; dropped: no verdict within 1 s; SAFE: verdicts SAFE (the chain is judging the nominal "
         "frames, not "
         "stopping).\n\n";
-  if (!report.steps.empty()) md << steps_table(report.steps);
+  if (!report.steps.empty()) md << steps_table(report.steps) << prediction_lines(report.steps);
   if (!report.ramps.empty()) {
     md << "| arm | triangles | size | highest rate sustained (Hz) | stopped at |\n";
     md << "| --- | --- | --- | --- | --- |\n";
@@ -984,7 +1085,7 @@ std::string bench_markdown(const BenchReport& report) {
          << r.stopped_because << " |\n";
       all.insert(all.end(), r.steps.begin(), r.steps.end());
     }
-    md << "\nEvery step of the ramps:\n\n" << steps_table(all);
+    md << "\nEvery step of the ramps:\n\n" << steps_table(all) << prediction_lines(all);
   }
   if (!report.floors.empty()) md << floors_table(report);
   for (const std::string& s : report.skipped) md << "\n" << s << "\n";

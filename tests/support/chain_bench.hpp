@@ -48,6 +48,14 @@ struct BenchOptions {
   // A TOF_DEPTH whose SAFETY_RISK has not come this long after it was sent
   // is dropped.
   int64_t result_timeout_us = 1000000;
+  // Also publish the arm's path as the arm controller's plan
+  // (PLANNED_TRAJECTORY: a point at every frame's capture time, sent in
+  // chunks ahead of the frames), so that tofguard-renderer renders each next
+  // frame ahead while it waits (renderer.prediction; docs/renderer.md) and
+  // a frame within the tolerances of its plan is not rendered on its
+  // critical path. The renderer's hits and misses are reported per step.
+  // Off: no plan, every frame rendered when it comes (the default).
+  bool plan = false;
   // Measure the floors (BenchFloors) after each arm and size's run;
   // floor_frames renders (and compute_discrepancy calls) back to back.
   bool floors = true;
@@ -89,6 +97,14 @@ struct BenchStep {
   // Process name -> CPU time over the step / its wall time, percent of one
   // core; "tofguard-bench" is this process (publisher and receiver).
   std::map<std::string, double> cpu_percent;
+  // With BenchOptions::plan: tofguard-renderer's prediction over the step,
+  // from its heartbeat's status before the step and after its last verdict
+  // (hits: rendered ahead and within the tolerances; misses: rendered ahead,
+  // not within them; without: no prediction for the frame). -1: no plan, or
+  // no heartbeat said.
+  int prediction_hits = -1;
+  int prediction_misses = -1;
+  int frames_without_prediction = -1;
 };
 
 // A ramp on one arm and camera size: the rates tried, the highest one

@@ -5,7 +5,7 @@
 //
 //   tofguard-bench [--arms default,iiwa14,kinova] [--resolutions 176x144,320x240,640x480]
 //                  [--rate-hz 30] [--seconds 10] [--ramp] [--ramp-step-s 3] [--ramp-max-hz 1920]
-//                  [--shared DIR] [--markdown FILE] [--plot FILE.png] [--no-floors]
+//                  [--shared DIR] [--markdown FILE] [--plot FILE.png] [--no-floors] [--plan]
 //
 // --ramp: 30, 60, 120 ... Hz, --ramp-step-s each, up to the first rate with
 // a dropped frame, a stage's p99 above the frame period or a publisher that
@@ -16,6 +16,11 @@
 // same joint path, and one LCM hop of each stage's message size on a scratch
 // channel of the chain's URL at the run's rate; a table of them with each
 // stage's p50 over its floor. --no-floors skips them.
+//
+// --plan: the bench also publishes the arm's path as the controller's plan
+// (PLANNED_TRAJECTORY), so that tofguard-renderer renders each next frame
+// ahead while it waits; the report gives the renderer's hits and misses per
+// step (BenchOptions::plan).
 //
 // Prints the Markdown table (with the machine and the date) to stdout.
 #include <fstream>
@@ -35,7 +40,7 @@ int usage(const std::string& why) {
       << "tofguard-bench: " << why
       << "\nusage: tofguard-bench [--arms default,iiwa14,kinova] [--resolutions 176x144,320x240,640x480] "
          "[--rate-hz 30] [--seconds 10] [--ramp] [--ramp-step-s 3] [--ramp-max-hz 1920] [--shared DIR] "
-         "[--markdown FILE] [--plot FILE.png] [--no-floors]\n";
+         "[--markdown FILE] [--plot FILE.png] [--no-floors] [--plan]\n";
   return 2;
 }
 
@@ -57,6 +62,10 @@ int main(int argc, char** argv) {
     }
     if (option == "--no-floors") {
       options.floors = false;
+      continue;
+    }
+    if (option == "--plan") {
+      options.plan = true;
       continue;
     }
     if (option == "-h" || option == "--help") return usage("the observer chain's speed");

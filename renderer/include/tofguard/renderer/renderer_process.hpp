@@ -31,7 +31,9 @@
 // the tolerance, never the plan's guess beyond it. After 5 misses in a row
 // (an arm that does not follow its plan that closely, or a jittery camera)
 // only every 8th frame is predicted until one hits, so that useless
-// predictions do not double the rendering work.
+// predictions do not double the rendering work. The process renders a
+// prediction as late as still lets it finish before its frame is due
+// (PredictionSchedule), not while the frame just published is being judged.
 #include <deque>
 #include <memory>
 #include <optional>
@@ -66,6 +68,30 @@ constexpr double kMaxFarM = 32.767;
 // The scene options of the renderer's settings (geometry, padding) and the
 // robot's package paths. Throws ModelError for a bad geometry word.
 robot_model::SceneOptions scene_options(const RendererSettings& renderer, const RobotSettings& robot);
+
+// When tofguard-renderer renders the next frame's prediction ahead, on its
+// monotonic clock: as late as still lets the render finish before the frame
+// is due, so that it does not take the cores from the stages judging the
+// frame just published (tofguard-discrepancy starts on it at once; on the
+// 2-core machine a render ahead started at once made the discrepancy stage
+// 1-6 ms slower: docs/benchmarks.md, "The render ahead from a plan").
+// Due: the last frame's arrival plus the camera period; the render is given
+// the longest of its last kKeptRenders durations x 1.25, plus 2 ms. Before
+// there is a period or a duration: at once (0).
+class PredictionSchedule {
+ public:
+  static constexpr size_t kKeptRenders = 8;
+  static constexpr int64_t kMarginUs = 2000;
+  void frame_arrived(int64_t at_us) { last_frame_us_ = at_us; }
+  void rendered(int64_t duration_us);
+  // Monotonic us at which to start the render ahead (0: at once); a time
+  // before now means at once too.
+  int64_t start_us(int64_t period_us) const;
+
+ private:
+  int64_t last_frame_us_ = 0;
+  std::deque<int64_t> durations_us_;
+};
 
 struct RenderedFrame {
   link_labels_t labels;
