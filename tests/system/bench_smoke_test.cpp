@@ -15,13 +15,19 @@
 namespace tofguard::test {
 namespace {
 
-TEST(BenchSmoke, FramesGoThroughEveryStageAtTenHertz) {
+// The default arm at 176x144, 10 Hz for 3 s.
+BenchOptions smoke_options() {
   BenchOptions options;
   options.arms = {"default"};
   options.resolutions = {{176, 144}};
   options.rate_hz = 10;
   options.seconds = 3;
   options.shared_dir = shared_dir();
+  return options;
+}
+
+TEST(BenchSmoke, FramesGoThroughEveryStageAtTenHertz) {
+  const BenchOptions options = smoke_options();
   const BenchReport report = run_bench(options, std::cerr);
   ASSERT_EQ(report.steps.size(), 1u);
   const BenchStep& step = report.steps.front();
@@ -80,14 +86,9 @@ TEST(BenchSmoke, FramesGoThroughEveryStageAtTenHertz) {
 // RendererService): at least a third of the 30 frames. Without the plan,
 // or with other joints in it, there is none.
 TEST(BenchSmoke, WithThePlanFramesAreRenderedAhead) {
-  BenchOptions options;
-  options.arms = {"default"};
-  options.resolutions = {{176, 144}};
-  options.rate_hz = 10;
-  options.seconds = 3;
+  BenchOptions options = smoke_options();
   options.floors = false;
   options.plan = true;
-  options.shared_dir = shared_dir();
   const BenchReport report = run_bench(options, std::cerr);
   ASSERT_EQ(report.steps.size(), 1u);
   const BenchStep& step = report.steps.front();
