@@ -96,6 +96,28 @@ int64_t PredictionSchedule::start_us(int64_t period_us) const {
   return last_frame_us_ + period_us - (longest_us + longest_us / 4 + kMarginUs);
 }
 
+std::string RendererService::prediction_status(const PredictionStats& p) {
+  return "prediction: " + std::to_string(p.hits) + " hits, " + std::to_string(p.misses) + " misses, " +
+         std::to_string(p.without) + " frames without one, " + std::to_string(p.rendered) + " rendered ahead";
+}
+
+std::optional<RendererService::PredictionStats> RendererService::prediction_stats_from_status(
+    const std::string& status) {
+  const size_t at = status.find("prediction: ");
+  if (at == std::string::npos) return std::nullopt;
+  long long hits = 0, misses = 0, without = 0, rendered = 0;
+  if (std::sscanf(status.c_str() + at,
+                  "prediction: %lld hits, %lld misses, %lld frames without one, %lld rendered ahead", &hits,
+                  &misses, &without, &rendered) != 4)
+    return std::nullopt;
+  PredictionStats p;
+  p.hits = hits;
+  p.misses = misses;
+  p.without = without;
+  p.rendered = rendered;
+  return p;
+}
+
 void RendererService::on_plan(const planned_trajectory_t& plan) { plan_.add(plan); }
 
 int64_t RendererService::frame_period_us() const {
@@ -302,10 +324,8 @@ int run_renderer(const RendererProcessSettings& settings) {
     }
   };
   auto status = [&](const std::string& what) {
-    const RendererService::PredictionStats& p = service->prediction_stats();
-    node.heartbeat().set_status(what + "; prediction: " + std::to_string(p.hits) + " hits, " +
-                                std::to_string(p.misses) + " misses, " + std::to_string(p.without) +
-                                " frames without one, " + std::to_string(p.rendered) + " rendered ahead");
+    node.heartbeat().set_status(what + "; " +
+                                RendererService::prediction_status(service->prediction_stats()));
   };
   // Idle: how long to wait for messages before the render ahead is due.
   const auto idle_wait_ms = [&]() -> int {

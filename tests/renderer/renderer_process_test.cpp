@@ -8,7 +8,6 @@
 #include <iostream>
 #include <map>
 #include <optional>
-#include <regex>
 
 #include "test_support.hpp"
 #include "tofguard/common/camera_pose_message.hpp"
@@ -338,12 +337,11 @@ TEST(RendererProcess, FollowsAMovingCameraAtEachFramesUtime) {
   EXPECT_EQ(process.wait(std::chrono::seconds(5)), 0) << process.stderr_text();
 }
 
-// "N hits, M misses" from the renderer's heartbeat status.
+// Hits and misses from the renderer's heartbeat status ({-1, -1}: none said).
 std::pair<int, int> prediction_counts(const heartbeat_t& hb) {
-  static const std::regex counts("prediction: (\\d+) hits, (\\d+) misses");
-  std::smatch m;
-  if (!std::regex_search(hb.status, m, counts)) return {-1, -1};
-  return {std::stoi(m[1].str()), std::stoi(m[2].str())};
+  const auto stats = RendererService::prediction_stats_from_status(hb.status);
+  if (!stats) return {-1, -1};
+  return {static_cast<int>(stats->hits), static_cast<int>(stats->misses)};
 }
 
 TEST(RendererProcess, APlannedFrameIsRenderedAheadAndIdenticalToTheNormalRendering) {

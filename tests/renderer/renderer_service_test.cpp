@@ -186,6 +186,26 @@ TEST(RendererService, IgnoresOtherRobotsAndRefusesFarBeyondInt16) {
   EXPECT_THROW(RendererService{deployment::renderer_process_settings(config)}, std::invalid_argument);
 }
 
+// The heartbeat's prediction text and back: the process writes it, the
+// tools and tests read it (renderer_process_test, tofguard-bench).
+TEST(RendererService, PredictionCountsGoThroughTheHeartbeatStatus) {
+  RendererService::PredictionStats stats;
+  stats.hits = 291;
+  stats.misses = 3;
+  stats.without = 7;
+  stats.rendered = 296;
+  const std::string status = "rendering; " + RendererService::prediction_status(stats);
+  EXPECT_EQ(status, "rendering; prediction: 291 hits, 3 misses, 7 frames without one, 296 rendered ahead");
+  const auto back = RendererService::prediction_stats_from_status(status);
+  ASSERT_TRUE(back.has_value());
+  EXPECT_EQ(back->hits, 291);
+  EXPECT_EQ(back->misses, 3);
+  EXPECT_EQ(back->without, 7);
+  EXPECT_EQ(back->rendered, 296);
+  EXPECT_FALSE(RendererService::prediction_stats_from_status("waiting for frames").has_value());
+  EXPECT_FALSE(RendererService::prediction_stats_from_status("prediction: 3 hits").has_value());
+}
+
 // The render ahead starts as late as lets it finish before its frame is
 // due: the last frame's arrival + the period - (the longest of the last 8
 // renders x 1.25 + 2 ms); at once before there is a period or a render.

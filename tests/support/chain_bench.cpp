@@ -8,7 +8,6 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
-#include <cstdio>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -180,34 +179,18 @@ class ArrivalRecorder {
     std::lock_guard<std::mutex> lock(mutex_);
     for (auto it = frames_.begin(); it != frames_.end();) it = it->first < seq ? frames_.erase(it) : ++it;
   }
-  // tofguard-renderer's prediction counts (its heartbeat's status: "...;
-  // prediction: N hits, M misses, W frames without one, ..."), from the
-  // first of its heartbeats received after `after_us` (monotonic), waiting
-  // for one until `deadline_us`; nullopt when none came or it did not say.
-  struct PredictionCounts {
-    int64_t hits = 0;
-    int64_t misses = 0;
-    int64_t without = 0;
-  };
-  std::optional<PredictionCounts> renderer_prediction(int64_t after_us, int64_t deadline_us) {
+  // tofguard-renderer's prediction counts from the first of its heartbeats
+  // received after `after_us` (monotonic), waiting for one until
+  // `deadline_us`; nullopt when none came or its status did not say.
+  std::optional<renderer::RendererService::PredictionStats> renderer_prediction(int64_t after_us,
+                                                                                int64_t deadline_us) {
     std::unique_lock<std::mutex> lock(mutex_);
     while (renderer_heartbeat_us_ <= after_us) {
       const int64_t left_us = deadline_us - monotonic_us();
       if (left_us <= 0) return std::nullopt;
       heartbeat_.wait_for(lock, std::chrono::microseconds(std::min<int64_t>(left_us, 20000)));
     }
-    const size_t at = renderer_status_.find("prediction: ");
-    if (at == std::string::npos) return std::nullopt;
-    PredictionCounts c;
-    long long hits = 0, misses = 0, without = 0;
-    if (std::sscanf(renderer_status_.c_str() + at,
-                    "prediction: %lld hits, %lld misses, %lld frames without one", &hits, &misses,
-                    &without) != 3)
-      return std::nullopt;
-    c.hits = hits;
-    c.misses = misses;
-    c.without = without;
-    return c;
+    return renderer::RendererService::prediction_stats_from_status(renderer_status_);
   }
   // The largest TOF_RENDERED, SAFETY_DISCREPANCY and SAFETY_RISK received
   // for the bench's frames, bytes (0: none came).
@@ -427,7 +410,7 @@ class BenchChain {
     cpu_before[kBenchProcess] = sample_proc(getpid());
     // (Before the step: the renderer's counts so far, from a heartbeat
     // after the warm-up's last verdict; its heartbeats come at 20 Hz.)
-    std::optional<ArrivalRecorder::PredictionCounts> prediction_before;
+    std::optional<renderer::RendererService::PredictionStats> prediction_before;
     if (options_.plan)
       prediction_before = recorder_->renderer_prediction(monotonic_us(), monotonic_us() + 1000000);
     const int64_t start_us = monotonic_us();

@@ -141,6 +141,14 @@ class RendererService {
 
   const std::string& description() const { return renderer_->description(); }
 
+  // The prediction counts as the process's heartbeat status carries them
+  // ("prediction: N hits, M misses, W frames without one, R rendered
+  // ahead"), and back from a status that contains that text (nullopt when
+  // it does not: another process, or prediction off), for the tools and
+  // tests that read the heartbeat.
+  static std::string prediction_status(const PredictionStats& stats);
+  static std::optional<PredictionStats> prediction_stats_from_status(const std::string& status);
+
  private:
   struct Prediction {
     std::string camera_id;
