@@ -120,17 +120,15 @@ std::optional<RendererService::PredictionStats> RendererService::prediction_stat
 
 void RendererService::on_plan(const planned_trajectory_t& plan) { plan_.add(plan); }
 
-int64_t RendererService::frame_period_us() const {
-  if (frame_intervals_us_.empty()) return 0;
-  std::vector<int64_t> sorted(frame_intervals_us_.begin(), frame_intervals_us_.end());
-  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-  return sorted[sorted.size() / 2];
-}
-
+// The median of the kept intervals, learned once per frame: the process
+// asks for it at every idle wake-up (PredictionSchedule).
 void RendererService::learn_period(const depth_image_t& frame) {
   if (last_frame_utime_ && frame.utime > *last_frame_utime_) {
     frame_intervals_us_.push_back(frame.utime - *last_frame_utime_);
     while (frame_intervals_us_.size() > kKeptIntervals) frame_intervals_us_.pop_front();
+    std::vector<int64_t> sorted(frame_intervals_us_.begin(), frame_intervals_us_.end());
+    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+    frame_period_us_ = sorted[sorted.size() / 2];
   }
   last_frame_utime_ = frame.utime;
 }
@@ -335,11 +333,10 @@ int run_renderer(const RendererProcessSettings& settings) {
   };
   while (node.spin_once(service->has_pending() ? 0 : idle_wait_ms())) {
     if (!service->has_pending()) {
-      // Idle: render the next frame ahead from the plan when it is due,
-      // unless a frame has come meanwhile.
+      // Idle: render the next frame ahead from the plan when it is due
+      // (no wait left), unless a frame has come meanwhile.
       drain();
-      if (!service->has_pending() && service->has_prediction_to_render() &&
-          monotonic_us() >= schedule.start_us(service->frame_period_us())) {
+      if (!service->has_pending() && service->has_prediction_to_render() && idle_wait_ms() == 0) {
         const int64_t start_us = monotonic_us();
         service->render_prediction();
         schedule.rendered(monotonic_us() - start_us);

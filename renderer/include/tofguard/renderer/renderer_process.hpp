@@ -137,7 +137,7 @@ class RendererService {
   };
   const PredictionStats& prediction_stats() const { return prediction_stats_; }
   // The expected camera period learned from frame intervals, us (0: not yet).
-  int64_t frame_period_us() const;
+  int64_t frame_period_us() const { return frame_period_us_; }
 
   const std::string& description() const { return renderer_->description(); }
 
@@ -179,6 +179,7 @@ class RendererService {
   PlannedTrajectory plan_;
   std::optional<int64_t> last_frame_utime_;
   std::deque<int64_t> frame_intervals_us_;
+  int64_t frame_period_us_ = 0;  // their median (learn_period)
   std::optional<Prediction> prediction_;
   PredictionStats prediction_stats_;
   // Misses in a row, and frames since the last prediction while they are
