@@ -1,8 +1,10 @@
 #include "tofguard/discrepancy/joint_search.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <iterator>
+#include <limits>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -15,6 +17,20 @@ namespace {
 
 // The coarse trials' points per joint, at most (see search_joint_offsets).
 constexpr size_t kCoarsePoints = 1500;
+
+// How often (in pairs of points) PointCost::link_cost compares a trial's
+// partial cost with its bound: often enough to leave a hopeless trial after
+// a few percent of its points, rarely enough that the test costs nothing.
+constexpr int kBoundCheckPairs = 8;
+// The interleaved passes over a link's points (PointCost::link_cost).
+constexpr size_t kVisitPasses = 16;
+// A trial is left only when its partial cost, summed in another order than
+// the finished cost is, exceeds the bound by this fraction. Both sums add
+// n >= 0 terms, so each is within (n - 1) * 2^-53 (relative) of the exact
+// sum (Higham, "Accuracy and Stability of Numerical Algorithms", 4.2): for
+// fewer than 10^6 points a partial sum 1e-6 above the bound means the
+// finished cost is above it too, whatever the order.
+constexpr double kPruneMargin = 1e-6;
 
 // A rendered robot point: optical frame, mm, and 1 / sigma_i (1/mm).
 struct SearchPoint {
@@ -94,53 +110,77 @@ class PointCost {
     }
   }
 
-  // Every `every`-th point (the coarse trials), each standing for `every`.
-  // Two points at a time (Double2: the moved points and where they land
-  // the same to the last bit as one at a time), added to the sum in order.
-  double operator()(const std::vector<SearchPoint>& points, const Eigen::Isometry3d& motion,
-                    size_t every) const {
-    double sum = 0;
+  // The cost of one link's points moved by `motion`: every `every`-th point
+  // (the coarse trials), each standing for `every`, into *cost; or false,
+  // without a cost, as soon as `others` + the cost of the points seen so
+  // far is above `prune_above` (checked every kBoundCheckPairs pairs).
+  //
+  // The points are visited in kVisitPasses interleaved passes (every
+  // kVisitPasses-th of the chosen points, then the ones after them, ...),
+  // so that the first ones seen lie all over the link and a hopeless trial
+  // is left after a few of them. Each point's cost is kept in `point_cost`
+  // (scratch) and the finished sum taken in the points' order, as one pass
+  // in order would: the same to the last bit. Two points at a time
+  // (Double2: the moved points and where they land the same to the last
+  // bit as one at a time).
+  bool link_cost(const std::vector<SearchPoint>& points, const Eigen::Isometry3d& motion, size_t every,
+                 double others, double prune_above, std::vector<double>* point_cost, double* cost) const {
+    const double scale = weight_ * static_cast<double>(every);
+    const size_t chosen = (points.size() + every - 1) / every;
+    point_cost->resize(chosen);
+    double* pc = point_cost->data();
     const RigidMotion m(motion);
-    const auto add = [&](double qz, bool landed, double uf, double vf, double inv_sigma) {
+    const auto cost_of = [&](double qz, bool landed, double uf, double vf, double inv_sigma) {
       const int measured = landed ? tof_[static_cast<int>(vf) * width_ + static_cast<int>(uf)] : 0;
-      if (measured <= 0) {
-        sum += clip2_;
-        return;
-      }
+      if (measured <= 0) return clip2_;
       const double x = (qz - measured) * inv_sigma;
-      sum += std::min(x * x, clip2_);
+      return std::min(x * x, clip2_);
     };
     const Double2 one_mm = {1.0, 1.0};
     const Double2 zero = {0.0, 0.0};
     const Double2 width = {width_d_, width_d_};
     const Double2 height = {height_d_, height_d_};
-    size_t n = 0;
-    for (; n + every < points.size(); n += 2 * every) {
-      const SearchPoint& a = points[n];
-      const SearchPoint& b = points[n + every];
-      const Double2 px = {a.p_mm.x(), b.p_mm.x()};
-      const Double2 py = {a.p_mm.y(), b.p_mm.y()};
-      const Double2 pz = {a.p_mm.z(), b.p_mm.z()};
-      const Double2 qz = m.apply(2, px, py, pz);
-      // lands(), both lanes (a lane behind the camera computes nonsense
-      // that the test below discards).
-      const Double2 inv_z = 1.0 / qz;
-      const Double2 uf = fx_ * m.apply(0, px, py, pz) * inv_z + cx_ + 0.5;
-      const Double2 vf = fy_ * m.apply(1, px, py, pz) * inv_z + cy_ + 0.5;
-      // in_image(), both lanes: all ones where it holds.
-      const auto landed = (qz > one_mm) & (uf >= zero) & (vf >= zero) & (uf < width) & (vf < height);
-      add(qz[0], landed[0] != 0, uf[0], vf[0], a.inv_sigma);
-      add(qz[1], landed[1] != 0, uf[1], vf[1], b.inv_sigma);
+    const size_t passes = std::min<size_t>(kVisitPasses, chosen);
+    double seen = 0;  // the points visited so far, in the order visited
+    int pairs = 0;
+    for (size_t pass = 0; pass < passes; ++pass) {
+      size_t q = pass;
+      for (; q + passes < chosen; q += 2 * passes) {
+        if (++pairs == kBoundCheckPairs) {
+          pairs = 0;
+          if (others + scale * seen > prune_above) return false;
+        }
+        const SearchPoint& a = points[q * every];
+        const SearchPoint& b = points[(q + passes) * every];
+        const Double2 px = {a.p_mm.x(), b.p_mm.x()};
+        const Double2 py = {a.p_mm.y(), b.p_mm.y()};
+        const Double2 pz = {a.p_mm.z(), b.p_mm.z()};
+        const Double2 qz = m.apply(2, px, py, pz);
+        // lands(), both lanes (a lane behind the camera computes nonsense
+        // that the test below discards).
+        const Double2 inv_z = 1.0 / qz;
+        const Double2 uf = fx_ * m.apply(0, px, py, pz) * inv_z + cx_ + 0.5;
+        const Double2 vf = fy_ * m.apply(1, px, py, pz) * inv_z + cy_ + 0.5;
+        // in_image(), both lanes: all ones where it holds.
+        const auto landed = (qz > one_mm) & (uf >= zero) & (vf >= zero) & (uf < width) & (vf < height);
+        pc[q] = cost_of(qz[0], landed[0] != 0, uf[0], vf[0], a.inv_sigma);
+        pc[q + passes] = cost_of(qz[1], landed[1] != 0, uf[1], vf[1], b.inv_sigma);
+        seen += pc[q] + pc[q + passes];
+      }
+      if (q < chosen) {
+        const SearchPoint& a = points[q * every];
+        const double qz = m.z(a.p_mm);
+        int u = 0;
+        int v = 0;
+        const bool landed = lands(m.x(a.p_mm), m.y(a.p_mm), qz, &u, &v);
+        pc[q] = cost_of(qz, landed, u, v, a.inv_sigma);
+        seen += pc[q];
+      }
     }
-    for (; n < points.size(); n += every) {
-      const Eigen::Vector3d& p = points[n].p_mm;
-      const double qz = m.z(p);
-      int u = 0;
-      int v = 0;
-      const bool landed = lands(m.x(p), m.y(p), qz, &u, &v);
-      add(qz, landed, u, v, points[n].inv_sigma);
-    }
-    return weight_ * static_cast<double>(every) * sum;
+    double sum = 0;
+    for (size_t q = 0; q < chosen; ++q) sum += pc[q];
+    *cost = scale * sum;
+    return true;
   }
 
  private:
@@ -315,20 +355,56 @@ void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rend
   }
   // `side` (optional) runs as task 0, the trials as 1.. (the longest task
   // first).
-  const auto run_trials = [&](const std::vector<Trial>& trials, std::vector<double>* costs, SideTask* side) {
+  //
+  // Only the least cost of a joint's trials is ever used, with the cost of
+  // its trial at no offset in the fine ones (the gain). So a trial stops,
+  // with cost +infinity, once its partial cost is above the least cost
+  // finished so far among its joint's trials (PointCost::link_cost,
+  // kPruneMargin: then the whole one is above it too): the least-cost trial and any trial
+  // tied with it never stop, whichever thread finished what first, so the
+  // choices below are the same as without the bound. `exact` (the fine
+  // trials' no-offset one, whose cost the gain needs) never stops.
+  const auto run_trials = [&](const std::vector<Trial>& trials, std::vector<double>* costs, SideTask* side,
+                              const std::vector<uint8_t>& exact) {
     costs->assign(trials.size(), 0.0);
+    std::vector<std::atomic<double>> least(static_cast<size_t>(k.num_joints));
+    for (std::atomic<double>& l : least) l.store(std::numeric_limits<double>::infinity());
     const int first = side != nullptr ? 1 : 0;
     const auto one = [&](int task) {
       if (task < first) {
         side->run_once();
         return;
       }
-      const int n = task - first;
-      const Trial& trial = trials[static_cast<size_t>(n)];
-      double sum = 0;
-      for (const MovedLink& m : trials_of[trial.joint].moved)
-        sum += cost(*m.points, motion_of(m, trial.offset), trial.every);
-      (*costs)[static_cast<size_t>(n)] = sum;
+      const auto n = static_cast<size_t>(task - first);
+      const Trial& trial = trials[n];
+      std::atomic<double>& joint_least = least[static_cast<size_t>(trial.joint)];
+      const double bound =
+          exact.empty() || exact[n] == 0 ? joint_least.load() : std::numeric_limits<double>::infinity();
+      const double prune_above = bound * (1.0 + kPruneMargin);
+      // Scratch, kept by each thread from call to call (no allocation once
+      // they have grown).
+      thread_local std::vector<double> point_cost;
+      thread_local std::vector<double> link_costs;
+      const std::vector<MovedLink>& moved = trials_of[trial.joint].moved;
+      link_costs.assign(moved.size(), 0.0);
+      // The links from the last (the distal ones, which an offset moves
+      // most), the finished cost summed over them in order.
+      double seen = 0;
+      bool left = false;
+      for (size_t l = moved.size(); l-- > 0 && !left;) {
+        left = !cost.link_cost(*moved[l].points, motion_of(moved[l], trial.offset), trial.every, seen,
+                               prune_above, &point_cost, &link_costs[l]);
+        seen += link_costs[l];
+      }
+      double sum = std::numeric_limits<double>::infinity();
+      if (!left) {
+        sum = 0;
+        for (const double c : link_costs) sum += c;
+      }
+      (*costs)[n] = sum;
+      double least_now = joint_least.load();
+      while (sum < least_now && !joint_least.compare_exchange_weak(least_now, sum)) {
+      }
     };
     const int tasks = first + static_cast<int>(trials.size());
     if (workers != nullptr) {
@@ -338,7 +414,7 @@ void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rend
     }
   };
   std::vector<double> coarse_cost;
-  run_trials(coarse, &coarse_cost, beside);
+  run_trials(coarse, &coarse_cost, beside, {});
   // Per joint, the coarse trials' best (0: none beat no offset), then
   // the fine trials.
   std::vector<double> centre_of(k.num_joints, 0.0);
@@ -363,8 +439,13 @@ void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rend
     if (centre == 0) continue;
     for (double f : kFine) fine.push_back(Trial{j, centre + f * t.step, 1});
   }
+  // Each joint's fine trial at no offset is computed whole (the gain).
+  std::vector<uint8_t> exact(fine.size(), 0);
+  for (const JointTrials& t : trials_of) {
+    if (!t.moved.empty()) exact[t.first_fine] = 1;
+  }
   std::vector<double> fine_cost;
-  run_trials(fine, &fine_cost, nullptr);
+  run_trials(fine, &fine_cost, nullptr, exact);
   for (int j = 0; j < k.num_joints; ++j) {
     const JointTrials& t = trials_of[j];
     if (t.moved.empty()) continue;
