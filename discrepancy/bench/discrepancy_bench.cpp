@@ -12,6 +12,7 @@
 // leaves it as it was.
 #include <benchmark/benchmark.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -19,6 +20,7 @@
 #include <memory>
 #include <random>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -194,7 +196,9 @@ SimulatedArmFrames make_simulated_arm_frames(int width, int height) {
 }
 
 // state.range(2): discrepancy.worker_threads (0: none, all on the caller's
-// thread).
+// thread). state.range(3): a pause between frames, ms (0: back to back; 33:
+// frames at 30 Hz as tofguard-discrepancy gets them, the threads and the
+// caches idle between frames), not timed; wall time then.
 void BM_ComputeDiscrepancySimulatedArm(benchmark::State& state) {
   // Made once per size (Google Benchmark calls this several times).
   static std::map<std::pair<int64_t, int64_t>, SimulatedArmFrames> made;
@@ -221,7 +225,7 @@ void BM_ComputeDiscrepancySimulatedArm(benchmark::State& state) {
     for (uint8_t byte : encoded) digest = (digest ^ byte) * 0x100000001b3ULL;
   }
   static std::map<std::vector<int64_t>, uint64_t> printed;
-  const std::vector<int64_t> run = {state.range(0), state.range(1), state.range(2)};
+  const std::vector<int64_t> run = {state.range(0), state.range(1), state.range(2)};  // pauses: the same
   if (printed.count(run) == 0) {
     printed[run] = digest;
     std::fprintf(stderr, "BM_ComputeDiscrepancySimulatedArm/%d/%d/%d: digest of the summaries %016llx\n",
@@ -229,7 +233,13 @@ void BM_ComputeDiscrepancySimulatedArm(benchmark::State& state) {
                  static_cast<unsigned long long>(digest));
   }
   size_t k = 0;
+  const auto pause = std::chrono::milliseconds(state.range(3));
   for (auto _ : state) {
+    if (pause.count() > 0) {
+      state.PauseTiming();
+      std::this_thread::sleep_for(pause);
+      state.ResumeTiming();
+    }
     const Frames& f = sim.frames[k++ % sim.frames.size()];
     auto frame =
         tofguard::discrepancy::compute_discrepancy(f.camera, f.rendered, f.labels, parameters, workers.get());
@@ -238,10 +248,13 @@ void BM_ComputeDiscrepancySimulatedArm(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * state.range(0) * state.range(1));
 }
 BENCHMARK(BM_ComputeDiscrepancySimulatedArm)
-    ->ArgNames({"width", "height", "threads"})
-    ->Args({176, 144, 0})
-    ->Args({176, 144, 2})
-    ->Args({640, 480, 0})
+    ->ArgNames({"width", "height", "threads", "pause_ms"})
+    ->Args({176, 144, 0, 0})
+    ->Args({176, 144, 2, 0})
+    ->Args({176, 144, 0, 33})
+    ->Args({176, 144, 2, 33})
+    ->Args({640, 480, 0, 0})
+    ->UseRealTime()
     ->Unit(benchmark::kMicrosecond);
 
 void BM_DepthHash(benchmark::State& state) {

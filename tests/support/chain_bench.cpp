@@ -121,6 +121,9 @@ struct FrameArrivals {
   int64_t discrepancy_us = 0;
   int64_t risk_us = 0;
   int8_t level = -1;  // the verdict's risk_t level
+  // SAFETY_DISCREPANCY's compute_us: tofguard-discrepancy's own time for
+  // compute_discrepancy on the frame (-1: none came or it did not decode).
+  int32_t compute_us = -1;
 };
 
 // Receives TOF_RENDERED, SAFETY_DISCREPANCY and SAFETY_RISK on its own
@@ -226,6 +229,12 @@ class ArrivalRecorder {
                                                  : it->second.risk_us;
     if (at != 0) return;
     at = now_us;
+    if (stage == Stage::kDiscrepancy) {
+      // 3 kB: decoded whole for its compute_us (the images never are).
+      discrepancy_t summary;
+      if (summary.decode(buffer->data, 0, static_cast<int>(buffer->data_size)) >= 0)
+        it->second.compute_us = summary.compute_us;
+    }
     if (stage != Stage::kRisk) return;
     // risk_t's level follows its seq.
     if (buffer->data_size > kHashUtimeSeqBytes)
@@ -430,7 +439,7 @@ class BenchChain {
                                       ((end_us - start_us) * 1e-6);
     step.frames_sent = static_cast<int>(frames);
     step.sent_rate_hz = frames > 1 ? (frames - 1) / ((sent_us - start_us) * 1e-6) : rate_hz;
-    std::vector<double> render_ms, discrepancy_ms, risk_ms, end_to_end_ms;
+    std::vector<double> render_ms, discrepancy_ms, compute_ms, risk_ms, end_to_end_ms;
     for (int64_t seq = first_seq; seq <= last_seq; ++seq) {
       const FrameArrivals a = recorder_->arrivals(seq);
       if (a.rendered_us) {
@@ -440,6 +449,7 @@ class BenchChain {
       if (a.discrepancy_us) {
         ++step.frames_judged;
         if (a.rendered_us) discrepancy_ms.push_back((a.discrepancy_us - a.rendered_us) * 1e-3);
+        if (a.compute_us >= 0) compute_ms.push_back(a.compute_us * 1e-3);
       }
       if (a.risk_us) {
         ++step.frames_verdict;
@@ -459,6 +469,7 @@ class BenchChain {
     }
     step.render = summarise(render_ms);
     step.discrepancy = summarise(discrepancy_ms);
+    step.discrepancy_compute = summarise(compute_ms);
     step.risk = summarise(risk_ms);
     step.end_to_end = summarise(end_to_end_ms);
     recorder_->forget_before(next_seq_);
@@ -962,6 +973,22 @@ std::string steps_table(const std::vector<BenchStep>& steps) {
 }
 
 // With --plan: tofguard-renderer's prediction per step, a line each.
+std::string compute_lines(const std::vector<BenchStep>& steps) {
+  std::ostringstream t;
+  for (const BenchStep& s : steps) {
+    if (s.discrepancy_compute.count == 0) continue;
+    t << "- " << s.arm << ", " << size_text(s.width, s.height) << ", " << fixed_text(s.rate_hz, 0)
+      << " Hz: " << latency_cell(s.discrepancy_compute) << " (" << s.discrepancy_compute.count
+      << " frames)\n";
+  }
+  const std::string lines = t.str();
+  return lines.empty() ? lines
+                       : "\ncompute_discrepancy in tofguard-discrepancy (SAFETY_DISCREPANCY's compute_us, "
+                         "p50 / p99 / max ms; the rest of the discrepancy stage is delivery, decoding, "
+                         "pairing, waiting for a core and publishing):\n\n" +
+                             lines;
+}
+
 std::string prediction_lines(const std::vector<BenchStep>& steps) {
   std::ostringstream t;
   for (const BenchStep& s : steps) {
@@ -1057,7 +1084,8 @@ std::string bench_markdown(const BenchReport& report) {
         "the step; dropped: no verdict within 1 s; SAFE: verdicts SAFE (the chain is judging the nominal "
         "frames, not "
         "stopping).\n\n";
-  if (!report.steps.empty()) md << steps_table(report.steps) << prediction_lines(report.steps);
+  if (!report.steps.empty())
+    md << steps_table(report.steps) << compute_lines(report.steps) << prediction_lines(report.steps);
   if (!report.ramps.empty()) {
     md << "| arm | triangles | size | highest rate sustained (Hz) | stopped at |\n";
     md << "| --- | --- | --- | --- | --- |\n";
@@ -1068,7 +1096,7 @@ std::string bench_markdown(const BenchReport& report) {
          << r.stopped_because << " |\n";
       all.insert(all.end(), r.steps.begin(), r.steps.end());
     }
-    md << "\nEvery step of the ramps:\n\n" << steps_table(all) << prediction_lines(all);
+    md << "\nEvery step of the ramps:\n\n" << steps_table(all) << compute_lines(all) << prediction_lines(all);
   }
   if (!report.floors.empty()) md << floors_table(report);
   for (const std::string& s : report.skipped) md << "\n" << s << "\n";

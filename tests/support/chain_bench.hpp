@@ -92,6 +92,9 @@ struct BenchStep {
   // TOF_DEPTH sent -> SAFETY_RISK.
   LatencySummary render;
   LatencySummary discrepancy;
+  // Within the discrepancy stage: tofguard-discrepancy's compute_discrepancy
+  // (SAFETY_DISCREPANCY's compute_us).
+  LatencySummary discrepancy_compute;
   LatencySummary risk;
   LatencySummary end_to_end;
   // Process name -> CPU time over the step / its wall time, percent of one
