@@ -4,9 +4,11 @@
 
 namespace tofguard {
 
-WorkerPool::WorkerPool(int num_threads) {
+WorkerPool::WorkerPool(int num_threads, std::chrono::microseconds linger) : linger_(linger) {
   TOFGUARD_DEMAND(num_threads >= 1,
                   "WorkerPool: num_threads must be >= 1, got " + std::to_string(num_threads));
+  TOFGUARD_DEMAND(linger.count() >= 0, "WorkerPool: linger must be >= 0 us, got " +
+                                           std::to_string(static_cast<long long>(linger.count())));
   workers_.reserve(static_cast<size_t>(num_threads - 1));
   for (int i = 1; i < num_threads; ++i) workers_.emplace_back([this] { worker_loop(); });
 }
@@ -15,9 +17,39 @@ WorkerPool::~WorkerPool() {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     stopping_ = true;
+    stopping_flag_.store(true);
   }
   start_.notify_all();
   for (std::thread& t : workers_) t.join();
+}
+
+int64_t WorkerPool::now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+void WorkerPool::stay_awake(std::chrono::microseconds for_time) {
+  const int64_t until = now_ns() + std::chrono::duration_cast<std::chrono::nanoseconds>(for_time).count();
+  int64_t seen = awake_until_ns_.load();
+  while (seen < until && !awake_until_ns_.compare_exchange_weak(seen, until)) {
+  }
+}
+
+void WorkerPool::expect_call_within(std::chrono::microseconds within) {
+  if (workers_.empty() || within.count() <= 0) return;
+  {
+    // Under the lock: a worker between its wait's test and its sleep would
+    // otherwise miss the notification.
+    std::lock_guard<std::mutex> lock(mutex_);
+    stay_awake(within);
+  }
+  start_.notify_all();
+}
+
+void WorkerPool::poll_for_call(uint64_t seen) const {
+  while (open_generation_.load() == seen && !stopping_flag_.load() && now_ns() < awake_until_ns_.load())
+    std::this_thread::yield();
 }
 
 void WorkerPool::work() {
@@ -32,20 +64,26 @@ void WorkerPool::work() {
 }
 
 // A worker joins a call only while it is open: one that wakes after the
-// caller has run out of tasks (the other core was busy) goes back to sleep
-// without touching the call, and the caller does not wait for it.
+// caller has run out of tasks (the other core was busy) goes back to
+// waiting without touching the call, and the caller does not wait for it.
+// While it should be awake (after a call, or asked to), it waits by
+// polling without the lock; else it sleeps on start_.
 void WorkerPool::worker_loop() {
   uint64_t seen = 0;
-  std::unique_lock<std::mutex> lock(mutex_);
   for (;;) {
-    start_.wait(lock, [&] { return stopping_ || (open_ && generation_ != seen); });
+    poll_for_call(seen);
+    std::unique_lock<std::mutex> lock(mutex_);
+    start_.wait(lock, [&] { return stopping_ || generation_ != seen || now_ns() < awake_until_ns_.load(); });
     if (stopping_) return;
+    if (generation_ == seen) continue;  // asked to be awake: poll
     seen = generation_;
-    ++active_workers_;
+    if (!open_) continue;  // a call missed: it has ended
+    active_workers_.fetch_add(1);
     lock.unlock();
     work();
     lock.lock();
-    if (--active_workers_ == 0) done_.notify_one();
+    if (active_workers_.fetch_sub(1) == 1) done_.notify_one();
+    stay_awake(linger_);
   }
 }
 
@@ -64,14 +102,22 @@ void WorkerPool::run_erased(int num_tasks, Call call, const void* task) {
     error_ = nullptr;
     open_ = true;
     ++generation_;
+    open_generation_.store(generation_);
   }
   start_.notify_all();
   work();
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    open_ = false;
+  }
+  // The workers still in the call are finishing their last task: poll for
+  // them as long as a worker lingers, then sleep.
+  const int64_t poll_until = now_ns() + std::chrono::duration_cast<std::chrono::nanoseconds>(linger_).count();
+  while (active_workers_.load() > 0 && now_ns() < poll_until) std::this_thread::yield();
   std::exception_ptr error;
   {
     std::unique_lock<std::mutex> lock(mutex_);
-    open_ = false;
-    done_.wait(lock, [&] { return active_workers_ == 0; });
+    done_.wait(lock, [&] { return active_workers_.load() == 0; });
     error = error_;
     error_ = nullptr;
     call_ = nullptr;

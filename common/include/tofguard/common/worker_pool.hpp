@@ -5,6 +5,15 @@
 // the constructor, and wait on a condition variable between calls: no
 // thread is made per frame.
 //
+// Waking a sleeping thread is slow on a virtual machine: the other vCPU has
+// halted, and the wake-up goes through the hypervisor (at 30 Hz on the
+// 2-core VM, compute_discrepancy on 2 threads took 2.4 ms against 1.0 ms
+// back to back, about what one thread takes; docs/benchmarks.md). So a
+// worker that finishes a call stays awake for `linger` (the calls of one
+// frame come in quick succession), and a caller can ask the workers to be
+// awake for a call it expects (expect_call_within). Awake, a worker polls
+// for the call and yields its core to any other thread that wants it.
+//
 // Contract: run(n, task) calls task(i) exactly once for each i in [0, n)
 // and returns when every call has returned. Which thread runs which task,
 // and in which order, is not fixed: a task must write only its own results
@@ -12,6 +21,7 @@
 // An exception from a task is rethrown by run (the first one), after every
 // task has finished. One caller at a time (run is not reentrant).
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <exception>
@@ -24,14 +34,24 @@ namespace tofguard {
 
 class WorkerPool {
  public:
+  // How long a worker stays awake after a call by default: the gaps
+  // between the calls of one compute_discrepancy are tens of microseconds.
+  static constexpr std::chrono::microseconds kDefaultLinger{500};
+
   // num_threads: the threads a call runs on, the caller's included (>= 1;
-  // 1 = every task on the caller's thread, no worker started).
-  explicit WorkerPool(int num_threads);
+  // 1 = every task on the caller's thread, no worker started). linger: how
+  // long a worker polls for the next call after one (0: it sleeps at once).
+  explicit WorkerPool(int num_threads, std::chrono::microseconds linger = kDefaultLinger);
   ~WorkerPool();
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;
 
   int num_threads() const { return static_cast<int>(workers_.size()) + 1; }
+
+  // Wakes the workers, if they sleep, to poll for a call for `within` from
+  // now (a caller that knows one is coming: a frame's inputs are
+  // arriving). Costs nothing when no worker runs or none needs waking.
+  void expect_call_within(std::chrono::microseconds within);
 
   template <typename Task>
   void run(int num_tasks, const Task& task) {
@@ -44,6 +64,12 @@ class WorkerPool {
   void run_erased(int num_tasks, Call call, const void* task);
   void work();
   void worker_loop();
+  static int64_t now_ns();
+  // Keeps the workers awake until at least now + `for_time`.
+  void stay_awake(std::chrono::microseconds for_time);
+  // A worker's poll, without the lock, until a call newer than `seen` is
+  // open, the pool stops, or it should no longer be awake.
+  void poll_for_call(uint64_t seen) const;
 
   std::vector<std::thread> workers_;
   std::mutex mutex_;
@@ -55,11 +81,20 @@ class WorkerPool {
   const void* task_ = nullptr;
   int num_tasks_ = 0;
   std::atomic<int> next_task_{0};
-  bool open_ = false;       // workers may join the call
-  int active_workers_ = 0;  // workers that joined and have not finished
+  bool open_ = false;  // workers may join the call
+  // Workers that joined and have not finished: changed under mutex_, read
+  // without it by a caller polling for the end of its call.
+  std::atomic<int> active_workers_{0};
   uint64_t generation_ = 0;
   bool stopping_ = false;
   std::exception_ptr error_;
+  const std::chrono::microseconds linger_;
+  // Read without mutex_ by polling threads: the generation of the open
+  // call (0: none yet), whether the pool stops, and until when (steady
+  // clock, ns) workers stay awake. Written under mutex_.
+  std::atomic<uint64_t> open_generation_{0};
+  std::atomic<bool> stopping_flag_{false};
+  std::atomic<int64_t> awake_until_ns_{0};
 };
 
 // Work of a caller's that needs nothing from a later WorkerPool call and
