@@ -5,6 +5,8 @@
 #include "tofguard/common/worker_pool.hpp"
 
 #include <atomic>
+#include <chrono>
+#include <memory>
 #include <set>
 #include <stdexcept>
 #include <thread>
@@ -98,7 +100,44 @@ TEST(SideTask, RunsOnceBesideARunOrAfterIt) {
   EXPECT_EQ(side_runs, 1);
 }
 
+// Workers that sleep at once (linger 0), poll between the calls of a burst
+// (the default), or poll for longer than the test runs: every task still
+// runs once per call, also when the caller asks them to be awake for a
+// call (expect_call_within) before some calls and a worker wakes into a
+// call that has already ended.
+TEST(WorkerPool, RunsEveryTaskOnceWhetherItsWorkersSleepOrPoll) {
+  using std::chrono::microseconds;
+  for (const microseconds linger : {microseconds(0), WorkerPool::kDefaultLinger, microseconds(200000)}) {
+    WorkerPool pool(3, linger);
+    for (int call = 0; call < 300; ++call) {
+      if (call % 3 == 0) pool.expect_call_within(microseconds(call % 2 == 0 ? 1000 : 200000));
+      const int num_tasks = 1 + call % 11;
+      std::vector<int> runs(static_cast<size_t>(num_tasks), 0);
+      pool.run(num_tasks, [&](int i) { runs[static_cast<size_t>(i)] += 1; });
+      for (int i = 0; i < num_tasks; ++i)
+        ASSERT_EQ(runs[static_cast<size_t>(i)], 1)
+            << "linger " << linger.count() << " us, call " << call << ", task " << i << " of " << num_tasks;
+    }
+  }
+}
+
+// A pool whose workers were asked to poll for a minute stops when it is
+// destroyed, not after the minute (the test would hang until ctest's
+// timeout).
+TEST(WorkerPool, AnAwakePoolStopsWithoutWaitingOutItsPoll) {
+  auto pool = std::make_unique<WorkerPool>(2, std::chrono::seconds(60));
+  pool->expect_call_within(std::chrono::seconds(60));
+  int ran = 0;
+  pool->run(1, [&](int) { ++ran; });
+  pool.reset();
+  EXPECT_EQ(ran, 1);
+}
+
 TEST(WorkerPool, RefusesNoThreads) { EXPECT_DEATH(WorkerPool(0), "num_threads"); }
+
+TEST(WorkerPool, RefusesANegativeLinger) {
+  EXPECT_DEATH(WorkerPool(2, std::chrono::microseconds(-1)), "linger");
+}
 
 }  // namespace
 }  // namespace tofguard
