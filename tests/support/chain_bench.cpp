@@ -919,15 +919,34 @@ BenchReport run_bench(const BenchOptions& options, std::ostream& log) {
       ramp.width = width;
       ramp.height = height;
       ramp.triangles = chain.triangles();
-      for (double rate = options.ramp_start_hz; rate <= options.ramp_max_hz; rate *= 2) {
+      // Whether `rate` is sustained; if not, why (stopped_because).
+      const auto sustains = [&](double rate) {
         log << "  " << fixed_text(rate, 0) << " Hz for " << options.ramp_step_s << " s" << std::endl;
         ramp.steps.push_back(chain.run_step(rate, options.ramp_step_s));
         const std::string why = not_sustained_because(ramp.steps.back());
-        if (!why.empty()) {
-          ramp.stopped_because = fixed_text(rate, 0) + " Hz: " + why;
+        if (why.empty()) return true;
+        ramp.stopped_because = fixed_text(rate, 0) + " Hz: " + why;
+        return false;
+      };
+      double failed_hz = 0;
+      for (double rate = options.ramp_start_hz; rate <= options.ramp_max_hz; rate *= 2) {
+        if (!sustains(rate)) {
+          failed_hz = rate;
           break;
         }
         ramp.sustained_hz = rate;
+      }
+      // Between the last rate sustained and the first not, halving the gap
+      // (240 and 480 Hz: 360, then 300 or 420), whole Hz.
+      for (int k = 0; k < options.ramp_refinements && ramp.sustained_hz > 0 && failed_hz > 0; ++k) {
+        const double rate = std::round((ramp.sustained_hz + failed_hz) / 2);
+        if (rate <= ramp.sustained_hz || rate >= failed_hz) break;
+        // (stopped_because stays the lowest rate not sustained.)
+        if (sustains(rate)) {
+          ramp.sustained_hz = rate;
+        } else {
+          failed_hz = rate;
+        }
       }
       if (ramp.stopped_because.empty())
         ramp.stopped_because = "none up to " + fixed_text(options.ramp_max_hz, 0) + " Hz (the ramp's end)";

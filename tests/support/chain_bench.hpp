@@ -40,8 +40,11 @@ struct BenchOptions {
   double seconds = 10;
   // Ramp: rates ramp_start_hz, twice that, ... up to ramp_max_hz, each for
   // ramp_step_s, stopping at the first rate with a dropped frame, a stage's
-  // p99 above the frame period, or a publisher that could not keep the rate.
+  // p99 above the frame period, or a publisher that could not keep the rate;
+  // then ramp_refinements rates between the last rate sustained and that
+  // one, each halving the gap.
   bool ramp = false;
+  int ramp_refinements = 2;
   double ramp_start_hz = 30;
   double ramp_max_hz = 1920;
   double ramp_step_s = 3;

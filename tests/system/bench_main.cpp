@@ -9,7 +9,9 @@
 //
 // --ramp: 30, 60, 120 ... Hz, --ramp-step-s each, up to the first rate with
 // a dropped frame, a stage's p99 above the frame period or a publisher that
-// could not keep the rate; reports the highest rate sustained.
+// could not keep the rate, then two rates between the last one sustained and
+// that one, each halving the gap (240, 480: 360, then 300 or 420); reports
+// the highest rate sustained.
 //
 // After each arm and size, with its chain stopped, the floors (BenchFloors):
 // DepthRenderer::render and compute_discrepancy in this process along the
