@@ -50,7 +50,7 @@ class WorkerPool {
 
   // Wakes the workers, if they sleep, to poll for a call for `within` from
   // now (a caller that knows one is coming: a frame's inputs are
-  // arriving). Costs nothing when no worker runs or none needs waking.
+  // arriving). A lock and a notification; nothing without workers.
   void expect_call_within(std::chrono::microseconds within);
 
   template <typename Task>
