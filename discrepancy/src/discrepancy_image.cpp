@@ -20,7 +20,6 @@ namespace {
 // median from counts costs one pass over 8191 bins instead of sorting.
 constexpr int kHistogramMm = 4095;
 
-//
 // Reused from frame to frame (DisHistograms): a histogram keeps the range of
 // bins it has touched, and clearing, merging and ranking go over that range
 // only (a link's values span tens of bins, not 8191), so a frame neither
