@@ -11,6 +11,7 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iomanip>
 #include <memory>
 #include <mutex>
@@ -219,6 +220,15 @@ class ArrivalRecorder {
     if (get_int64_be(bytes) != hash) return;
     const int64_t seq = get_int64_be(bytes + kSeqOffset);
     if (seq < 0) return;  // a timeout verdict, about no frame
+    // SAFETY_DISCREPANCY (3 kB) is decoded whole for its compute_us (the
+    // images never are), before the lock: the publisher takes it to stamp
+    // each frame it sends.
+    int32_t compute_us = -1;
+    if (stage == Stage::kDiscrepancy) {
+      discrepancy_t summary;
+      if (summary.decode(buffer->data, 0, static_cast<int>(buffer->data_size)) >= 0)
+        compute_us = summary.compute_us;
+    }
     std::lock_guard<std::mutex> lock(mutex_);
     const auto it = frames_.find(seq);
     if (it == frames_.end()) return;  // not a frame this bench sent (or forgotten)
@@ -229,12 +239,7 @@ class ArrivalRecorder {
                                                  : it->second.risk_us;
     if (at != 0) return;
     at = now_us;
-    if (stage == Stage::kDiscrepancy) {
-      // 3 kB: decoded whole for its compute_us (the images never are).
-      discrepancy_t summary;
-      if (summary.decode(buffer->data, 0, static_cast<int>(buffer->data_size)) >= 0)
-        it->second.compute_us = summary.compute_us;
-    }
+    if (stage == Stage::kDiscrepancy) it->second.compute_us = compute_us;
     if (stage != Stage::kRisk) return;
     // risk_t's level follows its seq.
     if (buffer->data_size > kHashUtimeSeqBytes)
@@ -991,38 +996,48 @@ std::string steps_table(const std::vector<BenchStep>& steps) {
   return t.str();
 }
 
-// With --plan: tofguard-renderer's prediction per step, a line each.
-std::string compute_lines(const std::vector<BenchStep>& steps) {
+// A list under `heading`, a line per step that `line` says something of
+// ("" for none): "- arm, size, rate Hz: " and what it says. "" when no step
+// has a line.
+std::string step_lines(const std::vector<BenchStep>& steps, const std::string& heading,
+                       const std::function<std::string(const BenchStep&)>& line) {
   std::ostringstream t;
   for (const BenchStep& s : steps) {
-    if (s.discrepancy_compute.count == 0) continue;
+    const std::string what = line(s);
+    if (what.empty()) continue;
     t << "- " << s.arm << ", " << size_text(s.width, s.height) << ", " << fixed_text(s.rate_hz, 0)
-      << " Hz: " << latency_cell(s.discrepancy_compute) << " (" << s.discrepancy_compute.count
-      << " frames)\n";
+      << " Hz: " << what << "\n";
   }
   const std::string lines = t.str();
-  return lines.empty() ? lines
-                       : "\ncompute_discrepancy in tofguard-discrepancy (SAFETY_DISCREPANCY's compute_us, "
-                         "p50 / p99 / max ms; the rest of the discrepancy stage is delivery, decoding, "
-                         "pairing, waiting for a core and publishing):\n\n" +
-                             lines;
+  return lines.empty() ? lines : "\n" + heading + "\n\n" + lines;
 }
 
+// tofguard-discrepancy's own compute_discrepancy time per step.
+std::string compute_lines(const std::vector<BenchStep>& steps) {
+  return step_lines(
+      steps,
+      "compute_discrepancy in tofguard-discrepancy (SAFETY_DISCREPANCY's compute_us, p50 / p99 / "
+      "max ms; the rest of the discrepancy stage is delivery, decoding, pairing, waiting for a "
+      "core and publishing):",
+      [](const BenchStep& s) {
+        if (s.discrepancy_compute.count == 0) return std::string();
+        return latency_cell(s.discrepancy_compute) + " (" + std::to_string(s.discrepancy_compute.count) +
+               " frames)";
+      });
+}
+
+// With --plan: tofguard-renderer's prediction per step.
 std::string prediction_lines(const std::vector<BenchStep>& steps) {
-  std::ostringstream t;
-  for (const BenchStep& s : steps) {
-    if (s.prediction_hits < 0) continue;
-    t << "- " << s.arm << ", " << size_text(s.width, s.height) << ", " << fixed_text(s.rate_hz, 0)
-      << " Hz: tofguard-renderer rendered " << s.prediction_hits << " of " << s.frames_sent
-      << " frames ahead from the plan (hits), " << s.prediction_misses << " ahead but off the plan (misses), "
-      << s.frames_without_prediction << " without a prediction\n";
-  }
-  const std::string lines = t.str();
-  return lines.empty()
-             ? lines
-             : "\nWith the arm's path published as its plan (PLANNED_TRAJECTORY, --plan; counts from "
-               "tofguard-renderer's heartbeats before and after each step):\n\n" +
-                   lines;
+  return step_lines(steps,
+                    "With the arm's path published as its plan (PLANNED_TRAJECTORY, --plan; counts from "
+                    "tofguard-renderer's heartbeats before and after each step):",
+                    [](const BenchStep& s) {
+                      if (s.prediction_hits < 0) return std::string();
+                      return "tofguard-renderer rendered " + std::to_string(s.prediction_hits) + " of " +
+                             std::to_string(s.frames_sent) + " frames ahead from the plan (hits), " +
+                             std::to_string(s.prediction_misses) + " ahead but off the plan (misses), " +
+                             std::to_string(s.frames_without_prediction) + " without a prediction";
+                    });
 }
 
 std::string hop_cell(const HopFloor& h) {
