@@ -447,6 +447,14 @@ class BenchChain {
     std::vector<double> render_ms, discrepancy_ms, compute_ms, risk_ms, end_to_end_ms;
     for (int64_t seq = first_seq; seq <= last_seq; ++seq) {
       const FrameArrivals a = recorder_->arrivals(seq);
+      BenchStep::Frame frame;
+      frame.seq = seq;
+      if (a.rendered_us) frame.render_ms = (a.rendered_us - a.sent_us) * 1e-3;
+      if (a.rendered_us && a.discrepancy_us) frame.discrepancy_ms = (a.discrepancy_us - a.rendered_us) * 1e-3;
+      if (a.discrepancy_us && a.compute_us >= 0) frame.compute_ms = a.compute_us * 1e-3;
+      if (a.discrepancy_us && a.risk_us) frame.risk_ms = (a.risk_us - a.discrepancy_us) * 1e-3;
+      if (a.risk_us) frame.end_to_end_ms = (a.risk_us - a.sent_us) * 1e-3;
+      step.frames.push_back(frame);
       if (a.rendered_us) {
         ++step.frames_rendered;
         render_ms.push_back((a.rendered_us - a.sent_us) * 1e-3);
@@ -1106,6 +1114,21 @@ double discrepancy_stage_floor_ms(const BenchFloors& f) {
 }
 double risk_stage_floor_ms(const BenchFloors& f) {
   return f.risk_hop.latency.count == 0 ? 0 : f.risk_hop.latency.p50_ms;
+}
+
+std::string bench_frames_csv(const BenchReport& report) {
+  std::ostringstream csv;
+  csv << "arm,width,height,rate_hz,seq,render_ms,discrepancy_ms,compute_ms,risk_ms,end_to_end_ms\n";
+  const auto add = [&](const BenchStep& step) {
+    for (const BenchStep::Frame& f : step.frames)
+      csv << step.arm << ',' << step.width << ',' << step.height << ',' << step.rate_hz << ',' << f.seq << ','
+          << f.render_ms << ',' << f.discrepancy_ms << ',' << f.compute_ms << ',' << f.risk_ms << ','
+          << f.end_to_end_ms << '\n';
+  };
+  for (const BenchStep& step : report.steps) add(step);
+  for (const BenchRamp& ramp : report.ramps)
+    for (const BenchStep& step : ramp.steps) add(step);
+  return csv.str();
 }
 
 std::string bench_markdown(const BenchReport& report) {

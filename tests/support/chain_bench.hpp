@@ -111,6 +111,18 @@ struct BenchStep {
   int prediction_hits = -1;
   int prediction_misses = -1;
   int frames_without_prediction = -1;
+  // Each frame of the step, for a look at the tail (--frames FILE.csv):
+  // its stages' latencies in ms as above, -1 where the stage's message did
+  // not come.
+  struct Frame {
+    int64_t seq = 0;
+    double render_ms = -1;
+    double discrepancy_ms = -1;
+    double compute_ms = -1;
+    double risk_ms = -1;
+    double end_to_end_ms = -1;
+  };
+  std::vector<Frame> frames;
 };
 
 // A ramp on one arm and camera size: the rates tried, the highest one
@@ -201,6 +213,9 @@ BenchReport run_bench(const BenchOptions& options, std::ostream& log);
 // floors with each stage's p50 over its floor (a ramp's: its first step's,
 // at the floors' rate).
 std::string bench_markdown(const BenchReport& report);
+
+// Every step's frames as CSV: arm, size, rate, seq and the stages' ms.
+std::string bench_frames_csv(const BenchReport& report);
 
 // A PNG: p50 and p99 latency per stage against the camera's pixels (a
 // panel per arm), and the rate sustained (with --ramp; else the rate

@@ -5,7 +5,8 @@
 //
 //   tofguard-bench [--arms default,iiwa14,kinova] [--resolutions 176x144,320x240,640x480]
 //                  [--rate-hz 30] [--seconds 10] [--ramp] [--ramp-step-s 3] [--ramp-max-hz 1920]
-//                  [--shared DIR] [--markdown FILE] [--plot FILE.png] [--no-floors] [--plan]
+//                  [--shared DIR] [--markdown FILE] [--plot FILE.png] [--frames FILE.csv] [--no-floors]
+//                  [--plan]
 //
 // --ramp: 30, 60, 120 ... Hz, --ramp-step-s each, up to the first rate with
 // a dropped frame, a stage's p99 above the frame period or a publisher that
@@ -23,6 +24,9 @@
 // (PLANNED_TRAJECTORY), so that tofguard-renderer renders each next frame
 // ahead while it waits; the report gives the renderer's hits and misses per
 // step (BenchOptions::plan).
+//
+// --frames FILE.csv: every frame's stage latencies (bench_frames_csv), to
+// see which frames make the tail.
 //
 // Prints the Markdown table (with the machine and the date) to stdout.
 #include <fstream>
@@ -42,7 +46,7 @@ int usage(const std::string& why) {
       << "tofguard-bench: " << why
       << "\nusage: tofguard-bench [--arms default,iiwa14,kinova] [--resolutions 176x144,320x240,640x480] "
          "[--rate-hz 30] [--seconds 10] [--ramp] [--ramp-step-s 3] [--ramp-max-hz 1920] [--shared DIR] "
-         "[--markdown FILE] [--plot FILE.png] [--no-floors] [--plan]\n";
+         "[--markdown FILE] [--plot FILE.png] [--frames FILE.csv] [--no-floors] [--plan]\n";
   return 2;
 }
 
@@ -56,6 +60,7 @@ int main(int argc, char** argv) {
   options.shared_dir = shared_dir();
   std::string markdown_path;
   std::string plot_path;
+  std::string frames_path;
   for (int i = 1; i < argc; ++i) {
     const std::string option = argv[i];
     if (option == "--ramp") {
@@ -97,6 +102,8 @@ int main(int argc, char** argv) {
         markdown_path = value;
       } else if (option == "--plot") {
         plot_path = value;
+      } else if (option == "--frames") {
+        frames_path = value;
       } else {
         return usage("unknown option " + option);
       }
@@ -116,6 +123,11 @@ int main(int argc, char** argv) {
       std::ofstream out(markdown_path);
       out << markdown;
       if (!out) throw std::runtime_error(markdown_path + ": cannot write the table");
+    }
+    if (!frames_path.empty()) {
+      std::ofstream out(frames_path);
+      out << bench_frames_csv(report);
+      if (!out) throw std::runtime_error(frames_path + ": cannot write the frames");
     }
     if (!plot_path.empty()) {
       plot_bench(report, plot_path);
