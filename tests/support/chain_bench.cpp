@@ -72,6 +72,18 @@ constexpr int64_t kJointStatePeriodUs = 10000;
 constexpr int64_t kPlanChunkFrames = 30;
 // Frames in a row that must come through before the measured step starts.
 constexpr int kWarmupFrames = 5;
+// Before each step's measured frames, this many at the step's rate, not
+// measured: the chain then runs as it does behind a camera at that rate.
+// The warm-up sends one frame at a time, each after the last verdict, and
+// the ramp changes the rate from step to step; tofguard-renderer learns the
+// camera's period from its last 9 frame intervals and predicts only after 5
+// misses in a row every 8th frame (renderer_process.cpp), so without a
+// lead-in a step's first 8-10 frames had no prediction and were rendered on
+// their critical path: 3 of the 5 slowest frames of a 300-frame step
+// (--frames, 2026-11-27). The measured frames start after the lead-in's
+// verdicts and the renderer's next heartbeat, so their first frame comes
+// later than one period and misses its prediction.
+constexpr int64_t kLeadInFrames = 20;
 // The chain's start (EGL, mesh loading, the arm's cover of spheres) may
 // take this long on a loaded 2-core machine with the iiwa14's meshes.
 constexpr auto kStartDeadline = std::chrono::seconds(90);
@@ -413,6 +425,12 @@ class BenchChain {
     const int64_t frames = std::max<int64_t>(1, std::llround(rate_hz * seconds));
     const ArmPath path = prepare(rate_hz, static_cast<int>(std::min<int64_t>(frames, kMaxPreparedFrames)));
     if (!warm_) warm_up(path);
+    {
+      const int64_t lead_in_first = next_seq_;
+      publish(path, 0, kLeadInFrames);
+      recorder_->wait_for_verdicts(lead_in_first, next_seq_ - 1, last_send_us_ + options_.result_timeout_us);
+      recorder_->forget_before(next_seq_);
+    }
     BenchStep step;
     step.arm = arm_name_;
     step.width = intrinsics_.width;
@@ -429,7 +447,7 @@ class BenchChain {
       prediction_before = recorder_->renderer_prediction(monotonic_us(), monotonic_us() + 1000000);
     const int64_t start_us = monotonic_us();
     const int64_t first_seq = next_seq_;
-    publish(path, 0, frames);
+    publish(path, kLeadInFrames, frames);
     const int64_t sent_us = monotonic_us();
     const int64_t last_seq = next_seq_ - 1;
     recorder_->wait_for_verdicts(first_seq, last_seq, last_send_us_ + options_.result_timeout_us);

@@ -8,6 +8,10 @@
 //                  [--shared DIR] [--markdown FILE] [--plot FILE.png] [--frames FILE.csv] [--no-floors]
 //                  [--plan]
 //
+// Each step's measured frames come after 20 at its rate that are not
+// measured (the chain's steady state at that rate; chain_bench.cpp,
+// kLeadInFrames).
+//
 // --ramp: 30, 60, 120 ... Hz, --ramp-step-s each, up to the first rate with
 // a dropped frame, a stage's p99 above the frame period or a publisher that
 // could not keep the rate, then two rates between the last one sustained and
