@@ -1,20 +1,76 @@
 #include "tofguard/common/depth_frame.hpp"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
 namespace tofguard {
 
-int16_t depth_mm_from_m(double depth_m) {
-  const double mm = std::round(depth_m * 1000.0);
-  // NaN fails both comparisons: no return.
-  return (mm > 0 && mm <= kMaxDepthMm) ? static_cast<int16_t>(mm) : int16_t{0};
+namespace {
+
+// Z in mm (unrounded) -> the wire's depth_mm: rounded half away from zero,
+// as std::round, without its library call (the x86-64 baseline has no
+// rounding instruction, and this runs for every pixel of every rendered
+// frame: 0.6 ms of a 640x480 frame's critical path, 2026-11-27), and without
+// branches (a rendered image's edges would mispredict them). For
+// 0 < mm < 32768 the conversion truncates exactly and mm - whole is exact, so
+// the result is std::round's to the bit (depth_frame_test compares the two);
+// outside, and for NaN, which fails the comparison, 0 ("no return"), and a
+// value that rounds above kMaxDepthMm is no return too.
+inline int16_t rounded_depth_mm(double mm) {
+  const double in_range = (mm > 0 && mm < kMaxDepthMm + 1) ? mm : 0.0;
+  const int whole = static_cast<int>(in_range);
+  const int rounded = whole + (in_range - whole >= 0.5 ? 1 : 0);
+  return static_cast<int16_t>(rounded <= kMaxDepthMm ? rounded : 0);
 }
+
+}  // namespace
+
+int16_t depth_mm_from_m(double depth_m) { return rounded_depth_mm(depth_m * 1000.0); }
 
 std::vector<int16_t> depth_mm_from_m(const std::vector<float>& depth_m) {
   std::vector<int16_t> depth_mm(depth_m.size());
-  for (size_t i = 0; i < depth_m.size(); ++i) depth_mm[i] = depth_mm_from_m(static_cast<double>(depth_m[i]));
+  const float* in = depth_m.data();
+  int16_t* out = depth_mm.data();
+  const size_t n = depth_m.size();
+  size_t i = 0;
+#if defined(__SSE2__)
+  // Four pixels at a time, in SSE2 (the x86-64 baseline) as rounded_depth_mm
+  // does each: widened to double and scaled by 1000 (the same bits), masked
+  // to 0 outside (0, 32768) and for NaN, truncated, plus 1 where the rest is
+  // >= 0.5, 32768 -> 0; then packed to int16. 3x the scalar loop's speed
+  // (640x480: 1.0 -> 0.33 ms; std::round's 1.6 ms); depth_frame_test compares it with std::round.
+  const __m128d thousand = _mm_set1_pd(1000.0);
+  const __m128d zero = _mm_setzero_pd();
+  const __m128d beyond = _mm_set1_pd(kMaxDepthMm + 1.0);
+  const __m128d half = _mm_set1_pd(0.5);
+  const __m128i one = _mm_set1_epi32(1);
+  const __m128i max_mm = _mm_set1_epi32(kMaxDepthMm);
+  const auto round_two = [&](__m128d m) {
+    const __m128d mm = _mm_mul_pd(m, thousand);
+    const __m128d in_range = _mm_and_pd(_mm_and_pd(_mm_cmpgt_pd(mm, zero), _mm_cmplt_pd(mm, beyond)), mm);
+    const __m128i whole = _mm_cvttpd_epi32(in_range);  // two int32 in the low half
+    const __m128d rest = _mm_sub_pd(in_range, _mm_cvtepi32_pd(whole));
+    // The comparison's all-ones lanes, as doubles, shuffled to the two low
+    // int32 lanes: 1 where rest >= 0.5.
+    const __m128i up = _mm_shuffle_epi32(_mm_castpd_si128(_mm_cmpge_pd(rest, half)), _MM_SHUFFLE(3, 1, 2, 0));
+    return _mm_add_epi32(whole, _mm_and_si128(up, one));
+  };
+  for (; i + 4 <= n; i += 4) {
+    const __m128 z = _mm_loadu_ps(in + i);
+    const __m128i low = round_two(_mm_cvtps_pd(z));
+    const __m128i high = round_two(_mm_cvtps_pd(_mm_movehl_ps(z, z)));
+    __m128i rounded = _mm_unpacklo_epi64(low, high);
+    // 32768 (mm just below 32768 rounded up) is no return.
+    rounded = _mm_andnot_si128(_mm_cmpgt_epi32(rounded, max_mm), rounded);
+    _mm_storel_epi64(reinterpret_cast<__m128i*>(out + i), _mm_packs_epi32(rounded, rounded));
+  }
+#endif
+  for (; i < n; ++i) out[i] = rounded_depth_mm(static_cast<double>(in[i]) * 1000.0);
   return depth_mm;
 }
 

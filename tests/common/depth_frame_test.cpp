@@ -5,7 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iomanip>
 #include <limits>
+#include <random>
 #include <stdexcept>
 
 #include "tofguard/common/wire_checks.hpp"
@@ -37,6 +39,68 @@ TEST(DepthFrame, MillimetresRoundToNearestAndNeverInventDistances) {
   EXPECT_EQ(depth_mm_from_m(std::numeric_limits<double>::quiet_NaN()), 0);
   EXPECT_EQ(depth_mm_from_m(std::numeric_limits<double>::infinity()), 0);
   EXPECT_DOUBLE_EQ(metres_from_mm(1500), 1.5);
+}
+
+// depth_mm_from_m rounds without std::round's library call: the same result
+// as std::round for every input, halves and the range's ends included.
+TEST(DepthFrame, MillimetresAreStdRoundsToTheBit) {
+  const auto reference = [](double depth_m) -> int16_t {
+    const double mm = std::round(depth_m * 1000.0);
+    return (mm > 0 && mm <= kMaxDepthMm) ? static_cast<int16_t>(mm) : int16_t{0};
+  };
+  std::vector<double> inputs = {0.0,
+                                -0.0,
+                                -0.0005,
+                                0.0005,
+                                0.00049999999999999,
+                                std::nextafter(0.0005, 0.0),
+                                std::nextafter(0.0005, 1.0),
+                                32.7665,
+                                std::nextafter(32.7665, 0.0),
+                                std::nextafter(32.7665, 100.0),
+                                32.767,
+                                32.7675,
+                                32.768,
+                                1e300,
+                                -1e300,
+                                std::numeric_limits<double>::infinity(),
+                                -std::numeric_limits<double>::infinity(),
+                                std::numeric_limits<double>::quiet_NaN(),
+                                std::numeric_limits<double>::denorm_min()};
+  // Every half millimetre and its neighbours, over the wire's range.
+  for (int half = 0; half <= 2 * (kMaxDepthMm + 2); ++half) {
+    const double m = half * 0.0005;
+    inputs.push_back(m);
+    inputs.push_back(std::nextafter(m, 0.0));
+    inputs.push_back(std::nextafter(m, 100.0));
+  }
+  // And floats, as rendered depth comes: random depths to 40 m.
+  std::mt19937 random(17);
+  std::uniform_real_distribution<float> depth(-1.0f, 40.0f);
+  for (int i = 0; i < 200000; ++i) inputs.push_back(static_cast<double>(depth(random)));
+  for (const double m : inputs) ASSERT_EQ(depth_mm_from_m(m), reference(m)) << std::setprecision(17) << m;
+  // A whole image (four pixels at a time, then the rest one by one) as
+  // floats, which is what the renderer converts: every input that is a
+  // float, then one fewer for a length not a multiple of 4.
+  std::vector<float> image;
+  for (const double m : inputs) {
+    const auto f = static_cast<float>(m);
+    if (static_cast<double>(f) == m || std::isnan(m)) image.push_back(f);
+  }
+  // Floats exactly half a millimetre from two: m / 16 for odd m (62.5 mm,
+  // 187.5 mm, ...) to beyond the range, and their neighbours.
+  for (int m = 1; m < 16 * 34; m += 2) {
+    const float f = static_cast<float>(m) / 16.0f;
+    image.insert(image.end(), {f, std::nextafter(f, 0.0f), std::nextafter(f, 100.0f)});
+  }
+  for (size_t length : {image.size(), image.size() - 1}) {
+    const std::vector<float> part(image.begin(), image.begin() + static_cast<std::ptrdiff_t>(length));
+    const std::vector<int16_t> mm = depth_mm_from_m(part);
+    ASSERT_EQ(mm.size(), part.size());
+    for (size_t i = 0; i < part.size(); ++i)
+      ASSERT_EQ(mm[i], reference(static_cast<double>(part[i])))
+          << std::setprecision(9) << part[i] << " at " << i;
+  }
 }
 
 TEST(DepthFrame, MetresRoundTripThroughTheWireToTheMillimetre) {
