@@ -79,7 +79,7 @@ constexpr int kWarmupFrames = 5;
 // camera's period from its last 9 frame intervals and predicts only after 5
 // misses in a row every 8th frame (renderer_process.cpp), so without a
 // lead-in a step's first 8-10 frames had no prediction and were rendered on
-// their critical path: 3 of the 5 slowest frames of a 300-frame step
+// their critical path: 3 of the 12 slowest frames of a 300-frame step
 // (--frames, 2026-11-27). The measured frames start after the lead-in's
 // verdicts and the renderer's next heartbeat, so their first frame comes
 // later than one period and misses its prediction.
@@ -473,21 +473,15 @@ class BenchChain {
       if (a.discrepancy_us && a.risk_us) frame.risk_ms = (a.risk_us - a.discrepancy_us) * 1e-3;
       if (a.risk_us) frame.end_to_end_ms = (a.risk_us - a.sent_us) * 1e-3;
       step.frames.push_back(frame);
-      if (a.rendered_us) {
-        ++step.frames_rendered;
-        render_ms.push_back((a.rendered_us - a.sent_us) * 1e-3);
-      }
-      if (a.discrepancy_us) {
-        ++step.frames_judged;
-        if (a.rendered_us) discrepancy_ms.push_back((a.discrepancy_us - a.rendered_us) * 1e-3);
-        if (a.compute_us >= 0) compute_ms.push_back(a.compute_us * 1e-3);
-      }
-      if (a.risk_us) {
-        ++step.frames_verdict;
-        if (a.discrepancy_us) risk_ms.push_back((a.risk_us - a.discrepancy_us) * 1e-3);
-        end_to_end_ms.push_back((a.risk_us - a.sent_us) * 1e-3);
-        if (a.level == risk_t::SAFE) ++step.frames_safe;
-      }
+      if (frame.render_ms >= 0) render_ms.push_back(frame.render_ms);
+      if (frame.discrepancy_ms >= 0) discrepancy_ms.push_back(frame.discrepancy_ms);
+      if (frame.compute_ms >= 0) compute_ms.push_back(frame.compute_ms);
+      if (frame.risk_ms >= 0) risk_ms.push_back(frame.risk_ms);
+      if (frame.end_to_end_ms >= 0) end_to_end_ms.push_back(frame.end_to_end_ms);
+      if (a.rendered_us) ++step.frames_rendered;
+      if (a.discrepancy_us) ++step.frames_judged;
+      if (a.risk_us) ++step.frames_verdict;
+      if (a.risk_us && a.level == risk_t::SAFE) ++step.frames_safe;
       if (a.risk_us == 0 || a.risk_us - a.sent_us > options_.result_timeout_us) ++step.frames_dropped;
     }
     if (prediction_before) {
