@@ -1,5 +1,8 @@
 #include "tofguard/common/worker_pool.hpp"
 
+#include <pthread.h>
+#include <sched.h>
+
 #include "tofguard/common/demand.hpp"
 
 namespace tofguard {
@@ -9,6 +12,13 @@ WorkerPool::WorkerPool(int num_threads, std::chrono::microseconds linger) : ling
                   "WorkerPool: num_threads must be >= 1, got " + std::to_string(num_threads));
   TOFGUARD_DEMAND(linger.count() >= 0, "WorkerPool: linger must be >= 0 us, got " +
                                            std::to_string(static_cast<long long>(linger.count())));
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  if (num_threads > 1 && sched_getaffinity(0, sizeof(allowed), &allowed) == 0 && CPU_COUNT(&allowed) > 1) {
+    for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu) {
+      if (CPU_ISSET(cpu, &allowed)) allowed_cpus_.push_back(cpu);
+    }
+  }
   workers_.reserve(static_cast<size_t>(num_threads - 1));
   for (int i = 1; i < num_threads; ++i) workers_.emplace_back([this] { worker_loop(); });
 }
@@ -36,8 +46,27 @@ void WorkerPool::stay_awake(std::chrono::microseconds for_time) {
   }
 }
 
+void WorkerPool::note_caller_cpu() {
+  if (!allowed_cpus_.empty()) caller_cpu_.store(sched_getcpu());
+}
+
+void WorkerPool::keep_off_caller_cpu(int* excluded) const {
+  const int caller = caller_cpu_.load();
+  if (allowed_cpus_.empty() || caller < 0 || caller == *excluded) return;
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  for (int cpu : allowed_cpus_) {
+    if (cpu != caller) CPU_SET(cpu, &set);
+  }
+  // A caller outside the allowed CPUs (its affinity changed since) leaves
+  // them all: still a valid set. Failing, the worker runs where it is.
+  if (CPU_COUNT(&set) == 0 || pthread_setaffinity_np(pthread_self(), sizeof(set), &set) != 0) return;
+  *excluded = caller;
+}
+
 void WorkerPool::expect_call_within(std::chrono::microseconds within) {
   if (workers_.empty() || within.count() <= 0) return;
+  note_caller_cpu();
   {
     // Under the lock: a worker between its wait's test and its sleep would
     // otherwise miss the notification.
@@ -70,11 +99,13 @@ void WorkerPool::work() {
 // polling without the lock; else it sleeps on start_.
 void WorkerPool::worker_loop() {
   uint64_t seen = 0;
+  int excluded_cpu = -1;
   for (;;) {
     poll_for_call(seen);
     std::unique_lock<std::mutex> lock(mutex_);
     start_.wait(lock, [&] { return stopping_ || generation_ != seen || now_ns() < awake_until_ns_.load(); });
     if (stopping_) return;
+    keep_off_caller_cpu(&excluded_cpu);
     if (generation_ == seen) continue;  // asked to be awake: poll
     seen = generation_;
     if (!open_) continue;  // a call missed: it has ended
@@ -93,6 +124,7 @@ void WorkerPool::run_erased(int num_tasks, Call call, const void* task) {
     for (int i = 0; i < num_tasks; ++i) call(task, i);
     return;
   }
+  note_caller_cpu();
   {
     std::lock_guard<std::mutex> lock(mutex_);
     call_ = call;

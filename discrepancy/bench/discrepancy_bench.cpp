@@ -198,7 +198,9 @@ SimulatedArmFrames make_simulated_arm_frames(int width, int height) {
 // state.range(2): discrepancy.worker_threads (0: none, all on the caller's
 // thread). state.range(3): a pause between frames, ms (0: back to back; 33:
 // frames at 30 Hz as tofguard-discrepancy gets them, the threads and the
-// caches idle between frames), not timed; wall time then.
+// caches idle between frames; -33: the same pause with the caller spinning
+// through it, so that its core never idles: the pair showed the worker put
+// on the caller's core, WorkerPool), not timed; wall time then.
 void BM_ComputeDiscrepancySimulatedArm(benchmark::State& state) {
   // Made once per size (Google Benchmark calls this several times).
   static std::map<std::pair<int64_t, int64_t>, SimulatedArmFrames> made;
@@ -233,11 +235,18 @@ void BM_ComputeDiscrepancySimulatedArm(benchmark::State& state) {
                  static_cast<unsigned long long>(digest));
   }
   size_t k = 0;
-  const auto pause = std::chrono::milliseconds(state.range(3));
+  const auto pause = std::chrono::milliseconds(std::abs(state.range(3)));
+  const bool spin = state.range(3) < 0;
   for (auto _ : state) {
     if (pause.count() > 0) {
       state.PauseTiming();
-      std::this_thread::sleep_for(pause);
+      if (spin) {
+        const auto until = std::chrono::steady_clock::now() + pause;
+        while (std::chrono::steady_clock::now() < until) {
+        }
+      } else {
+        std::this_thread::sleep_for(pause);
+      }
       state.ResumeTiming();
     }
     const Frames& f = sim.frames[k++ % sim.frames.size()];
@@ -253,6 +262,8 @@ BENCHMARK(BM_ComputeDiscrepancySimulatedArm)
     ->Args({176, 144, 2, 0})
     ->Args({176, 144, 0, 33})
     ->Args({176, 144, 2, 33})
+    ->Args({176, 144, 0, -33})
+    ->Args({176, 144, 2, -33})
     ->Args({640, 480, 0, 0})
     ->UseRealTime()
     ->Unit(benchmark::kMicrosecond);

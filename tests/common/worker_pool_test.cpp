@@ -4,6 +4,9 @@
 // (scripts/sanitize).
 #include "tofguard/common/worker_pool.hpp"
 
+#include <pthread.h>
+#include <sched.h>
+
 #include <atomic>
 #include <chrono>
 #include <memory>
@@ -53,6 +56,58 @@ TEST(WorkerPool, SharesTheTasksAmongItsThreads) {
     seen.insert(ran_on.begin(), ran_on.end());
   }
   EXPECT_EQ(seen.size(), 2u);
+}
+
+// A worker keeps off the CPU its caller called from (worker_pool.hpp: on a
+// VM the scheduler put a woken worker on the caller's core, and the two
+// took turns on it). Checked on the worker's own CPU affinity, which is
+// what keeps it off, after the caller has been pinned to one CPU.
+TEST(WorkerPool, AWorkerKeepsOffTheCallersCpu) {
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  ASSERT_EQ(sched_getaffinity(0, sizeof(allowed), &allowed), 0);
+  if (CPU_COUNT(&allowed) < 2) GTEST_SKIP() << "this process may run on one CPU only: nothing to keep off";
+  int caller_cpu = 0;
+  while (!CPU_ISSET(caller_cpu, &allowed)) ++caller_cpu;
+  // The pool reads the process's CPUs when it is made, before the caller
+  // is pinned.
+  WorkerPool pool(2);
+  cpu_set_t pinned;
+  CPU_ZERO(&pinned);
+  CPU_SET(caller_cpu, &pinned);
+  ASSERT_EQ(pthread_setaffinity_np(pthread_self(), sizeof(pinned), &pinned), 0);
+  int worker_tasks = 0;
+  int worker_tasks_allowed_on_caller_cpu = 0;
+  int worker_tasks_on_caller_cpu = 0;
+  for (int attempt = 0; attempt < 50 && worker_tasks < 5; ++attempt) {
+    pool.expect_call_within(std::chrono::milliseconds(10));
+    std::atomic<int> arrived{0};
+    const std::thread::id caller = std::this_thread::get_id();
+    std::vector<int> on_worker(2, 0), allowed_on_caller_cpu(2, 0), on_caller_cpu(2, 0);
+    pool.run(2, [&](int i) {
+      const auto k = static_cast<size_t>(i);
+      arrived.fetch_add(1);
+      on_worker[k] = std::this_thread::get_id() != caller ? 1 : 0;
+      cpu_set_t mine;
+      CPU_ZERO(&mine);
+      if (pthread_getaffinity_np(pthread_self(), sizeof(mine), &mine) == 0)
+        allowed_on_caller_cpu[k] = CPU_ISSET(caller_cpu, &mine) ? 1 : 0;
+      on_caller_cpu[k] = sched_getcpu() == caller_cpu ? 1 : 0;
+      // As SharesTheTasksAmongItsThreads: the first task waits a little
+      // for the other, so that both threads take one.
+      for (int spin = 0; spin < 1000000 && arrived.load() < 2; ++spin) std::this_thread::yield();
+    });
+    for (size_t k = 0; k < 2; ++k) {
+      if (!on_worker[k]) continue;  // the caller's own task
+      ++worker_tasks;
+      worker_tasks_allowed_on_caller_cpu += allowed_on_caller_cpu[k];
+      worker_tasks_on_caller_cpu += on_caller_cpu[k];
+    }
+  }
+  ASSERT_EQ(pthread_setaffinity_np(pthread_self(), sizeof(allowed), &allowed), 0);
+  ASSERT_GT(worker_tasks, 0) << "no task ran on the worker in 50 calls";
+  EXPECT_EQ(worker_tasks_allowed_on_caller_cpu, 0) << "of " << worker_tasks << " worker tasks";
+  EXPECT_EQ(worker_tasks_on_caller_cpu, 0) << "of " << worker_tasks << " worker tasks";
 }
 
 TEST(WorkerPool, ATaskExceptionReachesTheCallerAfterTheOtherTasks) {

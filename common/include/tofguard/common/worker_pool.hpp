@@ -14,6 +14,16 @@
 // awake for a call it expects (expect_call_within). Awake, a worker polls
 // for the call and yields its core to any other thread that wants it.
 //
+// A worker keeps off the caller's core (Linux: its CPU affinity, within the
+// process's own, excludes the CPU the caller last called from). Woken while
+// both vCPUs idle, the scheduler put the worker on the waking caller's CPU
+// (it is cache-hot there), where the two took turns on one core while the
+// other stayed idle: at 30 Hz on the 2-core VM compute_discrepancy on 2
+// threads took 1.63 ms, what 1 thread takes (1.65), against 1.08-1.12 ms
+// with the worker on the other core (discrepancy-bench,
+// threads:2/pause_ms:33; docs/benchmarks.md, "The worker off the caller's
+// core"). With one CPU allowed, nothing changes.
+//
 // Contract: run(n, task) calls task(i) exactly once for each i in [0, n)
 // and returns when every call has returned. Which thread runs which task,
 // and in which order, is not fixed: a task must write only its own results
@@ -70,6 +80,12 @@ class WorkerPool {
   // A worker's poll, without the lock, until a call newer than `seen` is
   // open, the pool stops, or it should no longer be awake.
   void poll_for_call(uint64_t seen) const;
+  // Records the CPU the calling thread is on (a caller's, before it wakes
+  // the workers).
+  void note_caller_cpu();
+  // A worker's: moves it off the caller's last CPU, if it is not off it
+  // already (`excluded`: the CPU it keeps off now, -1 none; updated).
+  void keep_off_caller_cpu(int* excluded) const;
 
   std::vector<std::thread> workers_;
   std::mutex mutex_;
@@ -95,6 +111,11 @@ class WorkerPool {
   std::atomic<uint64_t> open_generation_{0};
   std::atomic<bool> stopping_flag_{false};
   std::atomic<int64_t> awake_until_ns_{0};
+  // The CPU the caller last woke the workers from (-1: unknown), and the
+  // CPUs the process may run on when the pool was made (the workers keep
+  // within them; empty: affinity is not used).
+  std::atomic<int> caller_cpu_{-1};
+  std::vector<int> allowed_cpus_;
 };
 
 // Work of a caller's that needs nothing from a later WorkerPool call and
