@@ -512,12 +512,31 @@ void unexplained_surfaces(const depth_image_t& camera, const link_labels_t& labe
   }
 }
 
+// The frame's identity and size, nothing judged: not usable, no
+// invalid pixels counted (unusable_summary counts them; a usable frame's
+// pixel stages do).
+discrepancy_t summary_of_frame(const depth_image_t& camera) {
+  discrepancy_t s{};
+  s.utime = camera.utime;
+  s.seq = camera.seq;
+  s.camera_id = camera.camera_id;
+  s.usable = false;
+  s.unusable_kind = discrepancy_t::UNUSABLE_NONE;
+  s.calibrated = camera.calibrated;
+  s.width = camera.width;
+  s.height = camera.height;
+  s.num_pixels = camera.num_pixels;
+  s.near_arm_min_distance_m = -1;
+  return s;
+}
+
 // The arm's reach about each joint (arm_distance.hpp), num_joints entries
-// (num_joints is 0 without kinematics; all 0 without a cover).
-void joint_reach(const link_labels_t& labels, discrepancy_t* s) {
+// (num_joints is 0 without kinematics; all 0 without a cover), from
+// `reach` = joint_reach_m(labels) (empty when the frame has no protective
+// field), once the evidence has set num_joints.
+void joint_reach(const std::vector<double>& reach, discrepancy_t* s) {
   s->joint_reach_m.assign(s->num_joints, 0.0);
   if (!s->field_available) return;
-  const std::vector<double> reach = joint_reach_m(labels);
   if (reach.size() == static_cast<size_t>(s->num_joints)) s->joint_reach_m = reach;
 }
 
@@ -578,20 +597,11 @@ Parameters parameters_from(const DiscrepancySettings& config) {
 }
 
 discrepancy_t unusable_summary(const depth_image_t& camera, int8_t kind, const std::string& reason) {
-  discrepancy_t s{};
-  s.utime = camera.utime;
-  s.seq = camera.seq;
-  s.camera_id = camera.camera_id;
-  s.usable = false;
+  discrepancy_t s = summary_of_frame(camera);
   s.unusable_kind = kind;
   s.unusable_reason = reason;
-  s.calibrated = camera.calibrated;
-  s.width = camera.width;
-  s.height = camera.height;
-  s.num_pixels = camera.num_pixels;
   for (int16_t d : camera.depth_mm) s.num_invalid += d <= 0 ? 1 : 0;
   s.invalid_fraction = s.num_pixels > 0 ? static_cast<float>(s.num_invalid) / s.num_pixels : 1.0f;
-  s.near_arm_min_distance_m = -1;
   return s;
 }
 
@@ -629,7 +639,8 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
 
   const int num_links = labels.num_links;
   discrepancy_t& s = frame.summary;
-  s = unusable_summary(camera, discrepancy_t::UNUSABLE_NONE, "");
+  // (num_invalid and invalid_fraction: the pixel stages', from the classes.)
+  s = summary_of_frame(camera);
   s.usable = true;
   s.num_robot_links = labels.num_robot_links;
   s.num_links = num_links;
@@ -642,8 +653,10 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
   s.link_median_dis_mm.assign(num_links, 0.0f);
 
   const std::vector<uint8_t> silhouette = silhouette_mask(rendered, parameters.silhouette_jump_mm);
+  std::vector<double> reach;  // the pixel stages' (joint_reach)
   // Stages 3 to 6 need nothing from the evidence, nor it from them (they
-  // write other fields of the summary): they run as one more task beside
+  // write other fields of the summary; the joints' reach, too, is the
+  // labels' only): they run as one more task beside
   // the naming search's trials (SideTask), so that a thread the trials
   // leave free does them.
   SideTask pixel_stages([&] {
@@ -671,12 +684,13 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
     const PixelFootprint footprint(camera, rendered);
     largest_blob(classes.mismatch_mask, parameters.opening_radius_px, footprint, &s);
     unexplained_surfaces(camera, labels, frame, classes, parameters, footprint, &s);
+    if (s.field_available) reach = joint_reach_m(labels);
   });
   // Stage 7, evidence (evidence.hpp).
   compute_evidence(camera, rendered, labels, silhouette, parameters.silhouette_jump_mm,
                    parameters.tolerance.noise, parameters.evidence, &s, workers, &pixel_stages);
   pixel_stages.run_once();
-  joint_reach(labels, &s);
+  joint_reach(reach, &s);
   return frame;
 }
 

@@ -1,6 +1,8 @@
 // The discrepancy image on synthetic frames whose every count is known.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+#include <random>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -492,6 +494,60 @@ TEST(Discrepancy, AStepJustOverTheJumpIsASilhouetteInWholeMillimetres) {
   // The link's inner 8 x 58 pixels count; its outline does not.
   EXPECT_EQ(seen.link_compared[0], 8 * 58);
   EXPECT_EQ(seen.link_match[0], 8 * 58);
+}
+
+// silhouette_mask against its rule written out pixel by pixel: a pixel is
+// beside a silhouette when it or one of its 4-neighbours has depth and the
+// other not, or both have depth and differ by more than the jump in whole
+// millimetres. Random depths near a few levels (steps just under and over
+// the jump), invalid pixels among them, on sizes with one row or column,
+// and the jumps at the edges (none, 1 mm, fractional, huge).
+TEST(SilhouetteMask, FollowsItsRuleOnEveryPairOfNeighbours) {
+  std::mt19937 random(17);
+  const auto reference = [](const std::vector<int16_t>& depth, int width, int height, double jump_mm) {
+    std::vector<uint8_t> mask(depth.size(), 0);
+    if (!(jump_mm > 0)) return mask;
+    const int limit = discrepancy::silhouette_step_limit_mm(jump_mm);
+    const auto steps = [&](int i, int j) {
+      const int a = depth[static_cast<size_t>(i)];
+      const int b = depth[static_cast<size_t>(j)];
+      if ((a > 0) != (b > 0)) return true;
+      return a > 0 && std::abs(a - b) > limit;
+    };
+    for (int v = 0; v < height; ++v) {
+      for (int u = 0; u < width; ++u) {
+        const int i = v * width + u;
+        const bool beside = (u > 0 && steps(i, i - 1)) || (u + 1 < width && steps(i, i + 1)) ||
+                            (v > 0 && steps(i, i - width)) || (v + 1 < height && steps(i, i + width));
+        mask[static_cast<size_t>(i)] = beside ? 1 : 0;
+      }
+    }
+    return mask;
+  };
+  int silhouettes = 0;
+  for (const auto& [width, height] :
+       std::vector<std::pair<int, int>>{{1, 1}, {1, 9}, {9, 1}, {2, 2}, {17, 13}, {176, 144}}) {
+    for (const double jump_mm : {0.0, -5.0, 0.5, 1.0, 1.5, 50.0, 50.4, 1e12}) {
+      for (int scene = 0; scene < 4; ++scene) {
+        std::vector<int16_t> depth(static_cast<size_t>(width) * height);
+        std::uniform_int_distribution<int> level(0, 4), jitter(-60, 60);
+        for (int16_t& d : depth) {
+          const int l = level(random);
+          d = static_cast<int16_t>(l == 0 ? (jitter(random) > 0 ? 0 : -1) : 1000 * l + jitter(random));
+        }
+        depth_image_t rendered = depth_frame(std::vector<int16_t>(kWidth * kHeight, 0), 1);
+        rendered.width = width;
+        rendered.height = height;
+        rendered.num_pixels = width * height;
+        rendered.depth_mm = depth;
+        const std::vector<uint8_t> mask = discrepancy::silhouette_mask(rendered, jump_mm);
+        ASSERT_EQ(mask, reference(depth, width, height, jump_mm))
+            << width << "x" << height << ", jump " << jump_mm << " mm, scene " << scene;
+        for (uint8_t m : mask) silhouettes += m;
+      }
+    }
+  }
+  EXPECT_GT(silhouettes, 1000);  // the scenes have silhouettes to find
 }
 
 }  // namespace
