@@ -101,16 +101,18 @@ void WorkerPool::worker_loop() {
   uint64_t seen = 0;
   int excluded_cpu = -1;
   for (;;) {
+    // (Off the caller's CPU outside the lock: a move is a system call.)
+    keep_off_caller_cpu(&excluded_cpu);
     poll_for_call(seen);
     std::unique_lock<std::mutex> lock(mutex_);
     start_.wait(lock, [&] { return stopping_ || generation_ != seen || now_ns() < awake_until_ns_.load(); });
     if (stopping_) return;
-    keep_off_caller_cpu(&excluded_cpu);
     if (generation_ == seen) continue;  // asked to be awake: poll
     seen = generation_;
     if (!open_) continue;  // a call missed: it has ended
     active_workers_.fetch_add(1);
     lock.unlock();
+    keep_off_caller_cpu(&excluded_cpu);
     work();
     lock.lock();
     if (active_workers_.fetch_sub(1) == 1) done_.notify_one();
