@@ -475,11 +475,11 @@ class BenchChain {
       if (a.discrepancy_us && a.risk_us) frame.risk_ms = (a.risk_us - a.discrepancy_us) * 1e-3;
       if (a.risk_us) frame.end_to_end_ms = (a.risk_us - a.sent_us) * 1e-3;
       step.frames.push_back(frame);
-      if (frame.render_ms >= 0) render_ms.push_back(frame.render_ms);
-      if (frame.discrepancy_ms >= 0) discrepancy_ms.push_back(frame.discrepancy_ms);
-      if (frame.compute_ms >= 0) compute_ms.push_back(frame.compute_ms);
-      if (frame.risk_ms >= 0) risk_ms.push_back(frame.risk_ms);
-      if (frame.end_to_end_ms >= 0) end_to_end_ms.push_back(frame.end_to_end_ms);
+      if (frame.render_ms) render_ms.push_back(*frame.render_ms);
+      if (frame.discrepancy_ms) discrepancy_ms.push_back(*frame.discrepancy_ms);
+      if (frame.compute_ms) compute_ms.push_back(*frame.compute_ms);
+      if (frame.risk_ms) risk_ms.push_back(*frame.risk_ms);
+      if (frame.end_to_end_ms) end_to_end_ms.push_back(*frame.end_to_end_ms);
       if (a.rendered_us) ++step.frames_rendered;
       if (a.discrepancy_us) ++step.frames_judged;
       if (a.risk_us) ++step.frames_verdict;
@@ -1133,11 +1133,12 @@ double risk_stage_floor_ms(const BenchFloors& f) {
 std::string bench_frames_csv(const BenchReport& report) {
   std::ostringstream csv;
   csv << "arm,width,height,rate_hz,seq,render_ms,discrepancy_ms,compute_ms,risk_ms,end_to_end_ms\n";
+  const auto ms = [](const std::optional<double>& v) { return v.value_or(-1.0); };  // -1: none
   const auto add = [&](const BenchStep& step) {
     for (const BenchStep::Frame& f : step.frames)
       csv << step.arm << ',' << step.width << ',' << step.height << ',' << step.rate_hz << ',' << f.seq << ','
-          << f.render_ms << ',' << f.discrepancy_ms << ',' << f.compute_ms << ',' << f.risk_ms << ','
-          << f.end_to_end_ms << '\n';
+          << ms(f.render_ms) << ',' << ms(f.discrepancy_ms) << ',' << ms(f.compute_ms) << ',' << ms(f.risk_ms)
+          << ',' << ms(f.end_to_end_ms) << '\n';
   };
   for (const BenchStep& step : report.steps) add(step);
   for (const BenchRamp& ramp : report.ramps)

@@ -112,15 +112,17 @@ struct BenchStep {
   int prediction_misses = -1;
   int frames_without_prediction = -1;
   // Each frame of the step, for a look at the tail (--frames FILE.csv):
-  // its stages' latencies in ms as above, -1 where the stage's message did
-  // not come.
+  // its stages' latencies in ms as above, none where the stage's message
+  // did not come (-1 in the CSV). A stage's latency may be below 0: the
+  // bench can read a message after the next stage's (it wakes later than
+  // the next process), and such a frame still counts in the stage's lists.
   struct Frame {
     int64_t seq = 0;
-    double render_ms = -1;
-    double discrepancy_ms = -1;
-    double compute_ms = -1;
-    double risk_ms = -1;
-    double end_to_end_ms = -1;
+    std::optional<double> render_ms;
+    std::optional<double> discrepancy_ms;
+    std::optional<double> compute_ms;
+    std::optional<double> risk_ms;
+    std::optional<double> end_to_end_ms;
   };
   std::vector<Frame> frames;
 };
