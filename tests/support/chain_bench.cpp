@@ -32,6 +32,7 @@
 #include "scaled_intrinsics.hpp"
 #include "simulated_frames.hpp"
 #include "test_support.hpp"
+#include "tofguard/authenticated_message_t.hpp"
 #include "tofguard/common/clock.hpp"
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/deployment/config.hpp"
@@ -135,7 +136,8 @@ struct FrameArrivals {
   int64_t rendered_us = 0;
   int64_t discrepancy_us = 0;
   int64_t risk_us = 0;
-  int8_t level = -1;  // the verdict's risk_t level
+  int8_t level = -1;         // the verdict's risk_t level
+  bool risk_signed = false;  // its first copy was the signed one
   // SAFETY_DISCREPANCY's compute_us: tofguard-discrepancy's own time for
   // compute_discrepancy on the frame (-1: none came or it did not decode).
   int32_t compute_us = -1;
@@ -143,16 +145,21 @@ struct FrameArrivals {
 
 // Receives TOF_RENDERED, SAFETY_DISCREPANCY and SAFETY_RISK on its own
 // thread and LCM sockets, so that the publisher's pacing does not delay the
-// time stamps; records the first arrival of each per frame seq.
+// time stamps; records the first arrival of each per frame seq. A verdict
+// is taken from whichever copy comes first: with a key, tofguard-risk
+// publishes each signed on SAFETY_RISK_AUTH first (the copy
+// tofguard-intervene acts on), then plain on SAFETY_RISK
+// (auth::publish_signed).
 class ArrivalRecorder {
  public:
   explicit ArrivalRecorder(const deployment::Config& config)
-      : safety_(config.lcm.url), images_(config.lcm.image_url) {
+      : risk_channel_(config.channels.risk), safety_(config.lcm.url), images_(config.lcm.image_url) {
     if (!safety_.good() || !images_.good())
       throw std::runtime_error("cannot open LCM (" + config.lcm.url + ", " + config.lcm.image_url + ")");
     images_.subscribe(config.channels.rendered, &ArrivalRecorder::on_rendered, this);
     safety_.subscribe(config.channels.discrepancy, &ArrivalRecorder::on_discrepancy, this);
     safety_.subscribe(config.channels.risk, &ArrivalRecorder::on_risk, this);
+    safety_.subscribe(config.channels.risk_auth, &ArrivalRecorder::on_signed_risk, this);
     safety_.subscribe(config.channels.heartbeat, &ArrivalRecorder::on_heartbeat, this);
     thread_ = std::thread([this] { receive(); });
   }
@@ -228,9 +235,12 @@ class ArrivalRecorder {
     }
   }
   void record(const lcm::ReceiveBuffer* buffer, int64_t hash, Stage stage) {
-    const int64_t now_us = monotonic_us();
-    if (buffer->data_size < kHashUtimeSeqBytes) return;
-    const auto* bytes = static_cast<const uint8_t*>(buffer->data);
+    record(static_cast<const uint8_t*>(buffer->data), buffer->data_size, monotonic_us(), hash, stage, false);
+  }
+  // The message `bytes` (LCM-encoded, `size` bytes) arrived at `now_us`;
+  // `is_signed`: it came as the payload of its signed copy.
+  void record(const uint8_t* bytes, size_t size, int64_t now_us, int64_t hash, Stage stage, bool is_signed) {
+    if (size < kHashUtimeSeqBytes) return;
     if (get_int64_be(bytes) != hash) return;
     const int64_t seq = get_int64_be(bytes + kSeqOffset);
     if (seq < 0) return;  // a timeout verdict, about no frame
@@ -240,14 +250,13 @@ class ArrivalRecorder {
     int32_t compute_us = -1;
     if (stage == Stage::kDiscrepancy) {
       discrepancy_t summary;
-      if (summary.decode(buffer->data, 0, static_cast<int>(buffer->data_size)) >= 0)
-        compute_us = summary.compute_us;
+      if (summary.decode(bytes, 0, static_cast<int>(size)) >= 0) compute_us = summary.compute_us;
     }
     std::lock_guard<std::mutex> lock(mutex_);
     const auto it = frames_.find(seq);
     if (it == frames_.end()) return;  // not a frame this bench sent (or forgotten)
     size_t& largest = largest_[static_cast<int>(stage)];
-    largest = std::max(largest, static_cast<size_t>(buffer->data_size));
+    largest = std::max(largest, size);
     int64_t& at = stage == Stage::kRendered      ? it->second.rendered_us
                   : stage == Stage::kDiscrepancy ? it->second.discrepancy_us
                                                  : it->second.risk_us;
@@ -255,9 +264,9 @@ class ArrivalRecorder {
     at = now_us;
     if (stage == Stage::kDiscrepancy) it->second.compute_us = compute_us;
     if (stage != Stage::kRisk) return;
+    it->second.risk_signed = is_signed;
     // risk_t's level follows its seq.
-    if (buffer->data_size > kHashUtimeSeqBytes)
-      it->second.level = static_cast<int8_t>(bytes[kHashUtimeSeqBytes]);
+    if (size > kHashUtimeSeqBytes) it->second.level = static_cast<int8_t>(bytes[kHashUtimeSeqBytes]);
     verdict_.notify_all();
   }
   void on_rendered(const lcm::ReceiveBuffer* b, const std::string&) {
@@ -269,6 +278,17 @@ class ArrivalRecorder {
   void on_risk(const lcm::ReceiveBuffer* b, const std::string&) {
     record(b, risk_t::getHash(), Stage::kRisk);
   }
+  // The signed copy: its payload is the risk_t as SAFETY_RISK carries it
+  // (the tag is tofguard-intervene's to check, not the bench's).
+  void on_signed_risk(const lcm::ReceiveBuffer* b, const std::string&) {
+    const int64_t now_us = monotonic_us();
+    authenticated_message_t signed_message;
+    if (signed_message.decode(b->data, 0, static_cast<int>(b->data_size)) < 0 ||
+        signed_message.channel != risk_channel_)
+      return;
+    record(signed_message.payload.data(), signed_message.payload.size(), now_us, risk_t::getHash(),
+           Stage::kRisk, true);
+  }
   void on_heartbeat(const lcm::ReceiveBuffer* b, const std::string&) {
     heartbeat_t h;
     if (h.decode(b->data, 0, static_cast<int>(b->data_size)) < 0 || h.process != "tofguard-renderer") return;
@@ -278,6 +298,7 @@ class ArrivalRecorder {
     heartbeat_.notify_all();
   }
 
+  const std::string risk_channel_;
   lcm::LCM safety_;
   lcm::LCM images_;
   mutable std::mutex mutex_;
@@ -293,20 +314,38 @@ class ArrivalRecorder {
 
 // The LCM hop floor's receiver: its own thread and LCM instances on the
 // chain's two URLs, subscribed to the scratch channels; each message
-// carries the monotonic time it was published at.
+// carries its kind, the monotonic time it was published at and a sequence
+// number. Kinds 0-2: the hops (kHopChannels); 3 + r and 5 + r: relay r's
+// message in and out (kRelayInChannels, kRelayOutChannels; r = 0 the
+// discrepancy relay, 1 the risk relay), received here both, the relay's
+// latency the out's receive time minus the in's.
 const std::string kHopChannels[3] = {"TOFGUARD_BENCH_HOP_IMAGE", "TOFGUARD_BENCH_HOP_DISCREPANCY",
                                      "TOFGUARD_BENCH_HOP_RISK"};
-constexpr size_t kHopHeaderBytes = 16;  // kind, sent_us (big-endian int64)
+const std::string kRelayInChannels[2] = {"TOFGUARD_BENCH_RELAY_IMAGE_IN",
+                                         "TOFGUARD_BENCH_RELAY_DISCREPANCY_IN"};
+const std::string kRelayOutChannels[2] = {"TOFGUARD_BENCH_RELAY_DISCREPANCY_OUT",
+                                          "TOFGUARD_BENCH_RELAY_RISK_OUT"};
+constexpr size_t kHopHeaderBytes = 24;  // kind, sent_us, seq (big-endian int64 each)
+constexpr int64_t kRelayInKind = 3;
+constexpr int64_t kRelayOutKind = 5;
 
-class HopReceiver {
+// Polls an LCM instance on each of the chain's two URLs from a thread of
+// its own until destroyed.
+class TwoUrlThread {
  public:
-  HopReceiver(const std::string& safety_url, const std::string& image_url)
+  TwoUrlThread(const std::string& safety_url, const std::string& image_url)
       : safety_(safety_url), images_(image_url) {
     if (!safety_.good() || !images_.good())
       throw std::runtime_error("cannot open LCM (" + safety_url + ", " + image_url + ")");
-    images_.subscribe(kHopChannels[0], &HopReceiver::on_message, this);
-    safety_.subscribe(kHopChannels[1], &HopReceiver::on_message, this);
-    safety_.subscribe(kHopChannels[2], &HopReceiver::on_message, this);
+  }
+  ~TwoUrlThread() { stop(); }
+  TwoUrlThread(const TwoUrlThread&) = delete;
+  TwoUrlThread& operator=(const TwoUrlThread&) = delete;
+
+  lcm::LCM& safety() { return safety_; }
+  lcm::LCM& images() { return images_; }
+  // After the subscriptions.
+  void start() {
     thread_ = std::thread([this] {
       pollfd fds[2] = {{safety_.getFileno(), POLLIN, 0}, {images_.getFileno(), POLLIN, 0}};
       while (!stop_) {
@@ -316,20 +355,56 @@ class HopReceiver {
       }
     });
   }
-  ~HopReceiver() {
+  // Before the members a handler uses go.
+  void stop() {
     stop_ = true;
-    thread_.join();
+    if (thread_.joinable()) thread_.join();
   }
+
+ private:
+  lcm::LCM safety_;
+  lcm::LCM images_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+class HopReceiver {
+ public:
+  HopReceiver(const std::string& safety_url, const std::string& image_url) : lcm_(safety_url, image_url) {
+    lcm_.images().subscribe(kHopChannels[0], &HopReceiver::on_message, this);
+    lcm_.safety().subscribe(kHopChannels[1], &HopReceiver::on_message, this);
+    lcm_.safety().subscribe(kHopChannels[2], &HopReceiver::on_message, this);
+    lcm_.images().subscribe(kRelayInChannels[0], &HopReceiver::on_message, this);
+    lcm_.safety().subscribe(kRelayInChannels[1], &HopReceiver::on_message, this);
+    for (const std::string& channel : kRelayOutChannels)
+      lcm_.safety().subscribe(channel, &HopReceiver::on_message, this);
+    lcm_.start();
+  }
+  ~HopReceiver() { lcm_.stop(); }
   HopReceiver(const HopReceiver&) = delete;
   HopReceiver& operator=(const HopReceiver&) = delete;
 
   size_t received() const {
     std::lock_guard<std::mutex> lock(mutex_);
-    return latency_ms_[0].size() + latency_ms_[1].size() + latency_ms_[2].size();
+    size_t n = latency_ms_[0].size() + latency_ms_[1].size() + latency_ms_[2].size();
+    for (int r = 0; r < 2; ++r) n += relay_in_us_[r].size() + relay_out_us_[r].size();
+    return n;
   }
   std::vector<double> latency_ms(int kind) const {
     std::lock_guard<std::mutex> lock(mutex_);
     return latency_ms_[kind];
+  }
+  // Relay r's latencies: for each sequence number received both in and out,
+  // the out's receive time minus the in's (below 0 when this thread read
+  // the out first: the two may come on different sockets).
+  std::vector<double> relay_latency_ms(int r) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<double> ms;
+    for (const auto& [seq, out_us] : relay_out_us_[r]) {
+      const auto in = relay_in_us_[r].find(seq);
+      if (in != relay_in_us_[r].end()) ms.push_back((out_us - in->second) * 1e-3);
+    }
+    return ms;
   }
 
  private:
@@ -338,17 +413,57 @@ class HopReceiver {
     if (buffer->data_size < kHopHeaderBytes) return;
     const auto* bytes = static_cast<const uint8_t*>(buffer->data);
     const int64_t kind = get_int64_be(bytes);
-    if (kind < 0 || kind > 2) return;
     std::lock_guard<std::mutex> lock(mutex_);
-    latency_ms_[kind].push_back((now_us - get_int64_be(bytes + 8)) * 1e-3);
+    if (kind >= 0 && kind <= 2) {
+      latency_ms_[kind].push_back((now_us - get_int64_be(bytes + 8)) * 1e-3);
+    } else if (kind == kRelayInKind || kind == kRelayInKind + 1) {
+      relay_in_us_[kind - kRelayInKind][get_int64_be(bytes + 16)] = now_us;
+    } else if (kind == kRelayOutKind || kind == kRelayOutKind + 1) {
+      relay_out_us_[kind - kRelayOutKind][get_int64_be(bytes + 16)] = now_us;
+    }
   }
 
-  lcm::LCM safety_;
-  lcm::LCM images_;
   mutable std::mutex mutex_;
   std::vector<double> latency_ms_[3];
-  std::atomic<bool> stop_{false};
-  std::thread thread_;
+  std::map<int64_t, int64_t> relay_in_us_[2];
+  std::map<int64_t, int64_t> relay_out_us_[2];
+  TwoUrlThread lcm_;  // last: its thread stops before the members go
+};
+
+// The relays' middle (BenchFloors::discrepancy_relay, risk_relay): its own
+// thread and LCM instances; on each relay r's message in it publishes, at
+// once, relay r's message out (out_bytes[r] bytes, the same sequence
+// number) on lcm.url, as a chain process publishes its result.
+class HopRelay {
+ public:
+  HopRelay(const std::string& safety_url, const std::string& image_url, const size_t out_bytes[2])
+      : lcm_(safety_url, image_url) {
+    for (int r = 0; r < 2; ++r) {
+      out_[r].assign(std::max(out_bytes[r], kHopHeaderBytes), 0);
+      put_int64_be(out_[r].data(), kRelayOutKind + r);
+    }
+    lcm_.images().subscribe(kRelayInChannels[0], &HopRelay::on_message, this);
+    lcm_.safety().subscribe(kRelayInChannels[1], &HopRelay::on_message, this);
+    lcm_.start();
+  }
+  ~HopRelay() { lcm_.stop(); }
+  HopRelay(const HopRelay&) = delete;
+  HopRelay& operator=(const HopRelay&) = delete;
+
+ private:
+  void on_message(const lcm::ReceiveBuffer* buffer, const std::string&) {
+    if (buffer->data_size < kHopHeaderBytes) return;
+    const auto* bytes = static_cast<const uint8_t*>(buffer->data);
+    const int64_t r = get_int64_be(bytes) - kRelayInKind;
+    if (r < 0 || r > 1) return;
+    std::vector<uint8_t>& out = out_[r];
+    put_int64_be(out.data() + 8, monotonic_us());
+    put_int64_be(out.data() + 16, get_int64_be(bytes + 16));
+    lcm_.safety().publish(kRelayOutChannels[r], out.data(), static_cast<unsigned int>(out.size()));
+  }
+
+  std::vector<uint8_t> out_[2];
+  TwoUrlThread lcm_;  // last: its thread stops before the members go
 };
 
 // The arm's path for a step: `prepared` frames taken 1/rate apart in motion
@@ -483,6 +598,7 @@ class BenchChain {
       if (a.rendered_us) ++step.frames_rendered;
       if (a.discrepancy_us) ++step.frames_judged;
       if (a.risk_us) ++step.frames_verdict;
+      if (a.risk_us && a.risk_signed) ++step.frames_verdict_signed_first;
       if (a.risk_us && a.level == risk_t::SAFE) ++step.frames_safe;
       if (a.risk_us == 0 || a.risk_us - a.sent_us > options_.result_timeout_us) ++step.frames_dropped;
     }
@@ -759,38 +875,66 @@ class BenchChain {
          << std::hex << digest << std::dec << std::endl;
   }
 
-  // Each period: an image-sized message on the image URL, a third of a
-  // period later a discrepancy_t-sized one and two thirds later a
-  // risk_t-sized one on the safety URL, through the publishers the chain's
-  // frames went through.
+  // Each period five messages a fifth of a period apart, through the
+  // publishers the chain's frames went through: an image-sized hop on the
+  // image URL, the discrepancy relay's image-sized message in (image URL),
+  // a discrepancy_t-sized hop, the risk relay's discrepancy_t-sized message
+  // in, a risk_t-sized hop (safety URL).
   void measure_hops(double rate_hz, int hops, BenchFloors* f) {
+    const size_t relay_out_bytes[2] = {f->discrepancy_hop.bytes, f->risk_hop.bytes};
     HopReceiver receiver(config_.lcm.url, config_.lcm.image_url);
+    HopRelay relay(config_.lcm.url, config_.lcm.image_url, relay_out_bytes);
     HopFloor* floors[3] = {&f->image_hop, &f->discrepancy_hop, &f->risk_hop};
-    lcm::LCM* urls[3] = {images_.get(), safety_.get(), safety_.get()};
-    std::vector<uint8_t> messages[3];
-    for (int kind = 0; kind < 3; ++kind) {
-      messages[kind].assign(std::max(floors[kind]->bytes, kHopHeaderBytes), 0);
-      floors[kind]->bytes = messages[kind].size();
-      put_int64_be(messages[kind].data(), kind);
-    }
-    // The receiver's sockets are open once it is constructed; let it settle.
+    RelayFloor* relays[2] = {&f->discrepancy_relay, &f->risk_relay};
+    relays[0]->in_bytes = f->image_hop.bytes;
+    relays[1]->in_bytes = f->discrepancy_hop.bytes;
+    // Message m of the period: its kind, floor or relay, URL and channel.
+    struct Message {
+      std::vector<uint8_t> bytes;
+      int* sent;
+      lcm::LCM* url;
+      const std::string* channel;
+    };
+    std::vector<Message> messages;
+    const auto add = [&](int64_t kind, size_t size, int* sent, lcm::LCM* url, const std::string& channel) {
+      Message m{std::vector<uint8_t>(std::max(size, kHopHeaderBytes), 0), sent, url, &channel};
+      put_int64_be(m.bytes.data(), kind);
+      messages.push_back(std::move(m));
+      return messages.back().bytes.size();
+    };
+    floors[0]->bytes = add(0, floors[0]->bytes, &floors[0]->sent, images_.get(), kHopChannels[0]);
+    relays[0]->in_bytes =
+        add(kRelayInKind, relays[0]->in_bytes, &relays[0]->sent, images_.get(), kRelayInChannels[0]);
+    floors[1]->bytes = add(1, floors[1]->bytes, &floors[1]->sent, safety_.get(), kHopChannels[1]);
+    relays[1]->in_bytes =
+        add(kRelayInKind + 1, relays[1]->in_bytes, &relays[1]->sent, safety_.get(), kRelayInChannels[1]);
+    floors[2]->bytes = add(2, floors[2]->bytes, &floors[2]->sent, safety_.get(), kHopChannels[2]);
+    for (int r = 0; r < 2; ++r) relays[r]->out_bytes = std::max(relay_out_bytes[r], kHopHeaderBytes);
+    // The receiver's and the relay's sockets are open once they are
+    // constructed; let them settle.
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
     const int64_t period_us = std::llround(1e6 / rate_hz);
     const int64_t start_mono_us = monotonic_us() + 2000;
+    const int count = static_cast<int>(messages.size());
     for (int k = 0; k < hops; ++k) {
-      for (int kind = 0; kind < 3; ++kind) {
+      for (int m = 0; m < count; ++m) {
         std::this_thread::sleep_until(std::chrono::steady_clock::time_point(
-            std::chrono::microseconds(start_mono_us + k * period_us + kind * period_us / 3)));
-        std::vector<uint8_t>& m = messages[kind];
-        put_int64_be(m.data() + 8, monotonic_us());
-        urls[kind]->publish(kHopChannels[kind], m.data(), static_cast<unsigned int>(m.size()));
-        ++floors[kind]->sent;
+            std::chrono::microseconds(start_mono_us + k * period_us + m * period_us / count)));
+        Message& message = messages[static_cast<size_t>(m)];
+        put_int64_be(message.bytes.data() + 8, monotonic_us());
+        put_int64_be(message.bytes.data() + 16, k);
+        message.url->publish(*message.channel, message.bytes.data(),
+                             static_cast<unsigned int>(message.bytes.size()));
+        ++*message.sent;
       }
     }
+    // Each hop once, each relay's message in and out.
+    const size_t expected = static_cast<size_t>(7 * hops);
     const int64_t deadline_us = monotonic_us() + options_.result_timeout_us;
-    while (receiver.received() < static_cast<size_t>(3 * hops) && monotonic_us() < deadline_us)
+    while (receiver.received() < expected && monotonic_us() < deadline_us)
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
     for (int kind = 0; kind < 3; ++kind) floors[kind]->latency = summarise(receiver.latency_ms(kind));
+    for (int r = 0; r < 2; ++r) relays[r]->latency = summarise(receiver.relay_latency_ms(r));
   }
 
   std::string arm_name_;
@@ -1069,6 +1213,14 @@ std::string hop_cell(const HopFloor& h) {
   return cell + ")";
 }
 
+std::string relay_cell(const RelayFloor& r) {
+  std::string cell = latency_cell(r.latency, 2) + " (" + std::to_string(r.in_bytes) + " → " +
+                     std::to_string(r.out_bytes) + " B";
+  if (r.latency.count != r.sent)
+    cell += ", " + std::to_string(r.latency.count) + " of " + std::to_string(r.sent) + " relayed";
+  return cell + ")";
+}
+
 // "1.4× (4.1 / 2.9 ms)": the stage's p50 over its floor.
 std::string ratio_cell(const LatencySummary& stage, double floor_ms) {
   if (stage.count == 0 || !(floor_ms > 0)) return "-";
@@ -1087,14 +1239,21 @@ std::string floors_table(const BenchReport& report) {
        "at their joints. LCM hop floor: a message of the size of "
     << ch.depth << " / " << ch.rendered << " (lcm.image_url), " << ch.discrepancy << " and " << ch.risk
     << " (lcm.url) on a scratch channel at the run's rate, sent → received by the bench's own thread. "
-       "p50 / p99 / max ms. Stage floors (p50s summed): render = image hop + render + image hop ("
-    << ch.depth << " in, " << ch.rendered << " out); discrepancy = compute + " << ch.discrepancy
-    << " hop; risk = " << ch.risk << " hop (the risk monitor's work not measured).\n\n";
+       "Relay floor: the shape of a stage that starts when a process receives a message: the bench "
+       "publishes a message of the size of the stage's input, a relay thread of its own publishes one of "
+       "the size of its output on receiving it, and the bench's receiver thread receives both; the "
+       "second's receive time minus the first's. p50 / p99 / max ms. Stage floors (p50s summed): render "
+       "= image hop + render + image hop ("
+    << ch.depth << " in, " << ch.rendered << " out); discrepancy = compute + relay (" << ch.rendered << " → "
+    << ch.discrepancy << "); risk = relay (" << ch.discrepancy << " → " << ch.risk
+    << "; the risk monitor's work not measured).\n\n";
   t << "| arm | size | rate (Hz) | render floor p50 / p99 / max | compute_discrepancy p50 / p99 / max | "
        "LCM hop floor p50 / p99 / max, "
     << ch.depth << " / " << ch.rendered << " | LCM hop floor, " << ch.discrepancy << " | LCM hop floor, "
-    << ch.risk << " | render p50 / floor | discrepancy p50 / floor | risk p50 / floor |\n";
-  t << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+    << ch.risk << " | relay floor, " << ch.rendered << " → " << ch.discrepancy << " | relay floor, "
+    << ch.discrepancy << " → " << ch.risk
+    << " | render p50 / floor | discrepancy p50 / floor | risk p50 / floor |\n";
+  t << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
   for (const BenchFloors& f : report.floors) {
     // The step at the floors' rate: the plain step, or the ramp's first.
     const BenchStep* step = nullptr;
@@ -1109,7 +1268,8 @@ std::string floors_table(const BenchReport& report) {
       << latency_cell(f.render, 2) << " (" << f.render.count << ") | "
       << latency_cell(f.discrepancy_compute, 2) << " (" << f.discrepancy_compute.count << ") | "
       << hop_cell(f.image_hop) << " | " << hop_cell(f.discrepancy_hop) << " | " << hop_cell(f.risk_hop)
-      << " | " << ratio_cell(s.render, render_stage_floor_ms(f)) << " | "
+      << " | " << relay_cell(f.discrepancy_relay) << " | " << relay_cell(f.risk_relay) << " | "
+      << ratio_cell(s.render, render_stage_floor_ms(f)) << " | "
       << ratio_cell(s.discrepancy, discrepancy_stage_floor_ms(f)) << " | "
       << ratio_cell(s.risk, risk_stage_floor_ms(f)) << " |\n";
   }
@@ -1123,11 +1283,11 @@ double render_stage_floor_ms(const BenchFloors& f) {
   return f.render.p50_ms + 2 * f.image_hop.latency.p50_ms;
 }
 double discrepancy_stage_floor_ms(const BenchFloors& f) {
-  if (f.discrepancy_compute.count == 0 || f.discrepancy_hop.latency.count == 0) return 0;
-  return f.discrepancy_compute.p50_ms + f.discrepancy_hop.latency.p50_ms;
+  if (f.discrepancy_compute.count == 0 || f.discrepancy_relay.latency.count == 0) return 0;
+  return f.discrepancy_compute.p50_ms + f.discrepancy_relay.latency.p50_ms;
 }
 double risk_stage_floor_ms(const BenchFloors& f) {
-  return f.risk_hop.latency.count == 0 ? 0 : f.risk_hop.latency.p50_ms;
+  return f.risk_relay.latency.count == 0 ? 0 : f.risk_relay.latency.p50_ms;
 }
 
 std::string bench_frames_csv(const BenchReport& report) {

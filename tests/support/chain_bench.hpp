@@ -91,6 +91,10 @@ struct BenchStep {
   int frames_verdict = 0;   // SAFETY_RISK arrived (at any time)
   int frames_dropped = 0;   // no SAFETY_RISK within result_timeout_us
   int frames_safe = 0;      // SAFETY_RISK arrived with level SAFE
+  // Verdicts whose first copy to arrive was the signed one (SAFETY_RISK_AUTH,
+  // which tofguard-risk publishes first when it has a key); the risk stage
+  // ends at the first copy.
+  int frames_verdict_signed_first = 0;
   // TOF_DEPTH sent -> TOF_RENDERED -> SAFETY_DISCREPANCY -> SAFETY_RISK, and
   // TOF_DEPTH sent -> SAFETY_RISK.
   LatencySummary render;
@@ -150,6 +154,13 @@ struct HopFloor {
   LatencySummary latency;
 };
 
+struct RelayFloor {
+  size_t in_bytes = 0;
+  size_t out_bytes = 0;
+  int sent = 0;
+  LatencySummary latency;
+};
+
 // The floors of one arm and camera size, measured by the bench alone (the
 // chain's processes stopped, no chain process involved).
 struct BenchFloors {
@@ -173,14 +184,27 @@ struct BenchFloors {
   HopFloor image_hop;
   HopFloor discrepancy_hop;
   HopFloor risk_hop;
+  // The relays: the shape of a stage that starts when a process receives a
+  // message and ends when the bench receives the one it publishes. The bench
+  // publishes `in_bytes`; a relay thread of its own (its own LCM instances)
+  // publishes `out_bytes` at once on receiving it; the bench's receiver
+  // thread receives both, and the latency is the second's receive time minus
+  // the first's, as the stage's is. It holds the wake-ups a hop does not:
+  // the relay's and the bench's after it, while the bench is woken by the
+  // first message too (on 2 cores the two woken threads and the sender
+  // contend). discrepancy_relay: TOF_RENDERED-sized in (lcm.image_url),
+  // SAFETY_DISCREPANCY-sized out (lcm.url); risk_relay: SAFETY_DISCREPANCY-
+  // sized in, SAFETY_RISK-sized out (lcm.url).
+  RelayFloor discrepancy_relay;
+  RelayFloor risk_relay;
 };
 
 // The floor of each stage (p50s summed), ms, and what it is made of: render
 // = image hop (TOF_DEPTH to the renderer) + render + image hop (TOF_RENDERED
-// back); discrepancy = compute_discrepancy + discrepancy_t hop (the bench
-// and tofguard-discrepancy receive TOF_RENDERED at the same time, so that
-// hop is not in the stage); risk = risk_t hop (the risk monitor's own work
-// is not measured). 0 when a part is missing.
+// back); discrepancy = compute_discrepancy + the discrepancy relay (the
+// stage starts at the bench's receive of TOF_RENDERED, which
+// tofguard-discrepancy receives at the same time); risk = the risk relay
+// (the risk monitor's own work is not measured). 0 when a part is missing.
 double render_stage_floor_ms(const BenchFloors& floors);
 double discrepancy_stage_floor_ms(const BenchFloors& floors);
 double risk_stage_floor_ms(const BenchFloors& floors);

@@ -41,6 +41,11 @@ TEST(BenchSmoke, FramesGoThroughEveryStageAtTenHertz) {
   for (const char* p : {"tofguard-renderer", "tofguard-discrepancy", "tofguard-risk", "tofguard-intervene"})
     EXPECT_EQ(step.cpu_percent.count(p), 1u) << p;
 
+  // config/sim.yaml has a key: tofguard-risk publishes each verdict signed
+  // first, and the stage ends at that copy (the one tofguard-intervene acts
+  // on). Nearly every frame's first copy is the signed one: a bench that
+  // read only SAFETY_RISK would count none.
+  EXPECT_GE(step.frames_verdict_signed_first, step.frames_verdict * 9 / 10) << step.frames_verdict;
   const std::string markdown = bench_markdown(report);
   std::cout << markdown;
   for (const char* column : {"TOF_DEPTH → TOF_RENDERED", "TOF_RENDERED → SAFETY_DISCREPANCY",
@@ -63,12 +68,28 @@ TEST(BenchSmoke, FramesGoThroughEveryStageAtTenHertz) {
     EXPECT_GT(hop->latency.count, 0);
     EXPECT_GT(hop->bytes, 0u);
   }
+  // Each relay's messages in and out, of the sizes of its stage's input
+  // and output (the image's, the discrepancy_t's, the risk_t's).
+  for (const RelayFloor* relay : {&floors.discrepancy_relay, &floors.risk_relay}) {
+    EXPECT_EQ(relay->sent, 30);
+    EXPECT_GT(relay->latency.count, 0);
+  }
+  EXPECT_EQ(floors.discrepancy_relay.in_bytes, floors.image_hop.bytes);
+  EXPECT_EQ(floors.discrepancy_relay.out_bytes, floors.discrepancy_hop.bytes);
+  EXPECT_EQ(floors.risk_relay.in_bytes, floors.discrepancy_hop.bytes);
+  EXPECT_EQ(floors.risk_relay.out_bytes, floors.risk_hop.bytes);
+  // The stages' floors are made of them.
+  EXPECT_DOUBLE_EQ(risk_stage_floor_ms(floors), floors.risk_relay.latency.p50_ms);
+  EXPECT_DOUBLE_EQ(discrepancy_stage_floor_ms(floors),
+                   floors.discrepancy_compute.p50_ms + floors.discrepancy_relay.latency.p50_ms);
   // A depth_image_t of 176x144 int16 pixels.
   EXPECT_GT(floors.image_hop.bytes, 176u * 144u * 2u);
   for (const char* column :
        {"render floor p50 / p99 / max", "compute_discrepancy p50 / p99 / max",
         "LCM hop floor p50 / p99 / max, TOF_DEPTH / TOF_RENDERED", "LCM hop floor, SAFETY_DISCREPANCY",
-        "LCM hop floor, SAFETY_RISK", "render p50 / floor", "discrepancy p50 / floor", "risk p50 / floor"})
+        "LCM hop floor, SAFETY_RISK", "relay floor, TOF_RENDERED → SAFETY_DISCREPANCY",
+        "relay floor, SAFETY_DISCREPANCY → SAFETY_RISK", "render p50 / floor", "discrepancy p50 / floor",
+        "risk p50 / floor"})
     EXPECT_NE(markdown.find(column), std::string::npos) << column;
   EXPECT_NE(markdown.find("| default | 176x144 | 10 | "), std::string::npos) << markdown;
 
