@@ -3,9 +3,18 @@
 #include <pthread.h>
 #include <sched.h>
 
+#include <algorithm>
+
 #include "tofguard/common/demand.hpp"
 
 namespace tofguard {
+
+int allowed_cpu_count() {
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  if (sched_getaffinity(0, sizeof(allowed), &allowed) != 0) return 1;
+  return std::max(CPU_COUNT(&allowed), 1);
+}
 
 WorkerPool::WorkerPool(int num_threads, std::chrono::microseconds linger) : linger_(linger) {
   TOFGUARD_DEMAND(num_threads >= 1,

@@ -28,6 +28,11 @@ int run_discrepancy(const DiscrepancyProcessSettings& settings) {
   FramePairer pairer(dc.pair_timeout_us, dc.max_pending_frames);
   RepeatCounter repeats;
   WorkerPool workers(dc.worker_threads);
+  // (`worker_threads: auto` depends on the machine: say what it became.)
+  std::fprintf(stderr,
+               "tofguard-discrepancy: compute_discrepancy on %d thread(s) (discrepancy.worker_threads; %d "
+               "CPUs allowed)\n",
+               dc.worker_threads, allowed_cpu_count());
   int64_t judged = 0;
   int64_t unusable = 0;
 

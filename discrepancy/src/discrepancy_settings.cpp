@@ -1,8 +1,15 @@
 #include "tofguard/discrepancy/discrepancy_settings.hpp"
 
+#include <algorithm>
+#include <charconv>
 #include <cmath>
+#include <string>
+
+#include "tofguard/common/worker_pool.hpp"
 
 namespace tofguard::discrepancy {
+
+int auto_worker_threads() { return std::min(allowed_cpu_count(), kMaxAutoWorkerThreads); }
 
 DiscrepancySettings read_discrepancy_settings(YamlMap map) {
   DiscrepancySettings d;
@@ -59,8 +66,18 @@ DiscrepancySettings read_discrepancy_settings(YamlMap map) {
     }
     evidence.finish();
   }
-  if (map.optional("worker_threads"))
-    d.worker_threads = static_cast<int>(map.integer("worker_threads", 1, 64));
+  if (map.optional("worker_threads")) {
+    const std::string text = map.string("worker_threads");
+    int threads = 0;
+    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), threads);
+    if (text == "auto") {
+      d.worker_threads = auto_worker_threads();
+    } else if (error == std::errc() && end == text.data() + text.size() && threads >= 1 && threads <= 64) {
+      d.worker_threads = threads;
+    } else {
+      map.fail("worker_threads", "an integer in [1, 64] or auto", "'" + text + "'");
+    }
+  }
   map.finish();
   return d;
 }

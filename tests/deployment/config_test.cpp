@@ -1,6 +1,7 @@
 // The deployment config: the embedded default loads, and every kind of
 // mistake gives one line naming the file, the key and what was expected.
 #include <gtest/gtest.h>
+#include <sched.h>
 
 #include <sys/stat.h>
 
@@ -189,6 +190,14 @@ INSTANTIATE_TEST_SUITE_P(
                   "  field: {range_m: 2.0, bin_m: 0.01}\n",
                   "  field: {range_m: 0.3, bin_m: 0.5}\n",
                   {"discrepancy.field.bin_m", "no wider than range_m"}},
+        BadConfig{"worker-threads-neither-a-count-nor-auto",
+                  "  worker_threads: auto\n",
+                  "  worker_threads: many\n",
+                  {"discrepancy.worker_threads", "expected an integer in [1, 64] or auto", "'many'"}},
+        BadConfig{"worker-threads-zero",
+                  "  worker_threads: auto\n",
+                  "  worker_threads: 0\n",
+                  {"discrepancy.worker_threads", "expected an integer in [1, 64] or auto", "'0'"}},
         BadConfig{"estimate-wait-out-of-range",
                   "    wait_ms: 0\n",
                   "    wait_ms: 5000\n",
@@ -274,6 +283,32 @@ TEST(Config, ABusOpenBeyondTheHostIsWarnedAbout) {
   const auto warnings = deployment::start_warnings(deployment::load_config(path, nullptr));
   ASSERT_EQ(warnings.size(), 1u);
   EXPECT_NE(warnings[0].find("WARNING: LCM bus udpm://239.255.76.67:7667?ttl=1"), std::string::npos);
+}
+
+// worker_threads: auto is read for the CPUs of the process reading it
+// (what taskset or systemd's CPUAffinity left it), at most 8; a number
+// stands as written.
+TEST(Config, AutoWorkerThreadsFollowTheCpusTheReaderMayRunOn) {
+  cpu_set_t before;
+  ASSERT_EQ(sched_getaffinity(0, sizeof(before), &before), 0);
+  const int cpus = CPU_COUNT(&before);
+  EXPECT_EQ(deployment::load_config(sim_yaml_path(), nullptr).discrepancy.worker_threads, std::min(cpus, 8));
+  // On one CPU: 1 (no worker thread).
+  cpu_set_t one;
+  CPU_ZERO(&one);
+  for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu) {
+    if (CPU_ISSET(cpu, &before)) {
+      CPU_SET(cpu, &one);
+      break;
+    }
+  }
+  ASSERT_EQ(sched_setaffinity(0, sizeof(one), &one), 0);
+  const int on_one_cpu = deployment::load_config(sim_yaml_path(), nullptr).discrepancy.worker_threads;
+  ASSERT_EQ(sched_setaffinity(0, sizeof(before), &before), 0);
+  EXPECT_EQ(on_one_cpu, 1);
+  const std::string fixed =
+      sim_variant("worker-threads-3", "  worker_threads: auto\n", "  worker_threads: 3\n");
+  EXPECT_EQ(deployment::load_config(fixed, nullptr).discrepancy.worker_threads, 3);
 }
 
 TEST(Config, MissingFileIsNamed) {

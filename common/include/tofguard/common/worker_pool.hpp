@@ -42,6 +42,11 @@
 
 namespace tofguard {
 
+// The CPUs the calling thread may run on (Linux: sched_getaffinity, which
+// a process inherits from its parent, taskset and systemd's CPUAffinity
+// included); 1 when it cannot be read.
+int allowed_cpu_count();
+
 class WorkerPool {
  public:
   // How long a worker stays awake after a call by default: the gaps

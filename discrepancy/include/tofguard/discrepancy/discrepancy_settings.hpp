@@ -83,8 +83,21 @@ struct DiscrepancySettings {
   // naming search shares its joints among, the process's own included
   // (WorkerPool; docs/benchmarks.md, "The hot paths"). A speed setting
   // only: the summary is the same for any value. 1: no worker thread.
+  // `auto`: the CPUs the reading process may run on, at most
+  // kMaxAutoWorkerThreads (auto_worker_threads).
   int worker_threads = 1;
 };
+
+// `worker_threads: auto`'s limit: compute_discrepancy's evidence sums run in
+// 8 fixed bands of rows and its naming search in a task per joint (6-7 for
+// the arms here), so a ninth thread would find no task. On a 16-core
+// machine 8 met issue 17's targets where 2 did not (docs/benchmarks.md, "On
+// an NVIDIA H200 machine").
+inline constexpr int kMaxAutoWorkerThreads = 8;
+
+// `worker_threads: auto`: min(allowed_cpu_count(), kMaxAutoWorkerThreads),
+// for the calling thread's CPUs when it is called.
+int auto_worker_threads();
 
 // Reads (and finishes) the `discrepancy` section.
 DiscrepancySettings read_discrepancy_settings(YamlMap section);
