@@ -337,6 +337,10 @@ class TwoUrlThread {
       : safety_(safety_url), images_(image_url) {
     if (!safety_.good() || !images_.good())
       throw std::runtime_error("cannot open LCM (" + safety_url + ", " + image_url + ")");
+    // LCM 1.3 joins the multicast groups lazily (first getFileno()/handle()):
+    // join now, so nothing published once this is constructed is missed.
+    safety_.getFileno();
+    images_.getFileno();
   }
   ~TwoUrlThread() { stop(); }
   TwoUrlThread(const TwoUrlThread&) = delete;
@@ -910,9 +914,8 @@ class BenchChain {
         add(kRelayInKind + 1, relays[1]->in_bytes, &relays[1]->sent, safety_.get(), kRelayInChannels[1]);
     floors[2]->bytes = add(2, floors[2]->bytes, &floors[2]->sent, safety_.get(), kHopChannels[2]);
     for (int r = 0; r < 2; ++r) relays[r]->out_bytes = std::max(relay_out_bytes[r], kHopHeaderBytes);
-    // The receiver's and the relay's sockets are open once they are
-    // constructed; let them settle.
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    // (The receiver's and the relay's sockets joined their groups when they
+    // were constructed: nothing sent from here on is missed.)
     const int64_t period_us = std::llround(1e6 / rate_hz);
     const int64_t start_mono_us = monotonic_us() + 2000;
     const int count = static_cast<int>(messages.size());
