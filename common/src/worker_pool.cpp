@@ -4,29 +4,39 @@
 #include <sched.h>
 
 #include <algorithm>
+#include <utility>
+#include <vector>
 
 #include "tofguard/common/demand.hpp"
 
 namespace tofguard {
 
-int allowed_cpu_count() {
+namespace {
+
+// The CPUs the calling thread may run on; none when they cannot be read.
+std::vector<int> allowed_cpus() {
   cpu_set_t allowed;
   CPU_ZERO(&allowed);
-  if (sched_getaffinity(0, sizeof(allowed), &allowed) != 0) return 1;
-  return std::max(CPU_COUNT(&allowed), 1);
+  std::vector<int> cpus;
+  if (sched_getaffinity(0, sizeof(allowed), &allowed) != 0) return cpus;
+  for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu) {
+    if (CPU_ISSET(cpu, &allowed)) cpus.push_back(cpu);
+  }
+  return cpus;
 }
+
+}  // namespace
+
+int allowed_cpu_count() { return std::max(static_cast<int>(allowed_cpus().size()), 1); }
 
 WorkerPool::WorkerPool(int num_threads, std::chrono::microseconds linger) : linger_(linger) {
   TOFGUARD_DEMAND(num_threads >= 1,
                   "WorkerPool: num_threads must be >= 1, got " + std::to_string(num_threads));
   TOFGUARD_DEMAND(linger.count() >= 0, "WorkerPool: linger must be >= 0 us, got " +
                                            std::to_string(static_cast<long long>(linger.count())));
-  cpu_set_t allowed;
-  CPU_ZERO(&allowed);
-  if (num_threads > 1 && sched_getaffinity(0, sizeof(allowed), &allowed) == 0 && CPU_COUNT(&allowed) > 1) {
-    for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu) {
-      if (CPU_ISSET(cpu, &allowed)) allowed_cpus_.push_back(cpu);
-    }
+  if (num_threads > 1) {
+    std::vector<int> cpus = allowed_cpus();
+    if (cpus.size() > 1) allowed_cpus_ = std::move(cpus);
   }
   workers_.reserve(static_cast<size_t>(num_threads - 1));
   for (int i = 1; i < num_threads; ++i) workers_.emplace_back([this] { worker_loop(); });

@@ -143,6 +143,49 @@ struct FrameArrivals {
   int32_t compute_us = -1;
 };
 
+// Polls an LCM instance on each of the chain's two URLs from a thread of
+// its own until destroyed.
+class TwoUrlThread {
+ public:
+  TwoUrlThread(const std::string& safety_url, const std::string& image_url)
+      : safety_(safety_url), images_(image_url) {
+    if (!safety_.good() || !images_.good())
+      throw std::runtime_error("cannot open LCM (" + safety_url + ", " + image_url + ")");
+    // LCM 1.3 joins the multicast groups lazily (first getFileno()/handle()):
+    // join now, so nothing published once this is constructed is missed.
+    safety_.getFileno();
+    images_.getFileno();
+  }
+  ~TwoUrlThread() { stop(); }
+  TwoUrlThread(const TwoUrlThread&) = delete;
+  TwoUrlThread& operator=(const TwoUrlThread&) = delete;
+
+  lcm::LCM& safety() { return safety_; }
+  lcm::LCM& images() { return images_; }
+  // After the subscriptions.
+  void start() {
+    thread_ = std::thread([this] {
+      pollfd fds[2] = {{safety_.getFileno(), POLLIN, 0}, {images_.getFileno(), POLLIN, 0}};
+      while (!stop_) {
+        if (poll(fds, 2, 20) <= 0) continue;
+        if (fds[0].revents & POLLIN) safety_.handleTimeout(0);
+        if (fds[1].revents & POLLIN) images_.handleTimeout(0);
+      }
+    });
+  }
+  // Before the members a handler uses go.
+  void stop() {
+    stop_ = true;
+    if (thread_.joinable()) thread_.join();
+  }
+
+ private:
+  lcm::LCM safety_;
+  lcm::LCM images_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
 // Receives TOF_RENDERED, SAFETY_DISCREPANCY and SAFETY_RISK on its own
 // thread and LCM sockets, so that the publisher's pacing does not delay the
 // time stamps; records the first arrival of each per frame seq. A verdict
@@ -153,20 +196,15 @@ struct FrameArrivals {
 class ArrivalRecorder {
  public:
   explicit ArrivalRecorder(const deployment::Config& config)
-      : risk_channel_(config.channels.risk), safety_(config.lcm.url), images_(config.lcm.image_url) {
-    if (!safety_.good() || !images_.good())
-      throw std::runtime_error("cannot open LCM (" + config.lcm.url + ", " + config.lcm.image_url + ")");
-    images_.subscribe(config.channels.rendered, &ArrivalRecorder::on_rendered, this);
-    safety_.subscribe(config.channels.discrepancy, &ArrivalRecorder::on_discrepancy, this);
-    safety_.subscribe(config.channels.risk, &ArrivalRecorder::on_risk, this);
-    safety_.subscribe(config.channels.risk_auth, &ArrivalRecorder::on_signed_risk, this);
-    safety_.subscribe(config.channels.heartbeat, &ArrivalRecorder::on_heartbeat, this);
-    thread_ = std::thread([this] { receive(); });
+      : risk_channel_(config.channels.risk), lcm_(config.lcm.url, config.lcm.image_url) {
+    lcm_.images().subscribe(config.channels.rendered, &ArrivalRecorder::on_rendered, this);
+    lcm_.safety().subscribe(config.channels.discrepancy, &ArrivalRecorder::on_discrepancy, this);
+    lcm_.safety().subscribe(config.channels.risk, &ArrivalRecorder::on_risk, this);
+    lcm_.safety().subscribe(config.channels.risk_auth, &ArrivalRecorder::on_signed_risk, this);
+    lcm_.safety().subscribe(config.channels.heartbeat, &ArrivalRecorder::on_heartbeat, this);
+    lcm_.start();
   }
-  ~ArrivalRecorder() {
-    stop_ = true;
-    thread_.join();
-  }
+  ~ArrivalRecorder() { lcm_.stop(); }
   ArrivalRecorder(const ArrivalRecorder&) = delete;
   ArrivalRecorder& operator=(const ArrivalRecorder&) = delete;
 
@@ -226,14 +264,6 @@ class ArrivalRecorder {
   }
 
  private:
-  void receive() {
-    pollfd fds[2] = {{safety_.getFileno(), POLLIN, 0}, {images_.getFileno(), POLLIN, 0}};
-    while (!stop_) {
-      if (poll(fds, 2, 20) <= 0) continue;
-      if (fds[0].revents & POLLIN) safety_.handleTimeout(0);
-      if (fds[1].revents & POLLIN) images_.handleTimeout(0);
-    }
-  }
   void record(const lcm::ReceiveBuffer* buffer, int64_t hash, Stage stage) {
     record(static_cast<const uint8_t*>(buffer->data), buffer->data_size, monotonic_us(), hash, stage, false);
   }
@@ -299,8 +329,6 @@ class ArrivalRecorder {
   }
 
   const std::string risk_channel_;
-  lcm::LCM safety_;
-  lcm::LCM images_;
   mutable std::mutex mutex_;
   std::condition_variable verdict_;
   std::condition_variable heartbeat_;
@@ -308,8 +336,7 @@ class ArrivalRecorder {
   int64_t renderer_heartbeat_us_ = 0;
   std::unordered_map<int64_t, FrameArrivals> frames_;
   size_t largest_[3] = {0, 0, 0};
-  std::atomic<bool> stop_{false};
-  std::thread thread_;
+  TwoUrlThread lcm_;  // last: its thread stops before the members go
 };
 
 // The LCM hop floor's receiver: its own thread and LCM instances on the
@@ -328,49 +355,6 @@ const std::string kRelayOutChannels[2] = {"TOFGUARD_BENCH_RELAY_DISCREPANCY_OUT"
 constexpr size_t kHopHeaderBytes = 24;  // kind, sent_us, seq (big-endian int64 each)
 constexpr int64_t kRelayInKind = 3;
 constexpr int64_t kRelayOutKind = 5;
-
-// Polls an LCM instance on each of the chain's two URLs from a thread of
-// its own until destroyed.
-class TwoUrlThread {
- public:
-  TwoUrlThread(const std::string& safety_url, const std::string& image_url)
-      : safety_(safety_url), images_(image_url) {
-    if (!safety_.good() || !images_.good())
-      throw std::runtime_error("cannot open LCM (" + safety_url + ", " + image_url + ")");
-    // LCM 1.3 joins the multicast groups lazily (first getFileno()/handle()):
-    // join now, so nothing published once this is constructed is missed.
-    safety_.getFileno();
-    images_.getFileno();
-  }
-  ~TwoUrlThread() { stop(); }
-  TwoUrlThread(const TwoUrlThread&) = delete;
-  TwoUrlThread& operator=(const TwoUrlThread&) = delete;
-
-  lcm::LCM& safety() { return safety_; }
-  lcm::LCM& images() { return images_; }
-  // After the subscriptions.
-  void start() {
-    thread_ = std::thread([this] {
-      pollfd fds[2] = {{safety_.getFileno(), POLLIN, 0}, {images_.getFileno(), POLLIN, 0}};
-      while (!stop_) {
-        if (poll(fds, 2, 20) <= 0) continue;
-        if (fds[0].revents & POLLIN) safety_.handleTimeout(0);
-        if (fds[1].revents & POLLIN) images_.handleTimeout(0);
-      }
-    });
-  }
-  // Before the members a handler uses go.
-  void stop() {
-    stop_ = true;
-    if (thread_.joinable()) thread_.join();
-  }
-
- private:
-  lcm::LCM safety_;
-  lcm::LCM images_;
-  std::atomic<bool> stop_{false};
-  std::thread thread_;
-};
 
 class HopReceiver {
  public:
@@ -890,8 +874,6 @@ class BenchChain {
     HopRelay relay(config_.lcm.url, config_.lcm.image_url, relay_out_bytes);
     HopFloor* floors[3] = {&f->image_hop, &f->discrepancy_hop, &f->risk_hop};
     RelayFloor* relays[2] = {&f->discrepancy_relay, &f->risk_relay};
-    relays[0]->in_bytes = f->image_hop.bytes;
-    relays[1]->in_bytes = f->discrepancy_hop.bytes;
     // Message m of the period: its kind, floor or relay, URL and channel.
     struct Message {
       std::vector<uint8_t> bytes;
@@ -908,10 +890,10 @@ class BenchChain {
     };
     floors[0]->bytes = add(0, floors[0]->bytes, &floors[0]->sent, images_.get(), kHopChannels[0]);
     relays[0]->in_bytes =
-        add(kRelayInKind, relays[0]->in_bytes, &relays[0]->sent, images_.get(), kRelayInChannels[0]);
+        add(kRelayInKind, floors[0]->bytes, &relays[0]->sent, images_.get(), kRelayInChannels[0]);
     floors[1]->bytes = add(1, floors[1]->bytes, &floors[1]->sent, safety_.get(), kHopChannels[1]);
     relays[1]->in_bytes =
-        add(kRelayInKind + 1, relays[1]->in_bytes, &relays[1]->sent, safety_.get(), kRelayInChannels[1]);
+        add(kRelayInKind + 1, floors[1]->bytes, &relays[1]->sent, safety_.get(), kRelayInChannels[1]);
     floors[2]->bytes = add(2, floors[2]->bytes, &floors[2]->sent, safety_.get(), kHopChannels[2]);
     for (int r = 0; r < 2; ++r) relays[r]->out_bytes = std::max(relay_out_bytes[r], kHopHeaderBytes);
     // (The receiver's and the relay's sockets joined their groups when they
