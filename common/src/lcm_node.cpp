@@ -46,9 +46,15 @@ LcmNode::LcmNode(const LcmSettings& lcm, const ChannelNames& channels, const std
       errors_(process_name),
       heartbeat_(safety_.get(), channels.heartbeat, process_name, heartbeat_rate_hz) {
   // LCM 1.3 joins the multicast groups lazily (first getFileno()/handle()):
-  // join now, so nothing sent after construction is missed.
+  // join the safety URL now, so nothing sent after construction is missed
+  // (every process reads SAFETY_* there). The image URL: in join(), on the
+  // first subscription on it.
   safety_->getFileno();
-  if (images_) images_->getFileno();
+}
+
+void LcmNode::join(lcm::LCM& lcm) {
+  lcm.getFileno();
+  if (&lcm == images_.get()) images_joined_ = true;
 }
 
 LcmNode::~LcmNode() = default;
@@ -65,13 +71,13 @@ bool LcmNode::spin_once(int max_wait_ms) {
   wait_us = std::max<int64_t>(0, wait_us);
 
   pollfd fds[2] = {{safety_->getFileno(), POLLIN, 0}, {-1, POLLIN, 0}};
-  const nfds_t nfds = images_ ? 2 : 1;
-  if (images_) fds[1].fd = images_->getFileno();
+  const nfds_t nfds = images_joined_ ? 2 : 1;
+  if (images_joined_) fds[1].fd = images_->getFileno();
   // Round up so that a wait never ends just before a timer is due.
   const int ready = poll(fds, nfds, static_cast<int>((wait_us + 999) / 1000));
   if (ready > 0) {
     if (fds[0].revents & POLLIN) safety_->handle();
-    if (images_ && (fds[1].revents & POLLIN)) images_->handle();
+    if (images_joined_ && (fds[1].revents & POLLIN)) images_->handle();
   }
 
   const int64_t after_us = monotonic_us();

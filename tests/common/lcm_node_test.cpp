@@ -1,7 +1,11 @@
 // LcmNode over real UDP multicast (private network namespace): malformed
 // messages are dropped and counted, never handed on; the heartbeat carries
-// the counters; timers fire by themselves.
+// the counters; timers fire by themselves; the image URL is read only by a
+// node that subscribes there.
 #include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
 
 #include "sample_messages.hpp"
 #include "test_support.hpp"
@@ -82,6 +86,56 @@ TEST(LcmNode, MalformedMessagesAreCountedAndNeverHandedOn) {
   EXPECT_EQ(heartbeats.last.frames_in, 1);
   EXPECT_EQ(heartbeats.last.validation_errors, 1);
   EXPECT_GT(heartbeats.last.pid, 0);
+}
+
+// The UDP sockets of this network namespace bound to `port` (the test runs
+// in a private one: only its own), from /proc/net/udp's local_address
+// column ("0100007F:1DF4", the port in hex).
+int udp_sockets_bound_to(int port) {
+  std::ifstream table("/proc/net/udp");
+  std::string line;
+  std::getline(table, line);  // the header
+  int count = 0;
+  while (std::getline(table, line)) {
+    std::istringstream fields(line);
+    std::string slot;
+    std::string local;
+    fields >> slot >> local;
+    const size_t colon = local.find(':');
+    if (colon != std::string::npos && std::stoi(local.substr(colon + 1), nullptr, 16) == port) ++count;
+  }
+  return count;
+}
+
+int port_of(const std::string& udpm_url) {
+  const size_t colon = udpm_url.rfind(':');
+  return std::stoi(udpm_url.substr(colon + 1));
+}
+
+TEST(LcmNode, OnlyANodeSubscribedOnTheImageUrlReceivesThere) {
+  const TestWiring config = test_config();
+  const int image_port = port_of(config.lcm.image_url);
+  ASSERT_NE(image_port, port_of(config.lcm.url));
+  ASSERT_EQ(udp_sockets_bound_to(image_port), 0);
+  // A node that publishes images but reads none (a camera, the joint
+  // simulator, tofguard-intervene): no socket on the image URL, so the
+  // kernel never wakes it with a frame.
+  LcmNode publisher_only(config.lcm, config.channels, "publishes-images");
+  const depth_image_t frame = sample_depth_image();
+  publisher_only.images().publish("TOF_DEPTH", &frame);
+  publisher_only.spin_once(0);
+  EXPECT_EQ(udp_sockets_bound_to(image_port), 0);
+  EXPECT_EQ(udp_sockets_bound_to(port_of(config.lcm.url)), 1);
+  // Subscribing there joins at once: the first image after the call arrives.
+  LcmNode reader(config.lcm, config.channels, "reads-images");
+  std::vector<depth_image_t> handled;
+  reader.subscribe<depth_image_t>(
+      reader.images(), "TOF_DEPTH", [&](const depth_image_t& m) { handled.push_back(m); }, check_depth_image);
+  EXPECT_EQ(udp_sockets_bound_to(image_port), 1);
+  publisher_only.images().publish("TOF_DEPTH", &frame);
+  ASSERT_TRUE(wait_until([&] { return handled.size() == 1; }, std::chrono::seconds(5),
+                         [&] { reader.spin_once(10); }));
+  EXPECT_EQ(handled[0].seq, frame.seq);
 }
 
 TEST(LcmNode, HeartbeatsComeAtTheirRateWithoutAnyTraffic) {

@@ -32,7 +32,8 @@ class LcmNode {
  public:
   // Opens both URLs (one LCM instance when they are equal); throws
   // std::runtime_error naming the URL when LCM cannot start. Heartbeats go
-  // out on channels.heartbeat at `heartbeat_rate_hz`.
+  // out on channels.heartbeat at `heartbeat_rate_hz`. The safety URL is
+  // joined here; the image URL on the first subscription on it (below).
   LcmNode(const LcmSettings& lcm, const ChannelNames& channels, const std::string& process_name,
           double heartbeat_rate_hz = 20);
   ~LcmNode();
@@ -47,6 +48,10 @@ class LcmNode {
   const std::string& process_name() const { return process_name_; }
 
   // Subscribes `on_message` to `channel` on `lcm` (safety() or images()).
+  // The first subscription on images() joins the image URL: a process that
+  // only publishes images, or never reads them, is not woken by each of
+  // the three image messages of every frame (TOF_DEPTH, TOF_LABELS,
+  // TOF_RENDERED, 25-300 KB each) on a core the chain needs.
   // `check` returns "" for a valid message, else "field: expected ..., got
   // ..." (see wire_checks.hpp). Every valid message counts as frames_in.
   template <class T>
@@ -64,6 +69,11 @@ class LcmNode {
   void run();
 
  private:
+  // Joins `lcm`'s multicast group now (LCM 1.3 joins lazily, on the first
+  // getFileno()/handle()), so that nothing sent after a subscription is
+  // missed; for images_, also marks it to be polled.
+  void join(lcm::LCM& lcm);
+
   struct SubscriptionBase {
     virtual ~SubscriptionBase() = default;
   };
@@ -78,6 +88,7 @@ class LcmNode {
   std::string process_name_;
   std::unique_ptr<lcm::LCM> safety_;
   std::unique_ptr<lcm::LCM> images_;  // null when the image URL is the safety URL
+  bool images_joined_ = false;        // images_ has its receive socket (subscribed on it)
   ErrorLog errors_;
   HeartbeatPublisher heartbeat_;
   std::vector<std::unique_ptr<SubscriptionBase>> subscriptions_;
@@ -121,6 +132,7 @@ void LcmNode::subscribe(lcm::LCM& lcm, const std::string& channel, std::function
   subscription->check = std::move(check);
   lcm.subscribe(channel, &CheckedSubscription<T>::handle, subscription.get());
   subscriptions_.push_back(std::move(subscription));
+  join(lcm);
 }
 
 }  // namespace tofguard
