@@ -422,6 +422,26 @@ class HopReceiver {
 // thread and LCM instances; on each relay r's message in it publishes, at
 // once, relay r's message out (out_bytes[r] bytes, the same sequence
 // number) on lcm.url, as a chain process publishes its result.
+// An LCM instance on each URL that reads everything sent there and handles
+// nothing (subscribed to a channel nobody publishes), as a chain process
+// does with the channels it does not read (BenchOptions::floor_listeners).
+class IdleListener {
+ public:
+  IdleListener(const std::string& safety_url, const std::string& image_url) : lcm_(safety_url, image_url) {
+    lcm_.safety().subscribe(kIdleChannel, &IdleListener::on_message, this);
+    lcm_.images().subscribe(kIdleChannel, &IdleListener::on_message, this);
+    lcm_.start();
+  }
+  ~IdleListener() { lcm_.stop(); }
+  IdleListener(const IdleListener&) = delete;
+  IdleListener& operator=(const IdleListener&) = delete;
+
+ private:
+  static constexpr const char* kIdleChannel = "TOFGUARD_BENCH_FLOOR_IDLE";
+  void on_message(const lcm::ReceiveBuffer*, const std::string&) {}
+  TwoUrlThread lcm_;
+};
+
 class HopRelay {
  public:
   HopRelay(const std::string& safety_url, const std::string& image_url, const size_t out_bytes[2])
@@ -616,6 +636,7 @@ class BenchChain {
     f.width = intrinsics_.width;
     f.height = intrinsics_.height;
     f.rate_hz = rate_hz;
+    f.listeners = options_.floor_listeners;
     f.image_hop.bytes = encoded_.empty() ? 0 : encoded_.front().size();
     f.discrepancy_hop.bytes = recorder_->largest_message(ArrivalRecorder::Stage::kDiscrepancy);
     f.risk_hop.bytes = recorder_->largest_message(ArrivalRecorder::Stage::kRisk);
@@ -872,6 +893,12 @@ class BenchChain {
     const size_t relay_out_bytes[2] = {f->discrepancy_hop.bytes, f->risk_hop.bytes};
     HopReceiver receiver(config_.lcm.url, config_.lcm.image_url);
     HopRelay relay(config_.lcm.url, config_.lcm.image_url, relay_out_bytes);
+    // Joined after the receiver and the relay, as the chain's processes
+    // joined after the bench's receiver: the kernel delivers to the newest
+    // socket of a port first.
+    std::vector<std::unique_ptr<IdleListener>> listeners;
+    for (int i = 0; i < f->listeners; ++i)
+      listeners.push_back(std::make_unique<IdleListener>(config_.lcm.url, config_.lcm.image_url));
     HopFloor* floors[3] = {&f->image_hop, &f->discrepancy_hop, &f->risk_hop};
     RelayFloor* relays[2] = {&f->discrepancy_relay, &f->risk_relay};
     // Message m of the period: its kind, floor or relay, URL and channel.
@@ -1231,7 +1258,15 @@ std::string floors_table(const BenchReport& report) {
        "= image hop + render + image hop ("
     << ch.depth << " in, " << ch.rendered << " out); discrepancy = compute + relay (" << ch.rendered << " → "
     << ch.discrepancy << "); risk = relay (" << ch.discrepancy << " → " << ch.risk
-    << "; the risk monitor's work not measured).\n\n";
+    << "; the risk monitor's work not measured).";
+  for (const BenchFloors& f : report.floors) {
+    if (f.listeners == 0) continue;
+    t << " With " << f.listeners
+      << " idle LCM instances on each URL while the hops and relays were measured (--floor-listeners), "
+         "as the chain's processes are: each message is delivered to every one.";
+    break;
+  }
+  t << "\n\n";
   t << "| arm | size | rate (Hz) | render floor p50 / p99 / max | compute_discrepancy p50 / p99 / max | "
        "LCM hop floor p50 / p99 / max, "
     << ch.depth << " / " << ch.rendered << " | LCM hop floor, " << ch.discrepancy << " | LCM hop floor, "

@@ -63,6 +63,13 @@ struct BenchOptions {
   // floor_frames renders (and compute_discrepancy calls) back to back.
   bool floors = true;
   int floor_frames = 100;
+  // Idle LCM instances on each URL while the hops and relays are measured
+  // (--floor-listeners): in the chain every process has a socket on the
+  // safety URL (and each image reader on the image URL), and the kernel
+  // delivers every multicast message to each, in the sender's send call
+  // (docs/benchmarks.md, "The floors with the chain's listeners"). 0: only
+  // the bench's own.
+  int floor_listeners = 0;
   std::string shared_dir;
   // Configs, scenes and the processes' output files.
   std::string work_dir;
@@ -168,6 +175,7 @@ struct BenchFloors {
   int width = 0;
   int height = 0;
   double rate_hz = 0;  // the hops' rate: the run's (with --ramp, its first)
+  int listeners = 0;   // BenchOptions::floor_listeners when they were measured
   // DepthRenderer::render (render, read-back, conversion to metres) in this
   // process: the scene tofguard-renderer loads (robot_model::load_scene with
   // renderer::scene_options), its near and far, the camera pose and

@@ -6,7 +6,7 @@
 //   tofguard-bench [--arms default,iiwa14,kinova] [--resolutions 176x144,320x240,640x480]
 //                  [--rate-hz 30] [--seconds 10] [--ramp] [--ramp-step-s 3] [--ramp-max-hz 1920]
 //                  [--shared DIR] [--markdown FILE] [--plot FILE.png] [--frames FILE.csv] [--no-floors]
-//                  [--plan]
+//                  [--floor-listeners N] [--plan]
 //
 // Each step's measured frames come after 20 at its rate that are not
 // measured (the chain's steady state at that rate; chain_bench.cpp,
@@ -29,6 +29,10 @@
 // ahead while it waits; the report gives the renderer's hits and misses per
 // step (BenchOptions::plan).
 //
+// --floor-listeners N: N idle LCM instances on each URL while the hops and
+// relays are measured, as many as the chain has processes (BenchOptions::
+// floor_listeners; default 0).
+//
 // --frames FILE.csv: every frame's stage latencies (bench_frames_csv), to
 // see which frames make the tail.
 //
@@ -50,7 +54,8 @@ int usage(const std::string& why) {
       << "tofguard-bench: " << why
       << "\nusage: tofguard-bench [--arms default,iiwa14,kinova] [--resolutions 176x144,320x240,640x480] "
          "[--rate-hz 30] [--seconds 10] [--ramp] [--ramp-step-s 3] [--ramp-max-hz 1920] [--shared DIR] "
-         "[--markdown FILE] [--plot FILE.png] [--frames FILE.csv] [--no-floors] [--plan]\n";
+         "[--markdown FILE] [--plot FILE.png] [--frames FILE.csv] [--no-floors] [--floor-listeners N] "
+         "[--plan]\n";
   return 2;
 }
 
@@ -108,6 +113,10 @@ int main(int argc, char** argv) {
         plot_path = value;
       } else if (option == "--frames") {
         frames_path = value;
+      } else if (option == "--floor-listeners") {
+        options.floor_listeners = std::stoi(value);
+        if (options.floor_listeners < 0 || options.floor_listeners > 16)
+          return usage("--floor-listeners: expected 0 to 16, got " + value);
       } else {
         return usage("unknown option " + option);
       }

@@ -27,7 +27,10 @@ BenchOptions smoke_options() {
 }
 
 TEST(BenchSmoke, FramesGoThroughEveryStageAtTenHertz) {
-  const BenchOptions options = smoke_options();
+  BenchOptions options = smoke_options();
+  // Two idle listeners on each URL while the floors are measured: every
+  // hop and relay must still arrive.
+  options.floor_listeners = 2;
   const BenchReport report = run_bench(options, std::cerr);
   ASSERT_EQ(report.steps.size(), 1u);
   const BenchStep& step = report.steps.front();
@@ -61,6 +64,8 @@ TEST(BenchSmoke, FramesGoThroughEveryStageAtTenHertz) {
   EXPECT_EQ(floors.arm, "default");
   EXPECT_EQ(floors.width, 176);
   EXPECT_EQ(floors.height, 144);
+  EXPECT_EQ(floors.listeners, 2);
+  EXPECT_NE(markdown.find("With 2 idle LCM instances on each URL"), std::string::npos);
   EXPECT_EQ(floors.render.count, options.floor_frames);
   EXPECT_GT(floors.discrepancy_compute.count, 0);
   for (const HopFloor* hop : {&floors.image_hop, &floors.discrepancy_hop, &floors.risk_hop}) {
