@@ -418,10 +418,6 @@ class HopReceiver {
   TwoUrlThread lcm_;  // last: its thread stops before the members go
 };
 
-// The relays' middle (BenchFloors::discrepancy_relay, risk_relay): its own
-// thread and LCM instances; on each relay r's message in it publishes, at
-// once, relay r's message out (out_bytes[r] bytes, the same sequence
-// number) on lcm.url, as a chain process publishes its result.
 // An LCM instance on each URL that reads everything sent there and handles
 // nothing (subscribed to a channel nobody publishes), as a chain process
 // does with the channels it does not read (BenchOptions::floor_listeners).
@@ -442,6 +438,10 @@ class IdleListener {
   TwoUrlThread lcm_;
 };
 
+// The relays' middle (BenchFloors::discrepancy_relay, risk_relay): its own
+// thread and LCM instances; on each relay r's message in it publishes, at
+// once, relay r's message out (out_bytes[r] bytes, the same sequence
+// number) on lcm.url, as a chain process publishes its result.
 class HopRelay {
  public:
   HopRelay(const std::string& safety_url, const std::string& image_url, const size_t out_bytes[2])

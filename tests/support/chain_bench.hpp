@@ -67,8 +67,8 @@ struct BenchOptions {
   // (--floor-listeners): in the chain every process has a socket on the
   // safety URL (and each image reader on the image URL), and the kernel
   // delivers every multicast message to each, in the sender's send call
-  // (docs/benchmarks.md, "The floors with the chain's listeners"). 0: only
-  // the bench's own.
+  // (docs/benchmarks.md, thirteenth session, "The floors with the chain's
+  // listeners"). 0: only the bench's own.
   int floor_listeners = 0;
   std::string shared_dir;
   // Configs, scenes and the processes' output files.
