@@ -8,7 +8,17 @@ set -euo pipefail
 root="$1"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
+# On a failure the recording is kept (build/test-output/record_scenario_failed.lcmlog), to
+# replay what the chain was given: a rare misnamed suspect was seen once in CI
+# (docs/reliability.md, "CI time").
+fail() {
+  echo "FAIL: $*"
+  if [ -f "$work/e.lcmlog" ] && [ -d "$root/build/test-output" ]; then
+    cp "$work/e.lcmlog" "$root/build/test-output/record_scenario_failed.lcmlog" &&
+      echo "kept the recording: $root/build/test-output/record_scenario_failed.lcmlog"
+  fi
+  exit 1
+}
 
 out=$("$root/scripts/record-scenario" encoder-offset --seconds 2 --fault-at 1 --out "$work/e.lcmlog" 2>&1) ||
   fail "record-scenario exited $?: $out"
