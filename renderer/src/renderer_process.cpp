@@ -140,16 +140,19 @@ void RendererService::plan_prediction(const depth_image_t& frame) {
   if (consecutive_misses_ >= kMissesBeforeProbing && ++frames_since_probe_ < kProbeEveryFrames) return;
   frames_since_probe_ = 0;
   const int64_t utime = frame.utime + period_us;
-  const auto planned = plan_.at(utime);
-  if (!planned) return;
   Prediction p;
   p.camera_id = frame.camera_id;
   p.utime = utime;
   p.intrinsics = intrinsics_of(frame);
-  for (const std::string& joint : scene_.actuated_joint_names) {
-    const auto value = planned->find(joint);
-    if (value == planned->end()) return;  // the plan does not cover the model
-    p.joints[joint] = value->second;
+  const auto planned = plan_.at(utime);
+  if (planned && covers_actuated_joints(*planned)) {
+    for (const std::string& joint : scene_.actuated_joint_names) p.joints[joint] = planned->at(joint);
+  } else if (settings_.renderer.prediction_from_joint_states) {
+    // The joints are guessed when the render ahead starts, from the joint
+    // states there are by then (render_prediction).
+    p.from_joint_states = true;
+  } else {
+    return;  // no plan for that time, or one that does not cover the model
   }
   // The pose for that time now; a moving camera's later reading may differ
   // (then the frame is a miss).
@@ -159,13 +162,39 @@ void RendererService::plan_prediction(const depth_image_t& frame) {
   prediction_ = std::move(p);
 }
 
-bool RendererService::has_prediction_to_render() const { return prediction_ && !prediction_->rendered; }
+bool RendererService::covers_actuated_joints(const robot_model::JointPositions& joints) const {
+  for (const std::string& joint : scene_.actuated_joint_names) {
+    if (joints.find(joint) == joints.end()) return false;
+  }
+  return true;
+}
 
-void RendererService::render_prediction() {
-  if (!has_prediction_to_render()) return;
-  prediction_->result = renderer_->render(prediction_->joints, prediction_->pose, prediction_->intrinsics);
-  prediction_->rendered = true;
+bool RendererService::has_prediction_to_render() const {
+  if (!prediction_ || prediction_->rendered) return false;
+  // A guess from the joint states that had to wait waits for a newer one.
+  return !prediction_->joints_wanted_after_utime ||
+         state_.joints().newest_utime() != prediction_->joints_wanted_after_utime;
+}
+
+bool RendererService::render_prediction() {
+  if (!has_prediction_to_render()) return false;
+  Prediction& p = *prediction_;
+  if (p.from_joint_states) {
+    // Linear through the two newest joint states (interpolated when they
+    // already bracket the frame's utime), at most one camera period beyond
+    // the newest: a joint stream slower than the camera, or one that has
+    // stopped, predicts nothing.
+    robot_state::JointsAtTime guess = state_.joints().at(p.utime, frame_period_us_);
+    if (!guess.usable || !covers_actuated_joints(guess.joints)) {
+      p.joints_wanted_after_utime = state_.joints().newest_utime();
+      return false;
+    }
+    p.joints = std::move(guess.joints);
+  }
+  p.result = renderer_->render(p.joints, p.pose, p.intrinsics);
+  p.rendered = true;
   prediction_stats_.rendered++;
+  return true;
 }
 
 bool RendererService::prediction_matches(const depth_image_t& frame,
@@ -333,13 +362,14 @@ int run_renderer(const RendererProcessSettings& settings) {
   };
   while (node.spin_once(service->has_pending() ? 0 : idle_wait_ms())) {
     if (!service->has_pending()) {
-      // Idle: render the next frame ahead from the plan when it is due
-      // (no wait left), unless a frame has come meanwhile.
+      // Idle: render the next frame ahead (from the plan, else from the
+      // joint states) when it is due (no wait left), unless a frame has
+      // come meanwhile. A guess from the joint states that finds them too
+      // old waits for the next one (the wait above ends with any message).
       drain();
       if (!service->has_pending() && service->has_prediction_to_render() && idle_wait_ms() == 0) {
         const int64_t start_us = monotonic_us();
-        service->render_prediction();
-        schedule.rendered(monotonic_us() - start_us);
+        if (service->render_prediction()) schedule.rendered(monotonic_us() - start_us);
       }
       continue;
     }

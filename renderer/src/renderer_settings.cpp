@@ -26,6 +26,9 @@ RendererSettings read_renderer_settings(YamlMap renderer) {
   {
     YamlMap prediction = renderer.map("prediction");
     r.prediction_enabled = prediction.boolean("enabled");
+    // Optional, so that configs written before it keep their meaning.
+    r.prediction_from_joint_states =
+        prediction.optional("from_joint_states") && prediction.boolean("from_joint_states");
     r.prediction_joint_tolerance_deg = prediction.number("joint_tolerance_deg", 0, 10);
     r.prediction_joint_tolerance_m = prediction.number("joint_tolerance_m", 0, 1);
     r.prediction_pose_tolerance_mm = prediction.number("pose_tolerance_mm", 0, 100);

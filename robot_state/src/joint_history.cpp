@@ -30,7 +30,7 @@ robot_model::JointPositions JointHistory::blend(const Sample& a, const Sample& b
   return result;
 }
 
-JointsAtTime JointHistory::at(int64_t utime) const {
+JointsAtTime JointHistory::at(int64_t utime, int64_t max_extrapolation_us) const {
   JointsAtTime result;
   if (history_.empty()) {
     result.unusable_reason = "no joint state received yet";
@@ -40,17 +40,17 @@ JointsAtTime JointHistory::at(int64_t utime) const {
   const Sample& oldest = history_.front();
   if (utime > newest.utime) {
     const int64_t ahead_us = utime - newest.utime;
-    if (ahead_us > max_extrapolation_us_) {
+    if (ahead_us > max_extrapolation_us) {
       result.unusable_reason = "newest joint state is " + std::to_string(ahead_us / 1000.0) +
                                " ms older than the frame (limit " +
-                               std::to_string(max_extrapolation_us_ / 1000.0) + " ms)";
+                               std::to_string(max_extrapolation_us / 1000.0) + " ms)";
       return result;
     }
     result.joints =
         history_.size() >= 2 ? blend(history_[history_.size() - 2], newest, utime) : newest.positions;
   } else if (utime < oldest.utime) {
     const int64_t behind_us = oldest.utime - utime;
-    if (behind_us > max_extrapolation_us_) {
+    if (behind_us > max_extrapolation_us) {
       result.unusable_reason =
           "frame is " + std::to_string(behind_us / 1000.0) + " ms older than the oldest joint state kept";
       return result;

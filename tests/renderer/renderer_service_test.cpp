@@ -206,6 +206,108 @@ TEST(RendererService, PredictionCountsGoThroughTheHeartbeatStatus) {
   EXPECT_FALSE(RendererService::prediction_stats_from_status("prediction: 3 hits").has_value());
 }
 
+// Without a plan (renderer.prediction.from_joint_states, on in
+// config/sim.yaml), the next frame's joints are guessed from the joint
+// states when the render ahead starts: linear through the two newest, at
+// most one camera period beyond the newest. A frame within the tolerances
+// of the guess is published from it (a hit); one that is not (an encoder
+// that jumped) is rendered at its own joints (a miss). Joint states too old
+// for the guess make it wait for a newer one.
+TEST(RendererService, WithoutAPlanTheNextFrameIsGuessedFromTheJointStates) {
+  const deployment::Config config = sim_config();
+  ASSERT_TRUE(config.renderer.prediction_enabled);
+  ASSERT_TRUE(config.renderer.prediction_from_joint_states);
+  RendererService service(deployment::renderer_process_settings(config));
+  const Intrinsics k = config.camera.intrinsics;
+  // Every joint at a constant rate (joint i: 0.1 i rad/s), so that a linear
+  // guess is the interpolation's value up to rounding.
+  const auto moving_arm = [](int64_t utime) { return arm((utime - 1'000'000) * 1e-6); };
+  int64_t next_joint_utime = 1'000'000;
+  const auto joint_states_until = [&](int64_t utime, double a2_offset_rad = 0) {
+    for (; next_joint_utime <= utime; next_joint_utime += 10'000) {
+      robot_model::JointPositions q = moving_arm(next_joint_utime);
+      q["a2"] += a2_offset_rad;
+      ASSERT_TRUE(service.on_joint_state(joint_state(next_joint_utime, q)));
+    }
+  };
+  const robot_model::SceneModel scene = robot_model::load_scene(
+      config.robot.urdf_path, config.environment.urdf_paths, scene_options(config.renderer, config.robot));
+  DepthRenderer renderer(scene, config.renderer.near_m, config.renderer.far_m);
+  // The frame is the library's rendering at `joints` (to the millimetre's
+  // rounding, as above).
+  const auto expect_rendered_at = [&](const RenderedFrame& out, const robot_model::JointPositions& joints) {
+    ASSERT_TRUE(out.depth.has_value()) << out.labels.unusable_reason;
+    const RenderResult expected = renderer.render(joints, config.camera.pose, k);
+    ASSERT_TRUE(expected.usable);
+    for (size_t i = 0; i < expected.depth_m.size(); ++i) {
+      ASSERT_LE(std::abs(out.depth->depth_mm[i] - expected.depth_m[i] * 1000), 0.5 + 1e-3) << "pixel " << i;
+      ASSERT_EQ(out.labels.label[i], expected.labels[i]) << "pixel " << i;
+    }
+  };
+
+  // Two frames 33 ms apart teach the period; after the second, the newest
+  // joint state (1.030 s) is 41 ms before the next frame's expected utime
+  // (1.071 s): more than a period, so nothing is rendered ahead yet, and
+  // the guess waits for a newer joint state.
+  joint_states_until(1'010'000);
+  ASSERT_TRUE(service.render(frame(1'005'000, 1, k)).depth.has_value());
+  joint_states_until(1'030'000);
+  ASSERT_TRUE(service.render(frame(1'038'000, 2, k)).depth.has_value());
+  EXPECT_EQ(service.frame_period_us(), 33'000);
+  ASSERT_TRUE(service.has_prediction_to_render());
+  EXPECT_FALSE(service.render_prediction());
+  EXPECT_FALSE(service.has_prediction_to_render());
+  EXPECT_EQ(service.prediction_stats().rendered, 0);
+  // A newer joint state (31 ms before it): rendered ahead.
+  joint_states_until(1'040'000);
+  ASSERT_TRUE(service.has_prediction_to_render());
+  EXPECT_TRUE(service.render_prediction());
+  EXPECT_EQ(service.prediction_stats().rendered, 1);
+  EXPECT_FALSE(service.has_prediction_to_render());
+
+  // The frame comes with the joints the guess had: a hit, the model at the
+  // frame's joints.
+  joint_states_until(1'080'000);
+  const RenderedFrame hit = service.render(frame(1'071'000, 3, k));
+  EXPECT_EQ(service.prediction_stats().hits, 1);
+  EXPECT_EQ(service.prediction_stats().misses, 0);
+  expect_rendered_at(hit, moving_arm(1'071'000));
+
+  // The next guess (from the states up to 1.090 s), then a2's encoder reads
+  // 0.2 deg more from 1.100 s on: the frame at 1.104 s is a miss, rendered
+  // at the joints reported for it.
+  joint_states_until(1'090'000);
+  ASSERT_TRUE(service.has_prediction_to_render());
+  EXPECT_TRUE(service.render_prediction());
+  const double jump_rad = 0.2 * M_PI / 180;
+  joint_states_until(1'110'000, jump_rad);
+  const RenderedFrame miss = service.render(frame(1'104'000, 4, k));
+  EXPECT_EQ(service.prediction_stats().hits, 1);
+  EXPECT_EQ(service.prediction_stats().misses, 1);
+  robot_model::JointPositions reported = moving_arm(1'104'000);
+  reported["a2"] += jump_rad;
+  expect_rendered_at(miss, reported);
+  EXPECT_EQ(service.prediction_stats().rendered, 2);
+}
+
+// With from_joint_states off (the default of a config without the key),
+// no frame is predicted without a plan.
+TEST(RendererService, WithoutAPlanOrTheJointStatesGuessNothingIsRenderedAhead) {
+  deployment::Config config = sim_config();
+  config.renderer.prediction_from_joint_states = false;
+  RendererService service(deployment::renderer_process_settings(config));
+  const Intrinsics k = config.camera.intrinsics;
+  for (int64_t t = 1'000'000; t <= 1'100'000; t += 10'000)
+    ASSERT_TRUE(service.on_joint_state(joint_state(t, arm(1.0))));
+  ASSERT_TRUE(service.render(frame(1'005'000, 1, k)).depth.has_value());
+  ASSERT_TRUE(service.render(frame(1'038'000, 2, k)).depth.has_value());
+  EXPECT_EQ(service.frame_period_us(), 33'000);
+  EXPECT_FALSE(service.has_prediction_to_render());
+  ASSERT_TRUE(service.render(frame(1'071'000, 3, k)).depth.has_value());
+  EXPECT_EQ(service.prediction_stats().rendered, 0);
+  EXPECT_EQ(service.prediction_stats().without, 3);
+}
+
 // The render ahead starts as late as lets it finish before its frame is
 // due: the last frame's arrival + the period - (the longest of the last 8
 // renders x 1.25 + 2 ms); at once before there is a period or a render.

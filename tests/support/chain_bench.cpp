@@ -523,7 +523,7 @@ class BenchChain {
           CameraPose(scene.links.front().name, pose.translation_m, UnitQuaternion(pose.rotation));
     }
     const std::string name = "bench-" + arm_name + "-" + size_text(intrinsics.width, intrinsics.height);
-    config_path_ = write_bench_config(arm_, intrinsics, name);
+    config_path_ = write_bench_config(arm_, intrinsics, name, options_.joint_prediction);
     config_ = deployment::load_config(config_path_, nullptr);
     // What tofguard-renderer draws (its geometry, padding and mesh
     // simplification), not the simulated camera's exact scene.
@@ -568,8 +568,7 @@ class BenchChain {
     // (Before the step: the renderer's counts so far, from a heartbeat
     // after the warm-up's last verdict; its heartbeats come at 20 Hz.)
     std::optional<renderer::RendererService::PredictionStats> prediction_before;
-    if (options_.plan)
-      prediction_before = recorder_->renderer_prediction(monotonic_us(), monotonic_us() + 1000000);
+    prediction_before = recorder_->renderer_prediction(monotonic_us(), monotonic_us() + 1000000);
     const int64_t start_us = monotonic_us();
     const int64_t first_seq = next_seq_;
     publish(path, kLeadInFrames, frames);
@@ -1027,8 +1026,8 @@ std::optional<CampaignArm> bench_arm(const std::string& name, const std::string&
   throw std::invalid_argument("--arms: expected default, iiwa14 or kinova, got '" + name + "'");
 }
 
-std::string write_bench_config(const CampaignArm& arm, const Intrinsics& intrinsics,
-                               const std::string& name) {
+std::string write_bench_config(const CampaignArm& arm, const Intrinsics& intrinsics, const std::string& name,
+                               bool joint_prediction) {
   const deployment::Config& c = arm.config;
   std::string robot = "urdf: " + c.robot.urdf_path;
   if (!c.robot.package_paths.empty()) {
@@ -1064,13 +1063,16 @@ std::string write_bench_config(const CampaignArm& arm, const Intrinsics& intrins
        // chain alone, judged by its rules.
        {"required_heartbeats: [tofguard-camera, tofguard-renderer, tofguard-discrepancy]",
         "required_heartbeats: [tofguard-renderer, tofguard-discrepancy]"},
-       {"estimate:\n    enabled: true", "estimate:\n    enabled: false"}});
+       {"estimate:\n    enabled: true", "estimate:\n    enabled: false"},
+       {"from_joint_states: true",
+        joint_prediction ? "from_joint_states: true" : "from_joint_states: false"}});
 }
 
 BenchReport run_bench(const BenchOptions& options, std::ostream& log) {
   BenchReport report;
   report.machine = machine_text();
   report.date = date_text();
+  report.options = options;
   const std::string scene_dir = options.work_dir.empty() ? output_dir() + "/bench" : options.work_dir;
   for (const std::string& arm_name : options.arms) {
     const std::optional<CampaignArm> arm = bench_arm(arm_name, options.shared_dir, scene_dir);
@@ -1204,18 +1206,26 @@ std::string compute_lines(const std::vector<BenchStep>& steps) {
       });
 }
 
-// With --plan: tofguard-renderer's prediction per step.
-std::string prediction_lines(const std::vector<BenchStep>& steps) {
-  return step_lines(steps,
-                    "With the arm's path published as its plan (PLANNED_TRAJECTORY, --plan; counts from "
-                    "tofguard-renderer's heartbeats before and after each step):",
-                    [](const BenchStep& s) {
-                      if (s.prediction_hits < 0) return std::string();
-                      return "tofguard-renderer rendered " + std::to_string(s.prediction_hits) + " of " +
-                             std::to_string(s.frames_sent) + " frames ahead from the plan (hits), " +
-                             std::to_string(s.prediction_misses) + " ahead but off the plan (misses), " +
-                             std::to_string(s.frames_without_prediction) + " without a prediction";
-                    });
+// tofguard-renderer's prediction per step: from the plan (--plan), else
+// from the joint states (unless --no-joint-prediction).
+std::string prediction_lines(const std::vector<BenchStep>& steps, const BenchOptions& options) {
+  const std::string source = options.plan ? "the plan" : "the joint states";
+  const std::string heading =
+      options.plan ? "With the arm's path published as its plan (PLANNED_TRAJECTORY, --plan; counts from "
+                     "tofguard-renderer's heartbeats before and after each step):"
+      : options.joint_prediction
+          ? "Without a plan, each next frame guessed from the joint states "
+            "(renderer.prediction.from_joint_states; counts from tofguard-renderer's heartbeats before and "
+            "after each step):"
+          : "Without a plan or the joint states' guess (--no-joint-prediction; counts from "
+            "tofguard-renderer's heartbeats before and after each step):";
+  return step_lines(steps, heading, [source](const BenchStep& s) {
+    if (s.prediction_hits < 0) return std::string();
+    return "tofguard-renderer rendered " + std::to_string(s.prediction_hits) + " of " +
+           std::to_string(s.frames_sent) + " frames ahead from " + source + " (hits), " +
+           std::to_string(s.prediction_misses) + " ahead but not within the tolerances (misses), " +
+           std::to_string(s.frames_without_prediction) + " without a prediction";
+  });
 }
 
 std::string hop_cell(const HopFloor& h) {
@@ -1337,7 +1347,8 @@ std::string bench_markdown(const BenchReport& report) {
         "frames, not "
         "stopping).\n\n";
   if (!report.steps.empty())
-    md << steps_table(report.steps) << compute_lines(report.steps) << prediction_lines(report.steps);
+    md << steps_table(report.steps) << compute_lines(report.steps)
+       << prediction_lines(report.steps, report.options);
   if (!report.ramps.empty()) {
     md << "| arm | triangles | size | highest rate sustained (Hz) | stopped at |\n";
     md << "| --- | --- | --- | --- | --- |\n";
@@ -1348,7 +1359,8 @@ std::string bench_markdown(const BenchReport& report) {
          << r.stopped_because << " |\n";
       all.insert(all.end(), r.steps.begin(), r.steps.end());
     }
-    md << "\nEvery step of the ramps:\n\n" << steps_table(all) << compute_lines(all) << prediction_lines(all);
+    md << "\nEvery step of the ramps:\n\n"
+       << steps_table(all) << compute_lines(all) << prediction_lines(all, report.options);
   }
   if (!report.floors.empty()) md << floors_table(report);
   for (const std::string& s : report.skipped) md << "\n" << s << "\n";

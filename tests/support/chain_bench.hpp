@@ -57,8 +57,14 @@ struct BenchOptions {
   // frame ahead while it waits (renderer.prediction; docs/renderer.md) and
   // a frame within the tolerances of its plan is not rendered on its
   // critical path. The renderer's hits and misses are reported per step.
-  // Off: no plan, every frame rendered when it comes (the default).
+  // Off: no plan (the default); then each next frame is rendered ahead from
+  // the joint states instead (renderer.prediction.from_joint_states, on in
+  // config/sim.yaml) unless joint_prediction is off too.
   bool plan = false;
+  // Off (--no-joint-prediction): the chain's renderer guesses no frame from
+  // the joint states (from_joint_states: false), so that without a plan
+  // every frame is rendered when it comes.
+  bool joint_prediction = true;
   // Measure the floors (BenchFloors) after each arm and size's run;
   // floor_frames renders (and compute_discrepancy calls) back to back.
   bool floors = true;
@@ -114,11 +120,11 @@ struct BenchStep {
   // Process name -> CPU time over the step / its wall time, percent of one
   // core; "tofguard-bench" is this process (publisher and receiver).
   std::map<std::string, double> cpu_percent;
-  // With BenchOptions::plan: tofguard-renderer's prediction over the step,
-  // from its heartbeat's status before the step and after its last verdict
-  // (hits: rendered ahead and within the tolerances; misses: rendered ahead,
-  // not within them; without: no prediction for the frame). -1: no plan, or
-  // no heartbeat said.
+  // tofguard-renderer's prediction over the step (from the plan with
+  // BenchOptions::plan, else from the joint states), from its heartbeat's
+  // status before the step and after its last verdict (hits: rendered ahead
+  // and within the tolerances; misses: rendered ahead, not within them;
+  // without: no prediction for the frame). -1: no heartbeat said.
   int prediction_hits = -1;
   int prediction_misses = -1;
   int frames_without_prediction = -1;
@@ -224,6 +230,7 @@ struct BenchReport {
   std::vector<BenchRamp> ramps;      // with --ramp
   std::vector<BenchFloors> floors;   // one per arm and size (unless --no-floors)
   std::vector<std::string> skipped;  // arms skipped, with why
+  BenchOptions options;              // what was run
 };
 
 // The campaign arm `name` (default, iiwa14, kinova; judge_campaign.hpp's
@@ -235,7 +242,9 @@ std::optional<CampaignArm> bench_arm(const std::string& name, const std::string&
 // config/sim.yaml for `arm` at `intrinsics` (its robot, environment,
 // camera pose and rate), as the bench's chain runs it, written to
 // output_dir()/<name>.yaml; returns the path.
-std::string write_bench_config(const CampaignArm& arm, const Intrinsics& intrinsics, const std::string& name);
+// joint_prediction false: renderer.prediction.from_joint_states off.
+std::string write_bench_config(const CampaignArm& arm, const Intrinsics& intrinsics, const std::string& name,
+                               bool joint_prediction = true);
 
 // Runs every arm and size of `options`; progress lines go to `log`. Throws
 // std::runtime_error when a chain does not come up or a scene cannot be

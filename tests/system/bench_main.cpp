@@ -6,7 +6,7 @@
 //   tofguard-bench [--arms default,iiwa14,kinova] [--resolutions 176x144,320x240,640x480]
 //                  [--rate-hz 30] [--seconds 10] [--ramp] [--ramp-step-s 3] [--ramp-max-hz 1920]
 //                  [--shared DIR] [--markdown FILE] [--plot FILE.png] [--frames FILE.csv] [--no-floors]
-//                  [--floor-listeners N] [--plan]
+//                  [--floor-listeners N] [--plan] [--no-joint-prediction]
 //
 // Each step's measured frames come after 20 at its rate that are not
 // measured (the chain's steady state at that rate; chain_bench.cpp,
@@ -27,7 +27,11 @@
 // --plan: the bench also publishes the arm's path as the controller's plan
 // (PLANNED_TRAJECTORY), so that tofguard-renderer renders each next frame
 // ahead while it waits; the report gives the renderer's hits and misses per
-// step (BenchOptions::plan).
+// step (BenchOptions::plan). Without it each next frame is guessed from the
+// joint states (renderer.prediction.from_joint_states in config/sim.yaml);
+// --no-joint-prediction turns that off, so that every frame is rendered
+// when it comes (BenchOptions::joint_prediction). The hits and misses are
+// reported either way.
 //
 // --floor-listeners N: N idle LCM instances on each URL while the hops and
 // relays are measured, as many as the chain has processes (BenchOptions::
@@ -55,7 +59,7 @@ int usage(const std::string& why) {
       << "\nusage: tofguard-bench [--arms default,iiwa14,kinova] [--resolutions 176x144,320x240,640x480] "
          "[--rate-hz 30] [--seconds 10] [--ramp] [--ramp-step-s 3] [--ramp-max-hz 1920] [--shared DIR] "
          "[--markdown FILE] [--plot FILE.png] [--frames FILE.csv] [--no-floors] [--floor-listeners N] "
-         "[--plan]\n";
+         "[--plan] [--no-joint-prediction]\n";
   return 2;
 }
 
@@ -82,6 +86,10 @@ int main(int argc, char** argv) {
     }
     if (option == "--plan") {
       options.plan = true;
+      continue;
+    }
+    if (option == "--no-joint-prediction") {
+      options.joint_prediction = false;
       continue;
     }
     if (option == "-h" || option == "--help") return usage("the observer chain's speed");

@@ -3,7 +3,8 @@
 // Asserts that every frame went through every stage, none was dropped, and
 // the report has its rows, the floors' included (renders, compute_discrepancy
 // calls and LCM hops counted); never a wall-clock latency (the machine may
-// be loaded). With --plan, that the renderer renders frames ahead.
+// be loaded). That the renderer renders frames ahead: from the joint states
+// without a plan, from the plan with --plan.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -49,8 +50,21 @@ TEST(BenchSmoke, FramesGoThroughEveryStageAtTenHertz) {
   // on). Nearly every frame's first copy is the signed one: a bench that
   // read only SAFETY_RISK would count none.
   EXPECT_GE(step.frames_verdict_signed_first, step.frames_verdict * 9 / 10) << step.frames_verdict;
+  // No plan: tofguard-renderer guesses each next frame from the joint
+  // states (renderer.prediction.from_joint_states in config/sim.yaml). The
+  // hits begin once it has learned the period from the step's frames, as
+  // with a plan (below); a hit at other joints than its frame's would not
+  // be SAFE.
+  ASSERT_GE(step.prediction_hits, 0) << "no heartbeat of tofguard-renderer said its prediction counts";
+  EXPECT_EQ(step.prediction_hits + step.prediction_misses + step.frames_without_prediction, step.frames_sent);
+  EXPECT_GE(step.prediction_hits, step.frames_sent / 3);
+  EXPECT_GE(step.frames_safe, step.frames_sent * 9 / 10);
   const std::string markdown = bench_markdown(report);
   std::cout << markdown;
+  EXPECT_NE(markdown.find("tofguard-renderer rendered " + std::to_string(step.prediction_hits) +
+                          " of 30 frames ahead from the joint states"),
+            std::string::npos)
+      << markdown;
   for (const char* column : {"TOF_DEPTH → TOF_RENDERED", "TOF_RENDERED → SAFETY_DISCREPANCY",
                              "SAFETY_DISCREPANCY → SAFETY_RISK", "TOF_DEPTH → SAFETY_RISK", "CPU %"})
     EXPECT_NE(markdown.find(column), std::string::npos) << column;
@@ -109,8 +123,7 @@ TEST(BenchSmoke, FramesGoThroughEveryStageAtTenHertz) {
 // begin once the renderer has learned the camera's period from the step's
 // frames (the warm-up's one-at-a-time frames teach it a wrong one, and
 // after 5 misses in a row it predicts only every 8th frame until a hit:
-// RendererService): at least a third of the 30 frames. Without the plan,
-// or with other joints in it, there is none.
+// RendererService): at least a third of the 30 frames.
 TEST(BenchSmoke, WithThePlanFramesAreRenderedAhead) {
   BenchOptions options = smoke_options();
   options.floors = false;

@@ -23,17 +23,16 @@
 // (PLANNED_TRAJECTORY), after each frame the next one is expected one
 // camera period later (the median of the last frame intervals); while idle,
 // the model is rendered ahead at the plan's joints and the camera pose for
-// that time. When the frame comes, its joints (interpolated from JOINT_STATE
-// at its utime, as always) and camera pose are compared with the
-// prediction's: within the tolerances, the image rendered ahead is
-// published at once (a hit); otherwise the frame is rendered as usual (a
-// miss). The image is always the model at the frame's own joints within
-// the tolerance, never the plan's guess beyond it. After 5 misses in a row
-// (an arm that does not follow its plan that closely, or a jittery camera)
-// only every 8th frame is predicted until one hits, so that useless
-// predictions do not double the rendering work. The process renders a
-// prediction as late as still lets it finish before its frame is due
-// (PredictionSchedule), not while the frame just published is being judged.
+// that time. Where no plan covers that time and prediction.from_joint_states
+// is on, the joints are guessed from JOINT_STATE when the render starts
+// (linear through the two newest, at most one period beyond them). When the frame comes, its joints
+// (interpolated from JOINT_STATE at its utime, as always) and camera pose are compared with the prediction's:
+// within the tolerances, the image rendered ahead is published at once (a hit); otherwise the frame is
+// rendered as usual (a miss). The image is always the model at the frame's own joints within the tolerance,
+// never the plan's guess beyond it. After 5 misses in a row (an arm that does not follow its plan that
+// closely, or a jittery camera) only every 8th frame is predicted until one hits, so that useless predictions
+// do not double the rendering work. The process renders a prediction as late as still lets it finish before
+// its frame is due (PredictionSchedule), not while the frame just published is being judged.
 #include <deque>
 #include <memory>
 #include <optional>
@@ -124,10 +123,14 @@ class RendererService {
 
   // A plan that passed check_planned_trajectory.
   void on_plan(const planned_trajectory_t& plan);
-  // True when a prediction for the next frame is due and not rendered yet.
+  // True when a prediction for the next frame is due and not rendered yet
+  // (a guess from the joint states that found them too old: once a newer
+  // one has come).
   bool has_prediction_to_render() const;
-  // Renders the due prediction (call while no frame is pending).
-  void render_prediction();
+  // Renders the due prediction (call while no frame is pending); false when
+  // nothing was rendered (none due, or the joint states are too old for the
+  // guess: then has_prediction_to_render() is false until a newer one).
+  bool render_prediction();
 
   struct PredictionStats {
     int64_t rendered = 0;  // predictions rendered ahead
@@ -154,7 +157,12 @@ class RendererService {
     std::string camera_id;
     int64_t utime = 0;
     Intrinsics intrinsics;
-    robot_model::JointPositions joints;
+    robot_model::JointPositions joints;  // from the plan, or once rendered
+    // Guessed from JOINT_STATE when the render starts (no plan for utime).
+    bool from_joint_states = false;
+    // The newest joint state's utime when the guess last found the joint
+    // states too old (nullopt: it has not).
+    std::optional<int64_t> joints_wanted_after_utime;
     CameraPose pose;
     bool rendered = false;
     RenderResult result;  // usable when rendered and worth using
@@ -164,6 +172,7 @@ class RendererService {
                             const std::optional<RenderedArmCover>& arm_cover) const;
   void learn_period(const depth_image_t& frame);
   void plan_prediction(const depth_image_t& frame);
+  bool covers_actuated_joints(const robot_model::JointPositions& joints) const;
   // True when `prediction_` may stand for `frame` rendered at `joints` and `pose`.
   bool prediction_matches(const depth_image_t& frame, const robot_model::JointPositions& joints,
                           const CameraPose& pose) const;

@@ -54,6 +54,12 @@ struct RendererSettings {
   // prediction_joint_tolerance_m) of the prediction, and its camera pose
   // within the pose tolerances, the image rendered ahead is published.
   bool prediction_enabled = false;
+  // prediction.from_joint_states (optional, default false: the plan only):
+  // where no plan covers the next frame's expected utime, its joints are
+  // guessed from JOINT_STATE instead, extrapolated linearly from the two
+  // newest messages when the render ahead starts, at most one camera period
+  // beyond the newest. The guess is held to the same tolerances as a plan's.
+  bool prediction_from_joint_states = false;
   double prediction_joint_tolerance_deg = 0;
   double prediction_joint_tolerance_m = 0;
   double prediction_pose_tolerance_mm = 0;

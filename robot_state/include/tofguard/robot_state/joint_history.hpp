@@ -10,6 +10,7 @@
 // the camera frame's mid-exposure.
 #include <cstdint>
 #include <deque>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -38,7 +39,17 @@ class JointHistory {
   // messages, so this is a duplicate or a second publisher, worth counting).
   bool add(int64_t utime, const robot_model::JointPositions& positions);
 
-  JointsAtTime at(int64_t utime) const;
+  JointsAtTime at(int64_t utime) const { return at(utime, max_extrapolation_us_); }
+  // The same with another limit beyond the newest message (or before the
+  // oldest), us (>= 0): for a guess that is checked later, e.g. the
+  // renderer's prediction of the next frame's joints.
+  JointsAtTime at(int64_t utime, int64_t max_extrapolation_us) const;
+
+  // The newest message's utime (nullopt before the first).
+  std::optional<int64_t> newest_utime() const {
+    if (history_.empty()) return std::nullopt;
+    return history_.back().utime;
+  }
 
   size_t size() const { return history_.size(); }
 
