@@ -3,6 +3,10 @@
 // debouncing and deadlines on an explicit monotonic clock.
 #include <gtest/gtest.h>
 
+#include <iomanip>
+#include <limits>
+#include <sstream>
+
 #include "synthetic_frames.hpp"
 #include "test_support.hpp"
 #include "tofguard/deployment/config.hpp"
@@ -15,6 +19,44 @@
 
 namespace tofguard::test {
 namespace {
+
+// risk::fixed, which writes every number of a verdict's detail, is what an
+// ostream with std::fixed and std::setprecision writes (the detail's text
+// did not change when it stopped using one): halfway cases, signs, zero,
+// NaN, infinities, and a number too long for its buffer.
+TEST(FixedText, IsWhatAStreamWithFixedPrecisionWrites) {
+  const auto streamed = [](double value, int decimals) {
+    std::ostringstream s;
+    s << std::fixed << std::setprecision(decimals) << value;
+    return s.str();
+  };
+  const double values[] = {0.0,
+                           -0.0,
+                           0.05,
+                           0.15,
+                           0.25,
+                           2.5,
+                           -2.5,
+                           1.005,
+                           -0.049,
+                           123.45,
+                           1e15,
+                           -3.14159,
+                           1e-300,
+                           1e300,
+                           1e308,
+                           6.02e23,
+                           std::numeric_limits<double>::quiet_NaN(),
+                           -std::numeric_limits<double>::quiet_NaN(),
+                           std::numeric_limits<double>::infinity(),
+                           -std::numeric_limits<double>::infinity()};
+  for (const double value : values) {
+    for (int decimals = 0; decimals <= 6; ++decimals)
+      EXPECT_EQ(risk::fixed(value, decimals), streamed(value, decimals)) << value << " " << decimals;
+  }
+  EXPECT_EQ(risk::fixed(2.25, 1), "2.2");  // round half to even, as printf
+  EXPECT_EQ(risk::fixed(-0.04, 1), "-0.0");
+}
 
 using risk::ClassifierContext;
 using risk::classify_frame;
