@@ -45,15 +45,14 @@ LcmNode::LcmNode(const LcmSettings& lcm, const ChannelNames& channels, const std
       images_(lcm.image_url == lcm.url ? nullptr : open_lcm(lcm.image_url)),
       errors_(process_name),
       heartbeat_(safety_.get(), channels.heartbeat, process_name, heartbeat_rate_hz) {
-  // LCM 1.3 joins the multicast groups lazily (first getFileno()/handle()):
-  // join the safety URL now, so nothing sent after construction is missed
-  // (every process reads SAFETY_* there). The image URL: in join(), on the
-  // first subscription on it.
-  safety_->getFileno();
+  // LCM 1.3 joins a multicast group lazily (first getFileno()/handle()),
+  // and publishing needs no receive socket: each URL is joined in join(),
+  // on the first subscription on it.
 }
 
 void LcmNode::join(lcm::LCM& lcm) {
   lcm.getFileno();
+  if (&lcm == safety_.get()) safety_joined_ = true;
   if (&lcm == images_.get()) images_joined_ = true;
 }
 
@@ -70,13 +69,15 @@ bool LcmNode::spin_once(int max_wait_ms) {
   for (const auto& timer : timers_) wait_us = std::min(wait_us, timer.next_us - now_us);
   wait_us = std::max<int64_t>(0, wait_us);
 
-  pollfd fds[2] = {{safety_->getFileno(), POLLIN, 0}, {-1, POLLIN, 0}};
-  const nfds_t nfds = images_joined_ ? 2 : 1;
-  if (images_joined_) fds[1].fd = images_->getFileno();
+  // Only the joined URLs: polling an LCM instance's fd would join it. A
+  // negative fd is ignored by poll (a node that reads nothing waits for its
+  // timers and heartbeat only).
+  pollfd fds[2] = {{safety_joined_ ? safety_->getFileno() : -1, POLLIN, 0},
+                   {images_joined_ ? images_->getFileno() : -1, POLLIN, 0}};
   // Round up so that a wait never ends just before a timer is due.
-  const int ready = poll(fds, nfds, static_cast<int>((wait_us + 999) / 1000));
+  const int ready = poll(fds, 2, static_cast<int>((wait_us + 999) / 1000));
   if (ready > 0) {
-    if (fds[0].revents & POLLIN) safety_->handle();
+    if (safety_joined_ && (fds[0].revents & POLLIN)) safety_->handle();
     if (images_joined_ && (fds[1].revents & POLLIN)) images_->handle();
   }
 

@@ -125,7 +125,9 @@ TEST(LcmNode, OnlyANodeSubscribedOnTheImageUrlReceivesThere) {
   publisher_only.images().publish("TOF_DEPTH", &frame);
   publisher_only.spin_once(0);
   EXPECT_EQ(udp_sockets_bound_to(image_port), 0);
-  EXPECT_EQ(udp_sockets_bound_to(port_of(config.lcm.url)), 1);
+  // Nor on the safety URL, where it reads nothing either (its heartbeat
+  // goes out all the same).
+  EXPECT_EQ(udp_sockets_bound_to(port_of(config.lcm.url)), 0);
   // Subscribing there joins at once: the first image after the call arrives.
   LcmNode reader(config.lcm, config.channels, "reads-images");
   std::vector<depth_image_t> handled;
@@ -136,6 +138,38 @@ TEST(LcmNode, OnlyANodeSubscribedOnTheImageUrlReceivesThere) {
   ASSERT_TRUE(wait_until([&] { return handled.size() == 1; }, std::chrono::seconds(5),
                          [&] { reader.spin_once(10); }));
   EXPECT_EQ(handled[0].seq, frame.seq);
+  EXPECT_EQ(udp_sockets_bound_to(port_of(config.lcm.url)), 0);
+}
+
+// The same on the safety URL: a node joins it on its first subscription
+// there, and receives what is sent after it.
+TEST(LcmNode, OnlyANodeSubscribedOnTheSafetyUrlReceivesThere) {
+  const TestWiring config = test_config();
+  const int safety_port = port_of(config.lcm.url);
+  ASSERT_EQ(udp_sockets_bound_to(safety_port), 0);
+  LcmNode publisher_only(config.lcm, config.channels, "publishes-joints");
+  joint_state_t state;
+  state.utime = 1;
+  state.robot_id = "arm";
+  state.num_joints = 1;
+  state.name = {"a1"};
+  state.position = {0.5};
+  state.velocity = {0.0};
+  publisher_only.safety().publish("JOINT_STATE", &state);
+  publisher_only.spin_once(0);
+  EXPECT_EQ(udp_sockets_bound_to(safety_port), 0);
+  LcmNode reader(config.lcm, config.channels, "reads-joints");
+  std::vector<joint_state_t> handled;
+  reader.subscribe<joint_state_t>(
+      reader.safety(), "JOINT_STATE", [&](const joint_state_t& m) { handled.push_back(m); },
+      check_joint_state);
+  EXPECT_EQ(udp_sockets_bound_to(safety_port), 1);
+  EXPECT_EQ(udp_sockets_bound_to(port_of(config.lcm.image_url)), 0);
+  state.utime = 2;
+  publisher_only.safety().publish("JOINT_STATE", &state);
+  ASSERT_TRUE(wait_until([&] { return handled.size() == 1; }, std::chrono::seconds(5),
+                         [&] { reader.spin_once(10); }));
+  EXPECT_EQ(handled[0].utime, 2);
 }
 
 TEST(LcmNode, HeartbeatsComeAtTheirRateWithoutAnyTraffic) {

@@ -32,8 +32,8 @@ class LcmNode {
  public:
   // Opens both URLs (one LCM instance when they are equal); throws
   // std::runtime_error naming the URL when LCM cannot start. Heartbeats go
-  // out on channels.heartbeat at `heartbeat_rate_hz`. The safety URL is
-  // joined here; the image URL on the first subscription on it (below).
+  // out on channels.heartbeat at `heartbeat_rate_hz`. Each URL is joined on
+  // the first subscription on it (below).
   LcmNode(const LcmSettings& lcm, const ChannelNames& channels, const std::string& process_name,
           double heartbeat_rate_hz = 20);
   ~LcmNode();
@@ -48,10 +48,14 @@ class LcmNode {
   const std::string& process_name() const { return process_name_; }
 
   // Subscribes `on_message` to `channel` on `lcm` (safety() or images()).
-  // The first subscription on images() joins the image URL: a process that
-  // only publishes images, or never reads them, is not woken by each of
-  // the three image messages of every frame (TOF_DEPTH, TOF_LABELS,
-  // TOF_RENDERED, 25-300 KB each) on a core the chain needs.
+  // The first subscription on a URL joins it: a process that only
+  // publishes images, or never reads them, is not woken by each of the
+  // three image messages of every frame (TOF_DEPTH, TOF_LABELS,
+  // TOF_RENDERED, 25-300 KB each) on a core the chain needs, and one that
+  // reads nothing on the safety URL (tofguard-discrepancy) not by each
+  // joint state, heartbeat and verdict there (the kernel copies every
+  // message of a multicast group to each socket joined to it, inside the
+  // sender's send).
   // `check` returns "" for a valid message, else "field: expected ..., got
   // ..." (see wire_checks.hpp). Every valid message counts as frames_in.
   template <class T>
@@ -88,6 +92,7 @@ class LcmNode {
   std::string process_name_;
   std::unique_ptr<lcm::LCM> safety_;
   std::unique_ptr<lcm::LCM> images_;  // null when the image URL is the safety URL
+  bool safety_joined_ = false;        // safety_ has its receive socket (subscribed on it)
   bool images_joined_ = false;        // images_ has its receive socket (subscribed on it)
   ErrorLog errors_;
   HeartbeatPublisher heartbeat_;
