@@ -567,8 +567,8 @@ class BenchChain {
     cpu_before[kBenchProcess] = sample_proc(getpid());
     // (Before the step: the renderer's counts so far, from a heartbeat
     // after the warm-up's last verdict; its heartbeats come at 20 Hz.)
-    std::optional<renderer::RendererService::PredictionStats> prediction_before;
-    prediction_before = recorder_->renderer_prediction(monotonic_us(), monotonic_us() + 1000000);
+    const std::optional<renderer::RendererService::PredictionStats> prediction_before =
+        recorder_->renderer_prediction(monotonic_us(), monotonic_us() + 1000000);
     const int64_t start_us = monotonic_us();
     const int64_t first_seq = next_seq_;
     publish(path, kLeadInFrames, frames);

@@ -25,14 +25,18 @@
 // the model is rendered ahead at the plan's joints and the camera pose for
 // that time. Where no plan covers that time and prediction.from_joint_states
 // is on, the joints are guessed from JOINT_STATE when the render starts
-// (linear through the two newest, at most one period beyond them). When the frame comes, its joints
-// (interpolated from JOINT_STATE at its utime, as always) and camera pose are compared with the prediction's:
-// within the tolerances, the image rendered ahead is published at once (a hit); otherwise the frame is
-// rendered as usual (a miss). The image is always the model at the frame's own joints within the tolerance,
-// never the plan's guess beyond it. After 5 misses in a row (an arm that does not follow its plan that
-// closely, or a jittery camera) only every 8th frame is predicted until one hits, so that useless predictions
-// do not double the rendering work. The process renders a prediction as late as still lets it finish before
-// its frame is due (PredictionSchedule), not while the frame just published is being judged.
+// (linear through the two newest, at most one period beyond them). When the
+// frame comes, its joints (interpolated from JOINT_STATE at its utime, as
+// always) and camera pose are compared with the prediction's: within the
+// tolerances, the image rendered ahead is published at once (a hit);
+// otherwise the frame is rendered as usual (a miss). The image is always the
+// model at the frame's own joints within the tolerance, never the guess
+// beyond it. After 5 misses in a row (an arm that does not follow its plan
+// that closely, or a jittery camera) only every 8th frame is predicted until
+// one hits, so that useless predictions do not double the rendering work.
+// The process renders a prediction as late as still lets it finish before
+// its frame is due (PredictionSchedule), not while the frame just published
+// is being judged.
 #include <deque>
 #include <memory>
 #include <optional>
