@@ -242,13 +242,18 @@ class ArrivalRecorder {
     std::lock_guard<std::mutex> lock(mutex_);
     for (auto it = frames_.begin(); it != frames_.end();) it = it->first < seq ? frames_.erase(it) : ++it;
   }
-  // tofguard-renderer's prediction counts from the first of its heartbeats
-  // received after `after_us` (monotonic), waiting for one until
-  // `deadline_us`; nullopt when none came or its status did not say.
-  std::optional<renderer::RendererService::PredictionStats> renderer_prediction(int64_t after_us,
+  // tofguard-renderer's prediction counts as of the frame captured at
+  // `frame_utime`: from its newest heartbeat once one says it has handled
+  // that frame or a later one (heartbeat_t.last_frame_utime; the process
+  // sets it and the counts together, after each frame), waiting for one
+  // until `deadline_us` (monotonic); nullopt when none came or its status
+  // did not say. (Taken by arrival time instead, a heartbeat sent just
+  // before the frame's render and received after it, on a loaded machine,
+  // left that frame out of its step: 29 of 30 under ASan.)
+  std::optional<renderer::RendererService::PredictionStats> renderer_prediction(int64_t frame_utime,
                                                                                 int64_t deadline_us) {
     std::unique_lock<std::mutex> lock(mutex_);
-    while (renderer_heartbeat_us_ <= after_us) {
+    while (renderer_last_frame_utime_ < frame_utime) {
       const int64_t left_us = deadline_us - monotonic_us();
       if (left_us <= 0) return std::nullopt;
       heartbeat_.wait_for(lock, std::chrono::microseconds(std::min<int64_t>(left_us, 20000)));
@@ -324,7 +329,7 @@ class ArrivalRecorder {
     if (h.decode(b->data, 0, static_cast<int>(b->data_size)) < 0 || h.process != "tofguard-renderer") return;
     std::lock_guard<std::mutex> lock(mutex_);
     renderer_status_ = h.status;
-    renderer_heartbeat_us_ = monotonic_us();
+    renderer_last_frame_utime_ = h.last_frame_utime;
     heartbeat_.notify_all();
   }
 
@@ -333,7 +338,7 @@ class ArrivalRecorder {
   std::condition_variable verdict_;
   std::condition_variable heartbeat_;
   std::string renderer_status_;
-  int64_t renderer_heartbeat_us_ = 0;
+  int64_t renderer_last_frame_utime_ = 0;  // of the newest renderer heartbeat
   std::unordered_map<int64_t, FrameArrivals> frames_;
   size_t largest_[3] = {0, 0, 0};
   TwoUrlThread lcm_;  // last: its thread stops before the members go
@@ -565,10 +570,10 @@ class BenchChain {
     std::map<std::string, ProcSample> cpu_before;
     for (const auto& [name, p] : processes_) cpu_before[name] = sample_proc(p->pid());
     cpu_before[kBenchProcess] = sample_proc(getpid());
-    // (Before the step: the renderer's counts so far, from a heartbeat
-    // after the warm-up's last verdict; its heartbeats come at 20 Hz.)
+    // (Before the step: the renderer's counts up to the last frame sent
+    // before it, the lead-in's; its heartbeats come at 20 Hz.)
     const std::optional<renderer::RendererService::PredictionStats> prediction_before =
-        recorder_->renderer_prediction(monotonic_us(), monotonic_us() + 1000000);
+        recorder_->renderer_prediction(last_utime_, monotonic_us() + 1000000);
     const int64_t start_us = monotonic_us();
     const int64_t first_seq = next_seq_;
     publish(path, kLeadInFrames, frames);
@@ -610,7 +615,7 @@ class BenchChain {
       if (a.risk_us == 0 || a.risk_us - a.sent_us > options_.result_timeout_us) ++step.frames_dropped;
     }
     if (prediction_before) {
-      const auto after = recorder_->renderer_prediction(monotonic_us(), monotonic_us() + 1000000);
+      const auto after = recorder_->renderer_prediction(last_utime_, monotonic_us() + 1000000);
       if (after) {
         step.prediction_hits = static_cast<int>(after->hits - prediction_before->hits);
         step.prediction_misses = static_cast<int>(after->misses - prediction_before->misses);
