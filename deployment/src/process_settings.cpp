@@ -1,7 +1,5 @@
 #include "tofguard/deployment/process_settings.hpp"
 
-#include "tofguard/risk/protective_field.hpp"
-
 namespace tofguard::deployment {
 
 renderer::RendererProcessSettings renderer_process_settings(const Config& config) {
@@ -130,9 +128,8 @@ view::ViewSettings view_settings(const Config& config) {
   s.discrepancy = config.discrepancy;
   s.far_m = config.renderer.far_m;
   s.camera_rate_hz = config.camera.rate_hz;
-  s.fields.protective_at_rest_m =
-      risk::field_size(config.risk, risk::chain_response_time_s(config.risk, config.camera.rate_hz), 0)
-          .protective_m;
+  // (fields.protective_at_rest_m is the risk rules' S at rest: tofguard-view
+  // computes it with them, apps/tofguard-view.cpp.)
   s.fields.warning_margin_m = config.risk.field_warning_margin_m;
   return s;
 }

@@ -15,6 +15,7 @@
 #include "tofguard/common/risk_names.hpp"
 #include "tofguard/common/wire_checks.hpp"
 #include "tofguard/renderer/depth_renderer.hpp"
+#include "tofguard/renderer/state_history_settings.hpp"
 #include "tofguard/robot_model/kinematics.hpp"
 
 namespace tofguard::estimator {

@@ -15,6 +15,7 @@
 #include "tofguard/estimator/estimator_process.hpp"
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/renderer/depth_renderer.hpp"
+#include "tofguard/renderer/state_history_settings.hpp"
 #include "tofguard/robot_state/state_history.hpp"
 
 namespace tofguard::estimator {

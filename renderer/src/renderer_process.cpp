@@ -1,6 +1,7 @@
 #include "tofguard/renderer/renderer_process.hpp"
 #include "tofguard/renderer/llvmpipe_threads.hpp"
 #include "tofguard/renderer/rendered_kinematics.hpp"
+#include "tofguard/renderer/state_history_settings.hpp"
 
 #include <algorithm>
 #include <cmath>

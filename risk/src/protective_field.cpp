@@ -58,9 +58,4 @@ double field_range_m(const discrepancy_t& frame) {
   return frame.num_field_bins * static_cast<double>(frame.field_bin_m);
 }
 
-double iso13855_intrusion_distance_m(double detection_capability_m) {
-  if (detection_capability_m > 0.040) return 0.85;
-  return std::max(0.0, 8.0 * (detection_capability_m - 0.014));
-}
-
 }  // namespace tofguard::risk

@@ -7,11 +7,11 @@
 
 #include <gtest/gtest.h>
 
-#include "test_support.hpp"
 #include "tofguard/auth/auth_key.hpp"
 #include "tofguard/auth/message_signer.hpp"
 #include "tofguard/auth/message_verifier.hpp"
 #include "tofguard/safety_status_t.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::auth {
 namespace {

@@ -14,9 +14,9 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "sim_test_config.hpp"
-#include "test_support.hpp"
 #include "tofguard/camera/depth_calibration.hpp"
 #include "tofguard/sim/tof_error_model.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::camera {
 namespace {

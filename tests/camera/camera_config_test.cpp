@@ -2,9 +2,9 @@
 // camera.sim): strict, range-checked, one-line errors.
 #include <gtest/gtest.h>
 
-#include "test_support.hpp"
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/deployment/process_settings.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard {
 namespace {

@@ -6,7 +6,7 @@
 #include <cstdlib>
 #include <sstream>
 
-#include "test_support.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::test {
 namespace {

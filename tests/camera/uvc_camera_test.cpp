@@ -7,8 +7,8 @@
 
 #include <gtest/gtest.h>
 
-#include "test_support.hpp"
 #include "tofguard/camera/camera_sources.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::camera {
 namespace {

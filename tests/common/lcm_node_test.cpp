@@ -8,11 +8,11 @@
 #include <sstream>
 
 #include "sample_messages.hpp"
-#include "test_support.hpp"
 #include "tofguard/common/clock.hpp"
 #include "tofguard/common/lcm_node.hpp"
 #include "tofguard/common/lcm_settings.hpp"
 #include "tofguard/common/wire_checks.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::test {
 namespace {

@@ -8,9 +8,9 @@
 #include <algorithm>
 #include <string>
 
-#include "test_support.hpp"
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/deployment/process_settings.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::test {
 namespace {

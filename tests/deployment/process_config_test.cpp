@@ -7,7 +7,7 @@
 
 #include <csignal>
 
-#include "test_support.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::test {
 namespace {

@@ -9,12 +9,12 @@
 #include <random>
 
 #include "judge_campaign.hpp"
-#include "test_support.hpp"
 #include "tofguard/common/wire_checks.hpp"
 #include "tofguard/discrepancy/arm_distance.hpp"
 #include "tofguard/renderer/depth_renderer.hpp"
 #include "tofguard/renderer/rendered_kinematics.hpp"
 #include "tofguard/robot_model/scene_model.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::discrepancy {
 namespace {

@@ -14,7 +14,6 @@
 
 #include "estimator_test_support.hpp"
 #include "simulated_frames.hpp"
-#include "test_support.hpp"
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/common/wire_checks.hpp"
 #include "tofguard/discrepancy/discrepancy_image.hpp"
@@ -22,6 +21,7 @@
 #include "tofguard/renderer/depth_renderer.hpp"
 #include "tofguard/renderer/rendered_kinematics.hpp"
 #include "tofguard/robot_model/scene_model.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::discrepancy {
 namespace {

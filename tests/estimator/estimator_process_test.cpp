@@ -12,7 +12,6 @@
 #include <iostream>
 #include <optional>
 
-#include "test_support.hpp"
 #include "tofguard/common/clock.hpp"
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/deployment/process_settings.hpp"
@@ -20,6 +19,7 @@
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/heartbeat_t.hpp"
 #include "tofguard/motion_estimate_t.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::test {
 namespace {

@@ -2,7 +2,7 @@
 # CMakeLists.txt; scripts/fuzz configures it with clang in build-fuzz/).
 # It builds only what the targets below reach: the LCM headers, common/
 # (decoding, wire checks, the YAML reader), robot_model/ (URDF, assimp),
-# the config loader with the settings readers it calls, and spy's message
+# auth/, the config loader with the settings libraries, and spy's message
 # formatter. Everything is compiled with AddressSanitizer,
 # UndefinedBehaviorSanitizer and libFuzzer's coverage instrumentation, so a
 # bug in tofguard's own code is seen where it happens; the system libraries
@@ -24,39 +24,14 @@ add_subdirectory(robot_model)
 
 set(fuzz_dir ${CMAKE_CURRENT_LIST_DIR})
 
-# libsodium and auth/'s header-only verifier, for the signed envelopes
-# and the config's auth section.
-find_package(PkgConfig REQUIRED)
-pkg_check_modules(SODIUM REQUIRED IMPORTED_TARGET libsodium)
-add_library(tofguard_fuzz_auth INTERFACE)
-target_include_directories(tofguard_fuzz_auth INTERFACE ${PROJECT_SOURCE_DIR}/auth/include)
-target_link_libraries(tofguard_fuzz_auth INTERFACE tofguard_lcmtypes PkgConfig::SODIUM)
-
-
-# load_config and the settings readers it calls, compiled from the
-# components' sources here (the components' own libraries would pull in
-# the renderer's EGL, OpenCV, libuvc and libusb, which no reader needs).
-add_library(tofguard_fuzz_config
-  deployment/src/config.cpp
-  auth/src/auth_settings.cpp
-  camera/src/depth_camera_settings.cpp
-  discrepancy/src/discrepancy_settings.cpp
-  estimator/src/estimator_settings.cpp
-  intervene/src/intervention_settings.cpp
-  launch/src/launch_settings.cpp
-  renderer/src/renderer_settings.cpp
-  risk/src/protective_field.cpp
-  risk/src/risk_settings.cpp
-  sim/src/sim_settings.cpp)
-target_include_directories(tofguard_fuzz_config PUBLIC
-  deployment/include camera/include discrepancy/include estimator/include intervene/include launch/include
-  renderer/include risk/include sim/include robot_state/include view/include)
-target_link_libraries(tofguard_fuzz_config PUBLIC tofguard_common tofguard_robot_model tofguard_fuzz_auth)
-
-# tofguard-spy's formatter: it decodes every message type it sees.
-add_library(tofguard_fuzz_spy spy/src/message_format.cpp)
-target_include_directories(tofguard_fuzz_spy PUBLIC spy/include)
-target_link_libraries(tofguard_fuzz_spy PUBLIC tofguard_common)
+# The config loader (deployment/) on the settings libraries (settings/),
+# auth/ for the config's key and the signed envelopes, and tofguard-spy's
+# formatter, which decodes every message type it sees: their own targets,
+# which link no component's logic (no EGL, OpenCV, libuvc or libusb).
+add_subdirectory(auth)
+add_subdirectory(settings)
+add_subdirectory(deployment)
+add_subdirectory(spy)
 
 # tofguard_fuzz_target(NAME <name> LIBS <...>): tests/fuzz/<name>_fuzz.cpp
 # as a libFuzzer binary bin/<name>_fuzz.
@@ -69,9 +44,9 @@ function(tofguard_fuzz_target)
   target_link_options(${ARG_NAME}_fuzz PRIVATE -fsanitize=fuzzer)
 endfunction()
 
-tofguard_fuzz_target(NAME wire_messages LIBS tofguard_common tofguard_fuzz_auth)
-tofguard_fuzz_target(NAME spy_format LIBS tofguard_fuzz_spy)
-tofguard_fuzz_target(NAME config LIBS tofguard_fuzz_config)
+tofguard_fuzz_target(NAME wire_messages LIBS tofguard_common tofguard_auth)
+tofguard_fuzz_target(NAME spy_format LIBS tofguard_spy)
+tofguard_fuzz_target(NAME config LIBS tofguard_deployment)
 tofguard_fuzz_target(NAME urdf LIBS tofguard_scene_model)
 tofguard_fuzz_target(NAME mesh LIBS tofguard_scene_model)
 
@@ -80,4 +55,4 @@ tofguard_fuzz_target(NAME mesh LIBS tofguard_scene_model)
 # build time rather than committed). scripts/fuzz runs it.
 add_executable(make_wire_seeds ${fuzz_dir}/make_wire_seeds.cpp)
 target_include_directories(make_wire_seeds PRIVATE ${fuzz_dir})
-target_link_libraries(make_wire_seeds PRIVATE tofguard_lcmtypes tofguard_fuzz_auth)
+target_link_libraries(make_wire_seeds PRIVATE tofguard_lcmtypes tofguard_auth)

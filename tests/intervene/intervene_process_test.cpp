@@ -14,13 +14,13 @@
 
 #include "pseudo_terminal.hpp"
 #include "signed_publisher.hpp"
-#include "test_support.hpp"
 #include "tofguard/common/clock.hpp"
 #include "tofguard/heartbeat_t.hpp"
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/power_relay_t.hpp"
 #include "tofguard/risk_t.hpp"
 #include "tofguard/safety_status_t.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::test {
 namespace {

@@ -4,9 +4,9 @@
 #include <filesystem>
 #include <regex>
 
-#include "test_support.hpp"
 #include "tofguard/launch/log_rotation.hpp"
 #include "tofguard/launch/restart_policy.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::test {
 namespace {

@@ -1,25 +1,34 @@
 #!/usr/bin/env python3
-"""Fails on an #include that crosses tofguard's layers upwards or reaches into
-another folder's src/ (issue 13: "no component includes another component's
-src/, and the layer diagram matches the includes").
+"""Fails on an #include that crosses tofguard's layers upwards or sideways,
+or reaches into another folder's src/, and on a main() outside the programs'
+floor (apps/).
 
-Layers, bottom to top (docs/architecture.md):
+Layers, bottom to top (docs/architecture.md, "Layers"):
 
   lcmtypes      generated wire types, included as "tofguard/<name>_t.hpp"
   common        "tofguard/common/..."
   auth          message authentication (may include common)
   robot_model   the URDF's kinematic tree and geometry
   robot_state   joint and camera-pose histories (may include robot_model)
+  settings      each component's settings and their readers,
+                "tofguard/settings/..." (settings/)
   components    camera, renderer, sim, discrepancy, risk, estimator,
                 intervene, launch, spy, view, tune: each may include the layers
                 below and the components in ALLOWED_COMPONENT_DEPENDENCIES
-  deployment    the top-level config loader and process runner (everything
-                below)
-  top           main.cpp, *_main.cpp and bench/ programs: anything but tests/
+  deployment    the config loader (every section, through the settings) and
+                the process runner: beside the components, never including
+                one nor included by one
+  top           apps/: every program's main(), the tools and their engines;
+                anything but tests/ (and auth/examples/, the controllers'
+                examples, which stand alone)
 
 tests/ may include anything. Nobody writes "../" in an include, nor reaches
 into another folder's src/ (through a path or a bare name that only an
-include path finds).
+include path finds). No file outside apps/, tests/ and examples/ folders
+defines main() (or BENCHMARK_MAIN).
+
+The same rules hold for the links between the build's targets
+(check_links.py, on the build tree's link_graph.tsv).
 
 Usage: check_includes.py [REPO_ROOT]   (default: two folders up from here)
        check_includes.py --self-test   (the rules on a small made-up tree)
@@ -33,14 +42,17 @@ import re
 import sys
 
 # Rank of each layer: a folder may include its own layer's headers only as
-# the component rules allow, and any lower rank.
+# the component rules allow, and any lower rank; two different layers of
+# the same rank (the components and the deployment) include nothing of
+# each other.
 LAYER_RANK = {
     "lcmtypes": 0,
     "common": 1,
     "robot_model": 2,
     "auth": 2,
     "robot_state": 2,
-    "component": 3,
+    "settings": 3,
+    "component": 4,
     "deployment": 4,
     "top": 5,
 }
@@ -75,17 +87,15 @@ ALLOWED_SAME_LAYER = {
     "auth": [],
 }
 
-# Includes that break a rule today and the issue-13 item that removes each.
+# Includes that break a rule today, each with why it is allowed for now.
 # Each entry: (including file, fnmatch pattern relative to the repository
-# root; included header as written; why it is allowed for now). Empty this
-# list as the items land; an entry that no longer matches anything is
-# reported as stale (not an error, so that the removal can land in any order).
-KNOWN_VIOLATIONS = [
-    # None left: the estimator triggers on SAFETY_RISK as published (issue 13
-    # item 6) and no longer includes risk/.
-]
+# root; included header as written; why). An entry that no longer matches
+# anything is reported as stale.
+KNOWN_VIOLATIONS = []
 SKIP_DIRS = {".git", "node_modules", "__pycache__"}
 INCLUDE = re.compile(r'^\s*#\s*include\s*([<"])([^">]+)[">]')
+# A program's entry point: main() or Google Benchmark's BENCHMARK_MAIN().
+ENTRY_POINT = re.compile(r'^\s*(int\s+main\s*\(|BENCHMARK_MAIN\s*\()')
 
 
 def is_build_dir(path):
@@ -107,16 +117,13 @@ def layer_of_file(rel):
     top = parts[0]
     if top == "tests":
         return ("tests", None)
-    name = parts[-1]
-    if len(parts) == 2 and (name == "main.cpp" or name.endswith("_main.cpp")):
+    if top == "apps" or (len(parts) >= 2 and parts[1] == "examples"):
         return ("top", top)
-    if len(parts) >= 2 and parts[1] in ("bench", "tools", "examples"):
-        return ("top", top)
-    if top in ("lcmtypes", "common", "auth", "robot_model", "robot_state", "deployment"):
+    if top in ("lcmtypes", "common", "auth", "robot_model", "robot_state", "settings", "deployment"):
         return (top, top)
     if top in COMPONENTS:
         return ("component", top)
-    return ("top", top)  # anything else at the top (scripts, tools)
+    return ("top", top)  # anything else at the top (cmake/, scripts)
 
 
 def layer_of_header(header):
@@ -127,7 +134,7 @@ def layer_of_header(header):
     if len(parts) == 2:
         return ("lcmtypes", "lcmtypes")  # tofguard/<type>_t.hpp, generated
     name = parts[1]
-    if name in ("common", "auth", "robot_model", "robot_state", "deployment"):
+    if name in ("common", "auth", "robot_model", "robot_state", "settings", "deployment"):
         return (name, name)
     if name in COMPONENTS:
         return ("component", name)
@@ -147,6 +154,9 @@ def rule_broken(file_layer, file_component, header_layer, header_component):
         return None
     if header_rank > rank:
         return "%s (layer %s) may not include the higher layer %s" % (file_component, file_layer, header_layer)
+    if header_layer != file_layer and "deployment" in (file_layer, header_layer):
+        return "%s (layer %s) may not include %s (layer %s) beside it" % (file_component, file_layer,
+                                                                          header_component, header_layer)
     if file_layer == "component":
         allowed = ALLOWED_COMPONENT_DEPENDENCIES.get(file_component, [])
         if header_component in allowed:
@@ -198,6 +208,10 @@ def main(argv):
         file_layer, file_component = layer_of_file(rel)
         with open(os.path.join(root, rel), encoding="utf-8", errors="replace") as f:
             for number, line in enumerate(f, 1):
+                if file_layer not in ("top", "tests") and ENTRY_POINT.match(line):
+                    violations.append("%s:%d: a program's main() in %s/: programs live in apps/" %
+                                      (rel, number, rel.split(os.sep)[0]))
+                    continue
                 m = INCLUDE.match(line)
                 if not m:
                     continue
@@ -237,20 +251,27 @@ def self_test():
     files = {
         "common/src/a.cpp": ['"tofguard/common/a.hpp"', '"tofguard/depth_image_t.hpp"'],
         "robot_state/src/s.cpp": ['"tofguard/robot_model/m.hpp"'],
+        "settings/src/r.cpp": ['"tofguard/settings/s.hpp"', '"tofguard/auth/a.hpp"'],
         "sim/src/s.cpp": ['"tofguard/renderer/r.hpp"', '"tofguard/camera/c.hpp"', '"private.hpp"'],
         "sim/src/private.hpp": [],
-        "renderer/src/r.cpp": ['"tofguard/renderer/r.hpp"'],
-        "renderer/main.cpp": ['"tofguard/deployment/d.hpp"', '"tofguard/sim/s.hpp"'],
-        "deployment/src/d.cpp": ['"tofguard/risk/r.hpp"'],
-        "tests/x_test.cpp": ['"tofguard/risk/r.hpp"', '"test_support.hpp"'],
+        "renderer/src/r.cpp": ['"tofguard/renderer/r.hpp"', '"tofguard/settings/r.hpp"'],
+        "apps/tofguard-renderer.cpp": ['"tofguard/deployment/d.hpp"', '"tofguard/sim/s.hpp"'],
+        "deployment/src/d.cpp": ['"tofguard/settings/r.hpp"'],
+        "auth/examples/e.cpp": ['"tofguard/auth/a.hpp"'],
+        "tests/x_test.cpp": ['"tofguard/risk/r.hpp"', '"tool_support.hpp"'],
         # Bad, one per rule:
         "common/src/b.cpp": ['"tofguard/renderer/r.hpp"'],
         "robot_model/src/m.cpp": ['"tofguard/robot_state/s.hpp"'],
         "risk/src/r.cpp": ['"tofguard/renderer/r.hpp"', '"../common/src/x.hpp"', '"robot_tree.hpp"'],
         "risk/include/tofguard/risk/r.hpp": ['"tofguard/deployment/d.hpp"'],
+        "settings/src/s.cpp": ['"tofguard/risk/r.hpp"'],
+        "deployment/src/e.cpp": ['"tofguard/renderer/r.hpp"'],
         "renderer/src/robot_tree.hpp": [],
         "view/src/v.cpp": ['"renderer/src/r.hpp"', '"tofguard/nowhere/n.hpp"'],
     }
+    # main() outside apps/ (written as an include-less line below).
+    entry_points = {"renderer/main.cpp": "int main(int argc, char** argv) {", "apps/tofguard-x.cpp": "int main() {",
+                    "tests/t.cpp": "int main() {", "auth/examples/e.cpp": "int main() {"}
     expected_bad = {
         ("common/src/b.cpp", "tofguard/renderer/r.hpp"),
         ("robot_model/src/m.cpp", "tofguard/robot_state/s.hpp"),
@@ -258,14 +279,21 @@ def self_test():
         ("risk/src/r.cpp", "../common/src/x.hpp"),
         ("risk/src/r.cpp", "robot_tree.hpp"),
         ("risk/include/tofguard/risk/r.hpp", "tofguard/deployment/d.hpp"),
+        ("settings/src/s.cpp", "tofguard/risk/r.hpp"),
+        ("deployment/src/e.cpp", "tofguard/renderer/r.hpp"),
         ("view/src/v.cpp", "renderer/src/r.hpp"),
         ("view/src/v.cpp", "tofguard/nowhere/n.hpp"),
     }
+    expected_entry_points = {"renderer/main.cpp"}
     with tempfile.TemporaryDirectory() as root:
         for rel, includes in files.items():
             os.makedirs(os.path.join(root, os.path.dirname(rel)), exist_ok=True)
             with open(os.path.join(root, rel), "w") as f:
                 f.writelines("#include %s\n" % i for i in includes)
+        for rel, line in entry_points.items():
+            os.makedirs(os.path.join(root, os.path.dirname(rel)), exist_ok=True)
+            with open(os.path.join(root, rel), "a") as f:
+                f.write(line + "\n")
         out = io.StringIO()
         saved = list(KNOWN_VIOLATIONS)
         KNOWN_VIOLATIONS.clear()
@@ -275,7 +303,10 @@ def self_test():
         finally:
             KNOWN_VIOLATIONS.extend(saved)
     found = set(re.findall(r'LAYERING VIOLATION: (\S+):\d+: #include "([^"]+)"', out.getvalue()))
-    ok = status == 1 and found == expected_bad
+    found_entry_points = set(re.findall(r"LAYERING VIOLATION: (\S+):\d+: a program's main\(\)", out.getvalue()))
+    ok = status == 1 and found == expected_bad and found_entry_points == expected_entry_points
+    for wrong in sorted(found_entry_points ^ expected_entry_points):
+        print("SELF-TEST: main() wrongly judged: %s" % wrong)
     print(out.getvalue())
     for missed in sorted(expected_bad - found):
         print("SELF-TEST: not reported: %s -> %s" % missed)

@@ -9,7 +9,6 @@
 #include <map>
 #include <optional>
 
-#include "test_support.hpp"
 #include "tofguard/common/camera_pose_message.hpp"
 #include "tofguard/common/clock.hpp"
 #include "tofguard/common/depth_frame.hpp"
@@ -17,6 +16,7 @@
 #include "tofguard/heartbeat_t.hpp"
 #include "tofguard/renderer/depth_renderer.hpp"
 #include "tofguard/renderer/renderer_process.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::renderer {
 namespace {

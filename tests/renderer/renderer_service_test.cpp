@@ -4,10 +4,10 @@
 
 #include <cmath>
 
-#include "test_support.hpp"
 #include "tofguard/common/wire_checks.hpp"
 #include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/renderer/renderer_process.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::renderer {
 namespace {

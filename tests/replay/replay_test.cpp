@@ -32,7 +32,6 @@
 #include <string_view>
 
 #include "log_replay.hpp"
-#include "test_support.hpp"
 #include "tofguard/common/risk_names.hpp"
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/deployment/process_settings.hpp"
@@ -42,6 +41,7 @@
 #include "tofguard/safety_status_t.hpp"
 #include "tofguard/sim_camera_fault_t.hpp"
 #include "tofguard/sim_joint_fault_t.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::test {
 namespace {

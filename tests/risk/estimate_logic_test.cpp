@@ -8,7 +8,6 @@
 
 #include "synthetic_estimates.hpp"
 #include "synthetic_frames.hpp"
-#include "test_support.hpp"
 #include "tofguard/common/planned_trajectory.hpp"
 #include "tofguard/common/wire_checks.hpp"
 #include "tofguard/deployment/config.hpp"
@@ -17,6 +16,7 @@
 #include "tofguard/risk/estimate_finding.hpp"
 #include "tofguard/risk/risk_monitor.hpp"
 #include "tofguard/robot_model/kinematic_tree.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::test {
 namespace {

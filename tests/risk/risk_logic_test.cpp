@@ -8,7 +8,6 @@
 #include <sstream>
 
 #include "synthetic_frames.hpp"
-#include "test_support.hpp"
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/discrepancy/discrepancy_image.hpp"
@@ -16,6 +15,7 @@
 #include "tofguard/risk/protective_field.hpp"
 #include "tofguard/risk/risk_monitor.hpp"
 #include "tofguard/robot_model/kinematic_tree.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::test {
 namespace {

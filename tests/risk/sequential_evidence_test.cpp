@@ -15,11 +15,11 @@
 #include <vector>
 
 #include "synthetic_frames.hpp"
-#include "test_support.hpp"
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/risk/evidence_tests.hpp"
 #include "tofguard/risk/risk_monitor.hpp"
 #include "tofguard/robot_model/kinematic_tree.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::test {
 namespace {

@@ -10,10 +10,10 @@
 #include <random>
 
 #include "model_test_util.hpp"
-#include "test_support.hpp"
 #include "tofguard/robot_model/arm_spheres.hpp"
 #include "tofguard/robot_model/kinematics.hpp"
 #include "tofguard/robot_model/scene_model.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::robot_model {
 namespace {

@@ -4,11 +4,12 @@
 // ignored, and which of the two makes a frame unusable.
 #include <gtest/gtest.h>
 
-#include "test_support.hpp"
 #include "tofguard/common/camera_pose_message.hpp"
 #include "tofguard/deployment/config.hpp"
-#include "tofguard/renderer/renderer_settings.hpp"
+#include "tofguard/renderer/state_history_settings.hpp"
 #include "tofguard/robot_state/state_history.hpp"
+#include "tofguard/settings/renderer_settings.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::robot_state {
 namespace {

@@ -7,13 +7,13 @@
 #include <cmath>
 
 #include "signed_publisher.hpp"
-#include "test_support.hpp"
 #include "tofguard/common/clock.hpp"
 #include "tofguard/common/planned_trajectory.hpp"
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/planned_trajectory_t.hpp"
 #include "tofguard/safety_status_t.hpp"
 #include "tofguard/sim_joint_fault_t.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::test {
 namespace {

@@ -10,7 +10,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "test_support.hpp"
 #include "tofguard/common/camera_pose_message.hpp"
 #include "tofguard/common/clock.hpp"
 #include "tofguard/common/depth_frame.hpp"
@@ -22,6 +21,7 @@
 #include "tofguard/renderer/depth_renderer.hpp"
 #include "tofguard/renderer/renderer_process.hpp"
 #include "tofguard/sim_camera_fault_t.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::test {
 namespace {

@@ -8,9 +8,9 @@
 #include <cmath>
 #include <optional>
 
-#include "test_support.hpp"
 #include "tofguard/sim_camera_fault_t.hpp"
 #include "tofguard/sim_joint_fault_t.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::test {
 namespace {

@@ -2,10 +2,10 @@
 
 #include <cmath>
 
-#include "test_support.hpp"
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/sim/simulated_arm.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::sim {
 namespace {

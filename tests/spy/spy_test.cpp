@@ -10,12 +10,12 @@
 #include <thread>
 
 #include "sample_messages.hpp"
-#include "test_support.hpp"
 #include "tofguard/authenticated_message_t.hpp"
 #include "tofguard/motion_estimate_t.hpp"
 #include "tofguard/safety_status_t.hpp"
 #include "tofguard/spy/message_format.hpp"
 #include "tofguard/spy/status_board.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::test {
 namespace {

@@ -10,11 +10,11 @@
 #include <utility>
 #include <vector>
 
-#include "test_support.hpp"
 #include "tofguard/common/clock.hpp"
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/heartbeat_t.hpp"
 #include "tofguard/risk_t.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::test {
 

@@ -6,10 +6,10 @@
 #include <memory>
 
 #include "simulated_frames.hpp"
-#include "test_support.hpp"
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/estimator/motion_estimator.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::estimator::test {
 

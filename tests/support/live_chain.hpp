@@ -16,7 +16,6 @@
 #include <utility>
 #include <vector>
 
-#include "test_support.hpp"
 #include "tofguard/common/clock.hpp"
 #include "tofguard/common/risk_names.hpp"
 #include "tofguard/deployment/config.hpp"
@@ -24,6 +23,7 @@
 #include "tofguard/power_relay_t.hpp"
 #include "tofguard/risk_t.hpp"
 #include "tofguard/safety_status_t.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::test {
 

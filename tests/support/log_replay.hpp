@@ -30,7 +30,6 @@
 #include <string_view>
 #include <vector>
 
-#include "test_support.hpp"
 #include "tofguard/common/risk_names.hpp"
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/depth_image_t.hpp"
@@ -39,6 +38,7 @@
 #include "tofguard/safety_status_t.hpp"
 #include "tofguard/sim_camera_fault_t.hpp"
 #include "tofguard/sim_joint_fault_t.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::test {
 

@@ -7,7 +7,7 @@
 
 #include <Eigen/Geometry>
 
-#include "test_support.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::test {
 

@@ -7,11 +7,11 @@
 
 #include <string>
 
-#include "test_support.hpp"
 #include "tofguard/auth/auth_key.hpp"
 #include "tofguard/auth/message_signer.hpp"
 #include "tofguard/auth/signed_publish.hpp"
 #include "tofguard/common/clock.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::test {
 

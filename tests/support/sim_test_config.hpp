@@ -2,7 +2,7 @@
 // The simulated camera's settings used by the camera tests: the embedded
 // default's 176x144 camera and an error model like config/sim.yaml's.
 #include "tofguard/common/camera_settings.hpp"
-#include "tofguard/sim/sim_settings.hpp"
+#include "tofguard/settings/sim_settings.hpp"
 
 namespace tofguard::sim::sim_test {
 

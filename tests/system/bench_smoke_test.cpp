@@ -1,4 +1,4 @@
-// tofguard-bench's logic, short (tests/support/chain_bench.hpp): the
+// tofguard-bench's logic, short (apps/tofguard-bench/chain_bench.hpp): the
 // default arm at 176x144 and 10 Hz for 3 s through the real observer chain.
 // Asserts that every frame went through every stage, none was dropped, and
 // the report has its rows, the floors' included (renders, compute_discrepancy
@@ -11,7 +11,7 @@
 #include <iostream>
 
 #include "chain_bench.hpp"
-#include "test_support.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::test {
 namespace {

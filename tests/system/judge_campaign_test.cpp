@@ -17,9 +17,9 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "judge_campaign.hpp"
-#include "test_support.hpp"
-#include "tofguard/risk/risk_settings.hpp"
 #include "tofguard/risk_t.hpp"
+#include "tofguard/settings/risk_settings.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::test {
 namespace {

@@ -19,7 +19,6 @@
 #include <memory>
 #include <thread>
 
-#include "test_support.hpp"
 #include "tofguard/authenticated_message_t.hpp"
 #include "tofguard/camera_pose_t.hpp"
 #include "tofguard/common/clock.hpp"
@@ -35,6 +34,7 @@
 #include "tofguard/safety_status_t.hpp"
 #include "tofguard/sim_camera_fault_t.hpp"
 #include "tofguard/sim_joint_fault_t.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::test {
 namespace {

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "nominal_log.hpp"
-#include "test_support.hpp"
+#include "tool_support.hpp"
 #include "unseen_camera.hpp"
 
 namespace tofguard::test {

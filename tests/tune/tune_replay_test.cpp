@@ -20,7 +20,7 @@
 
 #include "log_replay.hpp"
 #include "nominal_log.hpp"
-#include "test_support.hpp"
+#include "tool_support.hpp"
 #include "unseen_camera.hpp"
 
 namespace tofguard::test {

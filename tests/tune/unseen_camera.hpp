@@ -6,7 +6,7 @@
 // replaces.
 #include <string>
 
-#include "test_support.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::test {
 

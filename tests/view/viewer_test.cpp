@@ -8,11 +8,11 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "log_events.hpp"
-#include "test_support.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/link_labels_t.hpp"
 #include "tofguard/risk_t.hpp"
 #include "tofguard/view/view_compose.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::test {
 namespace {

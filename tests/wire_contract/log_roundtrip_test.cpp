@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "sample_messages.hpp"
-#include "test_support.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::test {
 namespace {

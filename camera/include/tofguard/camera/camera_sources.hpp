@@ -2,7 +2,7 @@
 // tofguard-camera's USB source (the simulated one is tofguard/sim/sim_camera_runner.hpp), publishing
 // depth_image_t on channels.depth (image URL) at camera.rate_hz with the distance calibration applied, and a
 // heartbeat whose frames_dropped counts every frame that was lost or late.
-#include "tofguard/camera/depth_camera_settings.hpp"
+#include "tofguard/settings/depth_camera_settings.hpp"
 
 namespace tofguard::camera {
 

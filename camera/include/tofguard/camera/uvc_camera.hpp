@@ -19,8 +19,8 @@
 #include <string>
 #include <vector>
 
-#include "tofguard/camera/depth_camera_settings.hpp"
 #include "tofguard/camera/depth_conversion.hpp"
+#include "tofguard/settings/depth_camera_settings.hpp"
 
 struct uvc_context;
 struct uvc_device;

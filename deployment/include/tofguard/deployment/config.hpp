@@ -20,18 +20,18 @@
 #include <vector>
 
 #include "tofguard/auth/auth_settings.hpp"
-#include "tofguard/camera/depth_camera_settings.hpp"
 #include "tofguard/common/camera_settings.hpp"
 #include "tofguard/common/config_error.hpp"
 #include "tofguard/common/lcm_settings.hpp"
 #include "tofguard/common/robot_settings.hpp"
-#include "tofguard/discrepancy/discrepancy_settings.hpp"
-#include "tofguard/estimator/estimator_settings.hpp"
-#include "tofguard/intervene/intervention_settings.hpp"
-#include "tofguard/launch/launch_settings.hpp"
-#include "tofguard/renderer/renderer_settings.hpp"
-#include "tofguard/risk/risk_settings.hpp"
-#include "tofguard/sim/sim_settings.hpp"
+#include "tofguard/settings/depth_camera_settings.hpp"
+#include "tofguard/settings/discrepancy_settings.hpp"
+#include "tofguard/settings/estimator_settings.hpp"
+#include "tofguard/settings/intervention_settings.hpp"
+#include "tofguard/settings/launch_settings.hpp"
+#include "tofguard/settings/renderer_settings.hpp"
+#include "tofguard/settings/risk_settings.hpp"
+#include "tofguard/settings/sim_settings.hpp"
 
 namespace tofguard::deployment {
 

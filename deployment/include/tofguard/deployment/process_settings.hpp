@@ -2,7 +2,7 @@
 // What each process takes from the deployment config: its own section and
 // the shared pieces it needs, nothing else.
 #include "tofguard/deployment/config.hpp"
-#include "tofguard/view/view_settings.hpp"
+#include "tofguard/settings/view_settings.hpp"
 
 namespace tofguard::deployment {
 
@@ -19,6 +19,8 @@ camera::UvcCameraProcessSettings uvc_camera_process_settings(const Config& confi
 // Throws ConfigError naming the file when the config has no `launch`
 // section.
 launch::LaunchProcessSettings launch_process_settings(const Config& config);
+// All but fields.protective_at_rest_m, which the risk rules compute
+// (risk::field_size): tofguard-view fills it in.
 view::ViewSettings view_settings(const Config& config);
 
 }  // namespace tofguard::deployment

@@ -16,11 +16,11 @@
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/common/worker_pool.hpp"
 #include "tofguard/depth_image_t.hpp"
-#include "tofguard/discrepancy/discrepancy_settings.hpp"
 #include "tofguard/discrepancy/evidence.hpp"
 #include "tofguard/discrepancy_image_t.hpp"
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/link_labels_t.hpp"
+#include "tofguard/settings/discrepancy_settings.hpp"
 
 namespace tofguard::discrepancy {
 

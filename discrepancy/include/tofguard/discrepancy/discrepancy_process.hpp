@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "tofguard/common/process.hpp"
-#include "tofguard/discrepancy/discrepancy_settings.hpp"
+#include "tofguard/settings/discrepancy_settings.hpp"
 
 namespace tofguard::discrepancy {
 

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "tofguard/common/process.hpp"
-#include "tofguard/estimator/estimator_settings.hpp"
+#include "tofguard/settings/estimator_settings.hpp"
 
 namespace tofguard::estimator {
 

@@ -38,13 +38,13 @@
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/estimator/estimate_message.hpp"
-#include "tofguard/estimator/estimator_settings.hpp"
 #include "tofguard/estimator/motion_estimator.hpp"
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/motion_estimate_t.hpp"
 #include "tofguard/risk_t.hpp"
 #include "tofguard/robot_model/scene_model.hpp"
 #include "tofguard/robot_state/state_history.hpp"
+#include "tofguard/settings/estimator_settings.hpp"
 
 namespace tofguard::estimator {
 

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "tofguard/estimator/estimator_settings.hpp"
 #include "tofguard/estimator/motion_estimator.hpp"
+#include "tofguard/settings/estimator_settings.hpp"
 
 namespace tofguard::estimator {
 

@@ -4,7 +4,7 @@
 // change, SAFETY_RESET_REPLY, and the power-cut actuator
 // (intervention_logic.hpp holds the rules, without LCM or clocks).
 #include "tofguard/common/process.hpp"
-#include "tofguard/intervene/intervention_settings.hpp"
+#include "tofguard/settings/intervention_settings.hpp"
 
 namespace tofguard::intervene {
 

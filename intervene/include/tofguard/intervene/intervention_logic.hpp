@@ -26,10 +26,10 @@
 #include <cstdint>
 #include <string>
 
-#include "tofguard/intervene/intervention_settings.hpp"
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/reset_request_t.hpp"
 #include "tofguard/risk_t.hpp"
+#include "tofguard/settings/intervention_settings.hpp"
 
 namespace tofguard::intervene {
 

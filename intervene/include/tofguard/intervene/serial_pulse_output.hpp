@@ -20,19 +20,12 @@
 #include <string>
 
 #include "tofguard/intervene/power_actuator.hpp"
+#include "tofguard/settings/intervention_settings.hpp"
 
 namespace tofguard::intervene {
 
-enum class PulseLine { kDtr, kRts, kTx };
-
 // "dtr", "rts", "tx".
 std::string pulse_line_name(PulseLine line);
-
-struct SerialPulseSettings {
-  std::string device;  // e.g. /dev/ttyUSB0
-  PulseLine line = PulseLine::kDtr;
-  double frequency_hz = 0;  // pulses per second, > 0
-};
 
 class SerialPulseOutput : public PowerActuator {
  public:

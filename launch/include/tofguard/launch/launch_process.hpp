@@ -4,7 +4,7 @@
 // records every tofguard channel with lcm-logger into rotating files, and
 // stops everything on Ctrl-C / SIGTERM.
 #include "tofguard/common/process.hpp"
-#include "tofguard/launch/launch_settings.hpp"
+#include "tofguard/settings/launch_settings.hpp"
 
 namespace tofguard::launch {
 

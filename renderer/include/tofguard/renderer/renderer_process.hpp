@@ -52,8 +52,8 @@
 #include "tofguard/planned_trajectory_t.hpp"
 #include "tofguard/renderer/depth_renderer.hpp"
 #include "tofguard/renderer/rendered_kinematics.hpp"
-#include "tofguard/renderer/renderer_settings.hpp"
 #include "tofguard/robot_state/state_history.hpp"
+#include "tofguard/settings/renderer_settings.hpp"
 
 namespace tofguard::renderer {
 

@@ -19,8 +19,8 @@
 
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/risk/frame_classifier.hpp"
-#include "tofguard/risk/risk_settings.hpp"
 #include "tofguard/risk_t.hpp"
+#include "tofguard/settings/risk_settings.hpp"
 
 namespace tofguard::risk {
 

@@ -11,7 +11,7 @@
 
 #include "tofguard/motion_estimate_t.hpp"
 #include "tofguard/risk/frame_classifier.hpp"
-#include "tofguard/risk/risk_settings.hpp"
+#include "tofguard/settings/risk_settings.hpp"
 
 namespace tofguard::risk {
 

@@ -20,7 +20,7 @@
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/motion_estimate_t.hpp"
 #include "tofguard/risk/frame_classifier.hpp"
-#include "tofguard/risk/risk_settings.hpp"
+#include "tofguard/settings/risk_settings.hpp"
 
 namespace tofguard::risk {
 

@@ -17,8 +17,8 @@
 
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/risk/frame_classifier.hpp"
-#include "tofguard/risk/risk_settings.hpp"
 #include "tofguard/robot_model/kinematic_tree.hpp"
+#include "tofguard/settings/risk_settings.hpp"
 
 namespace tofguard::risk {
 

@@ -12,8 +12,8 @@
 #include "tofguard/common/risk_names.hpp"
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/risk/protective_field.hpp"
-#include "tofguard/risk/risk_settings.hpp"
 #include "tofguard/robot_model/kinematic_tree.hpp"
+#include "tofguard/settings/risk_settings.hpp"
 
 namespace tofguard::risk {
 

@@ -15,7 +15,7 @@
 
 #include "tofguard/common/lcm_settings.hpp"
 #include "tofguard/risk/frame_classifier.hpp"
-#include "tofguard/risk/risk_settings.hpp"
+#include "tofguard/settings/risk_settings.hpp"
 
 namespace tofguard::risk {
 

@@ -13,7 +13,7 @@
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/planned_trajectory_t.hpp"
 #include "tofguard/risk/frame_classifier.hpp"
-#include "tofguard/risk/risk_settings.hpp"
+#include "tofguard/settings/risk_settings.hpp"
 
 namespace tofguard::risk {
 

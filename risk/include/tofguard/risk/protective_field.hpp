@@ -18,7 +18,7 @@
 
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/joint_state_t.hpp"
-#include "tofguard/risk/risk_settings.hpp"
+#include "tofguard/settings/risk_settings.hpp"
 
 namespace tofguard::risk {
 
@@ -56,10 +56,8 @@ std::optional<double> object_distance_m(const discrepancy_t& frame, double min_a
 // The frame's field range, m: num_field_bins * field_bin_m.
 double field_range_m(const discrepancy_t& frame);
 
-// The intrusion distance C that ISO 13855 requires for a detection
-// capability of `detection_capability_m` (the smallest object always
-// detected), m: 8 * (d - 14 mm) for d <= 40 mm (not below 0), 0.85 m
-// beyond (a reach of the arm).
-double iso13855_intrusion_distance_m(double detection_capability_m);
+// (iso13855_intrusion_distance_m, the C the config must at least give, is
+// in risk_settings.hpp: the reader checks risk.field.intrusion_distance_m
+// against it.)
 
 }  // namespace tofguard::risk

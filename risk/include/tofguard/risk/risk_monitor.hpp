@@ -44,9 +44,9 @@
 #include "tofguard/risk/input_deadlines.hpp"
 #include "tofguard/risk/joint_states_by_utime.hpp"
 #include "tofguard/risk/plan_monitor.hpp"
-#include "tofguard/risk/risk_settings.hpp"
 #include "tofguard/risk_t.hpp"
 #include "tofguard/robot_model/kinematic_tree.hpp"
+#include "tofguard/settings/risk_settings.hpp"
 
 namespace tofguard::risk {
 

@@ -5,7 +5,7 @@
 // required), the discrepancy stream, and the heartbeats of the required
 // processes.
 #include "tofguard/common/process.hpp"
-#include "tofguard/risk/risk_settings.hpp"
+#include "tofguard/settings/risk_settings.hpp"
 
 namespace tofguard::risk {
 

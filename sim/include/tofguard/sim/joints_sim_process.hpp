@@ -6,7 +6,7 @@
 // permission or is older than joints_sim.status_deadline_ms; takes encoder
 // faults from the config and from SIM_JOINT_FAULT.
 #include "tofguard/common/process.hpp"
-#include "tofguard/sim/sim_settings.hpp"
+#include "tofguard/settings/sim_settings.hpp"
 
 namespace tofguard::sim {
 

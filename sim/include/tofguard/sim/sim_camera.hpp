@@ -17,7 +17,7 @@
 
 #include "tofguard/common/camera_settings.hpp"
 #include "tofguard/robot_state/joint_history.hpp"
-#include "tofguard/sim/sim_settings.hpp"
+#include "tofguard/settings/sim_settings.hpp"
 #include "tofguard/sim/tof_error_model.hpp"
 
 namespace tofguard::sim {

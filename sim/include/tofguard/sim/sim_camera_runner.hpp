@@ -1,6 +1,6 @@
 #pragma once
 // tofguard-camera's simulated source.
-#include "tofguard/sim/sim_settings.hpp"
+#include "tofguard/settings/sim_settings.hpp"
 
 namespace tofguard::sim {
 

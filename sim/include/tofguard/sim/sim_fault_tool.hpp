@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "tofguard/common/process.hpp"
-#include "tofguard/sim/sim_settings.hpp"
+#include "tofguard/settings/sim_settings.hpp"
 
 namespace tofguard::sim {
 

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "tofguard/sim/sim_settings.hpp"
+#include "tofguard/settings/sim_settings.hpp"
 
 namespace tofguard::sim {
 

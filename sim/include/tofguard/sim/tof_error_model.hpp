@@ -27,7 +27,7 @@
 #include <vector>
 
 #include "tofguard/camera/depth_conversion.hpp"
-#include "tofguard/sim/sim_settings.hpp"
+#include "tofguard/settings/sim_settings.hpp"
 
 namespace tofguard::sim {
 

@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
-#include "tofguard/discrepancy/discrepancy_settings.hpp"
-#include "tofguard/renderer/renderer_settings.hpp"
-#include "tofguard/risk/risk_settings.hpp"
+#include "tofguard/settings/discrepancy_settings.hpp"
+#include "tofguard/settings/renderer_settings.hpp"
+#include "tofguard/settings/risk_settings.hpp"
 #include "tofguard/tune/noise_fit.hpp"
 
 namespace tofguard::tune {

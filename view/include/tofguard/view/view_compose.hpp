@@ -15,6 +15,7 @@
 #include "tofguard/discrepancy/discrepancy_image.hpp"
 #include "tofguard/link_labels_t.hpp"
 #include "tofguard/risk_t.hpp"
+#include "tofguard/settings/view_settings.hpp"
 
 namespace tofguard::view {
 
@@ -23,16 +24,6 @@ struct FrameSet {
   std::optional<depth_image_t> rendered;
   std::optional<link_labels_t> labels;
   std::optional<risk_t> risk;  // the verdict on this frame, if known
-};
-
-// The protective and warning fields to draw (docs/safety-chain.md,
-// "Protective fields"): S with the arm at rest and the warning margin
-// beyond it, metres (protective_at_rest_m <= 0: none drawn). On a frame
-// whose verdict is an unknown object, that verdict's threshold (the S of
-// its frame) is drawn instead.
-struct FieldSizes {
-  double protective_at_rest_m = 0;
-  double warning_margin_m = 0;
 };
 
 // Per camera pixel, where its surface lies (labels' arm cover; CV_8U):

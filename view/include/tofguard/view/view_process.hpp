@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "tofguard/common/process.hpp"
-#include "tofguard/view/view_settings.hpp"
+#include "tofguard/settings/view_settings.hpp"
 
 namespace tofguard::view {
 

@@ -9,7 +9,6 @@
 #include "tofguard/common/lcm_settings.hpp"
 #include "tofguard/common/robot_settings.hpp"
 #include "tofguard/common/yaml_reader.hpp"
-#include "tofguard/robot_state/state_history.hpp"
 
 namespace tofguard::renderer {
 
@@ -68,14 +67,6 @@ struct RendererSettings {
 
 // Reads (and finishes) the `renderer` section.
 RendererSettings read_renderer_settings(YamlMap section);
-
-// The state history's limits (the renderer's max_extrapolation_us and
-// camera_pose_*_us, as read), the robot's id and the camera's id and static
-// pose: every process that renders or compares the model (renderer,
-// estimator, extrinsics calibration) builds its StateHistory from this.
-robot_state::StateHistorySettings state_history_settings(const RendererSettings& renderer,
-                                                         const std::string& robot_id,
-                                                         const CameraSettings& camera);
 
 // Everything tofguard-renderer needs: its section, the model, the camera,
 // the wiring.

@@ -153,4 +153,10 @@ struct RiskProcessSettings {
   RiskSettings risk;
 };
 
+// The intrusion distance C that ISO 13855 requires for a detection
+// capability of `detection_capability_m` (the smallest object always
+// detected), m: 8 * (d - 14 mm) for d <= 40 mm (not below 0), 0.85 m
+// beyond (a reach of the arm).
+double iso13855_intrusion_distance_m(double detection_capability_m);
+
 }  // namespace tofguard::risk

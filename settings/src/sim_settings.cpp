@@ -1,4 +1,4 @@
-#include "tofguard/sim/sim_settings.hpp"
+#include "tofguard/settings/sim_settings.hpp"
 
 #include <cmath>
 

@@ -1,4 +1,4 @@
-#include "tofguard/estimator/estimator_settings.hpp"
+#include "tofguard/settings/estimator_settings.hpp"
 
 namespace tofguard::estimator {
 

@@ -22,7 +22,7 @@ namespace {
 // jointly (estimator.frames_per_estimate: the frame and the ones 33 and 67
 // ms before it, the arm moving 0.5 degrees a frame per joint).
 void BM_Estimate(benchmark::State& state) {
-  // As tofguard-estimator runs (estimator/main.cpp): no llvmpipe render
+  // As tofguard-estimator runs (apps/tofguard-estimator.cpp): no llvmpipe render
   // threads, unless the environment says otherwise.
   setenv("LP_NUM_THREADS", "0", /*overwrite=*/0);
   const deployment::Config config =

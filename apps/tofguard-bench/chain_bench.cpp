@@ -31,7 +31,6 @@
 #include "report_format.hpp"
 #include "scaled_intrinsics.hpp"
 #include "simulated_frames.hpp"
-#include "test_support.hpp"
 #include "tofguard/authenticated_message_t.hpp"
 #include "tofguard/common/clock.hpp"
 #include "tofguard/common/depth_frame.hpp"
@@ -47,6 +46,7 @@
 #include "tofguard/risk_t.hpp"
 #include "tofguard/robot_model/arm_spheres.hpp"
 #include "tofguard/robot_model/scene_model.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::test {
 namespace {

@@ -1,4 +1,4 @@
-#include "tofguard/discrepancy/discrepancy_settings.hpp"
+#include "tofguard/settings/discrepancy_settings.hpp"
 
 #include <algorithm>
 #include <charconv>

@@ -1,4 +1,4 @@
-#include "tofguard/camera/depth_camera_settings.hpp"
+#include "tofguard/settings/depth_camera_settings.hpp"
 
 #include <regex>
 

@@ -1,8 +1,7 @@
-#include "tofguard/risk/risk_settings.hpp"
+#include "tofguard/settings/risk_settings.hpp"
 
+#include <algorithm>
 #include <cmath>
-
-#include "tofguard/risk/protective_field.hpp"
 
 namespace tofguard::risk {
 
@@ -108,6 +107,11 @@ RiskSettings read_risk_settings(YamlMap map) {
   }
   map.finish();
   return r;
+}
+
+double iso13855_intrusion_distance_m(double detection_capability_m) {
+  if (detection_capability_m > 0.040) return 0.85;
+  return std::max(0.0, 8.0 * (detection_capability_m - 0.014));
 }
 
 }  // namespace tofguard::risk

@@ -1,10 +1,19 @@
 #pragma once
 // What tofguard-view needs from the deployment config.
 #include "tofguard/common/lcm_settings.hpp"
-#include "tofguard/discrepancy/discrepancy_settings.hpp"
-#include "tofguard/view/view_compose.hpp"
+#include "tofguard/settings/discrepancy_settings.hpp"
 
 namespace tofguard::view {
+
+// The protective and warning fields to draw (docs/safety-chain.md,
+// "Protective fields"): S with the arm at rest and the warning margin
+// beyond it, metres (protective_at_rest_m <= 0: none drawn). On a frame
+// whose verdict is an unknown object, that verdict's threshold (the S of
+// its frame) is drawn instead.
+struct FieldSizes {
+  double protective_at_rest_m = 0;
+  double warning_margin_m = 0;
+};
 
 struct ViewSettings {
   LcmSettings lcm;

@@ -1,4 +1,4 @@
-#include "tofguard/intervene/intervention_settings.hpp"
+#include "tofguard/settings/intervention_settings.hpp"
 
 namespace tofguard::intervene {
 

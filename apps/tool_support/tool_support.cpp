@@ -1,4 +1,4 @@
-#include "test_support.hpp"
+#include "tool_support.hpp"
 
 #include <fcntl.h>
 #include <signal.h>

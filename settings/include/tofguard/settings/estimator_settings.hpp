@@ -10,7 +10,7 @@
 #include "tofguard/common/lcm_settings.hpp"
 #include "tofguard/common/robot_settings.hpp"
 #include "tofguard/common/yaml_reader.hpp"
-#include "tofguard/renderer/renderer_settings.hpp"
+#include "tofguard/settings/renderer_settings.hpp"
 
 namespace tofguard::estimator {
 

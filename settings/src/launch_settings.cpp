@@ -1,4 +1,4 @@
-#include "tofguard/launch/launch_settings.hpp"
+#include "tofguard/settings/launch_settings.hpp"
 
 namespace tofguard::launch {
 

@@ -11,11 +11,11 @@
 #include <Eigen/Core>
 
 #include "tofguard/auth/auth_settings.hpp"
-#include "tofguard/camera/depth_camera_settings.hpp"
 #include "tofguard/common/camera_settings.hpp"
 #include "tofguard/common/lcm_settings.hpp"
 #include "tofguard/common/robot_settings.hpp"
 #include "tofguard/common/yaml_reader.hpp"
+#include "tofguard/settings/depth_camera_settings.hpp"
 
 namespace tofguard::sim {
 

@@ -1,5 +1,5 @@
 // tofguard-bench: the observer chain's speed as real processes over real LCM
-// (issue 17 point 1; tests/support/chain_bench.hpp): latency per stage,
+// (chain_bench.hpp beside this file): latency per stage,
 // frames dropped and CPU per process, per arm and camera size, at one rate or
 // ramping. Run it through scripts/bench (a private network namespace).
 //
@@ -48,8 +48,8 @@
 
 #include "chain_bench.hpp"
 #include "report_format.hpp"
-#include "test_support.hpp"
 #include "tofguard/common/resident_heap.hpp"
+#include "tool_support.hpp"
 
 namespace {
 

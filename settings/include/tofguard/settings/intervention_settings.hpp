@@ -9,9 +9,18 @@
 #include "tofguard/auth/auth_settings.hpp"
 #include "tofguard/common/lcm_settings.hpp"
 #include "tofguard/common/yaml_reader.hpp"
-#include "tofguard/intervene/serial_pulse_output.hpp"
 
 namespace tofguard::intervene {
+
+// The serial pulse output's line (serial_pulse_output.hpp, docs/intervention.md).
+enum class PulseLine { kDtr, kRts, kTx };
+
+// `intervention.serial_pulse`: the pulse train for a hardware watchdog.
+struct SerialPulseSettings {
+  std::string device;  // e.g. /dev/ttyUSB0
+  PulseLine line = PulseLine::kDtr;
+  double frequency_hz = 0;  // pulses per second, > 0
+};
 
 struct InterventionSettings {
   // publish_rate_hz: SAFETY_STATUS rate; a change is published at once as

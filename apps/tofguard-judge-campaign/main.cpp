@@ -1,5 +1,5 @@
-// tofguard-judge-campaign: issue 14's and 15's figures (docs/safety-chain.md,
-// "Measured"; docs/detection.md): the judgement run in-process on simulated
+// tofguard-judge-campaign: the detection and false-stop figures
+// (docs/safety-chain.md, "Measured"; docs/detection.md): the judgement run in-process on simulated
 // frames of the default arm, the iiwa14 and the Kinova Gen3 (../shared) with
 // injected joint offsets, camera pose errors, objects, frozen and stalled
 // streams, and nominal frames for false stops.
@@ -15,7 +15,7 @@
 // axis of its optical frame by each magnitude (fault_runs).
 // --streams: that many runs each of a frozen camera image, a stalled camera
 // stream and a stalled joint stream.
-// --objects-cm: issue 15's objects (object_runs): a 10 cm cube still at each
+// --objects-cm: the unknown objects (object_runs): a 10 cm cube still at each
 // distance from the arm, a hand approaching at K, a person and a cart
 // walking past --beyond-cm beyond the warning field of the arm at rest.
 // --passers-s: people and carts crossing 10 cm beyond the warning field,
@@ -40,7 +40,7 @@
 
 #include "judge_campaign.hpp"
 #include "report_format.hpp"
-#include "test_support.hpp"
+#include "tool_support.hpp"
 
 namespace {
 

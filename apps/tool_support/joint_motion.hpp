@@ -4,7 +4,7 @@
 // arm's path without running the simulated arm.
 #include <cmath>
 
-#include "tofguard/sim/sim_settings.hpp"
+#include "tofguard/settings/sim_settings.hpp"
 
 namespace tofguard::test {
 
