@@ -1259,7 +1259,7 @@ std::string floors_table(const BenchReport& report) {
   const deployment::Config config = deployment::load_config(source_dir() + "/config/sim.yaml", nullptr);
   const ChannelNames& ch = config.channels;
   std::ostringstream t;
-  t << "\nFloors (issue 17: each stage within 2× of its floor), measured by the bench alone after the "
+  t << "\nFloors (target: each stage within 2× of its floor), measured by the bench alone after the "
        "chain's processes were stopped. Render floor: DepthRenderer::render (render, read-back, "
        "conversion) in the bench, the scene tofguard-renderer loads, the run's intrinsics and the last "
        "step's joint path, back to back. Compute: compute_discrepancy on the prepared frames and the model "

@@ -1,5 +1,5 @@
 #pragma once
-// The observer chain's speed as processes (issue 17 point 1): tofguard-renderer,
+// The observer chain's speed as processes: tofguard-renderer,
 // -discrepancy, -risk and -intervene started from build/bin with a config
 // made for the arm and camera size, fed over real LCM by the bench's own
 // publisher with depth frames prepared beforehand (the simulated ToF camera's
@@ -73,8 +73,7 @@ struct BenchOptions {
   // (--floor-listeners): in the chain every process has a socket on the
   // safety URL (and each image reader on the image URL), and the kernel
   // delivers every multicast message to each, in the sender's send call
-  // (docs/benchmarks.md, thirteenth session, "The floors with the chain's
-  // listeners"). 0: only the bench's own.
+  // (docs/benchmarks.md, "The floors with the chain's listeners"). 0: only the bench's own.
   int floor_listeners = 0;
   std::string shared_dir;
   // Configs, scenes and the processes' output files.

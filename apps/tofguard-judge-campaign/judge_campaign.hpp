@@ -1,5 +1,5 @@
 #pragma once
-// The judgement campaign (issue 14): the observer chain's judgement
+// The judgement campaign: the observer chain's judgement
 // (renderer -> discrepancy -> risk) run in-process, frame by frame, on
 // simulated camera frames of an arm with injected faults, without LCM or
 // clocks, so that thousands of frames are judged in minutes and every
@@ -173,7 +173,7 @@ struct CampaignResult {
 // Throws std::runtime_error when the scene cannot be loaded or rendered.
 std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vector<CampaignRun>& runs);
 
-// Issue 15's matrix: every actuated joint at each of `joint_offsets_deg`;
+// The detection matrix's faults (docs/detection.md): every actuated joint at each of `joint_offsets_deg`;
 // the camera moved by each of `camera_translations_cm` along its optical
 // x, y and z (the optical axis) and turned by each of
 // `camera_rotations_deg` about x, y and z (signs alternating).
@@ -188,7 +188,7 @@ std::vector<CampaignRun> fault_runs(const CampaignArm& arm, const FaultMagnitude
 // stream stalled and the joint stream stalled, `runs_each` runs each.
 std::vector<CampaignRun> stream_fault_runs(int runs_each);
 
-// Issue 15's objects on `arm`: a 10 cm cube held still beside the arm at
+// The detection matrix's objects on `arm`: a 10 cm cube held still beside the arm at
 // each of `distances_m`; a hand-sized box (10 x 10 x 20 cm) approaching
 // at K = risk.field.approach_speed_m_s from beyond the warning field; and
 // a person (0.4 x 0.3 x 1.7 m) and a cart (0.6 x 0.4 x 0.8 m) walking past
@@ -201,11 +201,11 @@ std::vector<CampaignRun> object_runs(const CampaignArm& arm, const std::vector<d
 std::vector<CampaignRun> nominal_runs(double seconds, double run_s, double rate_hz, uint64_t seed);
 
 // People and carts walking past beyond the warning field of the arm at
-// rest, one after another, for `seconds` in all (issue 15's false-stop
+// rest, one after another, for `seconds` in all (the false-stop
 // target: they may warn, never stop).
 std::vector<CampaignRun> passer_runs(const CampaignArm& arm, double seconds, uint64_t seed);
 
-// A markdown table of the object runs of `results` per kind (issue 15):
+// A markdown table of the object runs of `results` per kind:
 // runs, the object's pixels and distances, detection, latency, the
 // distance at the stop and S, warnings and false stops; and a line per run
 // that missed a target (an object in the field not stopped, or stopped

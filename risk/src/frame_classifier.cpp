@@ -16,7 +16,7 @@ std::string fixed(double value, int decimals) {
   // what an ostream with std::fixed and std::setprecision writes, without
   // a stream and its locale per number (a verdict formats about ten: they
   // were 40 % of RiskMonitor::on_frame's time; docs/benchmarks.md,
-  // fourteenth session). A number too long for the buffer goes the stream's
+  // "tofguard-risk's time per verdict"). A number too long for the buffer goes the stream's
   // way.
   char text[64];
   const std::to_chars_result r =

@@ -72,7 +72,7 @@ TEST(WireChecks, Discrepancy) {
   EXPECT_EQ(field_of(d), "near_arm_area_m2 / largest_blob_area_m2");
 }
 
-// With the evidence fields filled (issue 14).
+// With the evidence fields filled.
 discrepancy_t discrepancy_with_evidence() {
   discrepancy_t d = valid_discrepancy();
   d.evidence_available = true;

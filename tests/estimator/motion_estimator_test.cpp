@@ -69,7 +69,7 @@ std::vector<EstimatorFrame> frames_with_offset(tofguard::test::SimulatedFrames* 
 // Encoder offsets of 5, 10 and 20 degrees on each joint in turn (the
 // joint reports more than it is at), arm in the side-reach pose where every
 // link is seen, each estimate made of 3 frames like tofguard-estimator's.
-// Issue 7: the suspect is right in >= 95 % of the cases and the estimated
+// Target (docs/estimator.md): the suspect is right in >= 95 % of the cases and the estimated
 // offset within 1.5 degrees or 25 %. Measured (2026-11-22, 3 frames):
 // suspect right 21/21, offset accurate 21/21 (largest error 1.0 degree,
 // a5); see docs/estimator.md for single frames. The suspect is the joint
@@ -106,8 +106,8 @@ TEST_F(MotionEstimatorTest, EncoderOffsets) {
   }
   std::cout << "suspect right " << right << ", offset accurate " << accurate << " of " << cases
             << ", largest offset error " << largest_error_deg << " deg\n";
-  EXPECT_GE(right, 20);     // issue 7: >= 95 %
-  EXPECT_GE(accurate, 20);  // issue 7: >= 95 %
+  EXPECT_GE(right, 20);     // target: >= 95 %
+  EXPECT_GE(accurate, 20);  // target: >= 95 %
 }
 
 // One frame alone (the library's estimate(frame)): the same cases, for the
@@ -140,7 +140,7 @@ TEST_F(MotionEstimatorTest, EncoderOffsetsFromOneFrame) {
 }
 
 // The reported camera pose is off by 5 cm or 3 degrees; the joints are
-// right. Issue 7: the correction within 1 cm and 0.5 degrees, no joint
+// right. Target: the correction within 1 cm and 0.5 degrees, no joint
 // offset significant. Measured (2026-11-22): 2.0..5.5 mm and 0.03..0.29
 // degrees.
 TEST_F(MotionEstimatorTest, CameraPoseErrors) {
@@ -187,7 +187,7 @@ TEST_F(MotionEstimatorTest, CameraPoseErrors) {
                 << to_deg(r.correction_rotation_sigma_rad) << " deg\n";
       EXPECT_LT(error_mm, 10.0) << c.name;
       EXPECT_LT(error_deg, 0.5) << c.name;
-      // Issue 7: classified as calibration (tofguard-risk's rules), no
+      // Target: classified as calibration (tofguard-risk's rules), no
       // joint offset significant (classify_estimate would add "joint ...
       // also off by").
       const risk::FrameFinding finding = risk_finding(r, *config_);
@@ -199,7 +199,7 @@ TEST_F(MotionEstimatorTest, CameraPoseErrors) {
 
 // A box beside the arm (the simulated camera's intruding object) must not
 // pull the estimate: every joint's estimate moves by less than 1 degree
-// (issue 7). Measured (2026-11-22): at most 0.84 degrees (a6, box beside
+// (the target). Measured (2026-11-22): at most 0.84 degrees (a6, box beside
 // link4).
 TEST_F(MotionEstimatorTest, ObjectBesideTheArm) {
   MotionEstimator estimator(frames_->scene(), &frames_->renderer(), options());
@@ -236,7 +236,7 @@ TEST_F(MotionEstimatorTest, ObjectBesideTheArm) {
     }
     std::cout << " camera moved " << (a.correction.inverse() * b.correction).translation().norm() * 1000
               << " mm\n";
-    // Issue 7: the cause is UNKNOWN_OBJECT. The estimate names no joint and
+    // Target: the cause is UNKNOWN_OBJECT. The estimate names no joint and
     // no camera error; with the discrepancy's evidence of nearer surfaces
     // near the arm (what the object frame's discrepancy_t carries),
     // tofguard-risk's estimate rule calls it an unknown object.

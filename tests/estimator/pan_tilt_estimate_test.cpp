@@ -1,7 +1,7 @@
-// Issue 7, pan-tilt: a camera on a pan-tilt head whose reading (what
+// Pan-tilt: a camera on a pan-tilt head whose reading (what
 // CAMERA_POSE reports) disagrees with where it really looks is flagged by
 // the estimator's camera correction, and the risk classifier calls it a
-// calibration error (issue 7, item 4). The simulated camera's own pan-tilt model
+// calibration error. The simulated camera's own pan-tilt model
 // (sim's SimulatedCamera: true and reported pose at a time) with
 // a pan_tilt_offset fault; frames from the simulated ToF camera (noise,
 // mixed and invalid pixels, calibration).

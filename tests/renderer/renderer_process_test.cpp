@@ -129,7 +129,7 @@ TEST(RendererProcess, RendersFramesAtInterpolatedJointsAndMarksUnusableOnes) {
   ASSERT_EQ(bench.labels.count(out.seq), 1u);
   const link_labels_t& labels = bench.labels.at(out.seq);
   EXPECT_TRUE(labels.usable) << labels.unusable_reason;
-  EXPECT_GT(labels.num_axes, 0) << "the kinematics as rendered (issue 14)";
+  EXPECT_GT(labels.num_axes, 0) << "the kinematics as rendered";
   EXPECT_EQ(out.camera_id, bench.config.camera.id);
   EXPECT_EQ(out.width, 176);
   EXPECT_EQ(out.height, 144);

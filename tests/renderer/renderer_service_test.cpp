@@ -63,7 +63,7 @@ TEST(RendererService, PublishesTheModelAtTheInterpolatedJointsInMillimetres) {
   const RenderedFrame out = service.render(frame(1'002'500, 42, k));
   ASSERT_TRUE(out.labels.usable) << out.labels.unusable_reason;
   ASSERT_TRUE(out.depth.has_value());
-  // The kinematics as rendered travel with the labels (issue 14).
+  // The kinematics as rendered travel with the labels.
   EXPECT_GT(out.labels.num_axes, 0);
   EXPECT_EQ(out.labels.num_link_axes, out.labels.num_robot_links);
   EXPECT_EQ(check_link_labels(out.labels), "");

@@ -70,7 +70,7 @@ const deployment::Config& sim_config() {
 }
 
 // The deadline tests below count on one deadline for the camera and the
-// joint states (sim.yaml's depth deadline is 150 ms since issue 6).
+// joint states (sim.yaml's depth deadline is 150 ms).
 const deployment::Config& config_depth_100ms() {
   static const deployment::Config config = [] {
     deployment::Config c = sim_config();

@@ -1,9 +1,9 @@
 // The judgement (renderer -> discrepancy -> risk, in-process with the real
 // EGL renderer, the simulated ToF camera's error model and the config's
 // settings) on the default arm, the iiwa14 and the Kinova Gen3 (../shared,
-// skipped when absent): issue 14's targets on a short campaign (every joint
+// skipped when absent): the judgement's targets on a short campaign (every joint
 // 5 degrees off, the camera moved 2 cm along its optical axis and sideways
-// and turned 1 degree), and issue 15's objects (a cube inside the protective
+// and turned 1 degree), and the detection matrix's objects (a cube inside the protective
 // field, a person and a cart beyond the warning field), the iiwa14 also at
 // 25 Hz from a second camera placement, and frozen and stalled streams.
 // tofguard-judge-campaign runs the long ones (docs/safety-chain.md,
@@ -41,7 +41,7 @@ std::vector<CampaignRun> short_runs(const CampaignArm& arm) {
   return runs;
 }
 
-// Issue 15's objects: a 10 cm cube 10 and 40 cm from the arm (inside the
+// The detection matrix's objects: a 10 cm cube 10 and 40 cm from the arm (inside the
 // protective field: stopped within the debounce), a person and a cart
 // walking past beyond the warning field (never a stop).
 void expect_object_targets(const CampaignArm& arm) {
@@ -200,7 +200,7 @@ TEST(JudgeCampaign, Iiwa14) {
   expect_targets(*arm);
 }
 
-// Another camera rate and placement (issue 15: nothing tuned to one
+// Another camera rate and placement (nothing tuned to one
 // camera): the iiwa14 at 25 Hz, its camera turned 40 degrees about the
 // vertical through the robot's root.
 TEST(JudgeCampaign, Iiwa14At25HzFromASecondPlacement) {

@@ -1,4 +1,4 @@
-// The target of tofguard-tune (issue 15): on a nominal recording of a
+// The target of tofguard-tune: on a nominal recording of a
 // camera it has not seen, it gives thresholds that meet the false-stop
 // target on a second recording of that camera.
 //

@@ -1,5 +1,5 @@
 #pragma once
-// Distance calibration (issue 4, after the seed paper): a ToF camera's
+// Distance calibration (after the seed paper): a ToF camera's
 // distance has a systematic error that depends on the distance itself (the
 // "wiggling" error of the modulation). The camera measures the time of
 // flight along each pixel's ray, so the error is a function of the radial

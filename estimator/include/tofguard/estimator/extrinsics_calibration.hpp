@@ -1,5 +1,5 @@
 #pragma once
-// tofguard-calibrate-extrinsics (issue 7 item 5): the camera's pose from an
+// tofguard-calibrate-extrinsics: the camera's pose from an
 // LCM log of the arm moving with known joint angles. The motion estimator
 // with the joints fixed (they are exact) and the camera free, jointly over
 // several frames of diverse arm poses.

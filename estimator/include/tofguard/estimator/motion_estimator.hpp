@@ -1,5 +1,5 @@
 #pragma once
-// The motion estimator (issue 7): which joint angles and which camera pose
+// The motion estimator: which joint angles and which camera pose
 // best explain a camera's depth image? Articulated render-and-compare ICP
 // (docs/estimator.md):
 //   1. camera: Gauss-Newton on the camera correction alone, with the points

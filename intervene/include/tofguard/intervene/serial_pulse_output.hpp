@@ -1,5 +1,5 @@
 #pragma once
-// A dynamic (pulsed) power output (issue 16): a square wave on a USB serial
+// A dynamic (pulsed) power output: a square wave on a USB serial
 // adapter's line for a retriggerable hardware watchdog or a safety relay
 // with a dynamic input, which keeps the arm's power on only while the pulses
 // come. Unlike a relay held on (usb_hid_relay), it survives tofguard-

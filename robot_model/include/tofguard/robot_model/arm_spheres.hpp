@@ -1,6 +1,6 @@
 #pragma once
 // The robot's geometry as a cover of spheres, for the 3-D distance from a
-// seen surface to the arm (the protective and warning fields, issue 15):
+// seen surface to the arm (the protective and warning fields):
 // cheap to query for every unexplained pixel of every frame, and
 // conservative.
 //

@@ -91,7 +91,7 @@ struct DiscrepancySettings {
 // `worker_threads: auto`'s limit: compute_discrepancy's evidence sums run in
 // 8 fixed bands of rows and its naming search in a task per joint (6-7 for
 // the arms here), so a ninth thread would find no task. On a 16-core
-// machine 8 met issue 17's targets where 2 did not (docs/benchmarks.md, "On
+// machine 8 met the latency targets where 2 did not (docs/benchmarks.md, "On
 // an NVIDIA H200 machine").
 inline constexpr int kMaxAutoWorkerThreads = 8;
 
