@@ -17,7 +17,7 @@
 #include "tofguard/discrepancy/discrepancy_image.hpp"
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/renderer/renderer_process.hpp"
-#include "tofguard/risk/evidence_tests.hpp"
+#include "tofguard/risk/sequential_evidence.hpp"
 #include "tofguard/robot_model/kinematic_tree.hpp"
 
 namespace tofguard::tune {
