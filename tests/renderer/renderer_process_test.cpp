@@ -16,7 +16,7 @@
 #include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/heartbeat_t.hpp"
 #include "tofguard/renderer/depth_renderer.hpp"
-#include "tofguard/renderer/renderer_process.hpp"
+#include "tofguard/renderer/renderer_service.hpp"
 
 namespace tofguard::renderer {
 namespace {

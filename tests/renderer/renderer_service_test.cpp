@@ -7,7 +7,8 @@
 #include "test_support.hpp"
 #include "tofguard/common/wire_checks.hpp"
 #include "tofguard/deployment/process_settings.hpp"
-#include "tofguard/renderer/renderer_process.hpp"
+#include "tofguard/renderer/prediction_schedule.hpp"
+#include "tofguard/renderer/renderer_service.hpp"
 
 namespace tofguard::renderer {
 namespace {

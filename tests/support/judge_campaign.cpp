@@ -22,7 +22,7 @@
 #include "tofguard/common/risk_names.hpp"
 #include "tofguard/discrepancy/discrepancy_image.hpp"
 #include "tofguard/renderer/rendered_kinematics.hpp"
-#include "tofguard/renderer/renderer_process.hpp"
+#include "tofguard/renderer/renderer_service.hpp"
 #include "tofguard/risk/protective_field.hpp"
 #include "tofguard/risk/risk_monitor.hpp"
 #include "tofguard/risk_t.hpp"

@@ -16,7 +16,7 @@
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/discrepancy/discrepancy_image.hpp"
 #include "tofguard/joint_state_t.hpp"
-#include "tofguard/renderer/renderer_process.hpp"
+#include "tofguard/renderer/renderer_service.hpp"
 #include "tofguard/risk/sequential_evidence.hpp"
 #include "tofguard/robot_model/kinematic_tree.hpp"
 
