@@ -17,8 +17,8 @@
 #include "synthetic_frames.hpp"
 #include "test_support.hpp"
 #include "tofguard/deployment/config.hpp"
-#include "tofguard/risk/sequential_evidence.hpp"
 #include "tofguard/risk/risk_monitor.hpp"
+#include "tofguard/risk/sequential_evidence.hpp"
 #include "tofguard/robot_model/kinematic_tree.hpp"
 
 namespace tofguard::test {
