@@ -47,8 +47,11 @@ robot_model::SceneModel load_estimator_scene(const EstimatorProcessSettings& set
   return robot_model::load_scene(settings.robot.urdf_path, settings.environment.urdf_paths, options);
 }
 
-int run_estimator(const EstimatorProcessSettings& settings) {
-  const std::string name = process_info().name;
+namespace {
+
+// Keeps the estimator out of the stop path's way: no llvmpipe render
+// threads, and a lower priority.
+void stay_out_of_the_stop_path(const std::string& name) {
   // The estimator renders 176x144-sized images a dozen times per frame on
   // its worker thread: llvmpipe's own render threads cost more in hand-over
   // than they save at that size (docs/benchmarks.md, motion estimator: 36 ms
@@ -63,6 +66,114 @@ int run_estimator(const EstimatorProcessSettings& settings) {
   if (nice(10) == -1 && errno != 0) {
     std::cerr << name << ": cannot lower its priority (nice 10): " << std::strerror(errno) << "\n";
   }
+}
+
+// The LCM side: the inputs into the scheduler, its work to the worker (or
+// out as unusable), the worker's estimates out, and the heartbeat.
+class EstimatorWiring {
+ public:
+  EstimatorWiring(const EstimatorProcessSettings& settings, const std::string& name,
+                  EstimatorScheduler* scheduler, EstimatorWorker* worker)
+      : settings_(settings),
+        node_(settings.lcm, settings.channels, name),
+        scheduler_(*scheduler),
+        worker_(*worker) {
+    node_.heartbeat().set_status("waiting for frames");
+  }
+
+  void run() {
+    subscribe_inputs();
+    node_.add_timer(settings_.estimator.periodic_period_us, [this] {
+      scheduler_.request_newest();
+      dispatch();
+    });
+    node_.add_timer(5000, [this] { publish_results(); });
+    node_.run();
+  }
+
+ private:
+  void dispatch() {
+    for (ScheduledWork& work : scheduler_.take_ready()) {
+      if (work.unusable) {
+        node_.safety().publish(settings_.channels.motion_estimate, &*work.unusable);
+        node_.counters().frames_out++;
+        ++unusable_;
+        node_.errors().report("unusable", "frame " + std::to_string(work.unusable->seq) +
+                                              " not estimated: " + work.unusable->unusable_reason);
+      } else if (work.job && worker_.post(std::move(*work.job))) {
+        // Behind: the waiting job was replaced by this newer one.
+        node_.counters().frames_dropped++;
+      }
+    }
+  }
+
+  void subscribe_inputs() {
+    const ChannelNames& channels = settings_.channels;
+    node_.subscribe<joint_state_t>(
+        node_.safety(), channels.joint_state,
+        [this](const joint_state_t& state) {
+          if (!scheduler_.on_joint_state(state)) {
+            node_.counters().validation_errors++;
+            node_.errors().report(settings_.channels.joint_state,
+                                  settings_.channels.joint_state + ": ignored a message for robot_id '" +
+                                      state.robot_id + "' (expected '" + settings_.robot.id +
+                                      "') or not newer than the last");
+          }
+        },
+        check_joint_state);
+    node_.subscribe<camera_pose_t>(
+        node_.safety(), channels.camera_pose,
+        [this](const camera_pose_t& pose) { scheduler_.on_camera_pose(pose); }, check_camera_pose);
+    node_.subscribe<depth_image_t>(
+        node_.images(), channels.depth,
+        [this](const depth_image_t& frame) {
+          if (scheduler_.on_depth(frame)) {
+            node_.heartbeat().set_last_frame_utime(frame.utime);
+            dispatch();
+          }
+        },
+        check_depth_image);
+    node_.subscribe<discrepancy_t>(
+        node_.safety(), channels.discrepancy,
+        [this](const discrepancy_t& d) {
+          scheduler_.on_discrepancy(d);
+          dispatch();
+        },
+        check_discrepancy);
+    node_.subscribe<risk_t>(
+        node_.safety(), channels.risk,
+        [this](const risk_t& r) {
+          scheduler_.on_risk(r);
+          dispatch();
+        },
+        check_risk);
+  }
+
+  void publish_results() {
+    for (const motion_estimate_t& m : worker_.take_results()) {
+      node_.safety().publish(settings_.channels.motion_estimate, &m);
+      node_.counters().frames_out++;
+      ++published_;
+      if (!m.usable) ++unusable_;
+    }
+    node_.heartbeat().set_status(
+        "estimates " + std::to_string(published_) + ", unusable " + std::to_string(unusable_) + ", missed " +
+        std::to_string(scheduler_.missed()) + (worker_.busy() ? ", estimating" : ", idle"));
+  }
+
+  const EstimatorProcessSettings& settings_;
+  LcmNode node_;
+  EstimatorScheduler& scheduler_;
+  EstimatorWorker& worker_;
+  int64_t published_ = 0;
+  int64_t unusable_ = 0;
+};
+
+}  // namespace
+
+int run_estimator(const EstimatorProcessSettings& settings) {
+  const std::string name = process_info().name;
+  stay_out_of_the_stop_path(name);
   robot_model::SceneModel scene;
   try {
     scene = load_estimator_scene(settings);
@@ -77,80 +188,7 @@ int run_estimator(const EstimatorProcessSettings& settings) {
     return 1;
   }
   EstimatorScheduler scheduler(settings, scene);
-  LcmNode node(settings.lcm, settings.channels, name);
-  node.heartbeat().set_status("waiting for frames");
-  int64_t published = 0;
-  int64_t unusable = 0;
-
-  auto dispatch = [&] {
-    for (ScheduledWork& work : scheduler.take_ready()) {
-      if (work.unusable) {
-        node.safety().publish(settings.channels.motion_estimate, &*work.unusable);
-        node.counters().frames_out++;
-        ++unusable;
-        node.errors().report("unusable", "frame " + std::to_string(work.unusable->seq) +
-                                             " not estimated: " + work.unusable->unusable_reason);
-      } else if (work.job && worker.post(std::move(*work.job))) {
-        // Behind: the waiting job was replaced by this newer one.
-        node.counters().frames_dropped++;
-      }
-    }
-  };
-
-  node.subscribe<joint_state_t>(
-      node.safety(), settings.channels.joint_state,
-      [&](const joint_state_t& state) {
-        if (!scheduler.on_joint_state(state)) {
-          node.counters().validation_errors++;
-          node.errors().report(settings.channels.joint_state,
-                               settings.channels.joint_state + ": ignored a message for robot_id '" +
-                                   state.robot_id + "' (expected '" + settings.robot.id +
-                                   "') or not newer than the last");
-        }
-      },
-      check_joint_state);
-  node.subscribe<camera_pose_t>(
-      node.safety(), settings.channels.camera_pose,
-      [&](const camera_pose_t& pose) { scheduler.on_camera_pose(pose); }, check_camera_pose);
-  node.subscribe<depth_image_t>(
-      node.images(), settings.channels.depth,
-      [&](const depth_image_t& frame) {
-        if (scheduler.on_depth(frame)) {
-          node.heartbeat().set_last_frame_utime(frame.utime);
-          dispatch();
-        }
-      },
-      check_depth_image);
-  node.subscribe<discrepancy_t>(
-      node.safety(), settings.channels.discrepancy,
-      [&](const discrepancy_t& d) {
-        scheduler.on_discrepancy(d);
-        dispatch();
-      },
-      check_discrepancy);
-  node.subscribe<risk_t>(
-      node.safety(), settings.channels.risk,
-      [&](const risk_t& r) {
-        scheduler.on_risk(r);
-        dispatch();
-      },
-      check_risk);
-  node.add_timer(settings.estimator.periodic_period_us, [&] {
-    scheduler.request_newest();
-    dispatch();
-  });
-  node.add_timer(5000, [&] {
-    for (const motion_estimate_t& m : worker.take_results()) {
-      node.safety().publish(settings.channels.motion_estimate, &m);
-      node.counters().frames_out++;
-      ++published;
-      if (!m.usable) ++unusable;
-    }
-    node.heartbeat().set_status("estimates " + std::to_string(published) + ", unusable " +
-                                std::to_string(unusable) + ", missed " + std::to_string(scheduler.missed()) +
-                                (worker.busy() ? ", estimating" : ", idle"));
-  });
-  node.run();
+  EstimatorWiring(settings, name, &scheduler, &worker).run();
   return 0;
 }
 
