@@ -35,7 +35,7 @@
 #include "tofguard/discrepancy/joint_search.hpp"
 #include "tofguard/renderer/depth_renderer.hpp"
 #include "tofguard/renderer/rendered_kinematics.hpp"
-#include "tofguard/renderer/renderer_process.hpp"
+#include "tofguard/renderer/renderer_service.hpp"
 #include "tofguard/robot_model/arm_spheres.hpp"
 
 namespace {

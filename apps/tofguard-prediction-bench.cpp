@@ -13,7 +13,7 @@
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/deployment/process_settings.hpp"
-#include "tofguard/renderer/renderer_process.hpp"
+#include "tofguard/renderer/renderer_service.hpp"
 
 namespace tofguard::renderer {
 namespace {

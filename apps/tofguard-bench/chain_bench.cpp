@@ -42,7 +42,7 @@
 #include "tofguard/planned_trajectory_t.hpp"
 #include "tofguard/renderer/depth_renderer.hpp"
 #include "tofguard/renderer/rendered_kinematics.hpp"
-#include "tofguard/renderer/renderer_process.hpp"
+#include "tofguard/renderer/renderer_service.hpp"
 #include "tofguard/risk_t.hpp"
 #include "tofguard/robot_model/arm_spheres.hpp"
 #include "tofguard/robot_model/scene_model.hpp"

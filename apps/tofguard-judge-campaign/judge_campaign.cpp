@@ -22,7 +22,7 @@
 #include "tofguard/common/risk_names.hpp"
 #include "tofguard/discrepancy/discrepancy_image.hpp"
 #include "tofguard/renderer/rendered_kinematics.hpp"
-#include "tofguard/renderer/renderer_process.hpp"
+#include "tofguard/renderer/renderer_service.hpp"
 #include "tofguard/risk/protective_field.hpp"
 #include "tofguard/risk/risk_monitor.hpp"
 #include "tofguard/risk_t.hpp"
@@ -487,242 +487,320 @@ ObjectPath place_object(const CampaignFault& fault, const robot_model::PlacedArm
   return path;
 }
 
+// What every run of an arm's campaign shares: the true scene, the model as
+// tofguard-renderer loads it (the config's geometry, padding and mesh
+// simplification), and the tree tofguard-risk loads.
+struct CampaignWorld {
+  explicit CampaignWorld(const CampaignArm& arm)
+      : config(arm.config),
+        truth(config),
+        model_scene(robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths,
+                                            renderer::scene_options(config.renderer, config.robot))),
+        model(model_scene, config.renderer.near_m, config.renderer.far_m),
+        arm_cover(robot_model::cover_arm_with_spheres(model_scene, config.renderer.arm_cover_cell_m)),
+        truth_cover(robot_model::cover_arm_with_spheres(model_scene, 0.01)),
+        robot_tree(robot_model::load_kinematic_tree(config.robot.urdf_path)),
+        parameters(discrepancy::parameters_from(config.discrepancy)),
+        intrinsics(config.camera.intrinsics),
+        period_s(1.0 / config.camera.rate_hz),
+        period_us(static_cast<int64_t>(std::llround(period_s * 1e6))),
+        reported_pose(config.camera.pose.frame_from_optical()) {}
+
+  const deployment::Config& config;
+  SimulatedFrames truth;
+  const robot_model::SceneModel model_scene;
+  renderer::DepthRenderer model;
+  const robot_model::ArmSpheres arm_cover;
+  // The objects' true distances: a finer cover (1 cm cells, within 3 cm
+  // of the surface) than the renderer's.
+  const robot_model::ArmSpheres truth_cover;
+  const robot_model::KinematicTree robot_tree;
+  const discrepancy::Parameters parameters;
+  const Intrinsics intrinsics;
+  const double period_s;
+  const int64_t period_us;
+  const Eigen::Isometry3d reported_pose;
+};
+
+// One run of the campaign: its frames through the discrepancy and the risk
+// monitor, and what they decided.
+class CampaignRunJudge {
+ public:
+  CampaignRunJudge(CampaignWorld* world, const CampaignRun& run)
+      : w_(*world),
+        config_(world->config),
+        run_(run),
+        monitor_(config_.risk, config_.channels, w_.robot_tree, config_.camera.rate_hz, 0),
+        kind_(run.fault.kind),
+        stall_(kind_ == Kind::kCameraStall || kind_ == Kind::kJointStall),
+        object_fault_(kind_ == Kind::kObject) {
+    result_.label = run.fault.label;
+    result_.group = run.fault.group;
+    result_.magnitude = run.fault.magnitude;
+  }
+
+  CampaignResult judge() {
+    const int num_frames = run_.onset_frame + run_.frames_after_onset;
+    for (int k = 0; k < num_frames; ++k) judge_frame(k);
+    grade();
+    return result_;
+  }
+
+ private:
+  using Kind = CampaignFault::Kind;
+
+  void judge_frame(int k) {
+    const double t_s = run_.start_s + k * w_.period_s;
+    const int64_t now_us = (k + 1) * w_.period_us;
+    const bool faulty = kind_ != Kind::kNone && k >= run_.onset_frame;
+    robot_model::JointPositions true_joints;
+    const joint_state_t state = reported_state(k, t_s, faulty, &true_joints);
+    const Eigen::Isometry3d true_pose =
+        faulty && kind_ == Kind::kCameraPose ? w_.reported_pose * run_.fault.camera_error : w_.reported_pose;
+    objects_.clear();
+    if (faulty && object_fault_) move_object(k, true_joints, true_pose);
+    if (stall_ && faulty && !result_.stopped) check_deadlines(k, now_us);
+    if (kind_ == Kind::kCameraStall && faulty) {
+      monitor_.on_joint_state(state, now_us);  // the joints go on
+      return;
+    }
+    const depth_image_t camera = capture(k, faulty, state, true_joints, true_pose);
+    discrepancy::DiscrepancyFrame frame = discrepancy_of(k, camera, state, true_joints, true_pose);
+    if (k < run_.onset_frame || kind_ == Kind::kNone) add_nominal_scores(frame.summary);
+    monitor_.on_depth(now_us);
+    if (!(kind_ == Kind::kJointStall && faulty)) monitor_.on_joint_state(state, now_us);
+    for (const risk_t& verdict : monitor_.on_frame(frame.summary, now_us)) judge_verdict(verdict);
+  }
+
+  // The joint state frame k reports (a joint offset fault's joint off by
+  // its offset), and the true joints into *true_joints.
+  joint_state_t reported_state(int k, double t_s, bool faulty,
+                               robot_model::JointPositions* true_joints) const {
+    joint_state_t state{};
+    state.utime = 1'700'000'000'000'000 + k * w_.period_us;
+    state.robot_id = config_.robot.id;
+    for (const sim::JointMotion& m : config_.joints_sim.motion) {
+      const double q = joint_position(m, t_s);
+      (*true_joints)[m.joint] = q;
+      state.name.push_back(m.joint);
+      state.position.push_back(q + (faulty && kind_ == Kind::kJointOffset && m.joint == run_.fault.joint
+                                        ? run_.fault.offset
+                                        : 0.0));
+      state.velocity.push_back(joint_velocity(m, t_s));
+    }
+    state.num_joints = static_cast<int32_t>(state.name.size());
+    return state;
+  }
+
+  // A kObject fault's box in frame k (placed at the onset): its distance
+  // to the arm and how the camera sees it.
+  void move_object(int k, const robot_model::JointPositions& true_joints,
+                   const Eigen::Isometry3d& true_pose) {
+    const robot_model::PlacedArmSpheres placed = robot_model::place_arm_spheres(
+        w_.truth_cover, robot_model::forward_kinematics(w_.model_scene, true_joints));
+    if (k == run_.onset_frame) {
+      object_path_ =
+          place_object(run_.fault, placed, true_pose, &w_.model,
+                       robot_model::forward_kinematics(w_.model_scene, true_joints), w_.intrinsics);
+    }
+    renderer::ExtraObject box;
+    box.kind = renderer::ExtraObject::Kind::kBox;
+    box.size_m = run_.fault.object_size_m;
+    box.world_from_object.translation() =
+        object_path_.start + object_path_.velocity * ((k - run_.onset_frame) * w_.period_s);
+    objects_.push_back(box);
+    object_distance_m_ = box_to_arm_m(box.world_from_object.translation(), box.size_m / 2, placed);
+    // The camera's view of it, without noise.
+    const renderer::RenderResult seen = w_.model.render_at(
+        robot_model::forward_kinematics(w_.model_scene, true_joints), true_pose, w_.intrinsics, objects_);
+    int pixels = 0;
+    for (int16_t label : seen.labels) pixels += label == kLabelExtraObjectFirst ? 1 : 0;
+    if (k == run_.onset_frame) {
+      result_.object_distance_at_onset_m = object_distance_m_;
+      result_.object_min_distance_m = object_distance_m_;
+      result_.object_pixels = pixels;
+    }
+    // First seen: as large as the smallest object counted, at 2 m.
+    if (result_.object_first_seen_m < 0 && pixels >= kObjectSeenPixels) {
+      result_.object_first_seen_m = object_distance_m_;
+    }
+    result_.object_min_distance_m = std::min(result_.object_min_distance_m, object_distance_m_);
+  }
+
+  // A stalled stream: its messages stop at the onset; the monitor's
+  // deadlines, checked every millisecond, must stop the arm. The
+  // latency runs from when the first missing message was due.
+  void check_deadlines(int k, int64_t now_us) {
+    const int64_t due_us = (run_.onset_frame + 1) * w_.period_us;
+    for (int64_t t_us = now_us - w_.period_us + 1000; t_us <= now_us; t_us += 1000) {
+      const std::optional<risk_t> timeout = monitor_.check_deadlines(t_us);
+      if (!timeout) continue;
+      record_stop(*timeout, k - run_.onset_frame + 1, 1e-6 * static_cast<double>(t_us - due_us), 0);
+      break;
+    }
+  }
+
+  // The camera's frame k (a frozen camera repeats its last image).
+  depth_image_t capture(int k, bool faulty, const joint_state_t& state,
+                        const robot_model::JointPositions& true_joints, const Eigen::Isometry3d& true_pose) {
+    std::vector<float> depth_m =
+        kind_ == Kind::kFrozenImage && faulty && !last_depth_m_.empty()
+            ? last_depth_m_
+            : w_.truth.capture(true_joints, true_pose, w_.intrinsics,
+                               run_.noise_seed * 100000 + static_cast<uint64_t>(k), objects_);
+    if (kind_ == Kind::kFrozenImage) last_depth_m_ = depth_m;
+    return make_depth_image(config_.camera.id, w_.intrinsics, state.utime, k, /*calibrated=*/true, depth_m);
+  }
+
+  // The model rendered at the reported joints and pose, and the frame's
+  // discrepancy as tofguard-discrepancy computes it.
+  discrepancy::DiscrepancyFrame discrepancy_of(int k, const depth_image_t& camera, const joint_state_t& state,
+                                               const robot_model::JointPositions& true_joints,
+                                               const Eigen::Isometry3d& true_pose) {
+    robot_model::JointPositions reported_joints;
+    for (int i = 0; i < state.num_joints; ++i) reported_joints[state.name[i]] = state.position[i];
+    const robot_model::LinkPoses poses = robot_model::forward_kinematics(w_.model_scene, reported_joints);
+    if (!poses.usable) throw std::runtime_error(poses.unusable_reason);
+    const renderer::RenderResult rendered_result = w_.model.render_at(poses, w_.reported_pose, w_.intrinsics);
+    if (!rendered_result.usable) throw std::runtime_error(rendered_result.unusable_reason);
+    const depth_image_t rendered = make_depth_image(config_.camera.id, w_.intrinsics, state.utime, k,
+                                                    /*calibrated=*/true, rendered_result.depth_m);
+    // Labels and kinematics as tofguard-renderer publishes them.
+    const link_labels_t labels =
+        renderer::make_rendered_link_labels(camera, rendered_result, w_.model_scene, w_.arm_cover);
+
+    if (k == run_.onset_frame && kind_ != Kind::kNone) {
+      result_.changed_pixels =
+          changed_pixels(w_.model, w_.model_scene, true_joints, true_pose, rendered_result.depth_m,
+                         w_.intrinsics, w_.parameters.tolerance.noise);
+    }
+    discrepancy::DiscrepancyFrame frame =
+        discrepancy::compute_discrepancy(camera, rendered, labels, w_.parameters);
+    // As tofguard-discrepancy counts a camera repeating its image.
+    frame.summary.depth_hash = discrepancy::depth_hash(camera.depth_mm);
+    frame.summary.repeat_count = repeats_.update(frame.summary.depth_hash);
+    return frame;
+  }
+
+  void add_score(double score, double information) {
+    if (!(information > 0)) return;
+    const double t = score / std::sqrt(information);
+    ++result_.nominal_scores;
+    result_.nominal_score_sum_sq += t * t;
+    result_.nominal_scores_beyond_4 += std::abs(t) > 4 ? 1 : 0;
+    result_.nominal_score_max_abs = std::max(result_.nominal_score_max_abs, std::abs(t));
+  }
+
+  // A nominal frame's joint scores (and, on request, camera scores), and
+  // their frame-to-frame differences.
+  void add_nominal_scores(const discrepancy_t& d) {
+    for (int j = 0; j < d.num_joints; ++j) {
+      add_score(d.joint_score[j], d.joint_information[j]);
+      if (!(d.joint_information[j] > 0)) continue;
+      const double t = d.joint_score[j] / std::sqrt(d.joint_information[j]);
+      const auto previous = previous_t_.find(d.joint_name[j]);
+      if (previous != previous_t_.end()) {
+        ++result_.nominal_differences;
+        result_.nominal_difference_sum_sq += (t - previous->second) * (t - previous->second) / 2;
+      }
+      previous_t_[d.joint_name[j]] = t;
+    }
+    if (std::getenv("TOFGUARD_CAMPAIGN_CAMERA_SCORES") != nullptr)
+      for (int a = 0; a < 6 && d.evidence_available; ++a)
+        add_score(d.camera_score[a], d.camera_information[7 * a]);
+  }
+
+  void judge_verdict(const risk_t& verdict) {
+    ++result_.frames_judged;
+    // An object outside the protective field must never stop the arm:
+    // its stops count as false stops, unless the arm's speed had grown
+    // the field over it then (an UNKNOWN_OBJECT stop whose S reaches the
+    // object's true distance, within the 3 cm the true distance's cover
+    // may err).
+    const bool inside_s_then =
+        object_fault_ && verdict.seq >= run_.onset_frame && verdict.level == risk_t::DANGEROUS &&
+        verdict.cause == risk_t::CAUSE_UNKNOWN_OBJECT && object_distance_m_ <= verdict.threshold + 0.03;
+    const bool after_onset =
+        verdict.seq >= run_.onset_frame && kind_ != Kind::kNone &&
+        (!object_fault_ || run_.fault.object_in_field || inside_s_then || result_.stopped);
+    if (verdict.seq >= run_.onset_frame && verdict.level == risk_t::WARNING) ++result_.warnings_after_onset;
+    if (verdict.level == risk_t::DANGEROUS && !after_onset && !result_.false_stop) {
+      result_.false_stop = true;
+      result_.false_stop_detail = "seq " + std::to_string(verdict.seq) + ": " + verdict.detail;
+    }
+    if (!after_onset) return;
+    if (!result_.stopped) {
+      if (verdict.level != risk_t::DANGEROUS) return;
+      const int frames = static_cast<int>(verdict.seq) - run_.onset_frame + 1;
+      record_stop(verdict, frames, frames * w_.period_s, object_distance_m_);
+      return;
+    }
+    if (verdict.level == risk_t::SAFE) ++result_.safe_after_stop;
+    if (verdict.suspect != result_.suspect || verdict.cause != result_.cause) ++result_.suspect_changes;
+  }
+
+  // Records the first DANGEROUS verdict at or after the onset.
+  void record_stop(const risk_t& verdict, int frames, double latency_s, double object_distance_m) {
+    result_.stopped = true;
+    result_.stop_frames = frames;
+    result_.stop_latency_s = latency_s;
+    result_.cause = verdict.cause;
+    result_.suspect = verdict.suspect;
+    result_.detail = verdict.detail;
+    result_.stop_score = verdict.score;
+    result_.stop_threshold = verdict.threshold;
+    // Judged in the frame it belongs to: the object's distance then.
+    result_.object_distance_at_stop_m = object_distance_m;
+  }
+
+  // Whether the stop was expected and named the right cause and suspect.
+  void grade() {
+    if (kind_ == Kind::kJointOffset) {
+      result_.right_cause = result_.stopped && result_.cause == risk_t::CAUSE_JOINT_ERROR;
+      result_.right_suspect = result_.right_cause && result_.suspect == run_.fault.joint;
+    } else if (kind_ == Kind::kCameraPose) {
+      result_.right_cause = result_.stopped && result_.cause == risk_t::CAUSE_CALIBRATION_ERROR;
+      result_.right_suspect = result_.right_cause;
+    } else if (object_fault_) {
+      result_.right_cause = result_.stopped && result_.cause == risk_t::CAUSE_UNKNOWN_OBJECT;
+      result_.right_suspect = result_.right_cause;
+      result_.object = true;
+      result_.approaching = run_.fault.object_approaches;
+    } else if (kind_ == Kind::kFrozenImage || stall_) {
+      // A sensor fault naming the stream that froze or stopped (a stalled
+      // camera starves the discrepancy stream too: either is right).
+      result_.right_cause = result_.stopped && result_.cause == risk_t::CAUSE_SENSOR_FAULT;
+      const bool names_stream = kind_ == Kind::kJointStall
+                                    ? result_.suspect == config_.channels.joint_state
+                                    : result_.suspect == config_.channels.depth ||
+                                          (stall_ && result_.suspect == config_.channels.discrepancy);
+      result_.right_suspect = result_.right_cause && names_stream;
+    }
+    result_.expected_stop = kind_ != Kind::kNone && !(object_fault_ && !run_.fault.object_in_field);
+  }
+
+  CampaignWorld& w_;
+  const deployment::Config& config_;
+  const CampaignRun& run_;
+  risk::RiskMonitor monitor_;
+  CampaignResult result_;
+  const Kind kind_;
+  const bool stall_;
+  const bool object_fault_;
+  discrepancy::RepeatCounter repeats_;
+  std::vector<float> last_depth_m_;  // the image a frozen camera repeats
+  std::map<std::string, double> previous_t_;
+  ObjectPath object_path_;
+  std::vector<renderer::ExtraObject> objects_;
+  double object_distance_m_ = 0;
+};
+
 }  // namespace
 
 std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vector<CampaignRun>& runs) {
-  const deployment::Config& config = arm.config;
-  SimulatedFrames truth(config);
-  // The model as tofguard-renderer loads it (the config's geometry,
-  // padding and mesh simplification), and the tree tofguard-risk loads.
-  const robot_model::SceneModel model_scene =
-      robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths,
-                              renderer::scene_options(config.renderer, config.robot));
-  renderer::DepthRenderer model(model_scene, config.renderer.near_m, config.renderer.far_m);
-  const robot_model::ArmSpheres arm_cover =
-      robot_model::cover_arm_with_spheres(model_scene, config.renderer.arm_cover_cell_m);
-  // The objects' true distances: a finer cover (1 cm cells, within 3 cm
-  // of the surface) than the renderer's.
-  const robot_model::ArmSpheres truth_cover = robot_model::cover_arm_with_spheres(model_scene, 0.01);
-  const robot_model::KinematicTree robot_tree = robot_model::load_kinematic_tree(config.robot.urdf_path);
-  const discrepancy::Parameters parameters = discrepancy::parameters_from(config.discrepancy);
-  const Intrinsics intrinsics = config.camera.intrinsics;
-  const double period_s = 1.0 / config.camera.rate_hz;
-  const auto period_us = static_cast<int64_t>(std::llround(period_s * 1e6));
-  const Eigen::Isometry3d reported_pose = config.camera.pose.frame_from_optical();
-
+  CampaignWorld world(arm);
   std::vector<CampaignResult> results;
-  for (const CampaignRun& run : runs) {
-    risk::RiskMonitor monitor(config.risk, config.channels, robot_tree, config.camera.rate_hz, 0);
-    CampaignResult result;
-    result.label = run.fault.label;
-    result.group = run.fault.group;
-    result.magnitude = run.fault.magnitude;
-    using Kind = CampaignFault::Kind;
-    const Kind kind = run.fault.kind;
-    const bool stall = kind == Kind::kCameraStall || kind == Kind::kJointStall;
-    discrepancy::RepeatCounter repeats;
-    std::vector<float> last_depth_m;  // the image a frozen camera repeats
-    // Records the first DANGEROUS verdict at or after the onset.
-    auto record_stop = [&](const risk_t& verdict, int frames, double latency_s, double object_distance_m) {
-      result.stopped = true;
-      result.stop_frames = frames;
-      result.stop_latency_s = latency_s;
-      result.cause = verdict.cause;
-      result.suspect = verdict.suspect;
-      result.detail = verdict.detail;
-      result.stop_score = verdict.score;
-      result.stop_threshold = verdict.threshold;
-      // Judged in the frame it belongs to: the object's distance then.
-      result.object_distance_at_stop_m = object_distance_m;
-    };
-    const int num_frames = run.onset_frame + run.frames_after_onset;
-    std::map<std::string, double> previous_t;
-    const bool object_fault = run.fault.kind == CampaignFault::Kind::kObject;
-    ObjectPath object_path;
-    std::vector<renderer::ExtraObject> objects;
-    double object_distance_m = 0;
-    for (int k = 0; k < num_frames; ++k) {
-      const double t_s = run.start_s + k * period_s;
-      const int64_t now_us = (k + 1) * period_us;
-      const bool faulty = run.fault.kind != CampaignFault::Kind::kNone && k >= run.onset_frame;
-      robot_model::JointPositions true_joints;
-      joint_state_t state{};
-      state.utime = 1'700'000'000'000'000 + k * period_us;
-      state.robot_id = config.robot.id;
-      for (const sim::JointMotion& m : config.joints_sim.motion) {
-        const double q = joint_position(m, t_s);
-        true_joints[m.joint] = q;
-        state.name.push_back(m.joint);
-        state.position.push_back(
-            q + (faulty && run.fault.kind == CampaignFault::Kind::kJointOffset && m.joint == run.fault.joint
-                     ? run.fault.offset
-                     : 0.0));
-        state.velocity.push_back(joint_velocity(m, t_s));
-      }
-      state.num_joints = static_cast<int32_t>(state.name.size());
-      robot_model::JointPositions reported_joints;
-      for (int i = 0; i < state.num_joints; ++i) reported_joints[state.name[i]] = state.position[i];
-      const Eigen::Isometry3d true_pose = faulty && run.fault.kind == CampaignFault::Kind::kCameraPose
-                                              ? reported_pose * run.fault.camera_error
-                                              : reported_pose;
-
-      objects.clear();
-      if (faulty && object_fault) {
-        const robot_model::PlacedArmSpheres placed = robot_model::place_arm_spheres(
-            truth_cover, robot_model::forward_kinematics(model_scene, true_joints));
-        if (k == run.onset_frame) {
-          object_path = place_object(run.fault, placed, true_pose, &model,
-                                     robot_model::forward_kinematics(model_scene, true_joints), intrinsics);
-        }
-        renderer::ExtraObject box;
-        box.kind = renderer::ExtraObject::Kind::kBox;
-        box.size_m = run.fault.object_size_m;
-        box.world_from_object.translation() =
-            object_path.start + object_path.velocity * ((k - run.onset_frame) * period_s);
-        objects.push_back(box);
-        object_distance_m = box_to_arm_m(box.world_from_object.translation(), box.size_m / 2, placed);
-        // The camera's view of it, without noise.
-        const renderer::RenderResult seen = model.render_at(
-            robot_model::forward_kinematics(model_scene, true_joints), true_pose, intrinsics, objects);
-        int pixels = 0;
-        for (int16_t label : seen.labels) pixels += label == kLabelExtraObjectFirst ? 1 : 0;
-        if (k == run.onset_frame) {
-          result.object_distance_at_onset_m = object_distance_m;
-          result.object_min_distance_m = object_distance_m;
-          result.object_pixels = pixels;
-        }
-        // First seen: as large as the smallest object counted, at 2 m.
-        if (result.object_first_seen_m < 0 && pixels >= kObjectSeenPixels) {
-          result.object_first_seen_m = object_distance_m;
-        }
-        result.object_min_distance_m = std::min(result.object_min_distance_m, object_distance_m);
-      }
-      // A stalled stream: its messages stop at the onset; the monitor's
-      // deadlines, checked every millisecond, must stop the arm. The
-      // latency runs from when the first missing message was due.
-      if (stall && faulty && !result.stopped) {
-        const int64_t due_us = (run.onset_frame + 1) * period_us;
-        for (int64_t t_us = now_us - period_us + 1000; t_us <= now_us; t_us += 1000) {
-          const std::optional<risk_t> timeout = monitor.check_deadlines(t_us);
-          if (!timeout) continue;
-          record_stop(*timeout, k - run.onset_frame + 1, 1e-6 * static_cast<double>(t_us - due_us), 0);
-          break;
-        }
-      }
-      if (kind == Kind::kCameraStall && faulty) {
-        monitor.on_joint_state(state, now_us);  // the joints go on
-        continue;
-      }
-      std::vector<float> depth_m =
-          kind == Kind::kFrozenImage && faulty && !last_depth_m.empty()
-              ? last_depth_m
-              : truth.capture(true_joints, true_pose, intrinsics,
-                              run.noise_seed * 100000 + static_cast<uint64_t>(k), objects);
-      if (kind == Kind::kFrozenImage) last_depth_m = depth_m;
-      const depth_image_t camera =
-          make_depth_image(config.camera.id, intrinsics, state.utime, k, /*calibrated=*/true, depth_m);
-
-      const robot_model::LinkPoses poses = robot_model::forward_kinematics(model_scene, reported_joints);
-      if (!poses.usable) throw std::runtime_error(poses.unusable_reason);
-      const renderer::RenderResult rendered_result = model.render_at(poses, reported_pose, intrinsics);
-      if (!rendered_result.usable) throw std::runtime_error(rendered_result.unusable_reason);
-      const depth_image_t rendered = make_depth_image(config.camera.id, intrinsics, state.utime, k,
-                                                      /*calibrated=*/true, rendered_result.depth_m);
-      // Labels and kinematics as tofguard-renderer publishes them.
-      const link_labels_t labels =
-          renderer::make_rendered_link_labels(camera, rendered_result, model_scene, arm_cover);
-
-      if (k == run.onset_frame && run.fault.kind != CampaignFault::Kind::kNone) {
-        result.changed_pixels =
-            changed_pixels(model, model_scene, true_joints, true_pose, rendered_result.depth_m, intrinsics,
-                           parameters.tolerance.noise);
-      }
-      discrepancy::DiscrepancyFrame frame =
-          discrepancy::compute_discrepancy(camera, rendered, labels, parameters);
-      // As tofguard-discrepancy counts a camera repeating its image.
-      frame.summary.depth_hash = discrepancy::depth_hash(camera.depth_mm);
-      frame.summary.repeat_count = repeats.update(frame.summary.depth_hash);
-      if (k < run.onset_frame || run.fault.kind == CampaignFault::Kind::kNone) {
-        const discrepancy_t& d = frame.summary;
-        auto add_score = [&](double score, double information) {
-          if (!(information > 0)) return;
-          const double t = score / std::sqrt(information);
-          ++result.nominal_scores;
-          result.nominal_score_sum_sq += t * t;
-          result.nominal_scores_beyond_4 += std::abs(t) > 4 ? 1 : 0;
-          result.nominal_score_max_abs = std::max(result.nominal_score_max_abs, std::abs(t));
-        };
-        for (int j = 0; j < d.num_joints; ++j) {
-          add_score(d.joint_score[j], d.joint_information[j]);
-          if (!(d.joint_information[j] > 0)) continue;
-          const double t = d.joint_score[j] / std::sqrt(d.joint_information[j]);
-          const auto previous = previous_t.find(d.joint_name[j]);
-          if (previous != previous_t.end()) {
-            ++result.nominal_differences;
-            result.nominal_difference_sum_sq += (t - previous->second) * (t - previous->second) / 2;
-          }
-          previous_t[d.joint_name[j]] = t;
-        }
-        if (std::getenv("TOFGUARD_CAMPAIGN_CAMERA_SCORES") != nullptr)
-          for (int a = 0; a < 6 && d.evidence_available; ++a)
-            add_score(d.camera_score[a], d.camera_information[7 * a]);
-      }
-      monitor.on_depth(now_us);
-      if (!(kind == Kind::kJointStall && faulty)) monitor.on_joint_state(state, now_us);
-      for (const risk_t& verdict : monitor.on_frame(frame.summary, now_us)) {
-        ++result.frames_judged;
-        // An object outside the protective field must never stop the arm:
-        // its stops count as false stops, unless the arm's speed had grown
-        // the field over it then (an UNKNOWN_OBJECT stop whose S reaches the
-        // object's true distance, within the 3 cm the true distance's cover
-        // may err).
-        const bool inside_s_then =
-            object_fault && verdict.seq >= run.onset_frame && verdict.level == risk_t::DANGEROUS &&
-            verdict.cause == risk_t::CAUSE_UNKNOWN_OBJECT && object_distance_m <= verdict.threshold + 0.03;
-        const bool after_onset =
-            verdict.seq >= run.onset_frame && run.fault.kind != CampaignFault::Kind::kNone &&
-            (!object_fault || run.fault.object_in_field || inside_s_then || result.stopped);
-        if (verdict.seq >= run.onset_frame && verdict.level == risk_t::WARNING) ++result.warnings_after_onset;
-        if (verdict.level == risk_t::DANGEROUS && !after_onset && !result.false_stop) {
-          result.false_stop = true;
-          result.false_stop_detail = "seq " + std::to_string(verdict.seq) + ": " + verdict.detail;
-        }
-        if (!after_onset) continue;
-        if (!result.stopped) {
-          if (verdict.level != risk_t::DANGEROUS) continue;
-          const int frames = static_cast<int>(verdict.seq) - run.onset_frame + 1;
-          record_stop(verdict, frames, frames * period_s, object_distance_m);
-          continue;
-        }
-        if (verdict.level == risk_t::SAFE) ++result.safe_after_stop;
-        if (verdict.suspect != result.suspect || verdict.cause != result.cause) ++result.suspect_changes;
-      }
-    }
-    if (run.fault.kind == CampaignFault::Kind::kJointOffset) {
-      result.right_cause = result.stopped && result.cause == risk_t::CAUSE_JOINT_ERROR;
-      result.right_suspect = result.right_cause && result.suspect == run.fault.joint;
-    } else if (run.fault.kind == CampaignFault::Kind::kCameraPose) {
-      result.right_cause = result.stopped && result.cause == risk_t::CAUSE_CALIBRATION_ERROR;
-      result.right_suspect = result.right_cause;
-    } else if (object_fault) {
-      result.right_cause = result.stopped && result.cause == risk_t::CAUSE_UNKNOWN_OBJECT;
-      result.right_suspect = result.right_cause;
-      result.object = true;
-      result.approaching = run.fault.object_approaches;
-    } else if (kind == Kind::kFrozenImage || stall) {
-      // A sensor fault naming the stream that froze or stopped (a stalled
-      // camera starves the discrepancy stream too: either is right).
-      result.right_cause = result.stopped && result.cause == risk_t::CAUSE_SENSOR_FAULT;
-      const bool names_stream = kind == Kind::kJointStall
-                                    ? result.suspect == config.channels.joint_state
-                                    : result.suspect == config.channels.depth ||
-                                          (stall && result.suspect == config.channels.discrepancy);
-      result.right_suspect = result.right_cause && names_stream;
-    }
-    result.expected_stop =
-        run.fault.kind != CampaignFault::Kind::kNone && !(object_fault && !run.fault.object_in_field);
-    results.push_back(result);
-  }
+  for (const CampaignRun& run : runs) results.push_back(CampaignRunJudge(&world, run).judge());
   return results;
 }
 

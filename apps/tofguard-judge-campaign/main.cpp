@@ -1,5 +1,5 @@
-// tofguard-judge-campaign: the detection and false-stop figures
-// (docs/safety-chain.md, "Measured"; docs/detection.md): the judgement run in-process on simulated
+// tofguard-judge-campaign: the detection and false-stop figures (docs/safety-chain.md,
+// "Measured"; docs/detection.md): the judgement run in-process on simulated
 // frames of the default arm, the iiwa14 and the Kinova Gen3 (../shared) with
 // injected joint offsets, camera pose errors, objects, frozen and stalled
 // streams, and nominal frames for false stops.
@@ -35,6 +35,7 @@
 #include <fstream>
 #include <iostream>
 #include <iterator>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -54,12 +55,10 @@ int usage(const std::string& why) {
   return 2;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  using namespace tofguard::test;
+// The command line's choices.
+struct Options {
   std::vector<std::string> arms = {"default", "iiwa14", "kinova"};
-  FaultMagnitudes magnitudes{{3, 5, 10}, {2, 3}, {1}};
+  tofguard::test::FaultMagnitudes magnitudes{{3, 5, 10}, {2, 3}, {1}};
   double nominal_s = 0;
   double passers_s = 0;
   int streams = 0;
@@ -71,118 +70,167 @@ int main(int argc, char** argv) {
   std::string tsv_path;
   std::string plots_dir;
   std::string plots_from;
-  std::string shared = shared_dir();
+  std::string shared = tofguard::test::shared_dir();
+};
+
+// Option `option`'s value into *o; false for an unknown option. Throws
+// for a value that is not a number (list).
+bool set_option(const std::string& option, const std::string& value, Options* o) {
+  using namespace tofguard::test;
+  if (option == "--arms") {
+    o->arms = split_list(value);
+  } else if (option == "--offsets-deg") {
+    o->magnitudes.joint_offsets_deg = number_list(value);
+  } else if (option == "--camera-cm") {
+    o->magnitudes.camera_translations_cm = number_list(value);
+  } else if (option == "--camera-deg") {
+    o->magnitudes.camera_rotations_deg = number_list(value);
+  } else if (option == "--streams") {
+    o->streams = std::stoi(value);
+  } else if (option == "--nominal-s") {
+    o->nominal_s = std::stod(value);
+  } else if (option == "--passers-s") {
+    o->passers_s = std::stod(value);
+  } else if (option == "--objects-cm") {
+    for (double cm : number_list(value)) o->objects_m.push_back(cm / 100);
+  } else if (option == "--beyond-cm") {
+    o->beyond_m = std::stod(value) / 100;
+  } else if (option == "--rates-hz") {
+    o->rates_hz = number_list(value);
+  } else if (option == "--turns-deg") {
+    o->turns_deg = number_list(value);
+  } else if (option == "--shared") {
+    o->shared = value;
+  } else if (option == "--tsv") {
+    o->tsv_path = value;
+  } else if (option == "--plots") {
+    o->plots_dir = value;
+  } else if (option == "--plots-from") {
+    o->plots_from = value;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+// The command line into *o; the exit code (usage) when it is wrong.
+std::optional<int> parse_options(int argc, char** argv, Options* o) {
   for (int i = 1; i < argc; ++i) {
     const std::string option = argv[i];
     if (option == "--no-faults") {
-      faults = false;
+      o->faults = false;
       continue;
     }
     if (i + 1 >= argc) return usage(option + ": expected a value");
     const std::string value = argv[++i];
     try {
-      if (option == "--arms") {
-        arms = split_list(value);
-      } else if (option == "--offsets-deg") {
-        magnitudes.joint_offsets_deg = number_list(value);
-      } else if (option == "--camera-cm") {
-        magnitudes.camera_translations_cm = number_list(value);
-      } else if (option == "--camera-deg") {
-        magnitudes.camera_rotations_deg = number_list(value);
-      } else if (option == "--streams") {
-        streams = std::stoi(value);
-      } else if (option == "--nominal-s") {
-        nominal_s = std::stod(value);
-      } else if (option == "--passers-s") {
-        passers_s = std::stod(value);
-      } else if (option == "--objects-cm") {
-        for (double cm : number_list(value)) objects_m.push_back(cm / 100);
-      } else if (option == "--beyond-cm") {
-        beyond_m = std::stod(value) / 100;
-      } else if (option == "--rates-hz") {
-        rates_hz = number_list(value);
-      } else if (option == "--turns-deg") {
-        turns_deg = number_list(value);
-      } else if (option == "--shared") {
-        shared = value;
-      } else if (option == "--tsv") {
-        tsv_path = value;
-      } else if (option == "--plots") {
-        plots_dir = value;
-      } else if (option == "--plots-from") {
-        plots_from = value;
-      } else {
-        return usage("unknown option " + option);
-      }
+      if (!set_option(option, value, o)) return usage("unknown option " + option);
     } catch (const std::exception&) {
       return usage(option + ": expected a number list or a number, got '" + value + "'");
     }
   }
-  if (!plots_from.empty()) {
-    if (plots_dir.empty()) return usage("--plots-from: needs --plots DIR");
-    std::ifstream in(plots_from);
-    if (!in) return usage("--plots-from: cannot read '" + plots_from + "'");
-    const std::string tsv((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    try {
-      for (const std::string& path : plot_campaign(tsv, plots_dir)) std::cout << "plot: " << path << "\n";
-    } catch (const std::exception& e) {
-      std::cerr << "tofguard-judge-campaign: " << e.what() << "\n";
-      return 1;
-    }
-    return 0;
-  }
-  const std::string scene_dir = output_dir() + "/judge_campaign";
-  std::string tsv;
+  return std::nullopt;
+}
+
+// --plots-from: the plots of the runs in a TSV file, without running any.
+int plot_from_file(const Options& o) {
+  if (o.plots_dir.empty()) return usage("--plots-from: needs --plots DIR");
+  std::ifstream in(o.plots_from);
+  if (!in) return usage("--plots-from: cannot read '" + o.plots_from + "'");
+  const std::string tsv((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   try {
-    for (const std::string& name : arms) {
-      std::optional<CampaignArm> base;
-      if (name == "default") {
-        base = default_campaign_arm();
-      } else if (name == "iiwa14") {
-        base = iiwa14_campaign_arm(shared, scene_dir);
-      } else if (name == "kinova") {
-        base = kinova_gen3_campaign_arm(shared, scene_dir);
-      } else {
-        return usage("--arms: expected default, iiwa14 or kinova, got '" + name + "'");
-      }
-      if (!base) {
-        std::cout << name << ": skipped, its URDF is not under " << shared << "/robots\n";
-        continue;
-      }
-      std::vector<CampaignArm> variants;
-      for (double turn : turns_deg) {
-        const CampaignArm placed = turn == 0 ? *base : with_camera_turned(*base, turn);
-        if (rates_hz.empty()) variants.push_back(placed);
-        for (double rate : rates_hz) variants.push_back(with_camera_rate(placed, rate));
-      }
-      for (const CampaignArm& arm : variants) {
-        std::vector<CampaignRun> runs;
-        auto append = [&runs](const std::vector<CampaignRun>& more) {
-          runs.insert(runs.end(), more.begin(), more.end());
-        };
-        if (faults) append(fault_runs(arm, magnitudes));
-        if (streams > 0) append(stream_fault_runs(streams));
-        if (nominal_s > 0) append(nominal_runs(nominal_s, 60, arm.config.camera.rate_hz, 7));
-        if (passers_s > 0) append(passer_runs(arm, passers_s, 9000));
-        if (!objects_m.empty()) append(object_runs(arm, objects_m, beyond_m));
-        const std::vector<CampaignResult> results = run_campaign(arm, runs);
-        std::cout << campaign_report(arm.name, results, 1.0 / arm.config.camera.rate_hz) << "\n";
-        if (!objects_m.empty() || passers_s > 0)
-          std::cout << object_report(arm.name, results, arm.config) << "\n";
-        std::cout << std::flush;
-        tsv += campaign_tsv(arm.name, results, tsv.empty());
-      }
-    }
-    if (!tsv_path.empty()) {
-      std::ofstream out(tsv_path);
-      out << tsv;
-      if (!out) throw std::runtime_error(tsv_path + ": cannot write the runs");
-    }
-    if (!plots_dir.empty())
-      for (const std::string& path : plot_campaign(tsv, plots_dir)) std::cout << "plot: " << path << "\n";
+    for (const std::string& path : tofguard::test::plot_campaign(tsv, o.plots_dir))
+      std::cout << "plot: " << path << "\n";
   } catch (const std::exception& e) {
     std::cerr << "tofguard-judge-campaign: " << e.what() << "\n";
     return 1;
   }
   return 0;
+}
+
+// Each camera placement (--turns-deg) of `base` at each camera rate
+// (--rates-hz; none: the config's).
+std::vector<tofguard::test::CampaignArm> variants_of(const tofguard::test::CampaignArm& base,
+                                                     const Options& o) {
+  using namespace tofguard::test;
+  std::vector<CampaignArm> variants;
+  for (double turn : o.turns_deg) {
+    const CampaignArm placed = turn == 0 ? base : with_camera_turned(base, turn);
+    if (o.rates_hz.empty()) variants.push_back(placed);
+    for (double rate : o.rates_hz) variants.push_back(with_camera_rate(placed, rate));
+  }
+  return variants;
+}
+
+// The runs the options ask for on `arm`.
+std::vector<tofguard::test::CampaignRun> runs_for(const tofguard::test::CampaignArm& arm, const Options& o) {
+  using namespace tofguard::test;
+  std::vector<CampaignRun> runs;
+  auto append = [&runs](const std::vector<CampaignRun>& more) {
+    runs.insert(runs.end(), more.begin(), more.end());
+  };
+  if (o.faults) append(fault_runs(arm, o.magnitudes));
+  if (o.streams > 0) append(stream_fault_runs(o.streams));
+  if (o.nominal_s > 0) append(nominal_runs(o.nominal_s, 60, arm.config.camera.rate_hz, 7));
+  if (o.passers_s > 0) append(passer_runs(arm, o.passers_s, 9000));
+  if (!o.objects_m.empty()) append(object_runs(arm, o.objects_m, o.beyond_m));
+  return runs;
+}
+
+// Runs `arm`'s campaign, prints its report(s) and adds its runs to *tsv.
+void run_arm(const tofguard::test::CampaignArm& arm, const Options& o, std::string* tsv) {
+  using namespace tofguard::test;
+  const std::vector<CampaignResult> results = run_campaign(arm, runs_for(arm, o));
+  std::cout << campaign_report(arm.name, results, 1.0 / arm.config.camera.rate_hz) << "\n";
+  if (!o.objects_m.empty() || o.passers_s > 0)
+    std::cout << object_report(arm.name, results, arm.config) << "\n";
+  std::cout << std::flush;
+  *tsv += campaign_tsv(arm.name, results, tsv->empty());
+}
+
+// The campaign on every arm asked for, then the TSV and the plots; the
+// exit code.
+int run_campaigns(const Options& o) {
+  using namespace tofguard::test;
+  const std::string scene_dir = output_dir() + "/judge_campaign";
+  std::string tsv;
+  try {
+    for (const std::string& name : o.arms) {
+      std::optional<CampaignArm> base;
+      if (name == "default") {
+        base = default_campaign_arm();
+      } else if (name == "iiwa14") {
+        base = iiwa14_campaign_arm(o.shared, scene_dir);
+      } else if (name == "kinova") {
+        base = kinova_gen3_campaign_arm(o.shared, scene_dir);
+      } else {
+        return usage("--arms: expected default, iiwa14 or kinova, got '" + name + "'");
+      }
+      if (!base) {
+        std::cout << name << ": skipped, its URDF is not under " << o.shared << "/robots\n";
+        continue;
+      }
+      for (const CampaignArm& arm : variants_of(*base, o)) run_arm(arm, o, &tsv);
+    }
+    if (!o.tsv_path.empty()) {
+      std::ofstream out(o.tsv_path);
+      out << tsv;
+      if (!out) throw std::runtime_error(o.tsv_path + ": cannot write the runs");
+    }
+    if (!o.plots_dir.empty())
+      for (const std::string& path : plot_campaign(tsv, o.plots_dir)) std::cout << "plot: " << path << "\n";
+  } catch (const std::exception& e) {
+    std::cerr << "tofguard-judge-campaign: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options options;
+  if (const std::optional<int> rc = parse_options(argc, argv, &options)) return *rc;
+  if (!options.plots_from.empty()) return plot_from_file(options);
+  return run_campaigns(options);
 }

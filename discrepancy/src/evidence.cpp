@@ -334,6 +334,237 @@ void add_camera_fit(const double* jacobian, const double* weight, const double* 
 
 }  // namespace
 
+// EvidenceJacobian::at_pixel for compute_evidence's per-pixel step (a
+// friend of EvidenceJacobian).
+struct EvidencePixelAccess {
+  [[gnu::always_inline]] static bool at_pixel(const EvidenceJacobian& jacobian, int u, int v,
+                                              double camera[6], double* joints, bool* moved, int* link) {
+    return jacobian.at_pixel(u, v, camera, joints, moved, link);
+  }
+};
+
+namespace {
+
+// What every band of a frame reads: the images, the fit's settings and
+// the sampling.
+struct EvidenceFrame {
+  const depth_image_t& camera;
+  const depth_image_t& rendered;
+  const std::vector<uint8_t>& silhouette;
+  // The static pixels the naming search explains (when have_explained):
+  // the arm's evidence, kept out of the camera fit.
+  const std::vector<uint8_t>& explained_static;
+  bool have_explained;
+  const EvidenceJacobian& jacobian;
+  const DepthNoise& noise;
+  const EvidenceParameters& parameters;
+  // Every stride-th pixel in u and v (EvidenceParameters::max_pixels), each
+  // weighted (inv_pps) for the noise correlation left between the sampled
+  // pixels.
+  int stride;
+  double inv_pps;
+};
+
+// One row's static pixels in the camera fit: their Jacobians (6 to a
+// pixel, written there by the Jacobian), weights and clipped residuals,
+// `left` of them in the image's left half. The 6x6 sums then run
+// over the row in registers (add_camera_fit), not through 40 sums in
+// memory per pixel.
+struct RowFit {
+  explicit RowFit(int width)
+      : jacobian(static_cast<size_t>(6 * (width + 1))),
+        weight(static_cast<size_t>(width)),
+        residual(static_cast<size_t>(width)) {}
+  // Pixels n_first..n_end of the row into image region `region`'s sums.
+  void add_to(int n_first, int n_end, int region, EvidenceSums* b) const {
+    if (n_first >= n_end) return;
+    b->camera_region_fit_pixels[region] += n_end - n_first;
+    add_camera_fit(jacobian.data(), weight.data(), residual.data(), n_first, n_end, b->camera_score.data(),
+                   b->camera_information.data(), b->camera_region_score + 6 * region,
+                   b->camera_region_information + 6 * region);
+  }
+  std::vector<double> jacobian;
+  std::vector<double> weight;
+  std::vector<double> residual;
+  int fit = 0;
+  int left = 0;
+};
+
+// A robot pixel's weighted residual into the joints it moves.
+void add_robot_pixel(double w, double r, bool in_naming_fit, const std::vector<double>& joint_row,
+                     EvidenceSums* b) {
+  ++b->robot_fit_pixels;
+  b->robot_chi2 += w * r * r;
+  for (size_t j = 0; j < joint_row.size(); ++j) {
+    const double jj = joint_row[j];
+    if (jj == 0.0) continue;
+    ++b->joint_fit_pixels[j];
+    b->joint_score[j] -= w * jj * r;
+    b->joint_information[j] += w * jj * jj;
+    if (!in_naming_fit) continue;
+    b->joint_naming_score[j] -= w * jj * r;
+    b->joint_naming_information[j] += w * jj * jj;
+  }
+}
+
+// A static pixel's weighted residual into the static chi2 and, inside the
+// gate, into the row's camera fit (its Jacobian already in the row's slot).
+void add_static_pixel(double w, double r, bool in_naming_fit, bool left_half, RowFit* row, EvidenceSums* b) {
+  b->static_chi2 += w * r * r;
+  // A static pixel beyond the gate is outside the camera's linear model
+  // as the naming fit's are outside the joints': a pose off by the
+  // test's delta (2 cm, 1 degree) moves smooth static surfaces by a few
+  // sigma, while an object in front of them (a person walking past
+  // the wall) differs by tens of centimetres. Its clipped residual
+  // would say only that something is there, and the protective fields
+  // judge that; in the camera fit it would pull the pose.
+  if (!in_naming_fit) return;
+  // Into the row's camera fit (added at the row's end, sum_row).
+  row->weight[static_cast<size_t>(row->fit)] = w;
+  row->residual[static_cast<size_t>(row->fit)] = r;
+  if (left_half) row->left = row->fit + 1;
+  ++row->fit;
+}
+
+// Pixel (u, v) (index i) into the band's sums.
+void add_pixel(const EvidenceFrame& f, int u, int v, int i, std::vector<double>* joint_row, RowFit* row,
+               EvidenceSums* b) {
+  const int t = f.camera.depth_mm[static_cast<size_t>(i)];
+  const int gen = f.rendered.depth_mm[static_cast<size_t>(i)];
+  if (t <= 0 || gen <= 0 || f.silhouette[static_cast<size_t>(i)]) return;
+  bool moved = false;
+  int link = -1;
+  // A static pixel's camera Jacobian goes straight into the row's
+  // next slot (kept only if the pixel enters the camera fit).
+  double* camera_row = row->jacobian.data() + 6 * row->fit;
+  if (!EvidencePixelAccess::at_pixel(f.jacobian, u, v, camera_row, joint_row->data(), &moved, &link)) return;
+  if (!moved && f.have_explained && f.explained_static[static_cast<size_t>(i)]) return;
+  const EvidenceParameters& parameters = f.parameters;
+  const double sigma_d = f.noise.sigma_mm(t);
+  const double var = sigma_d * sigma_d + parameters.model_sigma_mm * parameters.model_sigma_mm;
+  const double limit = parameters.clip_sigmas * std::sqrt(var);
+  const double raw_r = static_cast<double>(gen - t);
+  const double r = std::clamp(raw_r, -limit, limit);
+  const bool in_naming_fit = std::abs(raw_r) <= parameters.naming_gate_sigmas * std::sqrt(var);
+  const double w = f.inv_pps / var;
+  b->link_sum_wr[link] += w * r;
+  b->link_sum_w[link] += w;
+  if (moved) {
+    add_robot_pixel(w, r, in_naming_fit, *joint_row, b);
+  } else {
+    add_static_pixel(w, r, in_naming_fit, u < f.camera.width / 2, row, b);
+  }
+}
+
+// Row v's sampled pixels u_first..u_end into the band's sums, its static
+// pixels in the camera fit left half then right (the image quadrants,
+// discrepancy_t.camera_region_*), each sum taking the pixels in the order
+// of the row as the pixels came.
+void sum_row(const EvidenceFrame& f, int v, int u_first, int u_end, std::vector<double>* joint_row,
+             RowFit* row, EvidenceSums* b) {
+  row->fit = 0;
+  row->left = 0;
+  const int stride = f.stride;
+  for (int u = (u_first + stride - 1) / stride * stride; u < u_end; u += stride) {
+    add_pixel(f, u, v, v * f.camera.width + u, joint_row, row, b);
+  }
+  b->camera_fit_pixels += row->fit;
+  const bool lower = v >= f.camera.height / 2;
+  row->add_to(0, row->left, lower ? 2 : 0, b);
+  row->add_to(row->left, row->fit, lower ? 3 : 1, b);
+}
+
+// Band `band` of kEvidenceBands (the image's pixels in bands of rows) into
+// *b: its rows, each from the band's first pixel (first row) to its last
+// (last row); with a sampling stride k every k-th row and column.
+void sum_band(const EvidenceFrame& f, int band, EvidenceSums* b) {
+  const int width = f.camera.width;
+  const int num_pixels = width * f.camera.height;
+  std::vector<double> joint_row(f.jacobian.num_joints(), 0.0);
+  const int first = static_cast<int>(static_cast<int64_t>(num_pixels) * band / kEvidenceBands);
+  const int last = static_cast<int>(static_cast<int64_t>(num_pixels) * (band + 1) / kEvidenceBands);
+  if (first >= last) return;
+  RowFit row(width);
+  for (int v = first / width; v <= (last - 1) / width; ++v) {
+    if (v % f.stride != 0) continue;
+    const int row_start = v * width;
+    sum_row(f, v, std::max(first - row_start, 0), std::min(last - row_start, width), &joint_row, &row, b);
+  }
+}
+
+// The frame's sums: the image in kEvidenceBands bands of rows, each summed
+// on its own (a WorkerPool task when `workers` is given) and the bands
+// added in order: the sums are the same whichever threads run them.
+EvidenceSums sum_frame(const EvidenceFrame& f, int num_links, WorkerPool* workers) {
+  const int num_joints = f.jacobian.num_joints();
+  std::vector<EvidenceSums> bands(kEvidenceBands, EvidenceSums(num_links, num_joints));
+  const auto one = [&](int band) { sum_band(f, band, &bands[static_cast<size_t>(band)]); };
+  if (workers != nullptr) {
+    workers->run(kEvidenceBands, one);
+  } else {
+    for (int band = 0; band < kEvidenceBands; ++band) one(band);
+  }
+  EvidenceSums total(num_links, num_joints);
+  for (const EvidenceSums& b : bands) total.add(b);
+  return total;
+}
+
+// The sums the summary carries as they are.
+void store_sums(const EvidenceSums& total, discrepancy_t* s) {
+  s->robot_fit_pixels = total.robot_fit_pixels;
+  s->robot_chi2 = total.robot_chi2;
+  s->static_chi2 = total.static_chi2;
+  s->camera_fit_pixels = total.camera_fit_pixels;
+  s->joint_fit_pixels = total.joint_fit_pixels;
+  s->joint_score = total.joint_score;
+  s->joint_information = total.joint_information;
+  s->joint_naming_score = total.joint_naming_score;
+  s->joint_naming_information = total.joint_naming_information;
+  std::copy(total.camera_region_fit_pixels, total.camera_region_fit_pixels + 4, s->camera_region_fit_pixels);
+  std::copy(total.camera_region_score, total.camera_region_score + 24, s->camera_region_score);
+  std::copy(total.camera_region_information, total.camera_region_information + 24,
+            s->camera_region_information);
+}
+
+// The camera fit: its score, its information (both halves) and the
+// correction it solves for.
+void store_camera_fit(const EvidenceSums& total, discrepancy_t* s) {
+  const Eigen::Matrix<double, 6, 1> camera_score = total.camera_score;
+  Eigen::Matrix<double, 6, 6> camera_information = total.camera_information;
+  camera_information = camera_information.selfadjointView<Eigen::Upper>();
+  Eigen::Matrix<double, 6, 1> correction = Eigen::Matrix<double, 6, 1>::Zero();
+  if (s->camera_fit_pixels > 0) {
+    const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(camera_information);
+    const Eigen::Matrix<double, 6, 1> d = ldlt.vectorD();
+    // Rank-deficient (e.g. a single plane seen head-on leaves the sideways
+    // translation unobservable): no correction.
+    if (ldlt.info() == Eigen::Success && ldlt.isPositive() && d.maxCoeff() > 0 &&
+        d.minCoeff() > 1e-12 * d.maxCoeff()) {
+      correction = ldlt.solve(camera_score);
+      if (!correction.allFinite()) correction.setZero();
+    }
+  }
+  for (int k = 0; k < 6; ++k) {
+    s->camera_score[k] = camera_score[k];
+    s->camera_correction[k] = correction[k];
+    for (int c = 0; c < 6; ++c) s->camera_information[6 * k + c] = camera_information(k, c);
+  }
+}
+
+// Each link's weighted mean residual (mm) and its sigma.
+void store_link_bias(const EvidenceSums& total, int num_links, discrepancy_t* s) {
+  s->num_link_bias = num_links;
+  s->link_bias_mm.assign(num_links, 0.0f);
+  s->link_bias_sigma_mm.assign(num_links, 0.0f);
+  for (int l = 0; l < num_links; ++l) {
+    if (total.link_sum_w[l] <= 0) continue;
+    s->link_bias_mm[l] = static_cast<float>(total.link_sum_wr[l] / total.link_sum_w[l]);
+    s->link_bias_sigma_mm[l] = static_cast<float>(1.0 / std::sqrt(total.link_sum_w[l]));
+  }
+}
+
+}  // namespace
+
 void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered, const link_labels_t& labels,
                       const std::vector<uint8_t>& silhouette, double silhouette_jump_mm,
                       const DepthNoise& noise, const EvidenceParameters& parameters, discrepancy_t* summary,
@@ -352,164 +583,22 @@ void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered
   std::vector<uint8_t> explained_static;
   search_joint_offsets(camera, rendered, labels, jacobian.kinematics(), noise, parameters, &s,
                        &explained_static, workers, beside);
-  const bool have_explained = explained_static.size() == static_cast<size_t>(num_pixels);
-  const int num_links = labels.num_links;
-  const int num_joints = jacobian.num_joints();
-  const int16_t* tof = camera.depth_mm.data();
-  const int16_t* gen = rendered.depth_mm.data();
-  const double model_var = parameters.model_sigma_mm * parameters.model_sigma_mm;
-  // Every stride-th pixel in u and v (EvidenceParameters::max_pixels), each
-  // weighted for the noise correlation left between the sampled pixels.
   const int stride = evidence_stride(camera.width, camera.height, parameters.max_pixels);
-  const double inv_pps = 1.0 / sampled_pixels_per_sample(parameters.pixels_per_sample, stride);
-  const int half_width = camera.width / 2;
-  const int half_height = camera.height / 2;
-  // The image in kEvidenceBands bands of rows, each summed on its own (a
-  // WorkerPool task when `workers` is given) and the bands added in order:
-  // the sums are the same whichever threads run them.
-  std::vector<EvidenceSums> bands(kEvidenceBands, EvidenceSums(num_links, num_joints));
-  const auto sum_band = [&](int band) {
-    EvidenceSums& b = bands[static_cast<size_t>(band)];
-    std::vector<double> joint_row(num_joints, 0.0);
-    const int first = static_cast<int>(static_cast<int64_t>(num_pixels) * band / kEvidenceBands);
-    const int last = static_cast<int>(static_cast<int64_t>(num_pixels) * (band + 1) / kEvidenceBands);
-    if (first >= last) return;
-    const int width = camera.width;
-    // One row's static pixels in the camera fit: their Jacobians (6 to a
-    // pixel, written there by the Jacobian), weights and clipped residuals,
-    // row_left of them in the image's left half. The 6x6 sums then run
-    // over the row in registers (add_camera_fit), not through 40 sums in
-    // memory per pixel.
-    std::vector<double> row_jacobian(static_cast<size_t>(6 * (width + 1)));
-    std::vector<double> row_weight(static_cast<size_t>(width));
-    std::vector<double> row_residual(static_cast<size_t>(width));
-    int row_fit = 0;
-    int row_left = 0;
-    const auto add_row_fit = [&](int n_first, int n_end, int region) {
-      if (n_first >= n_end) return;
-      b.camera_region_fit_pixels[region] += n_end - n_first;
-      add_camera_fit(row_jacobian.data(), row_weight.data(), row_residual.data(), n_first, n_end,
-                     b.camera_score.data(), b.camera_information.data(), b.camera_region_score + 6 * region,
-                     b.camera_region_information + 6 * region);
-    };
-    // The band's rows, each from the band's first pixel (first row) to its
-    // last (last row); with a sampling stride k every k-th row and column.
-    for (int v = first / width; v <= (last - 1) / width; ++v) {
-      if (v % stride != 0) continue;
-      row_fit = 0;
-      row_left = 0;
-      const int row = v * width;
-      const int u_first = std::max(first - row, 0);
-      const int u_end = std::min(last - row, width);
-      for (int u = (u_first + stride - 1) / stride * stride; u < u_end; u += stride) {
-        const int i = row + u;
-        const int t = tof[i];
-        if (t <= 0 || gen[i] <= 0 || silhouette[i]) continue;
-        bool moved = false;
-        int link = -1;
-        // A static pixel's camera Jacobian goes straight into the row's
-        // next slot (kept only if the pixel enters the camera fit).
-        double* camera_row = row_jacobian.data() + 6 * row_fit;
-        if (!jacobian.at_pixel(u, v, camera_row, joint_row.data(), &moved, &link)) continue;
-        if (!moved && have_explained && explained_static[i]) continue;
-        const double sigma_d = noise.sigma_mm(t);
-        const double var = sigma_d * sigma_d + model_var;
-        const double limit = parameters.clip_sigmas * std::sqrt(var);
-        const double raw_r = static_cast<double>(gen[i] - t);
-        const double r = std::clamp(raw_r, -limit, limit);
-        const bool in_naming_fit = std::abs(raw_r) <= parameters.naming_gate_sigmas * std::sqrt(var);
-        const double w = inv_pps / var;
-        b.link_sum_wr[link] += w * r;
-        b.link_sum_w[link] += w;
-        if (moved) {
-          ++b.robot_fit_pixels;
-          b.robot_chi2 += w * r * r;
-          for (int j = 0; j < num_joints; ++j) {
-            const double jj = joint_row[j];
-            if (jj == 0.0) continue;
-            ++b.joint_fit_pixels[j];
-            b.joint_score[j] -= w * jj * r;
-            b.joint_information[j] += w * jj * jj;
-            if (!in_naming_fit) continue;
-            b.joint_naming_score[j] -= w * jj * r;
-            b.joint_naming_information[j] += w * jj * jj;
-          }
-        } else {
-          b.static_chi2 += w * r * r;
-          // A static pixel beyond the gate is outside the camera's linear model
-          // as the naming fit's are outside the joints': a pose off by the
-          // test's delta (2 cm, 1 degree) moves smooth static surfaces by a few
-          // sigma, while an object in front of them (a person walking past
-          // the wall) differs by tens of centimetres. Its clipped residual
-          // would say only that something is there, and the protective fields
-          // judge that; in the camera fit it would pull the pose.
-          if (!in_naming_fit) continue;
-          // Into the row's camera fit (added at the row's end, below).
-          row_weight[static_cast<size_t>(row_fit)] = w;
-          row_residual[static_cast<size_t>(row_fit)] = r;
-          if (u < half_width) row_left = row_fit + 1;
-          ++row_fit;
-        }
-      }
-      b.camera_fit_pixels += row_fit;
-      // The row's static pixels in the camera fit, left half then right
-      // (the image quadrants, discrepancy_t.camera_region_*), each sum
-      // taking the pixels in the order of the row as the pixels came.
-      add_row_fit(0, row_left, v >= half_height ? 2 : 0);
-      add_row_fit(row_left, row_fit, v >= half_height ? 3 : 1);
-    }
-  };
-  if (workers != nullptr) {
-    workers->run(kEvidenceBands, sum_band);
-  } else {
-    for (int band = 0; band < kEvidenceBands; ++band) sum_band(band);
-  }
-  EvidenceSums total(num_links, num_joints);
-  for (const EvidenceSums& b : bands) total.add(b);
-  s.robot_fit_pixels = total.robot_fit_pixels;
-  s.robot_chi2 = total.robot_chi2;
-  s.static_chi2 = total.static_chi2;
-  s.camera_fit_pixels = total.camera_fit_pixels;
-  s.joint_fit_pixels = total.joint_fit_pixels;
-  s.joint_score = total.joint_score;
-  s.joint_information = total.joint_information;
-  s.joint_naming_score = total.joint_naming_score;
-  s.joint_naming_information = total.joint_naming_information;
-  std::copy(total.camera_region_fit_pixels, total.camera_region_fit_pixels + 4, s.camera_region_fit_pixels);
-  std::copy(total.camera_region_score, total.camera_region_score + 24, s.camera_region_score);
-  std::copy(total.camera_region_information, total.camera_region_information + 24,
-            s.camera_region_information);
-  const std::vector<double>& link_sum_wr = total.link_sum_wr;
-  const std::vector<double>& link_sum_w = total.link_sum_w;
-  Eigen::Matrix<double, 6, 1> camera_score = total.camera_score;
-  Eigen::Matrix<double, 6, 6> camera_information = total.camera_information;
-  camera_information = camera_information.selfadjointView<Eigen::Upper>();
-  Eigen::Matrix<double, 6, 1> correction = Eigen::Matrix<double, 6, 1>::Zero();
-  if (s.camera_fit_pixels > 0) {
-    const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(camera_information);
-    const Eigen::Matrix<double, 6, 1> d = ldlt.vectorD();
-    // Rank-deficient (e.g. a single plane seen head-on leaves the sideways
-    // translation unobservable): no correction.
-    if (ldlt.info() == Eigen::Success && ldlt.isPositive() && d.maxCoeff() > 0 &&
-        d.minCoeff() > 1e-12 * d.maxCoeff()) {
-      correction = ldlt.solve(camera_score);
-      if (!correction.allFinite()) correction.setZero();
-    }
-  }
-  for (int k = 0; k < 6; ++k) {
-    s.camera_score[k] = camera_score[k];
-    s.camera_correction[k] = correction[k];
-    for (int c = 0; c < 6; ++c) s.camera_information[6 * k + c] = camera_information(k, c);
-  }
-  s.num_link_bias = num_links;
-  s.link_bias_mm.assign(num_links, 0.0f);
-  s.link_bias_sigma_mm.assign(num_links, 0.0f);
-  for (int l = 0; l < num_links; ++l) {
-    if (link_sum_w[l] <= 0) continue;
-    s.link_bias_mm[l] = static_cast<float>(link_sum_wr[l] / link_sum_w[l]);
-    s.link_bias_sigma_mm[l] = static_cast<float>(1.0 / std::sqrt(link_sum_w[l]));
-  }
-  s.num_joints = num_joints;
+  const EvidenceFrame frame{camera,
+                            rendered,
+                            silhouette,
+                            explained_static,
+                            explained_static.size() == static_cast<size_t>(num_pixels),
+                            jacobian,
+                            noise,
+                            parameters,
+                            stride,
+                            1.0 / sampled_pixels_per_sample(parameters.pixels_per_sample, stride)};
+  const EvidenceSums total = sum_frame(frame, labels.num_links, workers);
+  store_sums(total, &s);
+  store_camera_fit(total, &s);
+  store_link_bias(total, labels.num_links, &s);
+  s.num_joints = jacobian.num_joints();
   s.joint_name = labels.joint_name;
   s.evidence_available = true;
 }

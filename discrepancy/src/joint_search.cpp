@@ -225,43 +225,59 @@ Eigen::Isometry3d axis_motion(const LabelAxis& axis, double amount) {
   return t;
 }
 
-}  // namespace
-
-void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rendered,
-                          const link_labels_t& labels, const LabelKinematics& k, const DepthNoise& noise,
-                          const EvidenceParameters& parameters, discrepancy_t* summary,
-                          std::vector<uint8_t>* explained_static, WorkerPool* workers, SideTask* beside) {
-  if (explained_static != nullptr) explained_static->clear();
-  discrepancy_t& s = *summary;
-  s.search_points = 0;
-  s.joint_search_offset.assign(k.num_joints, 0.0);
-  s.joint_search_gain.assign(k.num_joints, 0.0);
-  const int width = rendered.width;
-  const int height = rendered.height;
-  const size_t pixels = static_cast<size_t>(std::max(width, 0)) * static_cast<size_t>(std::max(height, 0));
-  if (k.num_joints <= 0 || camera.depth_mm.size() != pixels || rendered.depth_mm.size() != pixels ||
-      labels.label.size() != pixels || camera.width != width || !(rendered.fx > 0) || !(rendered.fy > 0)) {
-    return;
+// The robot link (one a joint moves) that pixel i of the rendered image
+// shows; -1 for none (no rendered depth, a static label, or a link without
+// an axis).
+class MovedLinkOf {
+ public:
+  MovedLinkOf(const depth_image_t& rendered, const link_labels_t& labels, const LabelKinematics& k)
+      : gen_(rendered.depth_mm.data()), label_(labels.label.data()), k_(k) {}
+  int operator()(size_t i) const {
+    if (gen_[i] <= 0) return -1;
+    const int link = link_of_label(label_[i], k_.num_robot_links, k_.num_links);
+    return link >= 0 && link < k_.num_robot_links && k_.link_axis[link] >= 0 ? link : -1;
   }
-  const int16_t* gen = rendered.depth_mm.data();
-  const int16_t* label = labels.label.data();
-  // The robot pixels a joint moves, and the stride that keeps them within
-  // search_max_points.
-  const auto moved_link = [&](size_t i) {
-    if (gen[i] <= 0) return -1;
-    const int link = link_of_label(label[i], k.num_robot_links, k.num_links);
-    return link >= 0 && link < k.num_robot_links && k.link_axis[link] >= 0 ? link : -1;
-  };
+
+ private:
+  const int16_t* gen_;
+  const int16_t* label_;
+  const LabelKinematics& k_;
+};
+
+// Whether the images and labels agree in size (`pixels` each) and the
+// rendered intrinsics can back-project.
+bool inputs_usable(const depth_image_t& camera, const depth_image_t& rendered, const link_labels_t& labels,
+                   const LabelKinematics& k, size_t pixels) {
+  return k.num_joints > 0 && camera.depth_mm.size() == pixels && rendered.depth_mm.size() == pixels &&
+         labels.label.size() == pixels && camera.width == rendered.width && rendered.fx > 0 &&
+         rendered.fy > 0;
+}
+
+// The pixel stride that keeps the moved robot pixels within `max_points`;
+// 0 when no pixel shows a moved link.
+int sampling_stride(const MovedLinkOf& moved_link, size_t pixels, int max_points) {
   int64_t moved_pixels = 0;
   for (size_t i = 0; i < pixels; ++i) moved_pixels += moved_link(i) >= 0 ? 1 : 0;
-  if (moved_pixels == 0) return;
+  if (moved_pixels == 0) return 0;
   int stride = 1;
-  while (moved_pixels > int64_t{parameters.search_max_points} * stride * stride) ++stride;
-  std::vector<std::vector<SearchPoint>> points_of_link(k.num_robot_links);
+  while (moved_pixels > int64_t{max_points} * stride * stride) ++stride;
+  return stride;
+}
+
+using PointsOfLink = std::vector<std::vector<SearchPoint>>;
+
+// The moved robot pixels every `stride`-th row and column, back-projected
+// (optical frame, mm) with their 1 / sigma_i, per link; counts them in
+// *search_points.
+PointsOfLink sample_points(const depth_image_t& rendered, const MovedLinkOf& moved_link, int num_robot_links,
+                           const DepthNoise& noise, const EvidenceParameters& parameters, int stride,
+                           int32_t* search_points) {
+  PointsOfLink points_of_link(num_robot_links);
+  const int16_t* gen = rendered.depth_mm.data();
   const double model_var = parameters.model_sigma_mm * parameters.model_sigma_mm;
-  for (int v = 0; v < height; v += stride) {
-    for (int u = 0; u < width; u += stride) {
-      const size_t i = static_cast<size_t>(v) * width + u;
+  for (int v = 0; v < rendered.height; v += stride) {
+    for (int u = 0; u < rendered.width; u += stride) {
+      const size_t i = static_cast<size_t>(v) * rendered.width + u;
       const int link = moved_link(i);
       if (link < 0) continue;
       const double z = gen[i];
@@ -269,75 +285,85 @@ void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rend
       points_of_link[link].push_back(SearchPoint{
           Eigen::Vector3d((u - rendered.cx) * z / rendered.fx, (v - rendered.cy) * z / rendered.fy, z),
           1.0 / std::sqrt(sigma_d * sigma_d + model_var)});
-      ++s.search_points;
+      ++*search_points;
     }
   }
-  const PointCost cost(camera, rendered, parameters.clip_sigmas,
-                       static_cast<double>(stride) * stride / parameters.pixels_per_sample);
+  return points_of_link;
+}
 
-  // The links joint j moves, each with j's axes in its chain, distal first
-  // (a distal axis turns about its line as rendered, before the proximal
-  // ones move that line).
-  struct MovedLink {
-    const std::vector<SearchPoint>* points;
-    std::vector<const LabelAxis*> axes;
-  };
-  const auto moved_links = [&](int j, bool* prismatic) {
-    std::vector<MovedLink> moved;
-    for (int l = 0; l < k.num_robot_links; ++l) {
-      if (points_of_link[l].empty()) continue;
-      MovedLink m{&points_of_link[l], {}};
-      for (int a = k.link_axis[l]; a >= 0; a = k.axes[a].parent) {
-        if (k.axes[a].joint != j) continue;
-        m.axes.push_back(&k.axes[a]);
-        *prismatic = k.axes[a].prismatic;
-      }
-      if (!m.axes.empty()) moved.push_back(std::move(m));
-    }
-    return moved;
-  };
-  // The rigid motion of link m for a joint offset (rad; m for a prismatic
-  // joint, whose axes move in mm).
-  const auto motion_of = [](const MovedLink& m, double offset) {
-    Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
-    for (const LabelAxis* axis : m.axes) {
-      const double unit = axis->prismatic ? 1000.0 : 1.0;
-      motion = axis_motion(*axis, axis->multiplier * offset * unit) * motion;
-    }
-    return motion;
-  };
+// A link joint j moves, with j's axes in its chain, distal first (a distal
+// axis turns about its line as rendered, before the proximal ones move that
+// line).
+struct MovedLink {
+  const std::vector<SearchPoint>* points;
+  std::vector<const LabelAxis*> axes;
+};
 
-  // Each joint's search: the coarse trials (every `coarse_every`-th point
-  // of each link the joint moves, no more than about kCoarsePoints of the
-  // joint's points in all: they only pick the basin) over +-range in
-  // steps, then every point at no offset and, when a trial beat no offset,
-  // at the best trial and a quarter and a half step either side of it.
-  // The trials of all joints are one list of tasks (WorkerPool), each
-  // writing its own cost: a base joint's trials move every robot point and
-  // a wrist's a few, so tasks per joint left one thread with most of the
-  // work. The choices below read the costs in a fixed order, so nothing
-  // depends on the threads.
-  struct JointTrials {
-    std::vector<MovedLink> moved;
-    size_t coarse_every = 1;
-    double step = 0;
-    int steps = 0;
-    size_t first_coarse = 0;  // index of its first coarse cost (offset 0)
-    size_t first_fine = 0;    // index of its first fine cost (none, then kFine)
-  };
-  // The fine trials about the coarse trials' best, in steps.
-  static constexpr double kFine[] = {0.0, -0.5, -0.25, 0.25, 0.5};
-  struct Trial {
-    int joint;
-    double offset;
-    size_t every;
-  };
-  std::vector<JointTrials> trials_of(k.num_joints);
+// The links (with points) joint j moves; *prismatic tells whether j is.
+std::vector<MovedLink> links_moved_by(int j, const LabelKinematics& k, const PointsOfLink& points_of_link,
+                                      bool* prismatic) {
+  std::vector<MovedLink> moved;
+  for (int l = 0; l < k.num_robot_links; ++l) {
+    if (points_of_link[l].empty()) continue;
+    MovedLink m{&points_of_link[l], {}};
+    for (int a = k.link_axis[l]; a >= 0; a = k.axes[a].parent) {
+      if (k.axes[a].joint != j) continue;
+      m.axes.push_back(&k.axes[a]);
+      *prismatic = k.axes[a].prismatic;
+    }
+    if (!m.axes.empty()) moved.push_back(std::move(m));
+  }
+  return moved;
+}
+
+// The rigid motion of link m for a joint offset (rad; m for a prismatic
+// joint, whose axes move in mm).
+Eigen::Isometry3d link_motion(const MovedLink& m, double offset) {
+  Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
+  for (const LabelAxis* axis : m.axes) {
+    const double unit = axis->prismatic ? 1000.0 : 1.0;
+    motion = axis_motion(*axis, axis->multiplier * offset * unit) * motion;
+  }
+  return motion;
+}
+
+// Each joint's search: the coarse trials (every `coarse_every`-th point
+// of each link the joint moves, no more than about kCoarsePoints of the
+// joint's points in all: they only pick the basin) over +-range in
+// steps, then every point at no offset and, when a trial beat no offset,
+// at the best trial and a quarter and a half step either side of it.
+// The trials of all joints are one list of tasks (WorkerPool), each
+// writing its own cost: a base joint's trials move every robot point and
+// a wrist's a few, so tasks per joint left one thread with most of the
+// work. The choices below read the costs in a fixed order, so nothing
+// depends on the threads.
+struct JointTrials {
+  std::vector<MovedLink> moved;
+  size_t coarse_every = 1;
+  double step = 0;
+  int steps = 0;
+  size_t first_coarse = 0;  // index of its first coarse cost (offset 0)
+  size_t first_fine = 0;    // index of its first fine cost (none, then kFine)
+};
+// The fine trials about the coarse trials' best, in steps.
+constexpr double kFine[] = {0.0, -0.5, -0.25, 0.25, 0.5};
+struct Trial {
+  int joint;
+  double offset;
+  size_t every;
+};
+
+// Each joint's moved links and steps (in *trials_of), and the coarse
+// trials of all joints: per joint, no offset first, then -steps..steps.
+std::vector<Trial> plan_coarse_trials(const LabelKinematics& k, const PointsOfLink& points_of_link,
+                                      const EvidenceParameters& parameters,
+                                      std::vector<JointTrials>* trials_of) {
+  trials_of->assign(k.num_joints, JointTrials{});
   std::vector<Trial> coarse;
   for (int j = 0; j < k.num_joints; ++j) {
-    JointTrials& t = trials_of[j];
+    JointTrials& t = (*trials_of)[j];
     bool prismatic = false;
-    t.moved = moved_links(j, &prismatic);
+    t.moved = links_moved_by(j, k, points_of_link, &prismatic);
     if (t.moved.empty()) continue;
     size_t moved_points = 0;
     for (const MovedLink& m : t.moved) moved_points += m.points->size();
@@ -353,21 +379,30 @@ void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rend
       if (g != 0) coarse.push_back(Trial{j, g * t.step, t.coarse_every});
     }
   }
+  return coarse;
+}
+
+// Runs lists of trials, on the workers when there are some.
+//
+// Only the least cost of a joint's trials is ever used, with the cost of
+// its trial at no offset in the fine ones (the gain). So a trial stops,
+// with cost +infinity, once its partial cost is above the least cost
+// finished so far among its joint's trials (PointCost::link_cost,
+// kPruneMargin: then the whole one is above it too): the least-cost trial and any trial
+// tied with it never stop, whichever thread finished what first, so the
+// choices below are the same as without the bound. `exact` (the fine
+// trials' no-offset one, whose cost the gain needs) never stops.
+class TrialRunner {
+ public:
+  TrialRunner(const PointCost& cost, const std::vector<JointTrials>& trials_of, WorkerPool* workers)
+      : cost_(cost), trials_of_(trials_of), workers_(workers) {}
+
   // `side` (optional) runs as task 0, the trials as 1.. (the longest task
   // first).
-  //
-  // Only the least cost of a joint's trials is ever used, with the cost of
-  // its trial at no offset in the fine ones (the gain). So a trial stops,
-  // with cost +infinity, once its partial cost is above the least cost
-  // finished so far among its joint's trials (PointCost::link_cost,
-  // kPruneMargin: then the whole one is above it too): the least-cost trial and any trial
-  // tied with it never stop, whichever thread finished what first, so the
-  // choices below are the same as without the bound. `exact` (the fine
-  // trials' no-offset one, whose cost the gain needs) never stops.
-  const auto run_trials = [&](const std::vector<Trial>& trials, std::vector<double>* costs, SideTask* side,
-                              const std::vector<uint8_t>& exact) {
+  void run(const std::vector<Trial>& trials, std::vector<double>* costs, SideTask* side,
+           const std::vector<uint8_t>& exact) const {
     costs->assign(trials.size(), 0.0);
-    std::vector<std::atomic<double>> least(static_cast<size_t>(k.num_joints));
+    std::vector<std::atomic<double>> least(trials_of_.size());
     for (std::atomic<double>& l : least) l.store(std::numeric_limits<double>::infinity());
     const int first = side != nullptr ? 1 : 0;
     const auto one = [&](int task) {
@@ -380,47 +415,57 @@ void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rend
       std::atomic<double>& joint_least = least[static_cast<size_t>(trial.joint)];
       const double bound =
           exact.empty() || exact[n] == 0 ? joint_least.load() : std::numeric_limits<double>::infinity();
-      const double prune_above = bound * (1.0 + kPruneMargin);
-      // Scratch, kept by each thread from call to call (no allocation once
-      // they have grown).
-      thread_local std::vector<double> point_cost;
-      thread_local std::vector<double> link_costs;
-      const std::vector<MovedLink>& moved = trials_of[trial.joint].moved;
-      link_costs.assign(moved.size(), 0.0);
-      // The links from the last (the distal ones, which an offset moves
-      // most), the finished cost summed over them in order.
-      double seen = 0;
-      bool left = false;
-      for (size_t l = moved.size(); l-- > 0 && !left;) {
-        left = !cost.link_cost(*moved[l].points, motion_of(moved[l], trial.offset), trial.every, seen,
-                               prune_above, &point_cost, &link_costs[l]);
-        seen += link_costs[l];
-      }
-      double sum = std::numeric_limits<double>::infinity();
-      if (!left) {
-        sum = 0;
-        for (const double c : link_costs) sum += c;
-      }
+      const double sum = trial_cost(trial, bound * (1.0 + kPruneMargin));
       (*costs)[n] = sum;
       double least_now = joint_least.load();
       while (sum < least_now && !joint_least.compare_exchange_weak(least_now, sum)) {
       }
     };
     const int tasks = first + static_cast<int>(trials.size());
-    if (workers != nullptr) {
-      workers->run(tasks, one);
+    if (workers_ != nullptr) {
+      workers_->run(tasks, one);
     } else {
       for (int task = 0; task < tasks; ++task) one(task);
     }
-  };
-  std::vector<double> coarse_cost;
-  run_trials(coarse, &coarse_cost, beside, {});
-  // Per joint, the coarse trials' best (0: none beat no offset), then
-  // the fine trials.
-  std::vector<double> centre_of(k.num_joints, 0.0);
+  }
+
+ private:
+  // The trial's cost, +infinity once it exceeds `prune_above`.
+  double trial_cost(const Trial& trial, double prune_above) const {
+    // Scratch, kept by each thread from call to call (no allocation once
+    // they have grown).
+    thread_local std::vector<double> point_cost;
+    thread_local std::vector<double> link_costs;
+    const std::vector<MovedLink>& moved = trials_of_[trial.joint].moved;
+    link_costs.assign(moved.size(), 0.0);
+    // The links from the last (the distal ones, which an offset moves
+    // most), the finished cost summed over them in order.
+    double seen = 0;
+    bool left = false;
+    for (size_t l = moved.size(); l-- > 0 && !left;) {
+      left = !cost_.link_cost(*moved[l].points, link_motion(moved[l], trial.offset), trial.every, seen,
+                              prune_above, &point_cost, &link_costs[l]);
+      seen += link_costs[l];
+    }
+    if (left) return std::numeric_limits<double>::infinity();
+    double sum = 0;
+    for (const double c : link_costs) sum += c;
+    return sum;
+  }
+
+  const PointCost& cost_;
+  const std::vector<JointTrials>& trials_of_;
+  WorkerPool* workers_;
+};
+
+// Per joint, the coarse trials' best offset (in *centre_of; 0: none beat
+// no offset), and the fine trials: no offset, then kFine about that best.
+std::vector<Trial> plan_fine_trials(const std::vector<double>& coarse_cost,
+                                    std::vector<JointTrials>* trials_of, std::vector<double>* centre_of) {
+  centre_of->assign(trials_of->size(), 0.0);
   std::vector<Trial> fine;
-  for (int j = 0; j < k.num_joints; ++j) {
-    JointTrials& t = trials_of[j];
+  for (size_t j = 0; j < trials_of->size(); ++j) {
+    JointTrials& t = (*trials_of)[j];
     if (t.moved.empty()) continue;
     size_t n = t.first_coarse;
     double coarse_best = coarse_cost[n++];
@@ -433,20 +478,29 @@ void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rend
         centre = g * t.step;
       }
     }
-    centre_of[j] = centre;
+    (*centre_of)[j] = centre;
     t.first_fine = fine.size();
-    fine.push_back(Trial{j, 0.0, 1});
+    fine.push_back(Trial{static_cast<int>(j), 0.0, 1});
     if (centre == 0) continue;
-    for (double f : kFine) fine.push_back(Trial{j, centre + f * t.step, 1});
+    for (double f : kFine) fine.push_back(Trial{static_cast<int>(j), centre + f * t.step, 1});
   }
-  // Each joint's fine trial at no offset is computed whole (the gain).
-  std::vector<uint8_t> exact(fine.size(), 0);
+  return fine;
+}
+
+// Which fine trials are computed whole: each joint's at no offset (the
+// gain).
+std::vector<uint8_t> exact_fine_trials(const std::vector<JointTrials>& trials_of, size_t fine_trials) {
+  std::vector<uint8_t> exact(fine_trials, 0);
   for (const JointTrials& t : trials_of) {
     if (!t.moved.empty()) exact[t.first_fine] = 1;
   }
-  std::vector<double> fine_cost;
-  run_trials(fine, &fine_cost, nullptr, exact);
-  for (int j = 0; j < k.num_joints; ++j) {
+  return exact;
+}
+
+// Each joint's best fine offset and its gain over no offset, into s.
+void choose_offsets(const std::vector<JointTrials>& trials_of, const std::vector<double>& centre_of,
+                    const std::vector<double>& fine_cost, discrepancy_t* s) {
+  for (size_t j = 0; j < trials_of.size(); ++j) {
     const JointTrials& t = trials_of[j];
     if (t.moved.empty()) continue;
     const double none = fine_cost[t.first_fine];
@@ -461,24 +515,66 @@ void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rend
         }
       }
     }
-    s.joint_search_offset[j] = best_offset;
-    s.joint_search_gain[j] = std::max(0.0, none - best);
+    s->joint_search_offset[j] = best_offset;
+    s->joint_search_gain[j] = std::max(0.0, none - best);
   }
+}
+
+// The joint with the greatest positive gain (the first of equals); -1 for
+// none.
+int best_joint(const discrepancy_t& s, int num_joints) {
+  int best = -1;
+  for (int j = 0; j < num_joints; ++j) {
+    if (s.joint_search_gain[j] > 0 && (best < 0 || s.joint_search_gain[j] > s.joint_search_gain[best]))
+      best = j;
+  }
+  return best;
+}
+
+}  // namespace
+
+void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rendered,
+                          const link_labels_t& labels, const LabelKinematics& k, const DepthNoise& noise,
+                          const EvidenceParameters& parameters, discrepancy_t* summary,
+                          std::vector<uint8_t>* explained_static, WorkerPool* workers, SideTask* beside) {
+  if (explained_static != nullptr) explained_static->clear();
+  discrepancy_t& s = *summary;
+  s.search_points = 0;
+  s.joint_search_offset.assign(k.num_joints, 0.0);
+  s.joint_search_gain.assign(k.num_joints, 0.0);
+  const size_t pixels =
+      static_cast<size_t>(std::max(rendered.width, 0)) * static_cast<size_t>(std::max(rendered.height, 0));
+  if (!inputs_usable(camera, rendered, labels, k, pixels)) return;
+  // The robot pixels a joint moves, and the stride that keeps them within
+  // search_max_points.
+  const MovedLinkOf moved_link(rendered, labels, k);
+  const int stride = sampling_stride(moved_link, pixels, parameters.search_max_points);
+  if (stride == 0) return;
+  const PointsOfLink points_of_link =
+      sample_points(rendered, moved_link, k.num_robot_links, noise, parameters, stride, &s.search_points);
+  const PointCost cost(camera, rendered, parameters.clip_sigmas,
+                       static_cast<double>(stride) * stride / parameters.pixels_per_sample);
+
+  std::vector<JointTrials> trials_of;
+  const std::vector<Trial> coarse = plan_coarse_trials(k, points_of_link, parameters, &trials_of);
+  const TrialRunner runner(cost, trials_of, workers);
+  std::vector<double> coarse_cost;
+  runner.run(coarse, &coarse_cost, beside, {});
+  std::vector<double> centre_of;
+  const std::vector<Trial> fine = plan_fine_trials(coarse_cost, &trials_of, &centre_of);
+  std::vector<double> fine_cost;
+  runner.run(fine, &fine_cost, nullptr, exact_fine_trials(trials_of, fine.size()));
+  choose_offsets(trials_of, centre_of, fine_cost, &s);
 
   // The static pixels the best joint's offset explains: where its moved
   // points land and match the measured depth.
   if (explained_static == nullptr) return;
   explained_static->assign(pixels, 0);
-  int best_joint = -1;
-  for (int j = 0; j < k.num_joints; ++j) {
-    if (s.joint_search_gain[j] > 0 &&
-        (best_joint < 0 || s.joint_search_gain[j] > s.joint_search_gain[best_joint]))
-      best_joint = j;
-  }
-  if (best_joint < 0) return;
+  const int joint = best_joint(s, k.num_joints);
+  if (joint < 0) return;
   const auto is_static = [&](int i) { return moved_link(static_cast<size_t>(i)) < 0; };
-  for (const MovedLink& m : trials_of[best_joint].moved) {
-    cost.mark_matches(*m.points, motion_of(m, s.joint_search_offset[best_joint]), stride, is_static,
+  for (const MovedLink& m : trials_of[joint].moved) {
+    cost.mark_matches(*m.points, link_motion(m, s.joint_search_offset[joint]), stride, is_static,
                       explained_static);
   }
 }

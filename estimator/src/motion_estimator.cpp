@@ -122,6 +122,16 @@ namespace {
 // The joint search scores at most about this many distal points per joint.
 constexpr size_t kSearchPoints = 500;
 
+// The joint search's offsets (rad): every step within +-range, 0 left out.
+std::vector<double> search_grid(double range_rad, double step_rad) {
+  std::vector<double> grid;
+  const int steps = static_cast<int>(std::floor(range_rad / step_rad));
+  for (int s = -steps; s <= steps; ++s) {
+    if (s != 0) grid.push_back(s * step_rad);
+  }
+  return grid;
+}
+
 // A robust scale level past the end of any schedule (the final scale).
 constexpr int kFinalLevel = 1000;
 
@@ -596,18 +606,39 @@ std::string MotionEstimator::solve(const std::vector<const EstimatorFrame*>& fra
   return "";
 }
 
+std::vector<const MotionEstimator::Sample*> MotionEstimator::distal_samples(
+    const std::vector<Sample>& samples, int k, size_t* every) const {
+  std::vector<const Sample*> distal;
+  for (const Sample& s : samples) {
+    for (const ChainJoint& c : chains_[s.link]) {
+      if (c.param == k) {
+        distal.push_back(&s);
+        break;
+      }
+    }
+  }
+  // Too few to judge: none.
+  if (static_cast<int>(distal.size()) < options_.min_joint_points) return {};
+  // Scoring every distal point of a large link for 30 offsets costs
+  // more than a render; a few hundred points, spread over the links,
+  // score as well.
+  *every = (distal.size() + kSearchPoints - 1) / kSearchPoints;
+  if (*every > 1) {
+    size_t kept = 0;
+    for (size_t i = 0; i < distal.size(); i += *every) distal[kept++] = distal[i];
+    distal.resize(kept);
+  }
+  return distal;
+}
+
 int MotionEstimator::search_joints(const EstimatorFrame& frame, State* state, std::string* error) {
   const Intrinsics& in = frame.intrinsics;
   const int width = in.width;
   const int height = in.height;
   const double tolerance_floor = options_.final_robust_scale_m;
   int moves = 0;
-  std::vector<double> grid;
-  const int steps =
-      static_cast<int>(std::floor(options_.joint_search_range_rad / options_.joint_search_step_rad));
-  for (int s = -steps; s <= steps; ++s) {
-    if (s != 0) grid.push_back(s * options_.joint_search_step_rad);
-  }
+  const std::vector<double> grid =
+      search_grid(options_.joint_search_range_rad, options_.joint_search_step_rad);
   for (int round = 0; round < options_.joint_search_rounds; ++round) {
     std::vector<Sample> samples;
     Linearization scratch;
@@ -653,25 +684,9 @@ int MotionEstimator::search_joints(const EstimatorFrame& frame, State* state, st
     int best_gain = 0;
     std::vector<Eigen::Isometry3d> moved(scene_.links.size(), Eigen::Isometry3d::Identity());
     for (int k = 0; k < num_params_; ++k) {
-      std::vector<const Sample*> distal;
-      for (const Sample& s : samples) {
-        for (const ChainJoint& c : chains_[s.link]) {
-          if (c.param == k) {
-            distal.push_back(&s);
-            break;
-          }
-        }
-      }
-      if (static_cast<int>(distal.size()) < options_.min_joint_points) continue;
-      // Scoring every distal point of a large link for 30 offsets costs
-      // more than a render; a few hundred points, spread over the links,
-      // score as well.
-      const size_t every = (distal.size() + kSearchPoints - 1) / kSearchPoints;
-      if (every > 1) {
-        size_t kept = 0;
-        for (size_t i = 0; i < distal.size(); i += every) distal[kept++] = distal[i];
-        distal.resize(kept);
-      }
+      size_t every = 1;
+      const std::vector<const Sample*> distal = distal_samples(samples, k, &every);
+      if (distal.empty()) continue;
       std::fill(moved.begin(), moved.end(), Eigen::Isometry3d::Identity());
       const int base_score = score(distal, moved);
       for (double offset : grid) {

@@ -129,7 +129,7 @@ FrameFinding frozen_image(const FrameEvidence& e) {
 // The three fraction rules below judge only frames without evidence
 // (discrepancy_t.evidence_available false: labels from a renderer that
 // publishes no kinematics). With evidence, the sequential tests
-// (evidence_tests.hpp) decide calibration and joint errors, in frame order
+// (sequential_evidence.hpp) decide calibration and joint errors, in frame order
 // (RiskMonitor).
 
 // CALIBRATION_ERROR: the static environment and the arm disagree broadly.

@@ -32,6 +32,132 @@ joint_state_t to_message(const ArmState& state, const std::string& robot_id, int
   return m;
 }
 
+// The process's LCM side: the permission to move and the encoder faults
+// in, the simulated arm stepped at joints_sim.rate_hz, its reported and true
+// joint states and its plan out.
+class JointsSimWiring {
+ public:
+  JointsSimWiring(const JointsSimProcessSettings& settings, SimulatedArm* arm)
+      : settings_(settings),
+        sim_(settings.joints_sim),
+        arm_(*arm),
+        node_(settings.lcm, settings.channels, "tofguard-joints-sim"),
+        plan_period_us_(static_cast<int64_t>(1e6 / sim_.plan_rate_hz)) {}
+
+  void run() {
+    subscribe_status();
+    subscribe_faults();
+    const int64_t period_us = static_cast<int64_t>(1e6 / sim_.rate_hz);
+    last_step_us_ = monotonic_us();
+    node_.add_timer(period_us, [this] { step(); });
+    node_.run();
+  }
+
+ private:
+  void on_status(const safety_status_t& s) {
+    status_allows_ = s.motion_allowed;
+    status_arrival_us_ = monotonic_us();
+  }
+
+  // The simulated arm's controller does what a real one must
+  // (docs/security.md): with a key it moves only on a verified
+  // SAFETY_STATUS_AUTH; the plain SAFETY_STATUS is not read at all.
+  void subscribe_status() {
+    const ChannelNames& channels = settings_.channels;
+    if (!auth::authenticated(settings_.auth)) {
+      node_.subscribe<safety_status_t>(
+          node_.safety(), channels.status, [this](const safety_status_t& s) { on_status(s); },
+          check_safety_status);
+      return;
+    }
+    verifier_.emplace(settings_.auth.key, settings_.auth.max_age_us);
+    node_.subscribe<authenticated_message_t>(
+        node_.safety(), channels.status_auth, [this](const authenticated_message_t& m) {
+          const ChannelNames& channels = settings_.channels;
+          std::string why;
+          const auto status = verifier_->open<safety_status_t>(m, channels.status, wall_utime(), &why);
+          if (status && (why = check_safety_status(*status)).empty()) {
+            on_status(*status);
+            return;
+          }
+          node_.counters().validation_errors++;
+          node_.errors().report(channels.status_auth, channels.status_auth + ": refused: " + why);
+        });
+  }
+
+  void subscribe_faults() {
+    node_.subscribe<sim_joint_fault_t>(
+        node_.safety(), settings_.channels.sim_joint_fault,
+        [this](const sim_joint_fault_t& fault) {
+          const ChannelNames& channels = settings_.channels;
+          if (!arm_.set_encoder_offset(fault.joint, fault.offset)) {
+            node_.counters().validation_errors++;
+            node_.errors().report(
+                channels.sim_joint_fault,
+                channels.sim_joint_fault + ": joint: expected a joint of the arm, got '" + fault.joint + "'");
+            return;
+          }
+          std::cerr << "tofguard-joints-sim: encoder fault on " << fault.joint << ": offset " << fault.offset
+                    << std::endl;
+        },
+        check_sim_joint_fault);
+  }
+
+  void publish_plan(int64_t utime) {
+    planned_trajectory_t plan;
+    plan.utime = utime;
+    plan.joint_name = arm_.true_state().name;
+    plan.num_joints = static_cast<int32_t>(plan.joint_name.size());
+    for (int64_t ahead_us = 0; ahead_us <= sim_.plan_horizon_us; ahead_us += sim_.plan_step_us) {
+      plan.point_utime.push_back(utime + ahead_us);
+      plan.position.push_back(arm_.planned_reported_positions(ahead_us * 1e-6));
+    }
+    plan.num_points = static_cast<int32_t>(plan.point_utime.size());
+    node_.safety().publish(settings_.channels.planned_trajectory, &plan);
+  }
+
+  // One period: the arm moves while the permission is fresh, then its
+  // plan (when due), reported and true joint states go out.
+  void step() {
+    const int64_t now_us = monotonic_us();
+    const bool allowed =
+        status_allows_ && status_arrival_us_ >= 0 && now_us - status_arrival_us_ <= sim_.status_deadline_us;
+    arm_.step((now_us - last_step_us_) * 1e-6, allowed);
+    last_step_us_ = now_us;
+    const int64_t utime = wall_utime();
+    const joint_state_t reported = to_message(arm_.reported_state(), settings_.robot.id, utime);
+    const joint_state_t truth = to_message(arm_.true_state(), settings_.robot.id, utime);
+    // The plan goes first: a replanned arm (halted, resumed, encoder jump)
+    // is never seen off its old plan.
+    if (sim_.publish_plan && (now_us >= next_plan_us_ || allowed != planned_allowed_ ||
+                              arm_.offsets_version() != planned_offsets_version_)) {
+      publish_plan(utime);
+      next_plan_us_ = now_us + plan_period_us_;
+      planned_allowed_ = allowed;
+      planned_offsets_version_ = arm_.offsets_version();
+    }
+    node_.safety().publish(settings_.channels.joint_state, &reported);
+    node_.safety().publish(settings_.channels.sim_true_joint_state, &truth);
+    node_.counters().frames_out++;
+    node_.heartbeat().set_status(allowed ? "moving" : "halted: no permission to move");
+  }
+
+  const JointsSimProcessSettings& settings_;
+  const JointsSimSettings& sim_;
+  SimulatedArm& arm_;
+  LcmNode node_;
+  std::optional<auth::MessageVerifier> verifier_;
+  bool status_allows_ = false;
+  int64_t status_arrival_us_ = -1;
+  int64_t last_step_us_ = 0;
+  // The plan: every 1/plan_rate_hz, and at once when the permission to move
+  // changes (the arm halts or resumes), from the joint state just published.
+  const int64_t plan_period_us_;
+  int64_t next_plan_us_ = 0;
+  bool planned_allowed_ = false;
+  int planned_offsets_version_ = 0;
+};
+
 }  // namespace
 
 ProcessInfo joints_sim_info() {
@@ -54,96 +180,7 @@ int run_joints_sim(const JointsSimProcessSettings& settings) {
     throw ConfigError(e.what());
   }
   const auto arm = std::make_unique<SimulatedArm>(settings.joints_sim, urdf_joints, settings.config_file);
-  LcmNode node(settings.lcm, settings.channels, "tofguard-joints-sim");
-
-  bool status_allows = false;
-  int64_t status_arrival_us = -1;
-  auto on_status = [&](const safety_status_t& s) {
-    status_allows = s.motion_allowed;
-    status_arrival_us = monotonic_us();
-  };
-  // The simulated arm's controller does what a real one must
-  // (docs/security.md): with a key it moves only on a verified
-  // SAFETY_STATUS_AUTH; the plain SAFETY_STATUS is not read at all.
-  std::optional<auth::MessageVerifier> verifier;
-  if (auth::authenticated(settings.auth)) {
-    verifier.emplace(settings.auth.key, settings.auth.max_age_us);
-    node.subscribe<authenticated_message_t>(
-        node.safety(), settings.channels.status_auth, [&](const authenticated_message_t& m) {
-          std::string why;
-          const auto status =
-              verifier->open<safety_status_t>(m, settings.channels.status, wall_utime(), &why);
-          if (status && (why = check_safety_status(*status)).empty()) {
-            on_status(*status);
-            return;
-          }
-          node.counters().validation_errors++;
-          node.errors().report(settings.channels.status_auth,
-                               settings.channels.status_auth + ": refused: " + why);
-        });
-  } else {
-    node.subscribe<safety_status_t>(node.safety(), settings.channels.status, on_status, check_safety_status);
-  }
-  node.subscribe<sim_joint_fault_t>(
-      node.safety(), settings.channels.sim_joint_fault,
-      [&](const sim_joint_fault_t& fault) {
-        if (!arm->set_encoder_offset(fault.joint, fault.offset)) {
-          node.counters().validation_errors++;
-          node.errors().report(settings.channels.sim_joint_fault,
-                               settings.channels.sim_joint_fault +
-                                   ": joint: expected a joint of the arm, got '" + fault.joint + "'");
-          return;
-        }
-        std::cerr << "tofguard-joints-sim: encoder fault on " << fault.joint << ": offset " << fault.offset
-                  << std::endl;
-      },
-      check_sim_joint_fault);
-
-  const int64_t period_us = static_cast<int64_t>(1e6 / settings.joints_sim.rate_hz);
-  int64_t last_step_us = monotonic_us();
-  // The plan: every 1/plan_rate_hz, and at once when the permission to move
-  // changes (the arm halts or resumes), from the joint state just published.
-  const JointsSimSettings& sim = settings.joints_sim;
-  const int64_t plan_period_us = static_cast<int64_t>(1e6 / sim.plan_rate_hz);
-  int64_t next_plan_us = 0;
-  bool planned_allowed = false;
-  int planned_offsets_version = 0;
-  auto publish_plan = [&](int64_t utime) {
-    planned_trajectory_t plan;
-    plan.utime = utime;
-    plan.joint_name = arm->true_state().name;
-    plan.num_joints = static_cast<int32_t>(plan.joint_name.size());
-    for (int64_t ahead_us = 0; ahead_us <= sim.plan_horizon_us; ahead_us += sim.plan_step_us) {
-      plan.point_utime.push_back(utime + ahead_us);
-      plan.position.push_back(arm->planned_reported_positions(ahead_us * 1e-6));
-    }
-    plan.num_points = static_cast<int32_t>(plan.point_utime.size());
-    node.safety().publish(settings.channels.planned_trajectory, &plan);
-  };
-  node.add_timer(period_us, [&] {
-    const int64_t now_us = monotonic_us();
-    const bool allowed =
-        status_allows && status_arrival_us >= 0 && now_us - status_arrival_us <= sim.status_deadline_us;
-    arm->step((now_us - last_step_us) * 1e-6, allowed);
-    last_step_us = now_us;
-    const int64_t utime = wall_utime();
-    const joint_state_t reported = to_message(arm->reported_state(), settings.robot.id, utime);
-    const joint_state_t truth = to_message(arm->true_state(), settings.robot.id, utime);
-    // The plan goes first: a replanned arm (halted, resumed, encoder jump)
-    // is never seen off its old plan.
-    if (sim.publish_plan && (now_us >= next_plan_us || allowed != planned_allowed ||
-                             arm->offsets_version() != planned_offsets_version)) {
-      publish_plan(utime);
-      next_plan_us = now_us + plan_period_us;
-      planned_allowed = allowed;
-      planned_offsets_version = arm->offsets_version();
-    }
-    node.safety().publish(settings.channels.joint_state, &reported);
-    node.safety().publish(settings.channels.sim_true_joint_state, &truth);
-    node.counters().frames_out++;
-    node.heartbeat().set_status(allowed ? "moving" : "halted: no permission to move");
-  });
-  node.run();
+  JointsSimWiring(settings, arm.get()).run();
   return 0;
 }
 

@@ -6,6 +6,7 @@
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/estimator/estimator_process.hpp"
+#include "tofguard/estimator/estimator_scheduler.hpp"
 
 namespace tofguard::estimator {
 namespace {

@@ -26,7 +26,7 @@
 #include "estimator_test_support.hpp"
 #include "scaled_intrinsics.hpp"
 #include "tofguard/renderer/depth_renderer.hpp"
-#include "tofguard/renderer/renderer_process.hpp"
+#include "tofguard/renderer/renderer_service.hpp"
 
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
 #define TOFGUARD_ALLOCATOR_INTERCEPTED 1

@@ -15,7 +15,7 @@
 #include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/heartbeat_t.hpp"
 #include "tofguard/renderer/depth_renderer.hpp"
-#include "tofguard/renderer/renderer_process.hpp"
+#include "tofguard/renderer/renderer_service.hpp"
 #include "tool_support.hpp"
 
 namespace tofguard::renderer {

@@ -6,7 +6,8 @@
 
 #include "tofguard/common/wire_checks.hpp"
 #include "tofguard/deployment/process_settings.hpp"
-#include "tofguard/renderer/renderer_process.hpp"
+#include "tofguard/renderer/prediction_schedule.hpp"
+#include "tofguard/renderer/renderer_service.hpp"
 #include "tool_support.hpp"
 
 namespace tofguard::renderer {

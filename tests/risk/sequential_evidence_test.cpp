@@ -1,4 +1,4 @@
-// The sequential evidence tests (risk/include/tofguard/risk/evidence_tests.hpp)
+// The sequential evidence tests (risk/include/tofguard/risk/sequential_evidence.hpp)
 // on synthetic evidence with known statistics: a parameter with information
 // I has score s ~ N(0, I) without a fault and s ~ N(I * delta, I) with the
 // parameter off by delta. Then the same evidence through RiskMonitor: the
@@ -16,8 +16,8 @@
 
 #include "synthetic_frames.hpp"
 #include "tofguard/deployment/config.hpp"
-#include "tofguard/risk/evidence_tests.hpp"
 #include "tofguard/risk/risk_monitor.hpp"
+#include "tofguard/risk/sequential_evidence.hpp"
 #include "tofguard/robot_model/kinematic_tree.hpp"
 #include "tool_support.hpp"
 

@@ -19,7 +19,7 @@
 #include "tofguard/heartbeat_t.hpp"
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/renderer/depth_renderer.hpp"
-#include "tofguard/renderer/renderer_process.hpp"
+#include "tofguard/renderer/renderer_service.hpp"
 #include "tofguard/sim_camera_fault_t.hpp"
 #include "tool_support.hpp"
 

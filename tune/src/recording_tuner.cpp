@@ -16,8 +16,8 @@
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/discrepancy/discrepancy_image.hpp"
 #include "tofguard/joint_state_t.hpp"
-#include "tofguard/renderer/renderer_process.hpp"
-#include "tofguard/risk/evidence_tests.hpp"
+#include "tofguard/renderer/renderer_service.hpp"
+#include "tofguard/risk/sequential_evidence.hpp"
 #include "tofguard/robot_model/kinematic_tree.hpp"
 
 namespace tofguard::tune {
@@ -122,102 +122,135 @@ std::string fixed(double value, int decimals) {
   return s.str();
 }
 
-}  // namespace
+// Reads a recording's joint states, camera poses and depth frames, and
+// renders each frame as tofguard-renderer would: the counts and the joints'
+// ranges go into the result.
+class RecordingRenderer {
+ public:
+  RecordingRenderer(const TuneSettings& settings, const TuneOptions& options, TuneResult* result)
+      : channels_(settings.renderer.channels),
+        camera_id_(settings.renderer.camera.id),
+        options_(options),
+        result_(*result),
+        service_(settings.renderer) {}
 
-TuneResult tune_recording(const TuneSettings& settings, const std::string& log_path,
-                          const TuneOptions& options) {
-  TuneResult result;
-  result.log_path = log_path;
-  lcm::LogFile log(log_path, "r");
-  if (!log.good()) {
-    result.error = log_path + ": cannot open as an LCM log";
-    return result;
+  // Every event of the log, then the frames still waiting.
+  std::vector<RenderedPair> read(lcm::LogFile* log) {
+    for (const lcm::LogEvent* event = log->readNextEvent(); event != nullptr; event = log->readNextEvent()) {
+      if (event->channel == channels_.joint_state) {
+        on_joint_state(*event);
+      } else if (event->channel == channels_.camera_pose) {
+        const auto pose = decode_message<camera_pose_t>(event->data, event->datalen);
+        if (pose && check_camera_pose(*pose).empty()) service_.on_camera_pose(*pose);
+      } else if (event->channel == channels_.depth && result_.depth_frames < options_.max_frames) {
+        on_depth(*event);
+      }
+    }
+    render_waiting(INT64_MAX);
+    finish();
+    return std::move(frames_);
   }
-  const ChannelNames& channels = settings.renderer.channels;
-  const std::string& camera_id = settings.renderer.camera.id;
-  renderer::RendererService service(settings.renderer);
+
+ private:
+  void on_joint_state(const lcm::LogEvent& event) {
+    const auto state = decode_message<joint_state_t>(event.data, event.datalen);
+    if (!state || !check_joint_state(*state).empty() || !service_.on_joint_state(*state)) return;
+    ++result_.joint_states;
+    newest_joint_utime_ = std::max(newest_joint_utime_, state->utime);
+    for (int j = 0; j < state->num_joints; ++j) {
+      auto [it, fresh] = joint_range_.try_emplace(state->name[j], state->position[j], state->position[j]);
+      if (!fresh) {
+        it->second.first = std::min(it->second.first, state->position[j]);
+        it->second.second = std::max(it->second.second, state->position[j]);
+      }
+    }
+    render_waiting(newest_joint_utime_);
+  }
+
+  void on_depth(const lcm::LogEvent& event) {
+    const auto frame = decode_message<depth_image_t>(event.data, event.datalen);
+    if (!frame || !check_depth_image_from(*frame, camera_id_).empty()) return;
+    if (result_.depth_frames++ == 0) first_utime_ = frame->utime;
+    last_utime_ = frame->utime;
+    waiting_.push_back(*frame);
+  }
 
   // Frames wait until a joint state at or after their utime has come (the
-  // joints are then interpolated, never extrapolated) or the log ends.
-  std::deque<depth_image_t> waiting;
-  std::vector<RenderedPair> frames;
-  int64_t newest_joint_utime = INT64_MIN;
-  int64_t first_utime = 0, last_utime = 0;
-  std::map<std::string, std::pair<double, double>> joint_range;
-  auto render = [&](const depth_image_t& camera) {
-    renderer::RenderedFrame rendered = service.render(camera);
+  // joints are then interpolated, never extrapolated) or the log ends:
+  // renders those at or before `utime`.
+  void render_waiting(int64_t utime) {
+    while (!waiting_.empty() && waiting_.front().utime <= utime) {
+      render(waiting_.front());
+      waiting_.pop_front();
+    }
+  }
+
+  void render(const depth_image_t& camera) {
+    renderer::RenderedFrame rendered = service_.render(camera);
     if (!rendered.depth) {
-      if (result.unusable_frames++ == 0) result.first_unusable_reason = rendered.labels.unusable_reason;
+      if (result_.unusable_frames++ == 0) result_.first_unusable_reason = rendered.labels.unusable_reason;
       return;
     }
     RenderedPair pair{camera, std::move(*rendered.depth), std::move(rendered.labels)};
     // The amplitude is not compared: not kept.
     pair.camera.num_amplitude = 0;
     pair.camera.amplitude.clear();
-    frames.push_back(std::move(pair));
-  };
-  for (const lcm::LogEvent* event = log.readNextEvent(); event != nullptr; event = log.readNextEvent()) {
-    if (event->channel == channels.joint_state) {
-      const auto state = decode_message<joint_state_t>(event->data, event->datalen);
-      if (!state || !check_joint_state(*state).empty() || !service.on_joint_state(*state)) continue;
-      ++result.joint_states;
-      newest_joint_utime = std::max(newest_joint_utime, state->utime);
-      for (int j = 0; j < state->num_joints; ++j) {
-        auto [it, fresh] = joint_range.try_emplace(state->name[j], state->position[j], state->position[j]);
-        if (!fresh) {
-          it->second.first = std::min(it->second.first, state->position[j]);
-          it->second.second = std::max(it->second.second, state->position[j]);
-        }
-      }
-      while (!waiting.empty() && waiting.front().utime <= newest_joint_utime) {
-        render(waiting.front());
-        waiting.pop_front();
-      }
-    } else if (event->channel == channels.camera_pose) {
-      const auto pose = decode_message<camera_pose_t>(event->data, event->datalen);
-      if (pose && check_camera_pose(*pose).empty()) service.on_camera_pose(*pose);
-    } else if (event->channel == channels.depth && result.depth_frames < options.max_frames) {
-      const auto frame = decode_message<depth_image_t>(event->data, event->datalen);
-      if (!frame || !check_depth_image_from(*frame, camera_id).empty()) continue;
-      if (result.depth_frames++ == 0) first_utime = frame->utime;
-      last_utime = frame->utime;
-      waiting.push_back(*frame);
+    frames_.push_back(std::move(pair));
+  }
+
+  // The frame counts, the measured rate and the most moving joint.
+  void finish() {
+    result_.used_frames = static_cast<int>(frames_.size());
+    result_.seconds = (last_utime_ - first_utime_) * 1e-6;
+    if (result_.depth_frames > 1 && last_utime_ > first_utime_) {
+      result_.measured_rate_hz = (result_.depth_frames - 1) / result_.seconds;
     }
-  }
-  while (!waiting.empty()) {
-    render(waiting.front());
-    waiting.pop_front();
-  }
-  result.used_frames = static_cast<int>(frames.size());
-  result.seconds = (last_utime - first_utime) * 1e-6;
-  if (result.depth_frames > 1 && last_utime > first_utime) {
-    result.measured_rate_hz = (result.depth_frames - 1) / result.seconds;
-  }
-  for (const auto& [joint, range] : joint_range) {
-    if (range.second - range.first > result.largest_motion) {
-      result.largest_motion = range.second - range.first;
-      result.most_moving_joint = joint;
+    for (const auto& [joint, range] : joint_range_) {
+      if (range.second - range.first > result_.largest_motion) {
+        result_.largest_motion = range.second - range.first;
+        result_.most_moving_joint = joint;
+      }
     }
   }
 
+  const ChannelNames& channels_;
+  const std::string& camera_id_;
+  const TuneOptions& options_;
+  TuneResult& result_;
+  renderer::RendererService service_;
+  std::deque<depth_image_t> waiting_;
+  std::vector<RenderedPair> frames_;
+  int64_t newest_joint_utime_ = INT64_MIN;
+  int64_t first_utime_ = 0, last_utime_ = 0;
+  std::map<std::string, std::pair<double, double>> joint_range_;  // min, max
+};
+
+// Why the recording is too short or too still to tune on; empty when it
+// is not.
+std::string recording_error(const TuneSettings& settings, const TuneOptions& options,
+                            const TuneResult& result) {
+  const ChannelNames& channels = settings.renderer.channels;
   if (result.used_frames < options.min_frames) {
     std::ostringstream why;
-    why << log_path << ": too few frames to tune on: " << result.used_frames << " rendered of "
-        << result.depth_frames << " " << channels.depth << " frames of camera '" << camera_id << "' ("
-        << result.joint_states << " " << channels.joint_state << " messages";
+    why << result.log_path << ": too few frames to tune on: " << result.used_frames << " rendered of "
+        << result.depth_frames << " " << channels.depth << " frames of camera '"
+        << settings.renderer.camera.id << "' (" << result.joint_states << " " << channels.joint_state
+        << " messages";
     if (result.unusable_frames > 0) why << "; first unusable: " << result.first_unusable_reason;
     why << "); need " << options.min_frames;
-    result.error = why.str();
-    return result;
+    return why.str();
   }
   if (result.largest_motion < options.min_motion) {
-    result.error = log_path + ": no motion: no joint moved more than " + fixed(options.min_motion, 3) +
-                   " rad (m) over the recording (largest: " + fixed(result.largest_motion, 4) +
-                   "); record the arm moving through its workspace";
-    return result;
+    return result.log_path + ": no motion: no joint moved more than " + fixed(options.min_motion, 3) +
+           " rad (m) over the recording (largest: " + fixed(result.largest_motion, 4) +
+           "); record the arm moving through its workspace";
   }
+  return "";
+}
 
-  // Pass 1: the samples and the fit.
+// Pass 1: the samples and the fit.
+NoiseFit fit_noise(const std::vector<RenderedPair>& frames, const TuneSettings& settings,
+                   const TuneOptions& options) {
   NoiseSamples samples(options.fit);
   const double jump_mm = settings.discrepancy.silhouette_jump_mm;
   for (const RenderedPair& frame : frames) {
@@ -227,29 +260,28 @@ TuneResult tune_recording(const TuneSettings& settings, const std::string& log_p
         samples.add(frame.camera.depth_mm[i], frame.rendered.depth_mm[i] - frame.camera.depth_mm[i]);
     }
   }
-  result.fit = samples.fit();
-  if (!result.fit.ok) {
-    result.error = log_path + ": cannot fit the noise: " + result.fit.error;
-    return result;
-  }
+  return samples.fit();
+}
 
-  // Pass 2: the neighbours' correlation of the standardised residuals'
-  // frame-to-frame differences, (z_k - z_k-1) / sqrt(2) on the pixels used
-  // in both frames: a bias fixed to a pixel (the distance calibration's
-  // residual, the model's) cancels, as in the frame-to-frame var(t), and
-  // only the noise's own correlation is left (measured on the residuals
-  // themselves, the default scene's static bias gave rho 0.011 and 1.17).
+// Pass 2: the neighbours' correlation of the standardised residuals'
+// frame-to-frame differences, (z_k - z_k-1) / sqrt(2) on the pixels used
+// in both frames: a bias fixed to a pixel (the distance calibration's
+// residual, the model's) cancels, as in the frame-to-frame var(t), and
+// only the noise's own correlation is left (measured on the residuals
+// themselves, the default scene's static bias gave rho 0.011 and 1.17).
+SpatialCorrelation measure_correlation(const std::vector<RenderedPair>& frames, const TuneSettings& settings,
+                                       const NoiseFit& fit) {
   SpatialCorrelation correlation;
   std::vector<float> previous_z;
   std::vector<uint8_t> previous_used;
   for (const RenderedPair& frame : frames) {
-    const std::vector<uint8_t> used = noise_pixels(frame, jump_mm);
+    const std::vector<uint8_t> used = noise_pixels(frame, settings.discrepancy.silhouette_jump_mm);
     std::vector<float> z(used.size(), 0.0f);
     for (size_t i = 0; i < used.size(); ++i) {
       if (!used[i]) continue;
       const int t = frame.camera.depth_mm[i];
       const double dis = frame.rendered.depth_mm[i] - t;
-      z[i] = static_cast<float>((dis - result.fit.median_mm_at(t)) / result.fit.sigma_mm(metres_from_mm(t)));
+      z[i] = static_cast<float>((dis - fit.median_mm_at(t)) / fit.sigma_mm(metres_from_mm(t)));
     }
     if (previous_z.size() == z.size()) {
       std::vector<float> difference(z.size(), 0.0f);
@@ -263,53 +295,91 @@ TuneResult tune_recording(const TuneSettings& settings, const std::string& log_p
     previous_z = std::move(z);
     previous_used = used;
   }
-  result.measured_pixels_per_sample = correlation.pixels_per_sample();
-  result.rho_u1 = correlation.rho(0, 1);
-  result.rho_v1 = correlation.rho(1, 1);
-  const double configured_pps = settings.discrepancy.evidence_pixels_per_sample;
-  result.pixels_per_sample_changed = std::abs(result.measured_pixels_per_sample - configured_pps) >
-                                     options.pixels_per_sample_change * configured_pps;
-  result.pixels_per_sample = result.pixels_per_sample_changed
-                                 ? std::round(result.measured_pixels_per_sample * 10) / 10
-                                 : configured_pps;
+  return correlation;
+}
 
-  // Pass 3: the sequential tests with the fitted model (and the config's).
+// The measured pixels per independent sample, and the one the tuned run
+// uses: the measured one (to a tenth) when it differs enough from the
+// configured one.
+void choose_pixels_per_sample(const SpatialCorrelation& correlation, const TuneSettings& settings,
+                              const TuneOptions& options, TuneResult* result) {
+  result->measured_pixels_per_sample = correlation.pixels_per_sample();
+  result->rho_u1 = correlation.rho(0, 1);
+  result->rho_v1 = correlation.rho(1, 1);
+  const double configured_pps = settings.discrepancy.evidence_pixels_per_sample;
+  result->pixels_per_sample_changed = std::abs(result->measured_pixels_per_sample - configured_pps) >
+                                      options.pixels_per_sample_change * configured_pps;
+  result->pixels_per_sample = result->pixels_per_sample_changed
+                                  ? std::round(result->measured_pixels_per_sample * 10) / 10
+                                  : configured_pps;
+}
+
+// Pass 3: the sequential tests with the fitted model (and the config's).
+void run_sequential_tests(const std::vector<RenderedPair>& frames, const TuneSettings& settings,
+                          const TuneOptions& options, TuneResult* result) {
   const robot_model::KinematicTree tree = robot_model::load_kinematic_tree(settings.renderer.robot.urdf_path);
   const risk::SequentialEvidence reference(settings.risk, tree, settings.renderer.camera.rate_hz);
-  result.threshold_h = reference.threshold();
-  result.warning_level = reference.warning_level();
-  result.hypotheses = reference.hypotheses();
-  result.tuned = run_evidence(frames, settings, tree, result.fit.sigma_at_0m_mm, result.fit.sigma_per_m2_mm,
-                              result.pixels_per_sample);
+  result->threshold_h = reference.threshold();
+  result->warning_level = reference.warning_level();
+  result->hypotheses = reference.hypotheses();
+  result->tuned = run_evidence(frames, settings, tree, result->fit.sigma_at_0m_mm,
+                               result->fit.sigma_per_m2_mm, result->pixels_per_sample);
   if (options.compare_with_config) {
-    result.has_config_run = true;
-    result.configured = run_evidence(frames, settings, tree, settings.discrepancy.noise_sigma_at_0m_mm,
-                                     settings.discrepancy.noise_sigma_per_m2_mm, configured_pps);
+    result->has_config_run = true;
+    result->configured = run_evidence(frames, settings, tree, settings.discrepancy.noise_sigma_at_0m_mm,
+                                      settings.discrepancy.noise_sigma_per_m2_mm,
+                                      settings.discrepancy.evidence_pixels_per_sample);
   }
+}
 
-  // Usable only when the tuned model makes the recording look nominal.
+// Usable only when the tuned model makes the recording look nominal: why
+// it does not; empty when it does.
+std::string not_nominal_error(const TuneOptions& options, const TuneResult& result) {
+  const std::string& log_path = result.log_path;
   if (result.tuned.mismatch_fraction() > options.max_mismatch_fraction) {
-    result.error = log_path + ": not nominal: " + fixed(100 * result.tuned.mismatch_fraction(), 2) +
-                   " % of the compared pixels mismatch even with the fitted noise (allowed " +
-                   fixed(100 * options.max_mismatch_fraction, 2) +
-                   " %): an object, a fault or a model that does not fit the scene";
-    return result;
+    return log_path + ": not nominal: " + fixed(100 * result.tuned.mismatch_fraction(), 2) +
+           " % of the compared pixels mismatch even with the fitted noise (allowed " +
+           fixed(100 * options.max_mismatch_fraction, 2) +
+           " %): an object, a fault or a model that does not fit the scene";
   }
   if (result.tuned.frames_crossed > 0) {
-    result.error = log_path + ": not nominal: a sequential test crossed h = " + fixed(result.threshold_h, 2) +
-                   " with the fitted noise, " + result.tuned.first_crossing;
-    return result;
+    return log_path + ": not nominal: a sequential test crossed h = " + fixed(result.threshold_h, 2) +
+           " with the fitted noise, " + result.tuned.first_crossing;
   }
   for (const ParameterScores& p : result.tuned.parameters) {
     if (p.scores >= options.min_scores && p.frame_to_frame_variance > options.max_frame_to_frame_variance) {
-      result.error = log_path + ": the fitted noise does not make the scores N(0, 1): " + p.name +
-                     "'s frame-to-frame var(t) is " + fixed(p.frame_to_frame_variance, 2) + " (allowed " +
-                     fixed(options.max_frame_to_frame_variance, 2) +
-                     "): spatially correlated noise (pixels_per_sample) or a bias that changes every frame";
-      return result;
+      return log_path + ": the fitted noise does not make the scores N(0, 1): " + p.name +
+             "'s frame-to-frame var(t) is " + fixed(p.frame_to_frame_variance, 2) + " (allowed " +
+             fixed(options.max_frame_to_frame_variance, 2) +
+             "): spatially correlated noise (pixels_per_sample) or a bias that changes every frame";
     }
   }
-  result.usable = true;
+  return "";
+}
+
+}  // namespace
+
+TuneResult tune_recording(const TuneSettings& settings, const std::string& log_path,
+                          const TuneOptions& options) {
+  TuneResult result;
+  result.log_path = log_path;
+  lcm::LogFile log(log_path, "r");
+  if (!log.good()) {
+    result.error = log_path + ": cannot open as an LCM log";
+    return result;
+  }
+  const std::vector<RenderedPair> frames = RecordingRenderer(settings, options, &result).read(&log);
+  result.error = recording_error(settings, options, result);
+  if (!result.error.empty()) return result;
+  result.fit = fit_noise(frames, settings, options);
+  if (!result.fit.ok) {
+    result.error = log_path + ": cannot fit the noise: " + result.fit.error;
+    return result;
+  }
+  choose_pixels_per_sample(measure_correlation(frames, settings, result.fit), settings, options, &result);
+  run_sequential_tests(frames, settings, options, &result);
+  result.error = not_nominal_error(options, result);
+  result.usable = result.error.empty();
   return result;
 }
 

@@ -181,9 +181,8 @@ class EvidenceJacobian {
   // a moved one (at() zeroes the other).
   bool at_pixel(int u, int v, double camera[6], double* joints, bool* moved, int* link) const;
   bool at_zeroing_the_other(int u, int v, double camera[6], double* joints, bool* moved, int* link) const;
-  friend void compute_evidence(const depth_image_t&, const depth_image_t&, const link_labels_t&,
-                               const std::vector<uint8_t>&, double, const DepthNoise&,
-                               const EvidenceParameters&, discrepancy_t*, WorkerPool*, SideTask*);
+  // compute_evidence's per-pixel step (evidence.cpp) calls at_pixel().
+  friend struct EvidencePixelAccess;
 
   bool available_ = false;
   int width_ = 0;

@@ -279,6 +279,9 @@ class MotionEstimator {
                     bool* converged, int* iterations);
   // The joint search on one frame; returns the number of joints moved.
   int search_joints(const EstimatorFrame& frame, State* state, std::string* error);
+  // The samples on links that parameter k moves, thinned to about
+  // kSearchPoints (every *every-th of them).
+  std::vector<const Sample*> distal_samples(const std::vector<Sample>& samples, int k, size_t* every) const;
   EstimateResult finish(const EstimatorFrame& frame, const State& state, const Linearization& lin,
                         bool camera_free, bool joints_free) const;
 

@@ -8,7 +8,7 @@
 //                                          estimate, which may rename a
 //                                          model mismatch's cause;
 //   PlanMonitor     (plan_monitor.hpp)     the arm leaving its plan;
-//   SequentialEvidence (evidence_tests.hpp) the CUSUMs on the frames'
+//   SequentialEvidence (sequential_evidence.hpp) the CUSUMs on the frames'
 //                                          evidence: calibration and joint
 //                                          errors;
 //   DecisionRule    (decision_rule.hpp)    debounce into WARNING/DANGEROUS,
@@ -39,11 +39,11 @@
 #include "tofguard/planned_trajectory_t.hpp"
 #include "tofguard/risk/decision_rule.hpp"
 #include "tofguard/risk/estimate_gate.hpp"
-#include "tofguard/risk/evidence_tests.hpp"
 #include "tofguard/risk/frame_classifier.hpp"
 #include "tofguard/risk/input_deadlines.hpp"
 #include "tofguard/risk/joint_states_by_utime.hpp"
 #include "tofguard/risk/plan_monitor.hpp"
+#include "tofguard/risk/sequential_evidence.hpp"
 #include "tofguard/risk_t.hpp"
 #include "tofguard/robot_model/kinematic_tree.hpp"
 #include "tofguard/settings/risk_settings.hpp"

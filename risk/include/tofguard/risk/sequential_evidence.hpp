@@ -121,6 +121,34 @@ class SequentialEvidence {
   bool quiet() const;
 
  private:
+  // A hypothesis's name ("camera" or a joint's) and its CUSUM.
+  struct NamedCusum {
+    std::string name;
+    double value;
+  };
+
+  // A frame's log-likelihood ratios into the CUSUMs.
+  void add_frame(const discrepancy_t& frame);
+  // The largest CUSUM (the camera's among equals).
+  NamedCusum largest_cusum() const;
+  // The joint test that crossed with the largest CUSUM (name empty: none).
+  NamedCusum crossed_joint() const;
+  // The index of the joint the stop names (-1: none explains the frame
+  // well enough). Which one: the joint whose offset explains this frame's
+  // residual best (naming_chi2: the naming search's gain, discrepancy_t.
+  // joint_search_*, else the linear naming fit's s^2 / I), among every
+  // joint of the robot (the first test to cross may be a distal joint's,
+  // whose links the true joint's offset moves furthest); a joint whose own
+  // test has not crossed only on strong evidence of this frame alone (2h
+  // more than the best crossed joint explains), so that a weak fault's
+  // neighbours' noise does not name them. Measured on three arms:
+  // docs/safety-chain.md, "Measured".
+  int suspect_joint(const discrepancy_t& frame) const;
+  // The finding of a stop for a joint: `crossed` is the joint test that
+  // crossed.
+  FrameFinding joint_stop_finding(const discrepancy_t& frame, const NamedCusum& crossed) const;
+  // The finding of a warning for the `largest` CUSUM.
+  FrameFinding warning_finding(const discrepancy_t& frame, const NamedCusum& largest) const;
   FrameFinding camera_finding(const discrepancy_t& frame) const;
   FrameFinding joint_finding(const discrepancy_t& frame, int index) const;
 

@@ -1,4 +1,4 @@
-#include "tofguard/risk/evidence_tests.hpp"
+#include "tofguard/risk/sequential_evidence.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -198,42 +198,36 @@ FrameFinding SequentialEvidence::joint_finding(const discrepancy_t& f, int i) co
   return finding;
 }
 
+namespace {
+
+// The joint arrays of a frame with evidence all have num_joints entries.
+void demand_joint_arrays(const discrepancy_t& f) {
+  TOFGUARD_DEMAND(f.num_joints >= 0 && f.joint_name.size() == static_cast<size_t>(f.num_joints) &&
+                      f.joint_score.size() == f.joint_name.size() &&
+                      f.joint_information.size() == f.joint_name.size() &&
+                      f.joint_naming_score.size() == f.joint_name.size() &&
+                      f.joint_naming_information.size() == f.joint_name.size(),
+                  "discrepancy seq " + std::to_string(f.seq) + ": joint arrays do not match num_joints");
+}
+
+}  // namespace
+
 EvidenceStep SequentialEvidence::update(const discrepancy_t& f) {
   EvidenceStep result;
-  if (f.evidence_available) {
-    TOFGUARD_DEMAND(f.num_joints >= 0 && f.joint_name.size() == static_cast<size_t>(f.num_joints) &&
-                        f.joint_score.size() == f.joint_name.size() &&
-                        f.joint_information.size() == f.joint_name.size() &&
-                        f.joint_naming_score.size() == f.joint_name.size() &&
-                        f.joint_naming_information.size() == f.joint_name.size(),
-                    "discrepancy seq " + std::to_string(f.seq) + ": joint arrays do not match num_joints");
-  }
+  if (f.evidence_available) demand_joint_arrays(f);
   // A repeated image (repeat_count > 0: the same depth bytes as the frame
   // before) is not new evidence: counted again it would double its weight,
   // and while the arm moves it shows the arm where it was (the frozen-image
   // rule names that fault).
   if (f.evidence_available && f.repeat_count == 0) {
     result.updated = true;
-    camera_cusum_ = step(camera_cusum_, camera_region_llr(f, camera_delta_).llr, h_);
-    for (int i = 0; i < f.num_joints; ++i) {
-      const auto it = joint_cusum_.find(f.joint_name[i]);
-      if (it == joint_cusum_.end()) continue;  // not a moving joint of the robot: not a hypothesis
-      const double delta = prismatic_.count(it->first) > 0 ? joint_delta_m_ : joint_delta_rad_;
-      it->second = step(it->second, joint_llr(f.joint_score[i], f.joint_information[i], delta), h_);
-    }
+    add_frame(f);
   }
   // The largest CUSUM relative to h, for warnings and the summary.
-  std::string largest_name = "camera";
-  double largest = camera_cusum_;
-  for (const auto& [joint, s] : joint_cusum_) {
-    if (s > largest) {
-      largest = s;
-      largest_name = joint;
-    }
-  }
+  const NamedCusum largest = largest_cusum();
   result.quiet = quiet();
   result.summary =
-      "evidence: largest CUSUM " + largest_name + " " + fixed(largest, 1) + " of h " + fixed(h_, 1);
+      "evidence: largest CUSUM " + largest.name + " " + fixed(largest.value, 1) + " of h " + fixed(h_, 1);
   if (!f.evidence_available) return result;
 
   if (camera_cusum_ >= h_) {
@@ -241,95 +235,115 @@ EvidenceStep SequentialEvidence::update(const discrepancy_t& f) {
     result.finding = camera_finding(f);
     return result;
   }
-  // The joint test that crossed with the largest CUSUM, if any: a joint
-  // reads other than seen.
-  std::string crossed;
-  double crossed_cusum = 0;
-  for (const auto& [joint, s] : joint_cusum_) {
-    if (s >= h_ && s > crossed_cusum) {
-      crossed_cusum = s;
-      crossed = joint;
-    }
-  }
-  if (!crossed.empty()) {
+  const NamedCusum crossed = crossed_joint();
+  if (!crossed.name.empty()) {
     result.crossed = true;
-    // Which one: the joint whose offset explains this frame's residual
-    // best (naming_chi2: the naming search's gain, discrepancy_t.
-    // joint_search_*, else the linear naming fit's s^2 / I), among every
-    // joint of the robot (the first test to cross may be a distal joint's,
-    // whose links the true joint's offset moves furthest); a joint whose own
-    // test has not crossed only on strong evidence of this frame alone (2h
-    // more than the best crossed joint explains, below), so that a weak
-    // fault's neighbours' noise does not name them. Measured on three arms:
-    // docs/safety-chain.md, "Measured".
-    int best = -1;
-    int best_crossed = -1;
-    double best_explained = -1;
-    double best_crossed_explained = -1;
-    for (int i = 0; i < f.num_joints; ++i) {
-      if (joint_cusum_.count(f.joint_name[i]) == 0) continue;
-      const double explained = naming_chi2(f, i);
-      if (!(explained > 0)) continue;
-      if (explained > best_explained) {
-        best_explained = explained;
-        best = i;
-      }
-      if (joint_cusum(f.joint_name[i]) >= h_ && explained > best_crossed_explained) {
-        best_crossed_explained = explained;
-        best_crossed = i;
-      }
-    }
-    // A joint whose test has not crossed must explain this frame better
-    // than the best crossed one by 2h (the difference of two hypotheses'
-    // chi-squares is twice their log-likelihood ratio: this frame alone
-    // prefers it at the threshold's level); with no crossed joint in the
-    // fit, by 2h against nothing.
-    const double crossed_explained = best_crossed >= 0 ? best_crossed_explained : 0.0;
-    const bool best_is_weak =
-        best >= 0 && joint_cusum(f.joint_name[best]) < h_ && best_explained - crossed_explained < 2 * h_;
-    const int suspect = best_is_weak ? best_crossed : best;
-    if (suspect < 0) {
-      // No joint explains anything this frame (no robot point seen, or
-      // every robot pixel beyond the naming fit's gate), or only a joint
-      // whose test has not crossed, weakly: the joint whose test crossed.
-      // Still a stop.
-      result.finding.cause = risk_t::CAUSE_JOINT_ERROR;
-      result.finding.suspect = crossed;
-      result.finding.score = crossed_cusum;
-      result.finding.threshold = h_;
-      result.finding.detail = "joint " + crossed +
-                              " reads other than seen (sequential evidence, CUSUM log-likelihood ratio): " +
-                              fixed(crossed_cusum, 1) + " of h " + fixed(h_, 1);
-      return result;
-    }
-    result.finding = joint_finding(f, suspect);
-    if (joint_cusum(f.joint_name[suspect]) < h_) {
-      // Named by the naming search (or fit); the evidence that crossed is another
-      // joint's test.
-      result.finding.score = crossed_cusum;
-      result.finding.detail += " (the test that crossed: " + crossed + "'s, " + fixed(crossed_cusum, 1) +
-                               " of h " + fixed(h_, 1) + ")";
-    }
+    result.finding = joint_stop_finding(f, crossed);
     return result;
   }
-  if (largest >= warning_level()) {
+  if (largest.value >= warning_level()) {
     result.warning = true;
-    const auto at = std::find(f.joint_name.begin(), f.joint_name.end(), largest_name);
-    if (largest_name == "camera" && largest == camera_cusum_) {
-      result.finding = camera_finding(f);
-    } else if (at != f.joint_name.end()) {
-      result.finding = joint_finding(f, static_cast<int>(at - f.joint_name.begin()));
-    } else {
-      result.finding.cause = risk_t::CAUSE_JOINT_ERROR;
-      result.finding.suspect = largest_name;
-      result.finding.score = largest;
-      result.finding.threshold = h_;
-      result.finding.detail = "joint " + largest_name +
-                              " evidence growing (CUSUM log-likelihood ratio): " + fixed(largest, 1) +
-                              " of h " + fixed(h_, 1);
-    }
+    result.finding = warning_finding(f, largest);
   }
   return result;
+}
+
+void SequentialEvidence::add_frame(const discrepancy_t& f) {
+  camera_cusum_ = step(camera_cusum_, camera_region_llr(f, camera_delta_).llr, h_);
+  for (int i = 0; i < f.num_joints; ++i) {
+    const auto it = joint_cusum_.find(f.joint_name[i]);
+    if (it == joint_cusum_.end()) continue;  // not a moving joint of the robot: not a hypothesis
+    const double delta = prismatic_.count(it->first) > 0 ? joint_delta_m_ : joint_delta_rad_;
+    it->second = step(it->second, joint_llr(f.joint_score[i], f.joint_information[i], delta), h_);
+  }
+}
+
+SequentialEvidence::NamedCusum SequentialEvidence::largest_cusum() const {
+  NamedCusum largest{"camera", camera_cusum_};
+  for (const auto& [joint, s] : joint_cusum_) {
+    if (s > largest.value) largest = NamedCusum{joint, s};
+  }
+  return largest;
+}
+
+SequentialEvidence::NamedCusum SequentialEvidence::crossed_joint() const {
+  NamedCusum crossed{"", 0};
+  for (const auto& [joint, s] : joint_cusum_) {
+    if (s >= h_ && s > crossed.value) crossed = NamedCusum{joint, s};
+  }
+  return crossed;
+}
+
+int SequentialEvidence::suspect_joint(const discrepancy_t& f) const {
+  int best = -1;
+  int best_crossed = -1;
+  double best_explained = -1;
+  double best_crossed_explained = -1;
+  for (int i = 0; i < f.num_joints; ++i) {
+    if (joint_cusum_.count(f.joint_name[i]) == 0) continue;
+    const double explained = naming_chi2(f, i);
+    if (!(explained > 0)) continue;
+    if (explained > best_explained) {
+      best_explained = explained;
+      best = i;
+    }
+    if (joint_cusum(f.joint_name[i]) >= h_ && explained > best_crossed_explained) {
+      best_crossed_explained = explained;
+      best_crossed = i;
+    }
+  }
+  // A joint whose test has not crossed must explain this frame better
+  // than the best crossed one by 2h (the difference of two hypotheses'
+  // chi-squares is twice their log-likelihood ratio: this frame alone
+  // prefers it at the threshold's level); with no crossed joint in the
+  // fit, by 2h against nothing.
+  const double crossed_explained = best_crossed >= 0 ? best_crossed_explained : 0.0;
+  const bool best_is_weak =
+      best >= 0 && joint_cusum(f.joint_name[best]) < h_ && best_explained - crossed_explained < 2 * h_;
+  return best_is_weak ? best_crossed : best;
+}
+
+FrameFinding SequentialEvidence::joint_stop_finding(const discrepancy_t& f, const NamedCusum& crossed) const {
+  const int suspect = suspect_joint(f);
+  if (suspect < 0) {
+    // No joint explains anything this frame (no robot point seen, or
+    // every robot pixel beyond the naming fit's gate), or only a joint
+    // whose test has not crossed, weakly: the joint whose test crossed.
+    // Still a stop.
+    FrameFinding finding;
+    finding.cause = risk_t::CAUSE_JOINT_ERROR;
+    finding.suspect = crossed.name;
+    finding.score = crossed.value;
+    finding.threshold = h_;
+    finding.detail = "joint " + crossed.name +
+                     " reads other than seen (sequential evidence, CUSUM log-likelihood ratio): " +
+                     fixed(crossed.value, 1) + " of h " + fixed(h_, 1);
+    return finding;
+  }
+  FrameFinding finding = joint_finding(f, suspect);
+  if (joint_cusum(f.joint_name[suspect]) < h_) {
+    // Named by the naming search (or fit); the evidence that crossed is another
+    // joint's test.
+    finding.score = crossed.value;
+    finding.detail += " (the test that crossed: " + crossed.name + "'s, " + fixed(crossed.value, 1) +
+                      " of h " + fixed(h_, 1) + ")";
+  }
+  return finding;
+}
+
+FrameFinding SequentialEvidence::warning_finding(const discrepancy_t& f, const NamedCusum& largest) const {
+  const auto at = std::find(f.joint_name.begin(), f.joint_name.end(), largest.name);
+  if (largest.name == "camera" && largest.value == camera_cusum_) return camera_finding(f);
+  if (at != f.joint_name.end()) return joint_finding(f, static_cast<int>(at - f.joint_name.begin()));
+  FrameFinding finding;
+  finding.cause = risk_t::CAUSE_JOINT_ERROR;
+  finding.suspect = largest.name;
+  finding.score = largest.value;
+  finding.threshold = h_;
+  finding.detail = "joint " + largest.name +
+                   " evidence growing (CUSUM log-likelihood ratio): " + fixed(largest.value, 1) + " of h " +
+                   fixed(h_, 1);
+  return finding;
 }
 
 }  // namespace tofguard::risk
