@@ -120,10 +120,10 @@ Frames make_frames(int width, int height) {
 void BM_ComputeDiscrepancy(benchmark::State& state) {
   const Frames f = make_frames(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
   // The third argument: evidence.max_pixels (0: every pixel).
-  tofguard::discrepancy::Parameters parameters;
-  parameters.evidence.max_pixels = static_cast<int>(state.range(2));
+  tofguard::discrepancy::DiscrepancyOptions options;
+  options.evidence.max_pixels = static_cast<int>(state.range(2));
   for (auto _ : state) {
-    auto frame = tofguard::discrepancy::compute_discrepancy(f.camera, f.rendered, f.labels, parameters);
+    auto frame = tofguard::discrepancy::compute_discrepancy(f.camera, f.rendered, f.labels, options);
     benchmark::DoNotOptimize(frame.summary.num_match);
   }
   state.SetItemsProcessed(state.iterations() * state.range(0) * state.range(1));
@@ -138,7 +138,7 @@ BENCHMARK(BM_ComputeDiscrepancy)
 // joints, their links' points.
 void BM_SearchJointOffsets(benchmark::State& state) {
   const Frames f = make_frames(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
-  const tofguard::discrepancy::Parameters parameters;
+  const tofguard::discrepancy::DiscrepancyOptions options;
   tofguard::discrepancy::LabelKinematics kinematics;
   if (!tofguard::discrepancy::read_label_kinematics(f.labels, f.labels.label.size(), &kinematics)) {
     state.SkipWithError("the bench frame's kinematics do not fit");
@@ -147,7 +147,7 @@ void BM_SearchJointOffsets(benchmark::State& state) {
   tofguard::discrepancy_t summary{};
   for (auto _ : state) {
     tofguard::discrepancy::search_joint_offsets(f.camera, f.rendered, f.labels, kinematics,
-                                                parameters.tolerance.noise, parameters.evidence, &summary);
+                                                options.tolerance.noise, options.evidence, &summary);
     benchmark::DoNotOptimize(summary.joint_search_gain.data());
   }
   state.counters["points"] = summary.search_points;
@@ -209,8 +209,8 @@ void BM_ComputeDiscrepancySimulatedArm(benchmark::State& state) {
     made[size] = make_simulated_arm_frames(static_cast<int>(size.first), static_cast<int>(size.second));
   }
   const SimulatedArmFrames& sim = made[size];
-  const tofguard::discrepancy::Parameters parameters =
-      tofguard::discrepancy::parameters_from(sim.config.discrepancy);
+  const tofguard::discrepancy::DiscrepancyOptions options =
+      tofguard::discrepancy::discrepancy_options(sim.config.discrepancy);
   std::unique_ptr<tofguard::WorkerPool> workers;
   if (state.range(2) > 0) workers = std::make_unique<tofguard::WorkerPool>(static_cast<int>(state.range(2)));
   // FNV-1a over the encoded summaries, utime and compute_us aside (as
@@ -218,7 +218,7 @@ void BM_ComputeDiscrepancySimulatedArm(benchmark::State& state) {
   uint64_t digest = 0xcbf29ce484222325ULL;
   for (const Frames& f : sim.frames) {
     tofguard::discrepancy_t summary =
-        tofguard::discrepancy::compute_discrepancy(f.camera, f.rendered, f.labels, parameters, workers.get())
+        tofguard::discrepancy::compute_discrepancy(f.camera, f.rendered, f.labels, options, workers.get())
             .summary;
     summary.utime = 0;
     summary.compute_us = 0;
@@ -251,7 +251,7 @@ void BM_ComputeDiscrepancySimulatedArm(benchmark::State& state) {
     }
     const Frames& f = sim.frames[k++ % sim.frames.size()];
     auto frame =
-        tofguard::discrepancy::compute_discrepancy(f.camera, f.rendered, f.labels, parameters, workers.get());
+        tofguard::discrepancy::compute_discrepancy(f.camera, f.rendered, f.labels, options, workers.get());
     benchmark::DoNotOptimize(frame.summary.num_match);
   }
   state.SetItemsProcessed(state.iterations() * state.range(0) * state.range(1));

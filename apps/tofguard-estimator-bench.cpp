@@ -29,8 +29,8 @@ void BM_Estimate(benchmark::State& state) {
       deployment::load_config(std::string(TOFGUARD_SOURCE_DIR) + "/config/sim.yaml", nullptr);
   tofguard::test::SimulatedFrames frames(config);
   EstimatorOptions options;
-  options.noise_sigma_at_0m_m = config.discrepancy.noise_sigma_at_0m_mm / 1000;
-  options.noise_sigma_per_m2_m = config.discrepancy.noise_sigma_per_m2_mm / 1000;
+  options.noise.sigma_at_0m_mm = config.discrepancy.noise_sigma_at_0m_mm;
+  options.noise.sigma_per_m2_mm = config.discrepancy.noise_sigma_per_m2_mm;
   MotionEstimator estimator(frames.scene(), &frames.renderer(), options);
   const robot_model::JointPositions truth = {{"a1", -0.6}, {"a2", 1.3}, {"a3", -0.4}, {"a4", 1.2},
                                              {"a5", 0.6},  {"a6", 1.0}, {"a7", -0.4}};

@@ -850,7 +850,8 @@ class BenchChain {
     // its joints, as tofguard-renderer makes TOF_RENDERED and TOF_LABELS.
     const robot_model::ArmSpheres cover =
         robot_model::cover_arm_with_spheres(scene_, config_.renderer.arm_cover_cell_m);
-    const discrepancy::Parameters parameters = discrepancy::parameters_from(config_.discrepancy);
+    const discrepancy::DiscrepancyOptions discrepancy_options =
+        discrepancy::discrepancy_options(config_.discrepancy);
     WorkerPool workers(config_.discrepancy.worker_threads);
     std::vector<double> compute_ms;
     // A digest (FNV-1a) of every summary computed, utime and compute_us
@@ -868,7 +869,7 @@ class BenchChain {
       const link_labels_t labels = renderer::make_rendered_link_labels(camera, result, scene_, cover);
       const int64_t start_us = monotonic_us();
       const discrepancy::DiscrepancyFrame frame =
-          discrepancy::compute_discrepancy(camera, rendered, labels, parameters, &workers);
+          discrepancy::compute_discrepancy(camera, rendered, labels, discrepancy_options, &workers);
       const int64_t end_us = monotonic_us();
       if (!frame.summary.usable) {
         log_ << "  floors: compute_discrepancy: unusable: " << frame.summary.unusable_reason << std::endl;

@@ -89,7 +89,7 @@ void judge_frames_only(deployment::Config* config) {
 int changed_pixels(renderer::DepthRenderer& model, const robot_model::SceneModel& scene,
                    const robot_model::JointPositions& true_joints, const Eigen::Isometry3d& true_pose,
                    const std::vector<float>& reported_depth_m, const Intrinsics& intrinsics,
-                   const discrepancy::DepthNoise& noise) {
+                   const DepthNoise& noise) {
   const robot_model::LinkPoses poses = robot_model::forward_kinematics(scene, true_joints);
   const renderer::RenderResult truth = model.render_at(poses, true_pose, intrinsics);
   if (!truth.usable) throw std::runtime_error(truth.unusable_reason);
@@ -500,7 +500,7 @@ struct CampaignWorld {
         arm_cover(robot_model::cover_arm_with_spheres(model_scene, config.renderer.arm_cover_cell_m)),
         truth_cover(robot_model::cover_arm_with_spheres(model_scene, 0.01)),
         robot_tree(robot_model::load_kinematic_tree(config.robot.urdf_path)),
-        parameters(discrepancy::parameters_from(config.discrepancy)),
+        options(discrepancy::discrepancy_options(config.discrepancy)),
         intrinsics(config.camera.intrinsics),
         period_s(1.0 / config.camera.rate_hz),
         period_us(static_cast<int64_t>(std::llround(period_s * 1e6))),
@@ -515,7 +515,7 @@ struct CampaignWorld {
   // of the surface) than the renderer's.
   const robot_model::ArmSpheres truth_cover;
   const robot_model::KinematicTree robot_tree;
-  const discrepancy::Parameters parameters;
+  const discrepancy::DiscrepancyOptions options;
   const Intrinsics intrinsics;
   const double period_s;
   const int64_t period_us;
@@ -672,10 +672,10 @@ class CampaignRunJudge {
     if (k == run_.onset_frame && kind_ != Kind::kNone) {
       result_.changed_pixels =
           changed_pixels(w_.model, w_.model_scene, true_joints, true_pose, rendered_result.depth_m,
-                         w_.intrinsics, w_.parameters.tolerance.noise);
+                         w_.intrinsics, w_.options.tolerance.noise);
     }
     discrepancy::DiscrepancyFrame frame =
-        discrepancy::compute_discrepancy(camera, rendered, labels, w_.parameters);
+        discrepancy::compute_discrepancy(camera, rendered, labels, w_.options);
     // As tofguard-discrepancy counts a camera repeating its image.
     frame.summary.depth_hash = discrepancy::depth_hash(camera.depth_mm);
     frame.summary.repeat_count = repeats_.update(frame.summary.depth_hash);

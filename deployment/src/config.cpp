@@ -55,7 +55,7 @@ Config load_config(const std::string& path, const char* lcm_default_url_env) {
   config.risk = risk::read_risk_settings(root.map("risk"));
   config.estimator = estimator::read_estimator_settings(root.map("estimator"));
   config.joints_sim = sim::read_joints_sim_settings(root.map("joints_sim"));
-  config.intervention = intervene::read_intervention_settings(root.map("intervention"));
+  config.intervene = intervene::read_intervene_settings(root.map("intervention"));
   if (auto launch = root.optional_map("launch")) config.launch = launch::read_launch_settings(*launch);
 
   root.finish();

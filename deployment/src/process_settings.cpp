@@ -53,7 +53,7 @@ intervene::InterveneProcessSettings intervene_process_settings(const Config& con
   s.lcm = config.lcm;
   s.channels = config.channels;
   s.auth = config.auth;
-  s.intervention = config.intervention;
+  s.intervene = config.intervene;
   return s;
 }
 

@@ -462,23 +462,23 @@ int surface_depth_mm(const int16_t* tof, const uint8_t* unexplained, int i, int 
 // (field_*).
 void unexplained_surfaces(const depth_image_t& camera, const link_labels_t& labels,
                           const DiscrepancyFrame& frame, const PixelClasses& classes,
-                          const Parameters& parameters, const PixelFootprint& footprint, discrepancy_t* s) {
+                          const DiscrepancyOptions& options, const PixelFootprint& footprint,
+                          discrepancy_t* s) {
   s->near_arm_min_distance_m = -1;
   s->field_available = labels.num_arm_spheres > 0;
-  const int num_bins = static_cast<int>(std::ceil(parameters.field_range_m / parameters.field_bin_m - 1e-9));
-  s->field_bin_m = static_cast<float>(parameters.field_bin_m);
+  const int num_bins = static_cast<int>(std::ceil(options.field_range_m / options.field_bin_m - 1e-9));
+  s->field_bin_m = static_cast<float>(options.field_bin_m);
   s->num_field_bins = num_bins;
   std::vector<double> area_in_bin(num_bins, 0.0);
-  const cv::Mat1b candidates =
-      opened_on_surfaces(classes.nearer_mask, camera.depth_mm.data(), parameters.opening_radius_px,
-                         parameters.silhouette_jump_mm);
+  const cv::Mat1b candidates = opened_on_surfaces(classes.nearer_mask, camera.depth_mm.data(),
+                                                  options.opening_radius_px, options.silhouette_jump_mm);
   const ArmDistance arm(labels);
   const int width = camera.width;
   const int num_pixels = width * camera.height;
   const int16_t* tof = camera.depth_mm.data();
   const uint8_t* pixel_class = frame.pixel_class.ptr<uint8_t>();
   const uint8_t* candidate = candidates.ptr<uint8_t>();
-  const double up_to_m = std::max(parameters.field_range_m, parameters.near_arm_m);
+  const double up_to_m = std::max(options.field_range_m, options.near_arm_m);
   double min_distance = std::numeric_limits<double>::infinity();
   double near_area = 0;
   for (int i = 0; i < num_pixels; ++i) {
@@ -487,19 +487,19 @@ void unexplained_surfaces(const depth_image_t& camera, const link_labels_t& labe
     if (s->field_available && pixel_class[i] != discrepancy_t::PIXEL_OCCLUDED) {
       // The camera-frame point (optical frame, m) of pixel i at its depth.
       const double z = metres_from_mm(
-          surface_depth_mm(tof, candidate, i, width, camera.height, parameters.silhouette_jump_mm));
+          surface_depth_mm(tof, candidate, i, width, camera.height, options.silhouette_jump_mm));
       const Eigen::Vector3d point((i % width - camera.cx) * z / camera.fx,
                                   (i / width - camera.cy) * z / camera.fy, z);
       distance_m = arm.distance_m(point, up_to_m);
     }
     const double area = footprint.m2(i);
-    if (distance_m <= parameters.near_arm_m) {
+    if (distance_m <= options.near_arm_m) {
       s->near_arm_pixels++;
       near_area += area;
       min_distance = std::min(min_distance, distance_m);
     }
     // Bin k holds (k*bin, (k+1)*bin]; distance 0 goes to bin 0.
-    const int bin = std::max(0, static_cast<int>(std::ceil(distance_m / parameters.field_bin_m)) - 1);
+    const int bin = std::max(0, static_cast<int>(std::ceil(distance_m / options.field_bin_m)) - 1);
     if (bin < num_bins) area_in_bin[bin] += area;
   }
   s->near_arm_area_m2 = static_cast<float>(near_area);
@@ -571,8 +571,8 @@ std::vector<uint8_t> silhouette_mask(const depth_image_t& rendered, double silho
   return silhouette;
 }
 
-Parameters parameters_from(const DiscrepancySettings& config) {
-  Parameters p;
+DiscrepancyOptions discrepancy_options(const DiscrepancySettings& config) {
+  DiscrepancyOptions p;
   p.tolerance.noise.sigma_at_0m_mm = config.noise_sigma_at_0m_mm;
   p.tolerance.noise.sigma_per_m2_mm = config.noise_sigma_per_m2_mm;
   p.tolerance.sigmas = config.tolerance_sigmas;
@@ -606,7 +606,7 @@ discrepancy_t unusable_summary(const depth_image_t& camera, int8_t kind, const s
 }
 
 DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_image_t& rendered,
-                                     const link_labels_t& labels, const Parameters& parameters,
+                                     const link_labels_t& labels, const DiscrepancyOptions& options,
                                      WorkerPool* workers) {
   // The workers' first call comes after the checks and the silhouettes:
   // woken now, they are awake by then (WorkerPool: a wake-up through the
@@ -652,7 +652,7 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
   s.link_invalid.assign(num_links, 0);
   s.link_median_dis_mm.assign(num_links, 0.0f);
 
-  const std::vector<uint8_t> silhouette = silhouette_mask(rendered, parameters.silhouette_jump_mm);
+  const std::vector<uint8_t> silhouette = silhouette_mask(rendered, options.silhouette_jump_mm);
   std::vector<double> reach;  // the pixel stages' (joint_reach)
   // Stages 3 to 6 need nothing from the evidence, nor it from them (they
   // write other fields of the summary; the joints' reach, too, is the
@@ -663,7 +663,7 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
     frame.pixel_class.create(camera.height, camera.width);
     frame.dis_mm.create(camera.height, camera.width);
     PixelClasses classes(camera.height, camera.width);
-    classify_pixels(camera, rendered, labels, silhouette, parameters.tolerance, &frame, &classes);
+    classify_pixels(camera, rendered, labels, silhouette, options.tolerance, &frame, &classes);
 
     // The seed's score and the class counts.
     s.num_match = classes.count[discrepancy_t::PIXEL_MATCH];
@@ -676,19 +676,19 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
     s.num_compared = classes.num_compared;
     s.sum_abs_dis_mm = classes.sum_abs_dis_mm;
     s.normalized_sum_abs_dis =
-        s.num_compared > 0 ? classes.sum_abs_dis_mm / (s.num_compared * parameters.max_depth_mm) : 0.0;
+        s.num_compared > 0 ? classes.sum_abs_dis_mm / (s.num_compared * options.max_depth_mm) : 0.0;
     s.mismatch_fraction =
         s.num_compared > 0 ? static_cast<float>(s.num_compared - s.num_match) / s.num_compared : 0.0f;
 
     per_link_statistics(frame, camera, rendered, labels, silhouette, &s);
     const PixelFootprint footprint(camera, rendered);
-    largest_blob(classes.mismatch_mask, parameters.opening_radius_px, footprint, &s);
-    unexplained_surfaces(camera, labels, frame, classes, parameters, footprint, &s);
+    largest_blob(classes.mismatch_mask, options.opening_radius_px, footprint, &s);
+    unexplained_surfaces(camera, labels, frame, classes, options, footprint, &s);
     if (s.field_available) reach = joint_reach_m(labels);
   });
   // Stage 7, evidence (evidence.hpp).
-  compute_evidence(camera, rendered, labels, silhouette, parameters.silhouette_jump_mm,
-                   parameters.tolerance.noise, parameters.evidence, &s, workers, &pixel_stages);
+  compute_evidence(camera, rendered, labels, silhouette, options.silhouette_jump_mm, options.tolerance.noise,
+                   options.evidence, &s, workers, &pixel_stages);
   pixel_stages.run_once();
   joint_reach(reach, &s);
   return frame;

@@ -24,7 +24,7 @@ int run_discrepancy(const DiscrepancyProcessSettings& settings) {
     std::fprintf(stderr, "tofguard-discrepancy: warning: mallopt refused keep_heap_resident's settings\n");
   LcmNode node(settings.lcm, settings.channels, process_info().name);
   const DiscrepancySettings& dc = settings.discrepancy;
-  const Parameters parameters = parameters_from(dc);
+  const DiscrepancyOptions options = discrepancy_options(dc);
   FramePairer pairer(dc.pair_timeout_us, dc.max_pending_frames);
   RepeatCounter repeats;
   WorkerPool workers(dc.worker_threads);
@@ -51,7 +51,7 @@ int run_discrepancy(const DiscrepancyProcessSettings& settings) {
       const int64_t start_us = monotonic_us();
       const depth_image_t empty{};
       DiscrepancyFrame frame = compute_discrepancy(pair.camera.image, pair.rendered ? *pair.rendered : empty,
-                                                   pair.labels, parameters, &workers);
+                                                   pair.labels, options, &workers);
       frame.summary.depth_hash = pair.camera.depth_hash;
       frame.summary.repeat_count = pair.camera.repeat_count;
       frame.summary.compute_us = static_cast<int32_t>(monotonic_us() - start_us);

@@ -357,8 +357,8 @@ struct EvidenceFrame {
   bool have_explained;
   const EvidenceJacobian& jacobian;
   const DepthNoise& noise;
-  const EvidenceParameters& parameters;
-  // Every stride-th pixel in u and v (EvidenceParameters::max_pixels), each
+  const EvidenceOptions& options;
+  // Every stride-th pixel in u and v (EvidenceOptions::max_pixels), each
   // weighted (inv_pps) for the noise correlation left between the sampled
   // pixels.
   int stride;
@@ -439,13 +439,13 @@ void add_pixel(const EvidenceFrame& f, int u, int v, int i, std::vector<double>*
   double* camera_row = row->jacobian.data() + 6 * row->fit;
   if (!EvidencePixelAccess::at_pixel(f.jacobian, u, v, camera_row, joint_row->data(), &moved, &link)) return;
   if (!moved && f.have_explained && f.explained_static[static_cast<size_t>(i)]) return;
-  const EvidenceParameters& parameters = f.parameters;
+  const EvidenceOptions& options = f.options;
   const double sigma_d = f.noise.sigma_mm(t);
-  const double var = sigma_d * sigma_d + parameters.model_sigma_mm * parameters.model_sigma_mm;
-  const double limit = parameters.clip_sigmas * std::sqrt(var);
+  const double var = sigma_d * sigma_d + options.model_sigma_mm * options.model_sigma_mm;
+  const double limit = options.clip_sigmas * std::sqrt(var);
   const double raw_r = static_cast<double>(gen - t);
   const double r = std::clamp(raw_r, -limit, limit);
-  const bool in_naming_fit = std::abs(raw_r) <= parameters.naming_gate_sigmas * std::sqrt(var);
+  const bool in_naming_fit = std::abs(raw_r) <= options.naming_gate_sigmas * std::sqrt(var);
   const double w = f.inv_pps / var;
   b->link_sum_wr[link] += w * r;
   b->link_sum_w[link] += w;
@@ -567,7 +567,7 @@ void store_link_bias(const EvidenceSums& total, int num_links, discrepancy_t* s)
 
 void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered, const link_labels_t& labels,
                       const std::vector<uint8_t>& silhouette, double silhouette_jump_mm,
-                      const DepthNoise& noise, const EvidenceParameters& parameters, discrepancy_t* summary,
+                      const DepthNoise& noise, const EvidenceOptions& options, discrepancy_t* summary,
                       WorkerPool* workers, SideTask* beside) {
   discrepancy_t& s = *summary;
   clear_evidence(&s);
@@ -581,9 +581,9 @@ void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered
   // offset explains (the real arm where the model's is not) are the arm's
   // evidence, not the camera's, and stay out of the camera fit.
   std::vector<uint8_t> explained_static;
-  search_joint_offsets(camera, rendered, labels, jacobian.kinematics(), noise, parameters, &s,
-                       &explained_static, workers, beside);
-  const int stride = evidence_stride(camera.width, camera.height, parameters.max_pixels);
+  search_joint_offsets(camera, rendered, labels, jacobian.kinematics(), noise, options, &s, &explained_static,
+                       workers, beside);
+  const int stride = evidence_stride(camera.width, camera.height, options.max_pixels);
   const EvidenceFrame frame{camera,
                             rendered,
                             silhouette,
@@ -591,9 +591,9 @@ void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered
                             explained_static.size() == static_cast<size_t>(num_pixels),
                             jacobian,
                             noise,
-                            parameters,
+                            options,
                             stride,
-                            1.0 / sampled_pixels_per_sample(parameters.pixels_per_sample, stride)};
+                            1.0 / sampled_pixels_per_sample(options.pixels_per_sample, stride)};
   const EvidenceSums total = sum_frame(frame, labels.num_links, workers);
   store_sums(total, &s);
   store_camera_fit(total, &s);

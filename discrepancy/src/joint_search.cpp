@@ -270,11 +270,11 @@ using PointsOfLink = std::vector<std::vector<SearchPoint>>;
 // (optical frame, mm) with their 1 / sigma_i, per link; counts them in
 // *search_points.
 PointsOfLink sample_points(const depth_image_t& rendered, const MovedLinkOf& moved_link, int num_robot_links,
-                           const DepthNoise& noise, const EvidenceParameters& parameters, int stride,
+                           const DepthNoise& noise, const EvidenceOptions& options, int stride,
                            int32_t* search_points) {
   PointsOfLink points_of_link(num_robot_links);
   const int16_t* gen = rendered.depth_mm.data();
-  const double model_var = parameters.model_sigma_mm * parameters.model_sigma_mm;
+  const double model_var = options.model_sigma_mm * options.model_sigma_mm;
   for (int v = 0; v < rendered.height; v += stride) {
     for (int u = 0; u < rendered.width; u += stride) {
       const size_t i = static_cast<size_t>(v) * rendered.width + u;
@@ -356,8 +356,7 @@ struct Trial {
 // Each joint's moved links and steps (in *trials_of), and the coarse
 // trials of all joints: per joint, no offset first, then -steps..steps.
 std::vector<Trial> plan_coarse_trials(const LabelKinematics& k, const PointsOfLink& points_of_link,
-                                      const EvidenceParameters& parameters,
-                                      std::vector<JointTrials>* trials_of) {
+                                      const EvidenceOptions& options, std::vector<JointTrials>* trials_of) {
   trials_of->assign(k.num_joints, JointTrials{});
   std::vector<Trial> coarse;
   for (int j = 0; j < k.num_joints; ++j) {
@@ -370,8 +369,8 @@ std::vector<Trial> plan_coarse_trials(const LabelKinematics& k, const PointsOfLi
     // At most kCoarsePoints (rounded up: a joint moving 2 999 points takes
     // every second, not all of them).
     t.coarse_every = std::max<size_t>(1, (moved_points + kCoarsePoints - 1) / kCoarsePoints);
-    const double range = prismatic ? parameters.search_range_m : parameters.search_range_rad;
-    t.step = prismatic ? parameters.search_step_m : parameters.search_step_rad;
+    const double range = prismatic ? options.search_range_m : options.search_range_rad;
+    t.step = prismatic ? options.search_step_m : options.search_step_rad;
     t.steps = static_cast<int>(std::floor(range / t.step + 1e-9));
     t.first_coarse = coarse.size();
     coarse.push_back(Trial{j, 0.0, t.coarse_every});
@@ -535,7 +534,7 @@ int best_joint(const discrepancy_t& s, int num_joints) {
 
 void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rendered,
                           const link_labels_t& labels, const LabelKinematics& k, const DepthNoise& noise,
-                          const EvidenceParameters& parameters, discrepancy_t* summary,
+                          const EvidenceOptions& options, discrepancy_t* summary,
                           std::vector<uint8_t>* explained_static, WorkerPool* workers, SideTask* beside) {
   if (explained_static != nullptr) explained_static->clear();
   discrepancy_t& s = *summary;
@@ -548,15 +547,15 @@ void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rend
   // The robot pixels a joint moves, and the stride that keeps them within
   // search_max_points.
   const MovedLinkOf moved_link(rendered, labels, k);
-  const int stride = sampling_stride(moved_link, pixels, parameters.search_max_points);
+  const int stride = sampling_stride(moved_link, pixels, options.search_max_points);
   if (stride == 0) return;
   const PointsOfLink points_of_link =
-      sample_points(rendered, moved_link, k.num_robot_links, noise, parameters, stride, &s.search_points);
-  const PointCost cost(camera, rendered, parameters.clip_sigmas,
-                       static_cast<double>(stride) * stride / parameters.pixels_per_sample);
+      sample_points(rendered, moved_link, k.num_robot_links, noise, options, stride, &s.search_points);
+  const PointCost cost(camera, rendered, options.clip_sigmas,
+                       static_cast<double>(stride) * stride / options.pixels_per_sample);
 
   std::vector<JointTrials> trials_of;
-  const std::vector<Trial> coarse = plan_coarse_trials(k, points_of_link, parameters, &trials_of);
+  const std::vector<Trial> coarse = plan_coarse_trials(k, points_of_link, options, &trials_of);
   const TrialRunner runner(cost, trials_of, workers);
   std::vector<double> coarse_cost;
   runner.run(coarse, &coarse_cost, beside, {});

@@ -32,8 +32,8 @@ EstimatorOptions options_from_settings(const EstimatorProcessSettings& settings)
   EstimatorOptions o;
   o.estimate_joints = settings.estimator.estimate_joints;
   o.estimate_camera = settings.estimator.estimate_camera;
-  o.noise_sigma_at_0m_m = std::max(1e-4, settings.noise_sigma_at_0m_mm / 1000.0);
-  o.noise_sigma_per_m2_m = settings.noise_sigma_per_m2_mm / 1000.0;
+  o.noise.sigma_at_0m_mm = std::max(0.1, settings.noise_sigma_at_0m_mm);
+  o.noise.sigma_per_m2_mm = settings.noise_sigma_per_m2_mm;
   o.max_iterations = settings.estimator.max_iterations;
   o.pixel_stride = settings.estimator.pixel_stride;
   return o;

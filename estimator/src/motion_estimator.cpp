@@ -179,8 +179,8 @@ MotionEstimator::MotionEstimator(const robot_model::SceneModel& scene, renderer:
       o.coarse_pixel_stride < 1 || !(o.coarse_skip_step >= 0) || o.max_camera_iterations < 1 ||
       !(o.step_tolerance > 0) || !(o.joint_search_step_rad > 0) || !(o.joint_search_range_rad >= 0) ||
       o.joint_search_rounds < 0 || o.min_joint_points < 1 || !(o.max_joint_sigma > 0) ||
-      !(o.sigma_scale > 0) || !(o.residual_clip_m > 0) || !(o.noise_sigma_at_0m_m > 0) ||
-      !(o.model_sigma_m >= 0) || !(o.noise_sigma_per_m2_m >= 0) || !(o.normal_jump_m > 0) ||
+      !(o.sigma_scale > 0) || !(o.residual_clip_m > 0) || !(o.noise.sigma_at_0m_mm > 0) ||
+      !(o.model_sigma_m >= 0) || !(o.noise.sigma_per_m2_mm >= 0) || !(o.normal_jump_m > 0) ||
       !(o.contour_jump_fraction > 0) || !(o.final_contour_scale_px > 0) || !(o.contour_sigma_px > 0)) {
     throw std::invalid_argument("MotionEstimator: options out of range");
   }
@@ -438,7 +438,7 @@ void MotionEstimator::add_depth_term(const RenderedView& view, const std::vector
   if (gated || std::abs(residual) >= view.scale) return;
   const double t = residual / view.scale;
   const double tukey = (1 - t * t) * (1 - t * t);
-  const double sigma = options_.noise_sigma_at_0m_m + options_.noise_sigma_per_m2_m * z_measured * z_measured;
+  const double sigma = options_.noise.sigma_m(z_measured);
   ++lin->num_inliers;
   add_residual(view, chain, m, world, normal, residual,
                // (A strided pixel stands for point_stride^2 pixels, so that
@@ -457,7 +457,7 @@ std::string MotionEstimator::linearize(const EstimatorFrame& frame, const State&
   const Eigen::Isometry3d world_from_optical = frame.world_from_optical * state.correction;
   const renderer::RenderResult rendered = renderer_->render_at(poses, world_from_optical, frame.intrinsics);
   if (!rendered.usable) return "render: " + rendered.unusable_reason;
-  const double sigma_1m = options_.noise_sigma_at_0m_m + options_.noise_sigma_per_m2_m;
+  const double sigma_1m = options_.noise.sigma_m(1.0);
   const RenderedView view{
       frame,
       state,
@@ -663,7 +663,7 @@ int MotionEstimator::search_joints(const EstimatorFrame& frame, State* state, st
         if (u < 0 || v < 0 || u >= width || v >= height) continue;
         const double z = frame.depth_m[static_cast<size_t>(v) * width + u];
         if (!(z > 0) || !std::isfinite(z)) continue;
-        const double sigma = options_.noise_sigma_at_0m_m + options_.noise_sigma_per_m2_m * z * z;
+        const double sigma = options_.noise.sigma_m(z);
         const double tolerance = std::max(tolerance_floor, 3 * sigma);
         const double dz = m.z() - z;
         if (std::abs(dz) <= tolerance) {

@@ -10,57 +10,16 @@
 #include "tofguard/common/clock.hpp"
 #include "tofguard/common/lcm_node.hpp"
 #include "tofguard/common/wire_checks.hpp"
-#include "tofguard/intervene/intervention_logic.hpp"
+#include "tofguard/intervene/auth_refusals.hpp"
+#include "tofguard/intervene/intervene_logic.hpp"
+#include "tofguard/intervene/lcm_power_actuator.hpp"
 #include "tofguard/intervene/power_actuator.hpp"
 #include "tofguard/intervene/serial_pulse_output.hpp"
-#include "tofguard/power_relay_t.hpp"
 #include "tofguard/reset_reply_t.hpp"
 #include "tofguard/safety_status_t.hpp"
 
 namespace tofguard::intervene {
 namespace {
-
-// The `lcm` actuator: power_relay_t on SAFETY_POWER, and with a key signed
-// on SAFETY_POWER_AUTH first (power_enabled = true is a permission too).
-class LcmPowerActuator : public PowerActuator {
- public:
-  LcmPowerActuator(lcm::LCM& lcm, std::string channel, std::string auth_channel, auth::MessageSigner* signer)
-      : lcm_(lcm), channel_(std::move(channel)), auth_channel_(std::move(auth_channel)), signer_(signer) {}
-  std::string set_power(bool enabled, const std::string& reason) override {
-    power_relay_t message;
-    message.utime = wall_utime();
-    message.seq = seq_++;
-    message.power_enabled = enabled;
-    message.reason = reason;
-    return auth::publish_signed(lcm_, signer_, channel_, auth_channel_, message, wall_utime());
-  }
-
- private:
-  lcm::LCM& lcm_;
-  std::string channel_;
-  std::string auth_channel_;
-  auth::MessageSigner* signer_;  // null: insecure
-  int64_t seq_ = 0;
-};
-
-// Messages refused by the authentication: counted as validation errors in
-// the heartbeat, reported in one line each (rate-limited per channel), and
-// summed up in the heartbeat's status.
-struct AuthRefusals {
-  int64_t count = 0;
-  std::string last;
-
-  void refuse(LcmNode& node, const std::string& channel, const std::string& why) {
-    ++count;
-    last = channel + ": " + why;
-    node.counters().validation_errors++;
-    node.errors().report(channel, channel + ": refused: " + why);
-  }
-  std::string summary() const {
-    if (count == 0) return "";
-    return "; " + std::to_string(count) + " messages refused by authentication (last: " + last + ")";
-  }
-};
 
 // With a key, only signed risk verdicts and resets count, and the status
 // and power commands go out signed as well as plain.
@@ -73,7 +32,7 @@ std::optional<auth::MessageSigner> signer_for(const auth::AuthSettings& auth) {
   return std::optional<auth::MessageSigner>(std::in_place, auth.key, wall_utime());
 }
 
-// The process: the intervention logic between its inputs (risk verdicts,
+// The process: the intervene logic (InterveneLogic) between its inputs (risk verdicts,
 // joint states, resets, the timers) and its outputs (the status, the power
 // commands).
 class Intervener {
@@ -84,7 +43,7 @@ class Intervener {
         node_(settings.lcm, settings.channels, "tofguard-intervene"),
         verifier_(verifier_for(settings.auth)),
         signer_(signer_for(settings.auth)),
-        logic_(settings.intervention, monotonic_us(), wall_utime()) {
+        logic_(settings.intervene, monotonic_us(), wall_utime()) {
     make_actuator();
   }
 
@@ -108,11 +67,11 @@ class Intervener {
   auth::MessageSigner* signer() { return signer_ ? &*signer_ : nullptr; }
 
   void make_actuator() {
-    const InterventionSettings& intervention = settings_.intervention;
-    if (intervention.power_cut == "usb_hid_relay") {
-      actuator_ = std::make_unique<UsbHidRelay>(intervention.relay_channel, intervention.relay_serial);
-    } else if (intervention.power_cut == "serial_pulse") {
-      auto output = std::make_unique<SerialPulseOutput>(intervention.serial_pulse);
+    const InterveneSettings& section = settings_.intervene;
+    if (section.power_cut == "usb_hid_relay") {
+      actuator_ = std::make_unique<UsbHidRelay>(section.relay_channel, section.relay_serial);
+    } else if (section.power_cut == "serial_pulse") {
+      auto output = std::make_unique<SerialPulseOutput>(section.serial_pulse);
       pulse_output_ = output.get();
       actuator_ = std::move(output);
     } else {
@@ -239,7 +198,7 @@ class Intervener {
   }
 
   void add_timers() {
-    node_.add_timer(static_cast<int64_t>(1e6 / settings_.intervention.publish_rate_hz), [&] {
+    node_.add_timer(static_cast<int64_t>(1e6 / settings_.intervene.publish_rate_hz), [&] {
       logic_.tick(monotonic_us(), wall_utime());
       logic_.take_changed();
       apply_power();  // re-asserted at the status rate: positive logic
@@ -282,7 +241,7 @@ class Intervener {
   std::optional<auth::MessageVerifier> verifier_;
   std::optional<auth::MessageSigner> signer_;
   AuthRefusals refused_;
-  InterventionLogic logic_;
+  InterveneLogic logic_;
   std::unique_ptr<PowerActuator> actuator_;
   SerialPulseOutput* pulse_output_ = nullptr;  // the actuator, when it pulses
   int64_t seq_ = 0;

@@ -1,6 +1,5 @@
 #include "tofguard/launch/launch_process.hpp"
 
-#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -12,6 +11,7 @@
 #include "tofguard/common/lcm_node.hpp"
 #include "tofguard/launch/log_rotation.hpp"
 #include "tofguard/launch/process_group.hpp"
+#include "tofguard/launch/recordings_keeper.hpp"
 
 namespace tofguard::launch {
 namespace {
@@ -22,14 +22,6 @@ std::string own_dir() {
   std::error_code ec;
   const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
   return ec ? std::string() : exe.parent_path().string();
-}
-
-// Bytes free for an unprivileged writer on the filesystem of `dir`, or -1
-// when it cannot be read.
-int64_t free_bytes(const std::string& dir) {
-  struct statvfs fs {};
-  if (statvfs(dir.c_str(), &fs) != 0) return -1;
-  return static_cast<int64_t>(fs.f_bavail) * static_cast<int64_t>(fs.f_frsize);
 }
 
 // Every process of launch.processes, "{config}" in their commands replaced
@@ -93,55 +85,6 @@ bool add_recorders(const LaunchProcessSettings& settings, const std::string& rec
   return true;
 }
 
-// Watches the recordings' disk space and prunes them to the recorder's
-// size and age limits.
-class RecordingsKeeper {
- public:
-  RecordingsKeeper(const RecorderSettings& recorder, std::string recordings)
-      : recorder_(recorder), recordings_(std::move(recordings)) {}
-
-  // A full disk loses the black box (lcm-logger cannot write; it is not
-  // required, so the safety chain goes on): say so once when it happens,
-  // once when space is back, checked every second. "Full": less than one
-  // recording file's worth (max_file_mb) or 1 MB free, whichever is less.
-  void check_space(int64_t now_us) {
-    if (now_us < next_space_check_us_) return;
-    next_space_check_us_ = now_us + 1'000'000;
-    const int64_t free = free_bytes(recordings_);
-    const int64_t low = std::min<int64_t>(1'000'000, static_cast<int64_t>(recorder_.max_file_mb * 1e6));
-    if (free >= 0 && free < low && !disk_full_) {
-      disk_full_ = true;
-      say("recorder: ERROR: disk full at " + recordings_ + " (" + std::to_string(free) +
-          " bytes free): black-box recordings are being lost; the safety chain is not affected");
-    } else if (free >= low && disk_full_) {
-      disk_full_ = false;
-      say("recorder: disk space back at " + recordings_ + " (" + std::to_string(free) +
-          " bytes free): recording again");
-    }
-  }
-
-  // Every 5 s, deletes the oldest recordings beyond the size and age limits.
-  void prune(int64_t now_us) {
-    if (now_us < next_prune_us_) return;
-    next_prune_us_ = now_us + 5'000'000;
-    const auto doomed =
-        files_to_delete(list_log_files(recordings_), static_cast<uint64_t>(recorder_.max_total_mb * 1e6),
-                        static_cast<int64_t>(recorder_.max_age_h * 3600), wall_utime() / 1'000'000);
-    for (const auto& path : doomed) {
-      std::error_code ec;
-      std::filesystem::remove(path, ec);
-      say("recorder: deleted " + path + " (size or age limit)");
-    }
-  }
-
- private:
-  const RecorderSettings& recorder_;
-  std::string recordings_;
-  int64_t next_prune_us_ = 0;
-  int64_t next_space_check_us_ = 0;
-  bool disk_full_ = false;
-};
-
 RestartPolicy restart_policy(const LaunchSettings& launch) {
   RestartPolicy policy;
   policy.initial_delay_us = launch.restart_backoff_initial_us;
@@ -186,7 +129,7 @@ int run_launch(const LaunchProcessSettings& settings) {
   group.start_all(monotonic_us());
   std::cout << group.status_table() << std::flush;
 
-  RecordingsKeeper keeper(launch.recorder, recordings);
+  RecordingsKeeper keeper(launch.recorder, recordings, say);
   while (!stop_requested()) {
     const int64_t now_us = monotonic_us();
     group.poll(now_us);

@@ -2,7 +2,7 @@
 
 #include <regex>
 
-namespace tofguard::camera {
+namespace tofguard::settings {
 namespace {
 
 int read_usb_id(YamlMap& map, const std::string& key) {
@@ -38,4 +38,4 @@ UvcSettings read_uvc_settings(YamlMap map) {
   return c;
 }
 
-}  // namespace tofguard::camera
+}  // namespace tofguard::settings

@@ -7,7 +7,7 @@
 
 #include "tofguard/common/worker_pool.hpp"
 
-namespace tofguard::discrepancy {
+namespace tofguard::settings {
 
 int auto_worker_threads() { return std::min(allowed_cpu_count(), kMaxAutoWorkerThreads); }
 
@@ -82,4 +82,4 @@ DiscrepancySettings read_discrepancy_settings(YamlMap map) {
   return d;
 }
 
-}  // namespace tofguard::discrepancy
+}  // namespace tofguard::settings

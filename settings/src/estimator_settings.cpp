@@ -1,6 +1,6 @@
 #include "tofguard/settings/estimator_settings.hpp"
 
-namespace tofguard::estimator {
+namespace tofguard::settings {
 
 EstimatorSettings read_estimator_settings(YamlMap map) {
   EstimatorSettings e;
@@ -22,4 +22,4 @@ EstimatorSettings read_estimator_settings(YamlMap map) {
   return e;
 }
 
-}  // namespace tofguard::estimator
+}  // namespace tofguard::settings

@@ -1,6 +1,6 @@
 #include "tofguard/settings/launch_settings.hpp"
 
-namespace tofguard::launch {
+namespace tofguard::settings {
 
 LaunchSettings read_launch_settings(YamlMap map) {
   LaunchSettings launch;
@@ -28,4 +28,4 @@ LaunchSettings read_launch_settings(YamlMap map) {
   return launch;
 }
 
-}  // namespace tofguard::launch
+}  // namespace tofguard::settings

@@ -1,6 +1,6 @@
 #include "tofguard/settings/renderer_settings.hpp"
 
-namespace tofguard::renderer {
+namespace tofguard::settings {
 
 RendererSettings read_renderer_settings(YamlMap renderer) {
   RendererSettings r;
@@ -39,4 +39,4 @@ RendererSettings read_renderer_settings(YamlMap renderer) {
   return r;
 }
 
-}  // namespace tofguard::renderer
+}  // namespace tofguard::settings

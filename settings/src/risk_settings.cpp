@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace tofguard::risk {
+namespace tofguard::settings {
 
 namespace {
 
@@ -136,4 +136,4 @@ double iso13855_intrusion_distance_m(double detection_capability_m) {
   return std::max(0.0, 8.0 * (detection_capability_m - 0.014));
 }
 
-}  // namespace tofguard::risk
+}  // namespace tofguard::settings

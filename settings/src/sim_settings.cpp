@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-namespace tofguard::sim {
+namespace tofguard::settings {
 namespace {
 
 Eigen::Vector3d vector3(YamlMap& map, const std::string& key, double limit) {
@@ -129,4 +129,4 @@ JointsSimSettings read_joints_sim_settings(YamlMap map) {
   return sim;
 }
 
-}  // namespace tofguard::sim
+}  // namespace tofguard::settings

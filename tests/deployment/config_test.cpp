@@ -74,9 +74,9 @@ TEST(Config, EmbeddedDefaultLoads) {
 TEST(Config, TheRiskMonitorNamesAStalledInputBeforeTheInterveneSeesItSilent) {
   const deployment::Config config = deployment::load_config(sim_yaml_path(), nullptr);
   const int64_t inputs_us = std::max(config.risk.depth_deadline_us, config.risk.discrepancy_deadline_us);
-  EXPECT_GE(config.intervention.risk_deadline_us, inputs_us + config.risk.check_period_us + 10'000);
-  const auto tick_us = static_cast<int64_t>(1e6 / config.intervention.publish_rate_hz);
-  EXPECT_LE(config.intervention.risk_deadline_us + tick_us + 10'000, 200'000);
+  EXPECT_GE(config.intervene.risk_deadline_us, inputs_us + config.risk.check_period_us + 10'000);
+  const auto tick_us = static_cast<int64_t>(1e6 / config.intervene.publish_rate_hz);
+  EXPECT_LE(config.intervene.risk_deadline_us + tick_us + 10'000, 200'000);
 }
 
 // Durations are read once, rounded to the nearest microsecond: what the

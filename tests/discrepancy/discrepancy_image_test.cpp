@@ -17,7 +17,7 @@ namespace {
 
 using discrepancy::compute_discrepancy;
 using discrepancy::DiscrepancyFrame;
-using discrepancy::Parameters;
+using discrepancy::DiscrepancyOptions;
 
 // OpenCV's own parallel loops (the blob stage's morphology and connected
 // components) run on the calling thread in this test: OpenCV otherwise
@@ -31,14 +31,13 @@ const bool kOpenCvOnTheCallersThread = [] {
 }();
 
 // The simulated camera's noise, 4 sigma + 15 mm, 3x3 opening, 0.2 m.
-Parameters sim_parameters() { return Parameters{}; }
+DiscrepancyOptions sim_options() { return DiscrepancyOptions{}; }
 
 DiscrepancyFrame compare(const SyntheticImage& model, const std::vector<int16_t>& camera_depth,
-                         const Parameters& parameters = sim_parameters()) {
+                         const DiscrepancyOptions& options = sim_options()) {
   link_labels_t labels = labels_frame(model.label, 7);
   add_pixel_cover(&labels, model.depth_mm);
-  return compute_discrepancy(depth_frame(camera_depth, 7), depth_frame(model.depth_mm, 7), labels,
-                             parameters);
+  return compute_discrepancy(depth_frame(camera_depth, 7), depth_frame(model.depth_mm, 7), labels, options);
 }
 
 constexpr int kPixels = kWidth * kHeight;
@@ -141,7 +140,7 @@ TEST(Discrepancy, TheSummaryAndImagesDoNotDependOnTheWorkerThreads) {
   scene.push_back({30, 110, 50, 130, 1400, 0});
   const depth_image_t camera = depth_frame(with_noise(draw(scene).depth_mm, 5), 7);
   const depth_image_t rendered = depth_frame(model.depth_mm, 7);
-  const DiscrepancyFrame alone = compute_discrepancy(camera, rendered, labels, sim_parameters());
+  const DiscrepancyFrame alone = compute_discrepancy(camera, rendered, labels, sim_options());
   const discrepancy_t& a = alone.summary;
   ASSERT_TRUE(a.usable && a.evidence_available);
   ASSERT_GT(a.search_points, 500);
@@ -150,7 +149,7 @@ TEST(Discrepancy, TheSummaryAndImagesDoNotDependOnTheWorkerThreads) {
   for (int threads : {2, 4}) {
     WorkerPool pool(threads);
     for (int call = 0; call < 5; ++call) {
-      const DiscrepancyFrame shared = compute_discrepancy(camera, rendered, labels, sim_parameters(), &pool);
+      const DiscrepancyFrame shared = compute_discrepancy(camera, rendered, labels, sim_options(), &pool);
       EXPECT_TRUE(encoded(shared.summary) == encoded(a)) << threads << " threads, call " << call;
       EXPECT_EQ(cv::countNonZero(shared.pixel_class != alone.pixel_class), 0) << threads << " threads";
       EXPECT_EQ(cv::countNonZero(shared.dis_mm != alone.dis_mm), 0) << threads << " threads";
@@ -176,7 +175,7 @@ TEST(Discrepancy, ObjectInFrontOfTheArmIsOccludedAndNearTheArm) {
   EXPECT_EQ(s.near_arm_pixels, 400);
   EXPECT_FLOAT_EQ(s.near_arm_min_distance_m, 0);
   const double pixel_m2 = (1.4 / 200) * (1.4 / 200);
-  ASSERT_EQ(s.num_field_bins, 150);  // Parameters' default: 1.5 m in 1 cm bins
+  ASSERT_EQ(s.num_field_bins, 150);  // DiscrepancyOptions' default: 1.5 m in 1 cm bins
   EXPECT_NEAR(s.unexplained_area_within_m2[0], 200 * pixel_m2, 1e-6);
   // The other half: 9.5-10.6 cm from the arm's cover (noise: sigma 6.4 mm
   // at 1.4 m), none within 6 cm, all within 13 cm.
@@ -262,16 +261,16 @@ TEST(Discrepancy, TheArmsOwnEdgeBesideAPasserBehindItIsNotAnObject) {
   scene.push_back({100, 60, 102, 80, kArmMm, 0});
   scene.push_back({102, 50, 130, 90, 1800, 0});
   const std::vector<int16_t> seen = draw(scene).depth_mm;
-  Parameters parameters = sim_parameters();
-  parameters.silhouette_jump_mm = 50;
-  const discrepancy_t s = compare(model, seen, parameters).summary;
+  DiscrepancyOptions options = sim_options();
+  options.silhouette_jump_mm = 50;
+  const discrepancy_t s = compare(model, seen, options).summary;
   EXPECT_EQ(s.near_arm_pixels, 0);
   EXPECT_FLOAT_EQ(s.unexplained_area_within_m2[25], 0);  // nothing within 0.26 m
   EXPECT_GT(s.unexplained_area_within_m2[40], 0);        // the cart, 0.3 m behind
   // Without the depth condition (silhouette_jump_mm 0: the plain opening)
   // the sliver stays beside the arm.
-  parameters.silhouette_jump_mm = 0;
-  EXPECT_GT(compare(model, seen, parameters).summary.near_arm_pixels, 0);
+  options.silhouette_jump_mm = 0;
+  EXPECT_GT(compare(model, seen, options).summary.near_arm_pixels, 0);
 }
 
 TEST(Discrepancy, ThinSilhouetteSliversAreNotBlobs) {
@@ -293,7 +292,7 @@ TEST(Discrepancy, ThinSilhouetteSliversAreNotBlobs) {
   EXPECT_EQ(narrower.num_robot_missing, 20);
   EXPECT_EQ(narrower.largest_blob_pixels, 0);
   // Without the opening the slivers count.
-  Parameters raw = sim_parameters();
+  DiscrepancyOptions raw = sim_options();
   raw.opening_radius_px = 0;
   EXPECT_EQ(compare(wide_model, model.depth_mm, raw).summary.largest_blob_pixels, 20);
   EXPECT_EQ(compare(model, draw(scene).depth_mm, raw).summary.near_arm_pixels, 20);
@@ -355,7 +354,7 @@ TEST(Discrepancy, UnusableLabelsMakeAnUnusableFrame) {
   const SyntheticImage model = draw(default_arm());
   const depth_image_t camera = depth_frame(model.depth_mm, 9);
   const discrepancy_t s =
-      compute_discrepancy(camera, depth_image_t{}, unusable_labels(9, "joint 'a3' missing"), sim_parameters())
+      compute_discrepancy(camera, depth_image_t{}, unusable_labels(9, "joint 'a3' missing"), sim_options())
           .summary;
   EXPECT_FALSE(s.usable);
   EXPECT_EQ(s.unusable_kind, discrepancy_t::UNUSABLE_RENDERER);
@@ -371,21 +370,20 @@ TEST(Discrepancy, FramesThatDoNotFitAreUnusableAndSayWhy) {
   const link_labels_t labels = labels_frame(model.label, 4);
 
   const SyntheticImage small = draw({}, 88, 72);
-  auto s =
-      compute_discrepancy(camera, depth_frame(small.depth_mm, 4, 88, 72), labels, sim_parameters()).summary;
+  auto s = compute_discrepancy(camera, depth_frame(small.depth_mm, 4, 88, 72), labels, sim_options()).summary;
   EXPECT_FALSE(s.usable);
   EXPECT_EQ(s.unusable_kind, discrepancy_t::UNUSABLE_MISMATCHED);
   EXPECT_EQ(s.unusable_reason, "rendered frame is 88x72, camera frame 176x144");
 
   depth_image_t other_focal = depth_frame(model.depth_mm, 4);
   other_focal.fx = 210;
-  s = compute_discrepancy(camera, other_focal, labels, sim_parameters()).summary;
+  s = compute_discrepancy(camera, other_focal, labels, sim_options()).summary;
   EXPECT_FALSE(s.usable);
   EXPECT_NE(s.unusable_reason.find("intrinsics"), std::string::npos) << s.unusable_reason;
 
   link_labels_t bad_label = labels;
   bad_label.label[kWidth + 3] = 500;
-  s = compute_discrepancy(camera, depth_frame(model.depth_mm, 4), bad_label, sim_parameters()).summary;
+  s = compute_discrepancy(camera, depth_frame(model.depth_mm, 4), bad_label, sim_options()).summary;
   EXPECT_FALSE(s.usable);
   EXPECT_EQ(s.unusable_reason, "label[179]: expected 0, 1..3 or 1000..1000, got 500");
 
@@ -397,12 +395,12 @@ TEST(Discrepancy, FramesThatDoNotFitAreUnusableAndSayWhy) {
   bad_cover.arm_sphere_link = {0, 7};
   bad_cover.arm_sphere_center_m = {{0.f, 0.f, 1.f}, {0.f, 0.f, 1.f}};
   bad_cover.arm_sphere_radius_m = {0.05f, 0.05f};
-  s = compute_discrepancy(camera, depth_frame(model.depth_mm, 4), bad_cover, sim_parameters()).summary;
+  s = compute_discrepancy(camera, depth_frame(model.depth_mm, 4), bad_cover, sim_options()).summary;
   EXPECT_FALSE(s.usable);
   EXPECT_EQ(s.unusable_kind, discrepancy_t::UNUSABLE_MISMATCHED);
   EXPECT_NE(s.unusable_reason.find("arm_sphere_link[1]"), std::string::npos) << s.unusable_reason;
   bad_cover.num_arm_spheres = 3;
-  s = compute_discrepancy(camera, depth_frame(model.depth_mm, 4), bad_cover, sim_parameters()).summary;
+  s = compute_discrepancy(camera, depth_frame(model.depth_mm, 4), bad_cover, sim_options()).summary;
   EXPECT_FALSE(s.usable);
   EXPECT_NE(s.unusable_reason.find("num_arm_spheres"), std::string::npos) << s.unusable_reason;
 }
@@ -451,10 +449,10 @@ TEST(Discrepancy, MixedPixelsOnAThinLinksSilhouetteDoNotCountAgainstIt) {
     camera[v * kWidth + 80] = 1750;
     camera[v * kWidth + 82] = 1750;
   }
-  discrepancy::Parameters with_silhouettes;
+  discrepancy::DiscrepancyOptions with_silhouettes;
   with_silhouettes.silhouette_jump_mm = 50;
   const auto raw = compute_discrepancy(depth_frame(camera, 1), depth_frame(model.depth_mm, 1),
-                                       labels_frame(model.label, 1), discrepancy::Parameters{})
+                                       labels_frame(model.label, 1), discrepancy::DiscrepancyOptions{})
                        .summary;
   const auto seen = compute_discrepancy(depth_frame(camera, 1), depth_frame(model.depth_mm, 1),
                                         labels_frame(model.label, 1), with_silhouettes)
@@ -486,10 +484,10 @@ TEST(Discrepancy, AStepJustOverTheJumpIsASilhouetteInWholeMillimetres) {
     camera[v * kWidth + 80] = kArmMm + 25;
     camera[v * kWidth + 89] = kArmMm + 25;
   }
-  discrepancy::Parameters parameters;
-  parameters.silhouette_jump_mm = 50;
+  discrepancy::DiscrepancyOptions options;
+  options.silhouette_jump_mm = 50;
   const auto seen = compute_discrepancy(depth_frame(camera, 1), depth_frame(model.depth_mm, 1),
-                                        labels_frame(model.label, 1), parameters)
+                                        labels_frame(model.label, 1), options)
                         .summary;
   // The link's inner 8 x 58 pixels count; its outline does not.
   EXPECT_EQ(seen.link_compared[0], 8 * 58);

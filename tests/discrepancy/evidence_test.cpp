@@ -261,7 +261,9 @@ TEST(EvidenceOtherArms, JointJacobiansMatchRenderedChangesOnTheIiwa14AndTheKinov
 
 // ---- The fits on simulated camera frames ----
 
-Parameters parameters(const deployment::Config& config) { return parameters_from(config.discrepancy); }
+DiscrepancyOptions options_of(const deployment::Config& config) {
+  return discrepancy_options(config.discrepancy);
+}
 
 discrepancy_t evidence_of(test::SimulatedFrames* frames, const deployment::Config& config,
                           const JointPositions& true_q, const Eigen::Isometry3d& true_camera,
@@ -271,7 +273,7 @@ discrepancy_t evidence_of(test::SimulatedFrames* frames, const deployment::Confi
   const std::vector<float> seen = frames->capture(true_q, true_camera, in, index);
   const depth_image_t camera = make_depth_image("cam", in, 1, 1, true, seen);
   const Frame model = render_frame(&frames->renderer(), frames->scene(), reported_q, reported_camera, in);
-  const DiscrepancyFrame f = compute_discrepancy(camera, model.depth, model.labels, parameters(config));
+  const DiscrepancyFrame f = compute_discrepancy(camera, model.depth, model.labels, options_of(config));
   EXPECT_TRUE(f.summary.usable) << f.summary.unusable_reason;
   EXPECT_EQ(check_discrepancy(f.summary), "");
   return f.summary;
@@ -330,7 +332,7 @@ TEST_F(EvidenceTest, TheSummaryDoesNotDependOnTheWorkerThreads) {
     Frame model = render_frame(&frames_->renderer(), frames_->scene(), c.reported, camera(), in);
     const bool without_kinematics = std::string(c.what) == "no kinematics";
     if (without_kinematics) strip_kinematics(&model.labels);
-    const DiscrepancyFrame alone = compute_discrepancy(cam, model.depth, model.labels, parameters(*config_));
+    const DiscrepancyFrame alone = compute_discrepancy(cam, model.depth, model.labels, options_of(*config_));
     ASSERT_TRUE(alone.summary.usable) << c.what;
     ASSERT_EQ(alone.summary.evidence_available, !without_kinematics) << c.what;
     // The pixel stages ran: the offset leaves pixels that do not match.
@@ -341,7 +343,7 @@ TEST_F(EvidenceTest, TheSummaryDoesNotDependOnTheWorkerThreads) {
     const std::vector<uint8_t> expected = encoded(alone.summary);
     for (WorkerPool* pool : {&two, &four}) {
       const DiscrepancyFrame shared =
-          compute_discrepancy(cam, model.depth, model.labels, parameters(*config_), pool);
+          compute_discrepancy(cam, model.depth, model.labels, options_of(*config_), pool);
       EXPECT_TRUE(encoded(shared.summary) == expected) << c.what << ", " << pool->num_threads() << " threads";
       // The images too (the pixel stages write them).
       EXPECT_EQ(cv::countNonZero(shared.pixel_class != alone.pixel_class), 0) << c.what;
@@ -359,7 +361,7 @@ TEST_F(EvidenceTest, TheSummaryDoesNotDependOnTheWorkerThreads) {
   }
 }
 
-// The sampling stride (EvidenceParameters::max_pixels) and the weight the
+// The sampling stride (EvidenceOptions::max_pixels) and the weight the
 // sampled pixels keep.
 TEST(EvidenceSampling, TheStrideIsTheSmallestThatKeepsToMaxPixels) {
   EXPECT_EQ(evidence_stride(176, 144, 0), 1);
@@ -395,9 +397,9 @@ TEST_F(EvidenceTest, ASampledLargeFrameKeepsTheFalseStopRateAndFindsAnOffset) {
   const Intrinsics small = config_->camera.intrinsics;
   const Intrinsics in{3 * small.width, 3 * small.height, 3 * small.fx,
                       3 * small.fy,    3 * small.cx + 1, 3 * small.cy + 1};
-  Parameters full = parameters(*config_);
+  DiscrepancyOptions full = options_of(*config_);
   full.evidence.max_pixels = 0;
-  Parameters sampled = full;
+  DiscrepancyOptions sampled = full;
   sampled.evidence.max_pixels = 80000;
   ASSERT_EQ(evidence_stride(in.width, in.height, sampled.evidence.max_pixels), 2);
   ASSERT_GT(frames_->scene().actuated_joint_names.size(), 3u);
@@ -528,7 +530,7 @@ TEST_F(EvidenceTest, TheNamingSearchNamesAndSizesAnEncoderOffset) {
       ASSERT_TRUE(s.evidence_available);
       ASSERT_EQ(s.joint_search_gain.size(), static_cast<size_t>(s.num_joints));
       EXPECT_GT(s.search_points, 100);
-      EXPECT_LE(s.search_points, parameters(*config_).evidence.search_max_points);
+      EXPECT_LE(s.search_points, options_of(*config_).evidence.search_max_points);
       const auto [best, own] = searched_best_and_own(s, joint);
       ASSERT_GE(own, 0);
       const double found_deg = s.joint_search_offset[own] / kDeg;
@@ -659,7 +661,7 @@ TEST_F(EvidenceTest, TheCameraFitIsTheSumOverItsPixels) {
   const Intrinsics& in = config_->camera.intrinsics;
   const depth_image_t cam = make_depth_image("cam", in, 1, 1, true, frames_->capture(q, camera(), in, 79));
   const Frame model = render_frame(&frames_->renderer(), frames_->scene(), q, camera(), in);
-  Parameters p = parameters(*config_);
+  DiscrepancyOptions p = options_of(*config_);
   p.evidence.search_range_rad = 0;
   p.evidence.search_range_m = 0;
   const std::vector<uint8_t> silhouette = silhouette_mask(model.depth, p.silhouette_jump_mm);
@@ -756,7 +758,7 @@ TEST(Evidence, LabelsWithoutKinematicsGiveNoEvidence) {
   depth_image_t d =
       make_depth_image("cam", Intrinsics{4, 3, 10, 10, 2, 1}, 1, 1, true, std::vector<float>(12, 1.0f));
   link_labels_t labels = make_link_labels(d, 1, {"a", "floor"}, std::vector<int16_t>(12, kLabelRobotFirst));
-  const DiscrepancyFrame f = compute_discrepancy(d, d, labels, Parameters{});
+  const DiscrepancyFrame f = compute_discrepancy(d, d, labels, DiscrepancyOptions{});
   EXPECT_TRUE(f.summary.usable);
   EXPECT_FALSE(f.summary.evidence_available);
   EXPECT_EQ(f.summary.num_joints, 0);

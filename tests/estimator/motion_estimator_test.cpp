@@ -45,8 +45,8 @@ class MotionEstimatorTest : public ::testing::Test {
   }
   static EstimatorOptions options() {
     EstimatorOptions o;
-    o.noise_sigma_at_0m_m = config_->discrepancy.noise_sigma_at_0m_mm / 1000;
-    o.noise_sigma_per_m2_m = config_->discrepancy.noise_sigma_per_m2_mm / 1000;
+    o.noise.sigma_at_0m_mm = config_->discrepancy.noise_sigma_at_0m_mm;
+    o.noise.sigma_per_m2_mm = config_->discrepancy.noise_sigma_per_m2_mm;
     return o;
   }
   static deployment::Config* config_;

@@ -3,7 +3,7 @@
 or reaches into another folder's src/, and on a main() outside the programs'
 floor (apps/).
 
-Layers, bottom to top (docs/architecture.md, "Layers"):
+Layers, bottom to top (docs/architecture.md, "Layout and layers"):
 
   lcmtypes      generated wire types, included as "tofguard/<name>_t.hpp"
   common        "tofguard/common/..."

@@ -52,7 +52,7 @@ discrepancy_t summary_of(const std::vector<Box>& camera_scene, int64_t seq) {
   const SyntheticImage seen = draw(camera_scene);
   return discrepancy::compute_discrepancy(depth_frame(with_noise(seen.depth_mm, 1), seq),
                                           depth_frame(model.depth_mm, seq), labels_frame(model.label, seq),
-                                          discrepancy::parameters_from(sim_config().discrepancy))
+                                          discrepancy::discrepancy_options(sim_config().discrepancy))
       .summary;
 }
 

@@ -95,7 +95,7 @@ discrepancy_t summary_of(const std::vector<Box>& camera_scene, int64_t seq = 7, 
   add_pixel_cover(&labels, model.depth_mm);
   return discrepancy::compute_discrepancy(depth_frame(with_noise(seen.depth_mm, noise_seed), seq),
                                           depth_frame(model.depth_mm, seq), labels,
-                                          discrepancy::parameters_from(sim_config().discrepancy))
+                                          discrepancy::discrepancy_options(sim_config().discrepancy))
       .summary;
 }
 
@@ -392,7 +392,7 @@ TEST(FrameClassifier, LargeFartherMismatchIsUnclassified) {
   add_pixel_cover(&labels, model.depth_mm);
   const discrepancy_t d = discrepancy::compute_discrepancy(
                               depth_frame(with_noise(seen.depth_mm, 1), 7), depth_frame(model.depth_mm, 7),
-                              labels, discrepancy::parameters_from(sim_config().discrepancy))
+                              labels, discrepancy::discrepancy_options(sim_config().discrepancy))
                               .summary;
   const FrameFinding f = classify(d);
   EXPECT_EQ(f.cause, risk_t::CAUSE_UNCLASSIFIED) << f.detail;
@@ -413,7 +413,7 @@ TEST(FrameClassifier, ShiftOverArmAndEnvironmentIsACalibrationError) {
   const discrepancy_t d =
       discrepancy::compute_discrepancy(depth_frame(with_noise(seen.depth_mm, 2), 1),
                                        depth_frame(model.depth_mm, 1), labels_frame(model.label, 1),
-                                       discrepancy::parameters_from(sim_config().discrepancy))
+                                       discrepancy::discrepancy_options(sim_config().discrepancy))
           .summary;
   const FrameFinding f = classify(d);
   EXPECT_EQ(f.cause, risk_t::CAUSE_CALIBRATION_ERROR) << f.detail;

@@ -30,7 +30,7 @@ discrepancy_t summary(int64_t seq, int shift_px) {
   return discrepancy::compute_discrepancy(
              depth_frame(with_noise(draw(default_arm(shift_px)).depth_mm, seq), seq),
              depth_frame(model.depth_mm, seq), labels_frame(model.label, seq),
-             discrepancy::parameters_from(config.discrepancy))
+             discrepancy::discrepancy_options(config.discrepancy))
       .summary;
 }
 

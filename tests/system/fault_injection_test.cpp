@@ -111,8 +111,8 @@ TEST(FaultInjection, KillOrHangOfEachProcessDuringMotionStopsTheArmWithin200ms) 
       // latched.
       const int64_t statuses_before_resume = chain.statuses();
       chain.process("tofguard-intervene").signal(SIGCONT);
-      EXPECT_TRUE(
-          chain.wait([&] { return chain.statuses() >= statuses_before_resume + 2; }, std::chrono::seconds(2)));
+      EXPECT_TRUE(chain.wait([&] { return chain.statuses() >= statuses_before_resume + 2; },
+                             std::chrono::seconds(2)));
       std::cout << "tofguard-intervene resumed: second status motion_allowed="
                 << chain.last_status().motion_allowed << " (" << chain.last_status().reason << ")"
                 << std::endl;
@@ -340,8 +340,8 @@ TEST(FaultInjection, PacketLossOnTheBusDegradesTowardsAStopNeverTowardsMotion) {
   // most risk_deadline after the last SAFE verdict, and that verdict was
   // made with the depth and joint state within their deadlines. 30 ms
   // slack for scheduling between this test and the processes.
-  const int64_t depth_bound = cfg.risk.depth_deadline_us + cfg.intervention.risk_deadline_us + 30'000;
-  const int64_t joint_bound = cfg.risk.joint_state_deadline_us + cfg.intervention.risk_deadline_us + 30'000;
+  const int64_t depth_bound = cfg.risk.depth_deadline_us + cfg.intervene.risk_deadline_us + 30'000;
+  const int64_t joint_bound = cfg.risk.joint_state_deadline_us + cfg.intervene.risk_deadline_us + 30'000;
   auto last_before = [](const std::vector<int64_t>& arrivals, int64_t t) {
     int64_t last = -1;
     for (const int64_t a : arrivals) {

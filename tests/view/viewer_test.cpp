@@ -160,8 +160,8 @@ TEST(Viewer, DrawsTheProtectiveFieldsOutlineOnTheCameraPanel) {
   set.labels = l;
   const int scale = view::panel_scale(kW);
   const cv::Mat3b with_fields =
-      view::compose_view(set, discrepancy::Parameters{}, 8000, 200, view::FieldSizes{0.3, 0.2});
-  const cv::Mat3b without = view::compose_view(set, discrepancy::Parameters{}, 8000, 200);
+      view::compose_view(set, discrepancy::DiscrepancyOptions{}, 8000, 200, view::FieldSizes{0.3, 0.2});
+  const cv::Mat3b without = view::compose_view(set, discrepancy::DiscrepancyOptions{}, 8000, 200);
   const int banner = with_fields.rows - kH * scale;
   auto camera_pixel = [&](const cv::Mat3b& view, int u, int v) {
     return view(banner + v * scale + scale / 2, u * scale + scale / 2);

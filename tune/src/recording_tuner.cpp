@@ -56,10 +56,10 @@ EvidenceRun run_evidence(const std::vector<RenderedPair>& frames, const TuneSett
   run.sigma_at_0m_mm = sigma_at_0m_mm;
   run.sigma_per_m2_mm = sigma_per_m2_mm;
   run.pixels_per_sample = pixels_per_sample;
-  discrepancy::Parameters parameters = discrepancy::parameters_from(settings.discrepancy);
-  parameters.tolerance.noise.sigma_at_0m_mm = sigma_at_0m_mm;
-  parameters.tolerance.noise.sigma_per_m2_mm = sigma_per_m2_mm;
-  parameters.evidence.pixels_per_sample = pixels_per_sample;
+  discrepancy::DiscrepancyOptions options = discrepancy::discrepancy_options(settings.discrepancy);
+  options.tolerance.noise.sigma_at_0m_mm = sigma_at_0m_mm;
+  options.tolerance.noise.sigma_per_m2_mm = sigma_per_m2_mm;
+  options.evidence.pixels_per_sample = pixels_per_sample;
   risk::SequentialEvidence evidence(settings.risk, tree, settings.renderer.camera.rate_hz);
   std::map<std::string, ScoreStatistics> statistics;
   std::map<std::string, double> max_cusum;
@@ -70,14 +70,14 @@ EvidenceRun run_evidence(const std::vector<RenderedPair>& frames, const TuneSett
   };
   for (const RenderedPair& frame : frames) {
     const discrepancy::DiscrepancyFrame result =
-        discrepancy::compute_discrepancy(frame.camera, frame.rendered, frame.labels, parameters);
+        discrepancy::compute_discrepancy(frame.camera, frame.rendered, frame.labels, options);
     // The false mismatches on the fitted pixels.
     const std::vector<uint8_t> used = noise_pixels(frame, settings.discrepancy.silhouette_jump_mm);
     for (size_t i = 0; i < used.size(); ++i) {
       if (!used[i]) continue;
       const int t = frame.camera.depth_mm[i];
       ++run.pixels;
-      if (std::abs(frame.rendered.depth_mm[i] - t) > parameters.tolerance.at(t)) ++run.mismatches;
+      if (std::abs(frame.rendered.depth_mm[i] - t) > options.tolerance.at(t)) ++run.mismatches;
     }
     const discrepancy_t& d = result.summary;
     if (!d.usable || !d.evidence_available) continue;

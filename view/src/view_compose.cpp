@@ -89,8 +89,8 @@ std::string verdict_text(const FrameSet& frames) {
   return text;
 }
 
-cv::Mat3b compose_view(const FrameSet& frames, const discrepancy::Parameters& parameters, double max_depth_mm,
-                       double full_scale_mm, const FieldSizes& fields) {
+cv::Mat3b compose_view(const FrameSet& frames, const discrepancy::DiscrepancyOptions& options,
+                       double max_depth_mm, double full_scale_mm, const FieldSizes& fields) {
   const int w = frames.camera.width;
   const int h = frames.camera.height;
   const int scale = panel_scale(w);
@@ -114,7 +114,7 @@ cv::Mat3b compose_view(const FrameSet& frames, const discrepancy::Parameters& pa
   cv::Mat3b dis = blank_panel(w, h, scale, "no comparison");
   if (frames.rendered && frames.labels) {
     const auto frame =
-        discrepancy::compute_discrepancy(frames.camera, *frames.rendered, *frames.labels, parameters);
+        discrepancy::compute_discrepancy(frames.camera, *frames.rendered, *frames.labels, options);
     if (frame.summary.usable) {
       const discrepancy_image_t colour = discrepancy::colour_image(frame, full_scale_mm);
       // RGB on the wire, BGR in OpenCV.

@@ -31,7 +31,7 @@ int export_log(const ViewSettings& settings, const std::string& log_path, const 
     std::cerr << "tofguard-view: " << log_path << ": no camera frames on " << settings.channels.depth << "\n";
     return 1;
   }
-  const auto parameters = discrepancy::parameters_from(settings.discrepancy);
+  const auto options = discrepancy::discrepancy_options(settings.discrepancy);
   const double max_depth_mm = settings.far_m * 1000;
   const double full_scale = settings.discrepancy.colour_image_full_scale_mm;
   const bool video = out.size() > 4 && out.substr(out.size() - 4) == ".mp4";
@@ -39,7 +39,7 @@ int export_log(const ViewSettings& settings, const std::string& log_path, const 
   if (!video) std::filesystem::create_directories(out);
   int written = 0;
   for (const auto& [seq, set] : frames.by_seq) {
-    const cv::Mat3b view = compose_view(set, parameters, max_depth_mm, full_scale, settings.fields);
+    const cv::Mat3b view = compose_view(set, options, max_depth_mm, full_scale, settings.fields);
     if (video) {
       if (!writer.isOpened()) {
         writer.open(out, cv::VideoWriter::fourcc('m', 'p', '4', 'v'), settings.camera_rate_hz, view.size());
@@ -94,7 +94,7 @@ int live(const ViewSettings& settings) {
   images.subscribe(settings.channels.rendered, &Handler::rendered, &handler);
   images.subscribe(settings.channels.labels, &Handler::labels, &handler);
   safety.subscribe(settings.channels.risk, &Handler::risk, &handler);
-  const auto parameters = discrepancy::parameters_from(settings.discrepancy);
+  const auto options = discrepancy::discrepancy_options(settings.discrepancy);
   cv::namedWindow("tofguard-view", cv::WINDOW_AUTOSIZE);
   while (!stop_requested()) {
     images.handleTimeout(10);
@@ -105,7 +105,7 @@ int live(const ViewSettings& settings) {
       const FrameSet& set = it->second;
       if (set.camera.width > 0 && set.rendered && set.labels) {
         cv::imshow("tofguard-view",
-                   compose_view(set, parameters, settings.far_m * 1000,
+                   compose_view(set, options, settings.far_m * 1000,
                                 settings.discrepancy.colour_image_full_scale_mm, settings.fields));
         pending.erase(pending.begin(), std::next(it).base());
         break;

@@ -27,7 +27,7 @@
 #include "tofguard/settings/depth_camera_settings.hpp"
 #include "tofguard/settings/discrepancy_settings.hpp"
 #include "tofguard/settings/estimator_settings.hpp"
-#include "tofguard/settings/intervention_settings.hpp"
+#include "tofguard/settings/intervene_settings.hpp"
 #include "tofguard/settings/launch_settings.hpp"
 #include "tofguard/settings/renderer_settings.hpp"
 #include "tofguard/settings/risk_settings.hpp"
@@ -63,7 +63,7 @@ struct Config {
   risk::RiskSettings risk;
   estimator::EstimatorSettings estimator;
   sim::JointsSimSettings joints_sim;
-  intervene::InterventionSettings intervention;
+  intervene::InterveneSettings intervene;
   // Optional: only tofguard-launch needs it.
   std::optional<launch::LaunchSettings> launch;
 };

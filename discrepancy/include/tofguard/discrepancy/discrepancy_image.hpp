@@ -35,7 +35,7 @@ struct Tolerance {
   double at(double depth_mm) const { return sigmas * noise.sigma_mm(depth_mm) + model_mm; }
 };
 
-struct Parameters {
+struct DiscrepancyOptions {
   Tolerance tolerance;
   // Radius of the square opening of the mismatch masks, pixels (0 = none).
   int opening_radius_px = 1;
@@ -53,10 +53,10 @@ struct Parameters {
   // Logical maximum of |I_dis| per pixel for the normalised seed score, mm.
   double max_depth_mm = 8000;
   // The evidence stage (evidence.hpp).
-  EvidenceParameters evidence;
+  EvidenceOptions evidence;
 };
 
-Parameters parameters_from(const DiscrepancySettings& config);
+DiscrepancyOptions discrepancy_options(const DiscrepancySettings& config);
 
 // The result for one frame: the summary that goes on the wire, and the
 // images (for the colour image and for tests).
@@ -78,7 +78,7 @@ struct DiscrepancyFrame {
 // among (joint_search.hpp); nullptr runs it on the caller's thread. The
 // summary is the same either way.
 DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_image_t& rendered,
-                                     const link_labels_t& labels, const Parameters& parameters,
+                                     const link_labels_t& labels, const DiscrepancyOptions& options,
                                      WorkerPool* workers = nullptr);
 
 // compute_discrepancy's silhouette mask (row-major, 1 = beside a

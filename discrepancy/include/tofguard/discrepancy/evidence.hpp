@@ -29,6 +29,7 @@
 #include <Eigen/Core>
 
 #include "tofguard/common/depth_frame.hpp"
+#include "tofguard/common/depth_noise.hpp"
 #include "tofguard/common/worker_pool.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/discrepancy_t.hpp"
@@ -37,7 +38,7 @@
 namespace tofguard::discrepancy {
 
 // discrepancy.evidence.* (DiscrepancySettings).
-struct EvidenceParameters {
+struct EvidenceOptions {
   // The model's own inaccuracy per pixel, mm: sigma_i = sqrt(sigma(d)^2 +
   // model_sigma_mm^2).
   double model_sigma_mm = 3.0;
@@ -70,19 +71,8 @@ struct EvidenceParameters {
   int search_max_points = 3000;
 };
 
-// The camera's noise model (discrepancy.noise), shared by the pixel
-// tolerance (discrepancy_image.hpp) and the evidence weights:
-// sigma(d) = sigma_at_0m_mm + sigma_per_m2_mm * d^2, d the camera depth, m.
-struct DepthNoise {
-  double sigma_at_0m_mm = 4.0;
-  double sigma_per_m2_mm = 1.2;
-
-  // sigma at camera depth `depth_mm`, millimetres.
-  double sigma_mm(double depth_mm) const {
-    const double d_m = metres_from_mm(depth_mm);
-    return sigma_at_0m_mm + sigma_per_m2_mm * d_m * d_m;
-  }
-};
+// (The camera's noise model, DepthNoise, is common/depth_noise.hpp: the
+// pixel tolerance, these evidence weights and the motion estimator share it.)
 
 // compute_evidence's sampling stride k >= 1 for a width x height frame: the
 // smallest k with ceil(width / k) * ceil(height / k) <= max_pixels (1 when
@@ -204,7 +194,7 @@ class EvidenceJacobian {
 // after it (SideTask::run_once) when it did not.
 void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered, const link_labels_t& labels,
                       const std::vector<uint8_t>& silhouette, double silhouette_jump_mm,
-                      const DepthNoise& noise, const EvidenceParameters& parameters, discrepancy_t* summary,
+                      const DepthNoise& noise, const EvidenceOptions& options, discrepancy_t* summary,
                       WorkerPool* workers = nullptr, SideTask* beside = nullptr);
 
 // Clears the evidence fields (evidence_available false, everything zero).

@@ -52,8 +52,8 @@ namespace tofguard::discrepancy {
 // caller then runs it (SideTask::run_once).
 void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rendered,
                           const link_labels_t& labels, const LabelKinematics& kinematics,
-                          const DepthNoise& noise, const EvidenceParameters& parameters,
-                          discrepancy_t* summary, std::vector<uint8_t>* explained_static = nullptr,
-                          WorkerPool* workers = nullptr, SideTask* beside = nullptr);
+                          const DepthNoise& noise, const EvidenceOptions& options, discrepancy_t* summary,
+                          std::vector<uint8_t>* explained_static = nullptr, WorkerPool* workers = nullptr,
+                          SideTask* beside = nullptr);
 
 }  // namespace tofguard::discrepancy

@@ -35,6 +35,7 @@
 #include <Eigen/Geometry>
 
 #include "tofguard/common/camera_settings.hpp"
+#include "tofguard/common/depth_noise.hpp"
 #include "tofguard/renderer/depth_renderer.hpp"
 #include "tofguard/robot_model/kinematics.hpp"
 #include "tofguard/robot_model/scene_model.hpp"
@@ -56,10 +57,9 @@ struct EstimatorOptions {
   // The same for the static links' pixels (the environment) in the
   // iterations at a coarse robust scale (not the final one).
   int coarse_pixel_stride = 2;
-  // Camera noise sigma(Z) = noise_sigma_at_0m_m + noise_sigma_per_m2_m * Z^2,
-  // metres: residuals are weighted by (sigma(1 m) / sigma(Z))^2.
-  double noise_sigma_at_0m_m = 0.004;
-  double noise_sigma_per_m2_m = 0.0012;
+  // The camera's noise model (common/depth_noise.hpp, millimetres as the
+  // config states it): residuals are weighted by (sigma(1 m) / sigma(Z))^2.
+  DepthNoise noise{4.0, 1.2};
   // The model's and the calibration's own inaccuracy, metres: added (in
   // quadrature) to every depth residual's sigma. Such errors do not
   // average out over pixels the way noise does.

@@ -2,9 +2,9 @@
 // tofguard-intervene: SAFETY_RISK, JOINT_STATE, SAFETY_RESET -> SAFETY_STATUS
 // (positive-logic permission to move) at a fixed rate and at once on every
 // change, SAFETY_RESET_REPLY, and the power-cut actuator
-// (intervention_logic.hpp holds the rules, without LCM or clocks).
+// (intervene_logic.hpp holds the rules, without LCM or clocks).
 #include "tofguard/common/process.hpp"
-#include "tofguard/settings/intervention_settings.hpp"
+#include "tofguard/settings/intervene_settings.hpp"
 
 namespace tofguard::intervene {
 

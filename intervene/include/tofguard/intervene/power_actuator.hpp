@@ -11,7 +11,7 @@
 //   with SIGKILL the relay stays where it was. The controller's deadline on
 //   SAFETY_STATUS stays the primary stop; the relay is the second channel.
 // - `serial_pulse` (serial_pulse_output.hpp): a pulse train for a hardware
-//   watchdog, which survives this process's death (docs/intervention.md).
+//   watchdog, which survives this process's death (docs/intervene.md).
 #include <array>
 #include <cstdint>
 #include <memory>

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "tofguard/common/process.hpp"
-#include "tofguard/settings/intervention_settings.hpp"
+#include "tofguard/settings/intervene_settings.hpp"
 
 namespace tofguard::intervene {
 

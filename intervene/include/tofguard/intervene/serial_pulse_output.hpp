@@ -5,7 +5,7 @@
 // come. Unlike a relay held on (usb_hid_relay), it survives tofguard-
 // intervene's own death: kill -9, a hang or a crash stops the pulses, and
 // the watchdog drops the power within its period. Wiring:
-// docs/intervention.md.
+// docs/intervene.md.
 //
 // Lines:
 //   dtr, rts - the modem control line toggles every half period (TIOCMBIS /
@@ -20,7 +20,7 @@
 #include <string>
 
 #include "tofguard/intervene/power_actuator.hpp"
-#include "tofguard/settings/intervention_settings.hpp"
+#include "tofguard/settings/intervene_settings.hpp"
 
 namespace tofguard::intervene {
 

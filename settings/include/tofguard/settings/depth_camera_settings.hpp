@@ -10,7 +10,7 @@
 #include "tofguard/common/lcm_settings.hpp"
 #include "tofguard/common/yaml_reader.hpp"
 
-namespace tofguard::camera {
+namespace tofguard::settings {
 
 // camera.depth_calibration: distance calibration applied by tofguard-camera
 // before publishing:
@@ -59,4 +59,13 @@ struct UvcCameraProcessSettings {
   UvcSettings uvc;
 };
 
+}  // namespace tofguard::settings
+
+// The component's own names for its settings (tofguard::camera::DepthCalibrationSettings, ...).
+namespace tofguard::camera {
+using settings::DepthCalibrationSettings;
+using settings::read_depth_calibration_settings;
+using settings::read_uvc_settings;
+using settings::UvcCameraProcessSettings;
+using settings::UvcSettings;
 }  // namespace tofguard::camera

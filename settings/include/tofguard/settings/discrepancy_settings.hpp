@@ -9,7 +9,7 @@
 #include "tofguard/common/lcm_settings.hpp"
 #include "tofguard/common/yaml_reader.hpp"
 
-namespace tofguard::discrepancy {
+namespace tofguard::settings {
 
 struct DiscrepancySettings {
   // noise.{sigma_at_0m_mm, sigma_per_m2_mm}: camera noise model:
@@ -66,7 +66,7 @@ struct DiscrepancySettings {
   double evidence_naming_gate_sigmas = 0;
   // evidence.max_pixels (optional; absent: 0, every pixel): at most this
   // many pixels in the evidence sums, every k-th in u and v above it
-  // (EvidenceParameters::max_pixels: less information, the same false-stop
+  // (EvidenceOptions::max_pixels: less information, the same false-stop
   // rate).
   int evidence_max_pixels = 0;
   // evidence.search.{range_deg, step_deg, range_mm, step_mm, max_points}:
@@ -111,4 +111,13 @@ struct DiscrepancyProcessSettings {
   DiscrepancySettings discrepancy;
 };
 
+}  // namespace tofguard::settings
+
+// The component's own names for its settings (tofguard::discrepancy::DiscrepancySettings, ...).
+namespace tofguard::discrepancy {
+using settings::auto_worker_threads;
+using settings::DiscrepancyProcessSettings;
+using settings::DiscrepancySettings;
+using settings::kMaxAutoWorkerThreads;
+using settings::read_discrepancy_settings;
 }  // namespace tofguard::discrepancy

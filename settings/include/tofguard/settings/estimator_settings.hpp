@@ -12,7 +12,7 @@
 #include "tofguard/common/yaml_reader.hpp"
 #include "tofguard/settings/renderer_settings.hpp"
 
-namespace tofguard::estimator {
+namespace tofguard::settings {
 
 struct EstimatorSettings {
   // estimate_joints, estimate_camera: which parameters are estimated.
@@ -66,4 +66,11 @@ struct EstimatorProcessSettings {
   EstimatorSettings estimator;
 };
 
+}  // namespace tofguard::settings
+
+// The component's own names for its settings (tofguard::estimator::EstimatorSettings, ...).
+namespace tofguard::estimator {
+using settings::EstimatorProcessSettings;
+using settings::EstimatorSettings;
+using settings::read_estimator_settings;
 }  // namespace tofguard::estimator

@@ -9,7 +9,7 @@
 #include "tofguard/common/lcm_settings.hpp"
 #include "tofguard/common/yaml_reader.hpp"
 
-namespace tofguard::launch {
+namespace tofguard::settings {
 
 // One process of the group tofguard-launch starts (launch.processes), in
 // start order.
@@ -66,4 +66,13 @@ struct LaunchProcessSettings {
   LaunchSettings launch;
 };
 
+}  // namespace tofguard::settings
+
+// The component's own names for its settings (tofguard::launch::LaunchedProcess, ...).
+namespace tofguard::launch {
+using settings::LaunchedProcess;
+using settings::LaunchProcessSettings;
+using settings::LaunchSettings;
+using settings::read_launch_settings;
+using settings::RecorderSettings;
 }  // namespace tofguard::launch

@@ -10,7 +10,7 @@
 #include "tofguard/common/robot_settings.hpp"
 #include "tofguard/common/yaml_reader.hpp"
 
-namespace tofguard::renderer {
+namespace tofguard::settings {
 
 struct RendererSettings {
   // geometry: which URDF geometry to render: "visual" or "collision".
@@ -79,4 +79,11 @@ struct RendererProcessSettings {
   RendererSettings renderer;
 };
 
+}  // namespace tofguard::settings
+
+// The component's own names for its settings (tofguard::renderer::RendererSettings, ...).
+namespace tofguard::renderer {
+using settings::read_renderer_settings;
+using settings::RendererProcessSettings;
+using settings::RendererSettings;
 }  // namespace tofguard::renderer

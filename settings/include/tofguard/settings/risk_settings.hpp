@@ -11,7 +11,7 @@
 #include "tofguard/common/lcm_settings.hpp"
 #include "tofguard/common/yaml_reader.hpp"
 
-namespace tofguard::risk {
+namespace tofguard::settings {
 
 struct RiskSettings {
   // check_period_ms: how often deadlines are checked (and timeouts
@@ -159,4 +159,12 @@ struct RiskProcessSettings {
 // beyond (a reach of the arm).
 double iso13855_intrusion_distance_m(double detection_capability_m);
 
+}  // namespace tofguard::settings
+
+// The component's own names for its settings (tofguard::risk::RiskSettings, ...).
+namespace tofguard::risk {
+using settings::iso13855_intrusion_distance_m;
+using settings::read_risk_settings;
+using settings::RiskProcessSettings;
+using settings::RiskSettings;
 }  // namespace tofguard::risk

@@ -17,7 +17,7 @@
 #include "tofguard/common/yaml_reader.hpp"
 #include "tofguard/settings/depth_camera_settings.hpp"
 
-namespace tofguard::sim {
+namespace tofguard::settings {
 
 // ---- The simulated arm (joints_sim) ----
 
@@ -182,4 +182,18 @@ struct SimFaultToolSettings {
   std::string camera_id;
 };
 
+}  // namespace tofguard::settings
+
+// The component's own names for its settings (tofguard::sim::JointMotion, ...).
+namespace tofguard::sim {
+using settings::EncoderFault;
+using settings::JointMotion;
+using settings::JointsSimProcessSettings;
+using settings::JointsSimSettings;
+using settings::read_joints_sim_settings;
+using settings::read_sim_camera_settings;
+using settings::SimCameraFaultSettings;
+using settings::SimCameraProcessSettings;
+using settings::SimCameraSettings;
+using settings::SimFaultToolSettings;
 }  // namespace tofguard::sim

@@ -3,7 +3,7 @@
 #include "tofguard/common/lcm_settings.hpp"
 #include "tofguard/settings/discrepancy_settings.hpp"
 
-namespace tofguard::view {
+namespace tofguard::settings {
 
 // The protective and warning fields to draw (docs/safety-chain.md,
 // "Protective fields"): S with the arm at rest and the warning margin
@@ -30,4 +30,10 @@ struct ViewSettings {
   FieldSizes fields;
 };
 
+}  // namespace tofguard::settings
+
+// The component's own names for its settings (tofguard::view::FieldSizes, ...).
+namespace tofguard::view {
+using settings::FieldSizes;
+using settings::ViewSettings;
 }  // namespace tofguard::view

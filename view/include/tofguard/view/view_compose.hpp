@@ -36,12 +36,12 @@ cv::Mat1b field_classes(const depth_image_t& camera, const link_labels_t& labels
 // Integer scale so that a panel is at least 320 pixels wide.
 int panel_scale(int width);
 
-// The three panels and the verdict line; `parameters` decide what is a
+// The three panels and the verdict line; `options` decide what is a
 // match (the deployment's discrepancy tolerance). The camera panel shows
 // the fields' outlines on the seen surfaces: red the protective field's,
 // yellow the warning field's.
-cv::Mat3b compose_view(const FrameSet& frames, const discrepancy::Parameters& parameters, double max_depth_mm,
-                       double full_scale_mm, const FieldSizes& fields = {});
+cv::Mat3b compose_view(const FrameSet& frames, const discrepancy::DiscrepancyOptions& options,
+                       double max_depth_mm, double full_scale_mm, const FieldSizes& fields = {});
 
 // The verdict line: e.g. "seq 42  DANGEROUS joint error, suspect a4 | ...",
 // or "seq 42  no verdict".

@@ -29,7 +29,7 @@
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/reset_request_t.hpp"
 #include "tofguard/risk_t.hpp"
-#include "tofguard/settings/intervention_settings.hpp"
+#include "tofguard/settings/intervene_settings.hpp"
 
 namespace tofguard::intervene {
 
@@ -50,9 +50,9 @@ struct ResetDecision {
   std::string reason;
 };
 
-class InterventionLogic {
+class InterveneLogic {
  public:
-  InterventionLogic(const InterventionSettings& config, int64_t now_us, int64_t now_utime);
+  InterveneLogic(const InterveneSettings& config, int64_t now_us, int64_t now_utime);
 
   void on_risk(const risk_t& risk, int64_t now_us, int64_t now_utime);
   void on_joint_state(const joint_state_t& joints, int64_t now_us);
@@ -73,7 +73,7 @@ class InterventionLogic {
   // deadline (watched from the first tick on).
   void check_not_held_up(int64_t now_us, int64_t now_utime, bool from_tick);
 
-  InterventionSettings config_;
+  InterveneSettings config_;
   Status status_;
   bool changed_ = true;
   int64_t stop_started_us_ = 0;

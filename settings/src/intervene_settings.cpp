@@ -1,9 +1,9 @@
-#include "tofguard/settings/intervention_settings.hpp"
+#include "tofguard/settings/intervene_settings.hpp"
 
-namespace tofguard::intervene {
+namespace tofguard::settings {
 
-InterventionSettings read_intervention_settings(YamlMap map) {
-  InterventionSettings in;
+InterveneSettings read_intervene_settings(YamlMap map) {
+  InterveneSettings in;
   in.publish_rate_hz = map.number("publish_rate_hz", 10, 1000);
   in.risk_deadline_us = map.milliseconds_as_us("risk_deadline_ms", 1, 10000);
   in.stop_deadline_us = map.milliseconds_as_us("stop_deadline_ms", 1, 10000);
@@ -31,4 +31,4 @@ InterventionSettings read_intervention_settings(YamlMap map) {
   return in;
 }
 
-}  // namespace tofguard::intervene
+}  // namespace tofguard::settings

@@ -1,4 +1,4 @@
-#include "tofguard/intervene/intervention_logic.hpp"
+#include "tofguard/intervene/intervene_logic.hpp"
 
 #include <cmath>
 #include <sstream>
@@ -38,7 +38,7 @@ void demand_consistent(const Status& s) {
 
 }  // namespace
 
-InterventionLogic::InterventionLogic(const InterventionSettings& config, int64_t now_us, int64_t now_utime)
+InterveneLogic::InterveneLogic(const InterveneSettings& config, int64_t now_us, int64_t now_utime)
     : config_(config), risk_arrival_us_(now_us) {
   // Fail-safe start: stopped and latched. The risk deadline runs from now,
   // so a chain that never starts ends in a power cut.
@@ -59,20 +59,20 @@ InterventionLogic::InterventionLogic(const InterventionSettings& config, int64_t
   received_risk_ = false;
 }
 
-bool InterventionLogic::take_changed() {
+bool InterveneLogic::take_changed() {
   const bool changed = changed_;
   changed_ = false;
   return changed;
 }
 
-bool InterventionLogic::risk_fresh(int64_t now_us) const {
+bool InterveneLogic::risk_fresh(int64_t now_us) const {
   // Before the first risk, the deadline runs from start-up. After this
   // process was held up, only a risk that arrived a deadline later is
   // known not to have waited in the socket buffer meanwhile.
   return now_us - risk_arrival_us_ <= config_.risk_deadline_us && risk_arrival_us_ >= trusted_from_us_;
 }
 
-void InterventionLogic::check_not_held_up(int64_t now_us, int64_t now_utime, bool from_tick) {
+void InterveneLogic::check_not_held_up(int64_t now_us, int64_t now_utime, bool from_tick) {
   // The timer calls tick() at the publish rate: a longer silence than the
   // risk deadline means this process did not run (stopped, starved,
   // swapped). What it handles next was queued meanwhile and arrives "now"
@@ -95,8 +95,8 @@ void InterventionLogic::check_not_held_up(int64_t now_us, int64_t now_utime, boo
       now_us, now_utime);
 }
 
-void InterventionLogic::stop(int8_t kind, int8_t cause, const std::string& reason, int64_t now_us,
-                             int64_t now_utime) {
+void InterveneLogic::stop(int8_t kind, int8_t cause, const std::string& reason, int64_t now_us,
+                          int64_t now_utime) {
   if (status_.motion_allowed) {
     status_.motion_allowed = false;
     status_.stop = kind;
@@ -122,7 +122,7 @@ void InterventionLogic::stop(int8_t kind, int8_t cause, const std::string& reaso
   demand_consistent(status_);
 }
 
-void InterventionLogic::on_risk(const risk_t& risk, int64_t now_us, int64_t now_utime) {
+void InterveneLogic::on_risk(const risk_t& risk, int64_t now_us, int64_t now_utime) {
   check_not_held_up(now_us, now_utime, /*from_tick=*/false);
   risk_ = risk;
   risk_arrival_us_ = now_us;
@@ -132,7 +132,7 @@ void InterventionLogic::on_risk(const risk_t& risk, int64_t now_us, int64_t now_
   }
 }
 
-void InterventionLogic::on_joint_state(const joint_state_t& joints, int64_t now_us) {
+void InterveneLogic::on_joint_state(const joint_state_t& joints, int64_t now_us) {
   max_speed_ = 0;
   fastest_joint_.clear();
   for (int i = 0; i < joints.num_joints; ++i) {
@@ -145,7 +145,7 @@ void InterventionLogic::on_joint_state(const joint_state_t& joints, int64_t now_
   joint_state_arrival_us_ = now_us;
 }
 
-void InterventionLogic::on_actuator_result(const std::string& error, int64_t now_us, int64_t now_utime) {
+void InterveneLogic::on_actuator_result(const std::string& error, int64_t now_us, int64_t now_utime) {
   if (error == actuator_error_) return;
   actuator_error_ = error;
   if (!error.empty()) {
@@ -155,7 +155,7 @@ void InterventionLogic::on_actuator_result(const std::string& error, int64_t now
   changed_ = true;
 }
 
-void InterventionLogic::tick(int64_t now_us, int64_t now_utime) {
+void InterveneLogic::tick(int64_t now_us, int64_t now_utime) {
   check_not_held_up(now_us, now_utime, /*from_tick=*/true);
   if (!risk_fresh(now_us)) {
     const std::string reason = received_risk_
@@ -180,7 +180,7 @@ void InterventionLogic::tick(int64_t now_us, int64_t now_utime) {
   }
 }
 
-ResetDecision InterventionLogic::on_reset(const reset_request_t& request, int64_t now_us, int64_t now_utime) {
+ResetDecision InterveneLogic::on_reset(const reset_request_t& request, int64_t now_us, int64_t now_utime) {
   check_not_held_up(now_us, now_utime, /*from_tick=*/false);
   if (request.who.empty() || request.why.empty()) {
     return {false, "refused: a reset needs who and why"};

@@ -2,7 +2,7 @@
 // microseconds of the monotonic clock, so every deadline is exact.
 #include <gtest/gtest.h>
 
-#include "tofguard/intervene/intervention_logic.hpp"
+#include "tofguard/intervene/intervene_logic.hpp"
 #include "tofguard/intervene/power_actuator.hpp"
 #include "tofguard/safety_status_t.hpp"
 
@@ -12,8 +12,8 @@ namespace {
 constexpr int64_t kMs = 1000;
 constexpr int64_t kUtime0 = 1700000000000000;
 
-InterventionSettings test_config() {
-  InterventionSettings c;
+InterveneSettings test_config() {
+  InterveneSettings c;
   c.publish_rate_hz = 50;
   c.risk_deadline_us = 200000;
   c.stop_deadline_us = 300000;
@@ -56,15 +56,15 @@ reset_request_t reset(const std::string& who = "nurse", const std::string& why =
 }
 
 // Brought to "motion allowed" at t = 10 ms.
-InterventionLogic running_logic() {
-  InterventionLogic logic(test_config(), 0, kUtime0);
+InterveneLogic running_logic() {
+  InterveneLogic logic(test_config(), 0, kUtime0);
   logic.on_risk(risk(risk_t::SAFE), 5 * kMs, kUtime0);
   EXPECT_TRUE(logic.on_reset(reset(), 10 * kMs, kUtime0).accepted);
   return logic;
 }
 
-TEST(InterventionLogic, StartsStoppedAndLatched) {
-  InterventionLogic logic(test_config(), 0, kUtime0);
+TEST(InterveneLogic, StartsStoppedAndLatched) {
+  InterveneLogic logic(test_config(), 0, kUtime0);
   EXPECT_FALSE(logic.status().motion_allowed);
   EXPECT_TRUE(logic.status().latched);
   EXPECT_EQ(logic.status().stop, safety_status_t::STOP_SOFTWARE);
@@ -73,8 +73,8 @@ TEST(InterventionLogic, StartsStoppedAndLatched) {
   EXPECT_FALSE(logic.take_changed());
 }
 
-TEST(InterventionLogic, ResetOnlyWhileTheCurrentRiskIsSafeAndFresh) {
-  InterventionLogic logic(test_config(), 0, kUtime0);
+TEST(InterveneLogic, ResetOnlyWhileTheCurrentRiskIsSafeAndFresh) {
+  InterveneLogic logic(test_config(), 0, kUtime0);
   auto d = logic.on_reset(reset(), 1 * kMs, kUtime0);
   EXPECT_FALSE(d.accepted);
   EXPECT_EQ(d.reason, "refused: no SAFETY_RISK received yet");
@@ -128,15 +128,15 @@ TEST(InterventionLogic, ResetOnlyWhileTheCurrentRiskIsSafeAndFresh) {
   EXPECT_EQ(d.reason, "refused: SAFETY_RISK stale for 201 ms");
 }
 
-TEST(InterventionLogic, ResetNeedsWhoAndWhy) {
-  InterventionLogic logic(test_config(), 0, kUtime0);
+TEST(InterveneLogic, ResetNeedsWhoAndWhy) {
+  InterveneLogic logic(test_config(), 0, kUtime0);
   logic.on_risk(risk(risk_t::SAFE), 1 * kMs, kUtime0);
   EXPECT_FALSE(logic.on_reset(reset("", "x"), 2 * kMs, kUtime0).accepted);
   EXPECT_FALSE(logic.on_reset(reset("x", ""), 2 * kMs, kUtime0).accepted);
 }
 
-TEST(InterventionLogic, DangerousStopsAndLatchesWithTheFirstCause) {
-  InterventionLogic logic = running_logic();
+TEST(InterveneLogic, DangerousStopsAndLatchesWithTheFirstCause) {
+  InterveneLogic logic = running_logic();
   logic.take_changed();
   logic.on_risk(risk(risk_t::DANGEROUS, risk_t::CAUSE_JOINT_ERROR, "a4"), 20 * kMs, kUtime0 + 20000);
   EXPECT_TRUE(logic.take_changed());
@@ -156,15 +156,15 @@ TEST(InterventionLogic, DangerousStopsAndLatchesWithTheFirstCause) {
   EXPECT_FALSE(logic.take_changed());
 }
 
-TEST(InterventionLogic, WarningKeepsMotionAllowed) {
-  InterventionLogic logic = running_logic();
+TEST(InterveneLogic, WarningKeepsMotionAllowed) {
+  InterveneLogic logic = running_logic();
   logic.on_risk(risk(risk_t::WARNING, risk_t::CAUSE_UNKNOWN_OBJECT), 20 * kMs, kUtime0);
   logic.tick(30 * kMs, kUtime0);
   EXPECT_TRUE(logic.status().motion_allowed);
 }
 
-TEST(InterventionLogic, StaleRiskStreamCutsThePowerAtItsDeadline) {
-  InterventionLogic logic = running_logic();
+TEST(InterveneLogic, StaleRiskStreamCutsThePowerAtItsDeadline) {
+  InterveneLogic logic = running_logic();
   logic.on_risk(risk(risk_t::SAFE), 100 * kMs, kUtime0);
   logic.tick(300 * kMs, kUtime0);  // exactly 200 ms: still fresh
   EXPECT_TRUE(logic.status().motion_allowed);
@@ -176,8 +176,8 @@ TEST(InterventionLogic, StaleRiskStreamCutsThePowerAtItsDeadline) {
   EXPECT_EQ(logic.status().reason, "SAFETY_RISK stale: none for 201 ms");
 }
 
-TEST(InterventionLogic, HeldUpLongerThanTheRiskDeadlineStopsAndDistrustsWhatWasQueued) {
-  InterventionLogic logic = running_logic();
+TEST(InterveneLogic, HeldUpLongerThanTheRiskDeadlineStopsAndDistrustsWhatWasQueued) {
+  InterveneLogic logic = running_logic();
   logic.tick(20 * kMs, kUtime0);
   logic.on_risk(risk(risk_t::SAFE), 30 * kMs, kUtime0);
   logic.tick(40 * kMs, kUtime0);
@@ -206,8 +206,8 @@ TEST(InterventionLogic, HeldUpLongerThanTheRiskDeadlineStopsAndDistrustsWhatWasQ
   EXPECT_TRUE(logic.status().motion_allowed);
 }
 
-TEST(InterventionLogic, NoRiskEverCutsThePowerAfterStartUp) {
-  InterventionLogic logic(test_config(), 0, kUtime0);
+TEST(InterveneLogic, NoRiskEverCutsThePowerAfterStartUp) {
+  InterveneLogic logic(test_config(), 0, kUtime0);
   logic.tick(200 * kMs, kUtime0);
   EXPECT_TRUE(logic.status().power_enabled);
   logic.tick(201 * kMs, kUtime0);
@@ -215,8 +215,8 @@ TEST(InterventionLogic, NoRiskEverCutsThePowerAfterStartUp) {
   EXPECT_EQ(logic.status().stop, safety_status_t::STOP_POWER_CUT);
 }
 
-TEST(InterventionLogic, ArmStillMovingAfterTheStopDeadlineCutsThePower) {
-  InterventionLogic logic = running_logic();
+TEST(InterveneLogic, ArmStillMovingAfterTheStopDeadlineCutsThePower) {
+  InterveneLogic logic = running_logic();
   logic.on_risk(risk(risk_t::DANGEROUS, risk_t::CAUSE_UNKNOWN_OBJECT), 100 * kMs, kUtime0);
   // Keep the risk stream alive; the arm keeps moving at 0.5 rad/s on a3.
   for (int64_t t = 110; t <= 400; t += 10) {
@@ -236,8 +236,8 @@ TEST(InterventionLogic, ArmStillMovingAfterTheStopDeadlineCutsThePower) {
       << logic.status().reason;
 }
 
-TEST(InterventionLogic, ArmThatStoppedKeepsThePower) {
-  InterventionLogic logic = running_logic();
+TEST(InterveneLogic, ArmThatStoppedKeepsThePower) {
+  InterveneLogic logic = running_logic();
   logic.on_risk(risk(risk_t::DANGEROUS, risk_t::CAUSE_UNKNOWN_OBJECT), 100 * kMs, kUtime0);
   for (int64_t t = 110; t <= 1000; t += 10) {
     logic.on_risk(risk(risk_t::DANGEROUS, risk_t::CAUSE_UNKNOWN_OBJECT), t * kMs, kUtime0);
@@ -248,8 +248,8 @@ TEST(InterventionLogic, ArmThatStoppedKeepsThePower) {
   EXPECT_TRUE(logic.status().power_enabled);
 }
 
-TEST(InterventionLogic, NoJointStateToShowTheArmStoppedCutsThePower) {
-  InterventionLogic logic = running_logic();
+TEST(InterveneLogic, NoJointStateToShowTheArmStoppedCutsThePower) {
+  InterveneLogic logic = running_logic();
   logic.on_joint_state(joints(0.0), 50 * kMs);
   logic.on_risk(risk(risk_t::DANGEROUS, risk_t::CAUSE_UNKNOWN_OBJECT), 100 * kMs, kUtime0);
   for (int64_t t = 110; t <= 401; t += 10) {
@@ -261,8 +261,8 @@ TEST(InterventionLogic, NoJointStateToShowTheArmStoppedCutsThePower) {
   EXPECT_NE(logic.status().reason.find("no fresh JOINT_STATE"), std::string::npos) << logic.status().reason;
 }
 
-TEST(InterventionLogic, ActuatorErrorStopsAndBlocksResetUntilItWorks) {
-  InterventionLogic logic = running_logic();
+TEST(InterveneLogic, ActuatorErrorStopsAndBlocksResetUntilItWorks) {
+  InterveneLogic logic = running_logic();
   logic.on_actuator_result("USB HID relay 16c0:05df not found", 20 * kMs, kUtime0);
   EXPECT_FALSE(logic.status().motion_allowed);
   EXPECT_EQ(logic.status().cause, risk_t::CAUSE_COMPONENT_FAULT);

@@ -10,9 +10,9 @@
 #include "tofguard/common/lcm_settings.hpp"
 #include "tofguard/common/yaml_reader.hpp"
 
-namespace tofguard::intervene {
+namespace tofguard::settings {
 
-// The serial pulse output's line (serial_pulse_output.hpp, docs/intervention.md).
+// The serial pulse output's line (serial_pulse_output.hpp, docs/intervene.md).
 enum class PulseLine { kDtr, kRts, kTx };
 
 // `intervention.serial_pulse`: the pulse train for a hardware watchdog.
@@ -22,7 +22,7 @@ struct SerialPulseSettings {
   double frequency_hz = 0;  // pulses per second, > 0
 };
 
-struct InterventionSettings {
+struct InterveneSettings {
   // publish_rate_hz: SAFETY_STATUS rate; a change is published at once as
   // well.
   double publish_rate_hz = 0;
@@ -45,7 +45,7 @@ struct InterventionSettings {
   int relay_channel = 1;
   std::string relay_serial;
   // serial_pulse.{device, line, frequency_hz}: the dynamic power output
-  // (serial_pulse_output.hpp, docs/intervention.md): a square wave of
+  // (serial_pulse_output.hpp, docs/intervene.md): a square wave of
   // frequency_hz (1..1000) on line "dtr", "rts" or "tx" of the serial
   // device, for a retriggerable watchdog that drops the arm's power when
   // the pulses stop.
@@ -53,7 +53,7 @@ struct InterventionSettings {
 };
 
 // Reads (and finishes) the `intervention` section.
-InterventionSettings read_intervention_settings(YamlMap section);
+InterveneSettings read_intervene_settings(YamlMap section);
 
 // Everything tofguard-intervene needs.
 struct InterveneProcessSettings {
@@ -62,7 +62,7 @@ struct InterveneProcessSettings {
   // With a key: risk verdicts and resets are taken only from the
   // authenticated channels, and the status and power commands are signed.
   auth::AuthSettings auth;
-  InterventionSettings intervention;
+  InterveneSettings intervene;
 };
 
 // Everything tofguard-reset needs (it runs with or without a config).
@@ -75,4 +75,14 @@ struct ResetToolSettings {
   auth::AuthSettings auth;
 };
 
+}  // namespace tofguard::settings
+
+// The component's own names for its settings (tofguard::intervene::PulseLine, ...).
+namespace tofguard::intervene {
+using settings::InterveneProcessSettings;
+using settings::InterveneSettings;
+using settings::PulseLine;
+using settings::read_intervene_settings;
+using settings::ResetToolSettings;
+using settings::SerialPulseSettings;
 }  // namespace tofguard::intervene
