@@ -15,8 +15,10 @@ Usage: check_function_length.py REPO_ROOT
 """
 import os
 import re
-import subprocess
 import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import source_check  # noqa: E402
 
 MAX_LINES = 120
 SKIP_TOP = {"tests"}
@@ -80,9 +82,8 @@ def long_functions(text, limit=MAX_LINES):
 
 
 def tracked_sources(root):
-    listed = subprocess.run(["git", "ls-files", "--cached", "--others", "--exclude-standard", "*.cpp", "*.hpp",
-                             "*.h", "*.cc"], cwd=root, capture_output=True, text=True, check=True).stdout
-    return [rel for rel in listed.splitlines() if rel.split("/")[0] not in SKIP_TOP]
+    return [rel for rel in source_check.tree_files(root, ("*.cpp", "*.hpp", "*.h", "*.cc"))
+            if rel.split("/")[0] not in SKIP_TOP]
 
 
 def main(root):
@@ -125,9 +126,4 @@ def self_test():
 
 
 if __name__ == "__main__":
-    if sys.argv[1:] == ["--self-test"]:
-        sys.exit(self_test())
-    if len(sys.argv) != 2:
-        print(__doc__)
-        sys.exit(2)
-    sys.exit(main(sys.argv[1]))
+    source_check.run(__doc__, main, self_test)

@@ -12,8 +12,10 @@ Usage: check_present_tense.py REPO_ROOT
 """
 import os
 import re
-import subprocess
 import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import source_check  # noqa: E402
 
 ORDINALS = ("first|second|third|fourth|fifth|sixth|seventh|eighth|ninth|tenth|eleventh|twelfth|thirteenth|"
             "fourteenth|fifteenth|sixteenth|seventeenth|eighteenth|nineteenth|twentieth|[0-9]+(st|nd|rd|th)")
@@ -25,9 +27,7 @@ SELF = "tests/format/check_present_tense.py"
 
 
 def tracked_files(root):
-    listed = subprocess.run(["git", "ls-files", "--cached", "--others", "--exclude-standard"], cwd=root,
-                            capture_output=True, text=True, check=True).stdout
-    return [rel for rel in listed.splitlines() if not rel.endswith(SKIP_SUFFIXES) and rel != SELF]
+    return [rel for rel in source_check.tree_files(root) if not rel.endswith(SKIP_SUFFIXES) and rel != SELF]
 
 
 def history_lines(text):
@@ -72,9 +72,4 @@ def self_test():
 
 
 if __name__ == "__main__":
-    if sys.argv[1:] == ["--self-test"]:
-        sys.exit(self_test())
-    if len(sys.argv) != 2:
-        print(__doc__)
-        sys.exit(2)
-    sys.exit(main(sys.argv[1]))
+    source_check.run(__doc__, main, self_test)
