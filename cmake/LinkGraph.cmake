@@ -10,15 +10,7 @@
 # $<LINK_ONLY:x> counts as x; other generator expressions are left out
 # (none of the project's links uses one), and so are CMake's ::@(...)
 # markers of a link added from another folder.
-function(_tofguard_directory_targets dir out)
-  get_property(targets DIRECTORY ${dir} PROPERTY BUILDSYSTEM_TARGETS)
-  get_property(subdirs DIRECTORY ${dir} PROPERTY SUBDIRECTORIES)
-  foreach(sub ${subdirs})
-    _tofguard_directory_targets(${sub} sub_targets)
-    list(APPEND targets ${sub_targets})
-  endforeach()
-  set(${out} ${targets} PARENT_SCOPE)
-endfunction()
+include(TargetsBelow)
 
 function(_tofguard_direct_links target out)
   get_target_property(type ${target} TYPE)
@@ -49,7 +41,7 @@ function(_tofguard_direct_links target out)
 endfunction()
 
 function(tofguard_write_link_graph file)
-  _tofguard_directory_targets(${PROJECT_SOURCE_DIR} queue)
+  tofguard_targets_below(${PROJECT_SOURCE_DIR} queue)
   set(seen)
   set(lines)
   while(queue)

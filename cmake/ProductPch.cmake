@@ -20,18 +20,7 @@ target_precompile_headers(tofguard_pch PRIVATE
   <algorithm> <atomic> <chrono> <cmath> <cstdint> <functional> <iostream> <map> <memory>
   <optional> <sstream> <string> <vector>)
 
-# tofguard_targets_below(DIR OUT): every target defined in DIR and the
-# directories below it.
-function(tofguard_targets_below dir out)
-  get_property(targets DIRECTORY ${dir} PROPERTY BUILDSYSTEM_TARGETS)
-  get_property(subdirs DIRECTORY ${dir} PROPERTY SUBDIRECTORIES)
-  foreach(sub ${subdirs})
-    tofguard_targets_below(${sub} below)
-    list(APPEND targets ${below})
-  endforeach()
-  set(${out} ${targets} PARENT_SCOPE)
-endfunction()
-
+include(TargetsBelow)
 tofguard_targets_below(${PROJECT_SOURCE_DIR} tofguard_all_targets)
 foreach(target ${tofguard_all_targets})
   get_target_property(type ${target} TYPE)

@@ -43,9 +43,10 @@ PROGRAM_CLOSURES = {
     "tofguard-estimator": DEPLOYMENT + RENDERER + ["tofguard_estimator"],
     "tofguard-calibrate-extrinsics": DEPLOYMENT + RENDERER + ["tofguard_estimator"],
     # The camera program runs a USB camera or the simulated one.
-    "tofguard-camera": DEPLOYMENT + RENDERER + ["tofguard_camera", "tofguard_uvc_camera", "tofguard_sim"],
-    "tofguard-joints-sim": DEPLOYMENT + RENDERER + ["tofguard_camera", "tofguard_sim"],
-    "tofguard-sim-fault": DEPLOYMENT + RENDERER + ["tofguard_camera", "tofguard_sim"],
+    "tofguard-camera": DEPLOYMENT + RENDERER + ["tofguard_camera", "tofguard_uvc_camera", "tofguard_sim_camera"],
+    # The simulated arm and the fault injector: no renderer.
+    "tofguard-joints-sim": DEPLOYMENT + ["tofguard_sim_arm", "tofguard_robot_model"],
+    "tofguard-sim-fault": DEPLOYMENT + ["tofguard_sim_arm", "tofguard_robot_model"],
     "tofguard-launch": DEPLOYMENT + ["tofguard_launch"],
     "tofguard-spy": DEPLOYMENT + ["tofguard_spy"],
     # The viewer colours I_dis as tofguard-discrepancy does and draws the
