@@ -593,6 +593,8 @@ DiscrepancyOptions discrepancy_options(const DiscrepancySettings& config) {
   p.evidence.search_range_m = config.evidence_search_range_m;
   p.evidence.search_step_m = config.evidence_search_step_m;
   p.evidence.search_max_points = config.evidence_search_max_points;
+  p.evidence.static_bias_mm = config.evidence_static_bias_mm;
+  p.evidence.fixed_pattern_sigma_mm = config.evidence_fixed_pattern_sigma_mm;
   return p;
 }
 

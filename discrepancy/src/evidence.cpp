@@ -215,7 +215,9 @@ struct EvidenceSums {
         joint_score(num_joints, 0.0),
         joint_information(num_joints, 0.0),
         joint_naming_score(num_joints, 0.0),
-        joint_naming_information(num_joints, 0.0) {}
+        joint_naming_information(num_joints, 0.0),
+        joint_bias_abs(num_joints, 0.0),
+        joint_bias_square(num_joints, 0.0) {}
   void add(const EvidenceSums& o) {
     for (size_t l = 0; l < link_sum_wr.size(); ++l) {
       link_sum_wr[l] += o.link_sum_wr[l];
@@ -229,6 +231,8 @@ struct EvidenceSums {
       joint_information[j] += o.joint_information[j];
       joint_naming_score[j] += o.joint_naming_score[j];
       joint_naming_information[j] += o.joint_naming_information[j];
+      joint_bias_abs[j] += o.joint_bias_abs[j];
+      joint_bias_square[j] += o.joint_bias_square[j];
     }
     static_chi2 += o.static_chi2;
     camera_fit_pixels += o.camera_fit_pixels;
@@ -238,6 +242,8 @@ struct EvidenceSums {
     for (int k = 0; k < 24; ++k) {
       camera_region_score[k] += o.camera_region_score[k];
       camera_region_information[k] += o.camera_region_information[k];
+      camera_region_bias_abs[k] += o.camera_region_bias_abs[k];
+      camera_region_bias_square[k] += o.camera_region_bias_square[k];
     }
   }
   std::vector<double> link_sum_wr;
@@ -249,6 +255,10 @@ struct EvidenceSums {
   std::vector<double> joint_information;
   std::vector<double> joint_naming_score;
   std::vector<double> joint_naming_information;
+  // The static error's reach into each score (EvidenceOptions::
+  // static_bias_mm): sum w |J| and sum w^2 J^2 over the fit's pixels.
+  std::vector<double> joint_bias_abs;
+  std::vector<double> joint_bias_square;
   double static_chi2 = 0;
   int32_t camera_fit_pixels = 0;
   Eigen::Matrix<double, 6, 1> camera_score = Eigen::Matrix<double, 6, 1>::Zero();
@@ -256,7 +266,26 @@ struct EvidenceSums {
   int32_t camera_region_fit_pixels[4] = {0, 0, 0, 0};
   double camera_region_score[24] = {};
   double camera_region_information[24] = {};
+  // The camera fit's sum w |J| and sum w^2 J^2 per region and parameter
+  // (the whole image's: the four regions' together).
+  double camera_region_bias_abs[24] = {};
+  double camera_region_bias_square[24] = {};
 };
+
+// The static error's reach into the camera fit of pixels n_first ..
+// n_end - 1 (as add_camera_fit's): bias_abs[a] += w |J_a|, bias_square[a]
+// += (w J_a)^2.
+void add_camera_bias_reach(const double* jacobian, const double* weight, int n_first, int n_end,
+                           double* bias_abs, double* bias_square) {
+  for (int n = n_first; n < n_end; ++n) {
+    const double* j = jacobian + 6 * n;
+    for (int a = 0; a < 6; ++a) {
+      const double wj = weight[n] * j[a];
+      bias_abs[a] += std::abs(wj);
+      bias_square[a] += wj * wj;
+    }
+  }
+}
 
 // The camera fit's sums over one row's static pixels n_first .. n_end - 1
 // (their Jacobians 6 to a pixel in `jacobian`, weights w, clipped residuals
@@ -382,6 +411,8 @@ struct RowFit {
     add_camera_fit(jacobian.data(), weight.data(), residual.data(), n_first, n_end, b->camera_score.data(),
                    b->camera_information.data(), b->camera_region_score + 6 * region,
                    b->camera_region_information + 6 * region);
+    add_camera_bias_reach(jacobian.data(), weight.data(), n_first, n_end,
+                          b->camera_region_bias_abs + 6 * region, b->camera_region_bias_square + 6 * region);
   }
   std::vector<double> jacobian;
   std::vector<double> weight;
@@ -401,6 +432,8 @@ void add_robot_pixel(double w, double r, bool in_naming_fit, const std::vector<d
     ++b->joint_fit_pixels[j];
     b->joint_score[j] -= w * jj * r;
     b->joint_information[j] += w * jj * jj;
+    b->joint_bias_abs[j] += w * std::abs(jj);
+    b->joint_bias_square[j] += w * w * jj * jj;
     if (!in_naming_fit) continue;
     b->joint_naming_score[j] -= w * jj * r;
     b->joint_naming_information[j] += w * jj * jj;
@@ -551,6 +584,36 @@ void store_camera_fit(const EvidenceSums& total, discrepancy_t* s) {
   }
 }
 
+// The composite null (EvidenceOptions::static_bias_mm): every detection
+// score shrunk by the most a static error within the bound gives it. After
+// store_camera_fit: the fitted correction stays the plain fit's (what the
+// camera pose looks like), the scores the tests read are shrunk. The naming
+// fit is left plain: it names a joint among joints, all biased alike.
+void shrink_by_static_error(const EvidenceSums& total, const EvidenceOptions& options, discrepancy_t* s) {
+  const double b = options.static_bias_mm;
+  const double fp = kFixedPatternSigmas * options.fixed_pattern_sigma_mm;
+  if (!(b > 0) && !(fp > 0)) return;
+  const auto bound = [&](double bias_abs, double bias_square) {
+    return b * bias_abs + fp * std::sqrt(bias_square);
+  };
+  for (size_t j = 0; j < s->joint_score.size(); ++j) {
+    s->joint_score[j] =
+        shrink_score(s->joint_score[j], bound(total.joint_bias_abs[j], total.joint_bias_square[j]));
+  }
+  for (int a = 0; a < 6; ++a) {
+    double image_abs = 0, image_square = 0;
+    for (int r = 0; r < 4; ++r) {
+      const int k = 6 * r + a;
+      image_abs += total.camera_region_bias_abs[k];
+      image_square += total.camera_region_bias_square[k];
+      s->camera_region_score[k] =
+          shrink_score(s->camera_region_score[k],
+                       bound(total.camera_region_bias_abs[k], total.camera_region_bias_square[k]));
+    }
+    s->camera_score[a] = shrink_score(s->camera_score[a], bound(image_abs, image_square));
+  }
+}
+
 // Each link's weighted mean residual (mm) and its sigma.
 void store_link_bias(const EvidenceSums& total, int num_links, discrepancy_t* s) {
   s->num_link_bias = num_links;
@@ -597,6 +660,7 @@ void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered
   const EvidenceSums total = sum_frame(frame, labels.num_links, workers);
   store_sums(total, &s);
   store_camera_fit(total, &s);
+  shrink_by_static_error(total, options, &s);
   store_link_bias(total, labels.num_links, &s);
   s.num_joints = jacobian.num_joints();
   s.joint_name = labels.joint_name;

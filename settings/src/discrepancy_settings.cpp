@@ -48,6 +48,8 @@ DiscrepancySettings read_discrepancy_settings(YamlMap map) {
     d.evidence_clip_sigmas = evidence.number("clip_sigmas", 0.5, 100);
     d.evidence_pixels_per_sample = evidence.number("pixels_per_sample", 1, 10000);
     d.evidence_naming_gate_sigmas = evidence.number("naming_gate_sigmas", 1, 100);
+    d.evidence_static_bias_mm = evidence.number("static_bias_mm", 0, 1000);
+    d.evidence_fixed_pattern_sigma_mm = evidence.number("fixed_pattern_sigma_mm", 0, 1000);
     if (evidence.optional("max_pixels"))
       d.evidence_max_pixels = static_cast<int>(evidence.integer("max_pixels", 1000, 100000000));
     {

@@ -261,8 +261,14 @@ TEST(EvidenceOtherArms, JointJacobiansMatchRenderedChangesOnTheIiwa14AndTheKinov
 
 // ---- The fits on simulated camera frames ----
 
+// The config's options with no static-error allowance: these tests check
+// the plain fit (its scores, sums and offsets); the allowance, which
+// shrinks the scores, has its own test (AStaticErrorWithinItsBound...).
 DiscrepancyOptions options_of(const deployment::Config& config) {
-  return discrepancy_options(config.discrepancy);
+  DiscrepancyOptions options = discrepancy_options(config.discrepancy);
+  options.evidence.static_bias_mm = 0;
+  options.evidence.fixed_pattern_sigma_mm = 0;
+  return options;
 }
 
 discrepancy_t evidence_of(test::SimulatedFrames* frames, const deployment::Config& config,
@@ -277,6 +283,53 @@ discrepancy_t evidence_of(test::SimulatedFrames* frames, const deployment::Confi
   EXPECT_TRUE(f.summary.usable) << f.summary.unusable_reason;
   EXPECT_EQ(check_discrepancy(f.summary), "");
   return f.summary;
+}
+
+// As evidence_of with the camera's frame `bias_m` farther at every pixel (a
+// common-mode distance error the calibration left) and the evidence's
+// static-error bound set to `static_bias_mm`.
+discrepancy_t evidence_with_static_error(test::SimulatedFrames* frames, const deployment::Config& config,
+                                         const JointPositions& q, const Eigen::Isometry3d& true_camera,
+                                         const Eigen::Isometry3d& reported_camera, uint64_t index,
+                                         double bias_m, double static_bias_mm) {
+  const Intrinsics& in = config.camera.intrinsics;
+  std::vector<float> seen = frames->capture(q, true_camera, in, index);
+  for (float& z : seen) {
+    if (z > 0) z += static_cast<float>(bias_m);
+  }
+  const depth_image_t camera = make_depth_image("cam", in, 1, 1, true, seen);
+  const Frame model = render_frame(&frames->renderer(), frames->scene(), q, reported_camera, in);
+  DiscrepancyOptions options = options_of(config);
+  options.evidence.static_bias_mm = static_bias_mm;
+  const DiscrepancyFrame f = compute_discrepancy(camera, model.depth, model.labels, options);
+  EXPECT_TRUE(f.summary.usable) << f.summary.unusable_reason;
+  EXPECT_EQ(check_discrepancy(f.summary), "");
+  return f.summary;
+}
+
+// The largest |s| / sqrt(I) of the camera's parameters (whole image and
+// each region) and of the joints: how far the tests' scores are from
+// noise.
+double largest_camera_z(const discrepancy_t& s) {
+  double largest = 0;
+  for (int a = 0; a < 6; ++a) {
+    if (s.camera_information[7 * a] > 0)
+      largest = std::max(largest, std::abs(s.camera_score[a]) / std::sqrt(s.camera_information[7 * a]));
+    for (int r = 0; r < 4; ++r) {
+      const double info = s.camera_region_information[6 * r + a];
+      if (info > 0) largest = std::max(largest, std::abs(s.camera_region_score[6 * r + a]) / std::sqrt(info));
+    }
+  }
+  return largest;
+}
+
+double largest_joint_z(const discrepancy_t& s) {
+  double largest = 0;
+  for (int j = 0; j < s.num_joints; ++j) {
+    if (s.joint_information[j] > 0)
+      largest = std::max(largest, std::abs(s.joint_score[j]) / std::sqrt(s.joint_information[j]));
+  }
+  return largest;
 }
 
 // The encoded summary, utime and compute_us aside.
@@ -764,6 +817,41 @@ TEST(Evidence, LabelsWithoutKinematicsGiveNoEvidence) {
   EXPECT_EQ(f.summary.num_joints, 0);
   EXPECT_EQ(f.summary.num_link_bias, 0);
   EXPECT_EQ(check_discrepancy(f.summary), "");
+}
+
+}  // namespace
+}  // namespace tofguard::discrepancy
+
+namespace tofguard::discrepancy {
+namespace {
+
+// The composite null (EvidenceOptions::static_bias_mm): a common-mode
+// distance error of 12 mm reads as a camera pose error far beyond noise with
+// the plain scores; with a bound of 13 mm every score the tests read is
+// within noise (shrunk scores are never larger than the noise part), and a
+// camera 4 cm off along its axis still scores far beyond it.
+TEST_F(EvidenceTest, AStaticErrorWithinItsBoundScoresAsNoise) {
+  const JointPositions q = estimator::test::reach_pose();
+  const discrepancy_t plain =
+      evidence_with_static_error(frames_, *config_, q, camera(), camera(), 91, 0.012, 0);
+  const discrepancy_t bounded =
+      evidence_with_static_error(frames_, *config_, q, camera(), camera(), 91, 0.012, 13.0);
+  std::cout << "12 mm static error: largest camera z " << largest_camera_z(plain) << " plain, "
+            << largest_camera_z(bounded) << " bounded by 13 mm; joints " << largest_joint_z(plain) << ", "
+            << largest_joint_z(bounded) << "\n";
+  EXPECT_GT(largest_camera_z(plain), 30.0);
+  EXPECT_LT(largest_camera_z(bounded), 5.0);
+  EXPECT_LT(largest_joint_z(bounded), 5.0);
+  // The fitted correction stays the plain fit's: what the pose looks like.
+  EXPECT_EQ(plain.camera_correction[2], bounded.camera_correction[2]);
+
+  Eigen::Isometry3d moved = Eigen::Isometry3d::Identity();
+  moved.translation().z() = 0.04;
+  const discrepancy_t fault =
+      evidence_with_static_error(frames_, *config_, q, camera() * moved, camera(), 91, 0.012, 13.0);
+  const double z = fault.camera_score[2] / std::sqrt(fault.camera_information[14]);
+  std::cout << "camera 4 cm off with the 13 mm bound: t_z z " << z << "\n";
+  EXPECT_GT(std::abs(z), 30.0);
 }
 
 }  // namespace

@@ -69,7 +69,36 @@ struct EvidenceOptions {
   double search_range_m = 0.05;
   double search_step_m = 0.0025;
   int search_max_points = 3000;
+  // The static error the camera and the model keep after calibration (or
+  // commissioning), which does not average away from frame to frame
+  // (docs/safety-chain.md, "Static error: the composite null"), mm:
+  //  - static_bias_mm: a bound b on a smooth error shared by many pixels
+  //    (a residual distance error, a warm-up drift, a calibration's
+  //    tolerance): every pixel's static error within +-b, of any sign;
+  //  - fixed_pattern_sigma_mm: per-pixel offsets, independent between
+  //    pixels and fixed over frames, with this sigma.
+  // Each score s of the fits is shrunk towards 0 by the most that such an
+  // error can give it, B = b sum w |J| + fixed_pattern_sigmas *
+  // fixed_pattern_sigma_mm * sqrt(sum w^2 J^2), so that under every error
+  // within the bound |s_shrunk| <= |noise part of s| and the risk's tests
+  // keep their false-stop rate. 0 and 0: an ideal camera, the plain scores.
+  double static_bias_mm = 0.0;
+  double fixed_pattern_sigma_mm = 0.0;
 };
+
+// How many sigmas of a fixed pattern's score offset the shrinking allows
+// (EvidenceOptions::fixed_pattern_sigma_mm): the offset is one draw per
+// camera and geometry, N(0, fixed_pattern_sigma^2 sum w^2 J^2), and persists
+// over frames; 5 sigma leaves a chance of 5.7e-7 per parameter that a
+// camera's pattern exceeds it (docs/safety-chain.md).
+constexpr double kFixedPatternSigmas = 5.0;
+
+// s shrunk towards 0 by `bound` (>= 0): sign(s) max(0, |s| - bound).
+inline double shrink_score(double s, double bound) {
+  if (s > bound) return s - bound;
+  if (s < -bound) return s + bound;
+  return 0.0;
+}
 
 // (The camera's noise model, DepthNoise, is common/depth_noise.hpp: the
 // pixel tolerance, these evidence weights and the motion estimator share it.)

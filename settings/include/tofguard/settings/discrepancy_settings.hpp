@@ -64,6 +64,13 @@ struct DiscrepancySettings {
   // evidence.naming_gate_sigmas: the naming fit's gate in sigmas (the
   // suspect joint is named from the pixels within it).
   double evidence_naming_gate_sigmas = 0;
+  // evidence.{static_bias_mm, fixed_pattern_sigma_mm}: the static error the
+  // camera and the model keep after calibration, which frames do not
+  // average away: a bound on the smooth error shared by many pixels and the
+  // sigma of independent per-pixel offsets, mm (EvidenceOptions; the
+  // derivation: docs/safety-chain.md, "Static error: the composite null").
+  double evidence_static_bias_mm = 0;
+  double evidence_fixed_pattern_sigma_mm = 0;
   // evidence.max_pixels (optional; absent: 0, every pixel): at most this
   // many pixels in the evidence sums, every k-th in u and v above it
   // (EvidenceOptions::max_pixels: less information, the same false-stop
