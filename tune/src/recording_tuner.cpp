@@ -49,17 +49,17 @@ const char* const kCameraParameters[6] = {"camera t_x", "camera t_y", "camera t_
                                           "camera r_x", "camera r_y", "camera r_z"};
 
 // The sequential tests over every frame with `noise` and `pixels_per_sample`.
+// `model`: the noise model and static-error allowance to run with (its
+// sigma_*, pixels_per_sample, static_bias_mm, fixed_pattern_sigma_mm).
 EvidenceRun run_evidence(const std::vector<RenderedPair>& frames, const TuneSettings& settings,
-                         const robot_model::KinematicTree& tree, double sigma_at_0m_mm,
-                         double sigma_per_m2_mm, double pixels_per_sample) {
-  EvidenceRun run;
-  run.sigma_at_0m_mm = sigma_at_0m_mm;
-  run.sigma_per_m2_mm = sigma_per_m2_mm;
-  run.pixels_per_sample = pixels_per_sample;
+                         const robot_model::KinematicTree& tree, const EvidenceRun& model) {
+  EvidenceRun run = model;
   discrepancy::DiscrepancyOptions options = discrepancy::discrepancy_options(settings.discrepancy);
-  options.tolerance.noise.sigma_at_0m_mm = sigma_at_0m_mm;
-  options.tolerance.noise.sigma_per_m2_mm = sigma_per_m2_mm;
-  options.evidence.pixels_per_sample = pixels_per_sample;
+  options.tolerance.noise.sigma_at_0m_mm = model.sigma_at_0m_mm;
+  options.tolerance.noise.sigma_per_m2_mm = model.sigma_per_m2_mm;
+  options.evidence.pixels_per_sample = model.pixels_per_sample;
+  options.evidence.static_bias_mm = model.static_bias_mm;
+  options.evidence.fixed_pattern_sigma_mm = model.fixed_pattern_sigma_mm;
   risk::SequentialEvidence evidence(settings.risk, tree, settings.renderer.camera.rate_hz);
   std::map<std::string, ScoreStatistics> statistics;
   std::map<std::string, double> max_cusum;
@@ -314,7 +314,85 @@ void choose_pixels_per_sample(const SpatialCorrelation& correlation, const TuneS
                                   : configured_pps;
 }
 
-// Pass 3: the sequential tests with the fitted model (and the config's).
+// The smooth part of the static error: per depth bin of the rendered
+// depth (noise-free: binned by the camera's depth, a bin at the edge of the
+// scene's range holds the pixels whose noise carried them there, and its
+// median is the noise's, 15 mm at 3 m for the 8 mm + 2 mm/m^2 camera), the
+// median I_dis of the bins holding at least 1 % of the samples, plus twice
+// its standard error.
+NoiseFit measure_smooth_error(const std::vector<RenderedPair>& frames, const TuneSettings& settings,
+                              const TuneOptions& options, StaticError* error) {
+  NoiseSamples by_rendered_depth(options.fit);
+  for (const RenderedPair& frame : frames) {
+    const std::vector<uint8_t> used = noise_pixels(frame, settings.discrepancy.silhouette_jump_mm);
+    for (size_t i = 0; i < used.size(); ++i) {
+      if (used[i])
+        by_rendered_depth.add(frame.rendered.depth_mm[i],
+                              frame.rendered.depth_mm[i] - frame.camera.depth_mm[i]);
+    }
+  }
+  const NoiseFit smooth = by_rendered_depth.fit();
+  for (const DepthBin& b : smooth.bins) {
+    if (b.samples * 100 < smooth.samples) continue;
+    const double standard_error = 1.2533 * b.sigma_mm / std::sqrt(static_cast<double>(b.samples));
+    const double bound = std::abs(b.median_mm) + 2 * standard_error;
+    if (bound > error->smooth_bound_mm) {
+      error->smooth_bound_mm = bound;
+      error->smooth_depth_m = b.depth_m;
+    }
+  }
+  return smooth;
+}
+
+// Pass 2b: the static error (StaticError): the smooth part by rendered
+// depth, the fixed pattern from the environment pixels' means over the
+// frames less the smooth part.
+StaticError measure_static_error(const std::vector<RenderedPair>& frames, const TuneSettings& settings,
+                                 const TuneOptions& options) {
+  StaticError error;
+  const NoiseFit smooth = measure_smooth_error(frames, settings, options, &error);
+  // Per pixel: count, sum and sum of squares of I_dis less the smooth part.
+  std::vector<int32_t> count;
+  std::vector<double> sum, sum_squares;
+  for (const RenderedPair& frame : frames) {
+    const std::vector<uint8_t> used = noise_pixels(frame, settings.discrepancy.silhouette_jump_mm);
+    if (count.size() != used.size()) {
+      count.assign(used.size(), 0);
+      sum.assign(used.size(), 0.0);
+      sum_squares.assign(used.size(), 0.0);
+    }
+    for (size_t i = 0; i < used.size(); ++i) {
+      const int link =
+          link_of_label(frame.labels.label[i], frame.labels.num_robot_links, frame.labels.num_links);
+      if (!used[i] || link < frame.labels.num_robot_links) continue;  // environment pixels only
+      const int gen = frame.rendered.depth_mm[i];
+      const double e = gen - frame.camera.depth_mm[i] - smooth.median_mm_at(gen);
+      ++count[i];
+      sum[i] += e;
+      sum_squares[i] += e * e;
+    }
+  }
+  double pattern_variance = 0;
+  for (size_t i = 0; i < count.size(); ++i) {
+    if (count[i] < std::max(options.min_pattern_frames, 2)) continue;
+    const double n = count[i];
+    const double mean = sum[i] / n;
+    const double noise_variance = (sum_squares[i] - n * mean * mean) / (n - 1);
+    pattern_variance += mean * mean - noise_variance / n;
+    ++error.pattern_pixels;
+  }
+  if (error.pattern_pixels > 0) {
+    error.fixed_pattern_sigma_mm =
+        std::sqrt(std::max(0.0, pattern_variance / static_cast<double>(error.pattern_pixels)));
+  }
+  return error;
+}
+
+// A measured allowance as the config carries it: rounded up to 0.1 mm.
+double rounded_up_mm(double value_mm) { return std::ceil(value_mm * 10 - 1e-9) / 10; }
+
+// Pass 3: the sequential tests with the fitted model and the measured
+// static error (and with the config's).
 void run_sequential_tests(const std::vector<RenderedPair>& frames, const TuneSettings& settings,
                           const TuneOptions& options, TuneResult* result) {
   const robot_model::KinematicTree tree = robot_model::load_kinematic_tree(settings.renderer.robot.urdf_path);
@@ -322,13 +400,22 @@ void run_sequential_tests(const std::vector<RenderedPair>& frames, const TuneSet
   result->threshold_h = reference.threshold();
   result->warning_level = reference.warning_level();
   result->hypotheses = reference.hypotheses();
-  result->tuned = run_evidence(frames, settings, tree, result->fit.sigma_at_0m_mm,
-                               result->fit.sigma_per_m2_mm, result->pixels_per_sample);
+  EvidenceRun tuned;
+  tuned.sigma_at_0m_mm = result->fit.sigma_at_0m_mm;
+  tuned.sigma_per_m2_mm = result->fit.sigma_per_m2_mm;
+  tuned.pixels_per_sample = result->pixels_per_sample;
+  tuned.static_bias_mm = rounded_up_mm(result->static_error.smooth_bound_mm);
+  tuned.fixed_pattern_sigma_mm = rounded_up_mm(result->static_error.fixed_pattern_sigma_mm);
+  result->tuned = run_evidence(frames, settings, tree, tuned);
   if (options.compare_with_config) {
     result->has_config_run = true;
-    result->configured = run_evidence(frames, settings, tree, settings.discrepancy.noise_sigma_at_0m_mm,
-                                      settings.discrepancy.noise_sigma_per_m2_mm,
-                                      settings.discrepancy.evidence_pixels_per_sample);
+    EvidenceRun configured;
+    configured.sigma_at_0m_mm = settings.discrepancy.noise_sigma_at_0m_mm;
+    configured.sigma_per_m2_mm = settings.discrepancy.noise_sigma_per_m2_mm;
+    configured.pixels_per_sample = settings.discrepancy.evidence_pixels_per_sample;
+    configured.static_bias_mm = settings.discrepancy.evidence_static_bias_mm;
+    configured.fixed_pattern_sigma_mm = settings.discrepancy.evidence_fixed_pattern_sigma_mm;
+    result->configured = run_evidence(frames, settings, tree, configured);
   }
 }
 
@@ -377,6 +464,7 @@ TuneResult tune_recording(const TuneSettings& settings, const std::string& log_p
     return result;
   }
   choose_pixels_per_sample(measure_correlation(frames, settings, result.fit), settings, options, &result);
+  result.static_error = measure_static_error(frames, settings, options);
   run_sequential_tests(frames, settings, options, &result);
   result.error = not_nominal_error(options, result);
   result.usable = result.error.empty();
@@ -419,9 +507,18 @@ std::string tune_report(const TuneResult& r, const TuneSettings& settings) {
       << fixed(r.measured_pixels_per_sample, 2) << " (config "
       << settings.discrepancy.evidence_pixels_per_sample
       << (r.pixels_per_sample_changed ? ", replaced" : ", kept") << ")\n";
+  const StaticError& e = r.static_error;
+  out << "static error (the same in every frame): smooth part within " << fixed(e.smooth_bound_mm, 1)
+      << " mm (largest at " << fixed(e.smooth_depth_m, 2)
+      << " m rendered depth: the bin's median I_dis + 2 standard errors), "
+      << "fixed pattern sigma " << fixed(e.fixed_pattern_sigma_mm, 1) << " mm over " << e.pattern_pixels
+      << " environment pixels (config: static_bias_mm " << settings.discrepancy.evidence_static_bias_mm
+      << ", fixed_pattern_sigma_mm " << settings.discrepancy.evidence_fixed_pattern_sigma_mm << ")\n";
   auto describe = [&](const std::string& label, const EvidenceRun& run) {
     out << label << ": sigma(d) = " << fixed(run.sigma_at_0m_mm, 2) << " + " << fixed(run.sigma_per_m2_mm, 3)
-        << " d^2, pixels_per_sample " << run.pixels_per_sample << "\n"
+        << " d^2, pixels_per_sample " << run.pixels_per_sample << ", static error allowed "
+        << fixed(run.static_bias_mm, 1) << " mm + fixed pattern " << fixed(run.fixed_pattern_sigma_mm, 1)
+        << " mm\n"
         << "  false-mismatch rate per pixel at |I_dis| > " << settings.discrepancy.tolerance_sigmas
         << " sigma + " << settings.discrepancy.model_tolerance_mm << " mm: " << run.mismatches << " of "
         << run.pixels << " (" << std::setprecision(3) << run.mismatch_fraction() << ")\n"
@@ -464,16 +561,24 @@ std::string tuned_config_lines(const TuneResult& r, const std::string& date) {
       << "  # largest CUSUM " << fixed(r.tuned.max_cusum, 1) << " of h " << fixed(r.threshold_h, 1) << ".\n"
       << "  noise: {sigma_at_0m_mm: " << fixed(f.sigma_at_0m_mm, 2)
       << ", sigma_per_m2_mm: " << fixed(f.sigma_per_m2_mm, 3) << "}\n";
+  out << "  # under `evidence:`.\n";
   if (r.pixels_per_sample_changed) {
-    out << "  # under `evidence:`. Measured from the residuals' correlation between neighbours\n"
-        << "  # (rho_u(1) " << fixed(r.rho_u1, 3) << ", rho_v(1) " << fixed(r.rho_v1, 3)
+    out << "    # Measured from the residuals' correlation between neighbours\n"
+        << "    # (rho_u(1) " << fixed(r.rho_u1, 3) << ", rho_v(1) " << fixed(r.rho_v1, 3)
         << "), same pixels.\n"
         << "    pixels_per_sample: " << r.pixels_per_sample << "\n";
   } else {
-    out << "  # evidence.pixels_per_sample: the config's " << r.pixels_per_sample << " stands (measured "
+    out << "    # pixels_per_sample: the config's " << r.pixels_per_sample << " stands (measured "
         << fixed(r.measured_pixels_per_sample, 2) << "; rho_u(1) " << fixed(r.rho_u1, 3) << ", rho_v(1) "
         << fixed(r.rho_v1, 3) << ").\n";
   }
+  const StaticError& e = r.static_error;
+  out << "    # The static error on this recording (docs/safety-chain.md, \"Static error: the\n"
+      << "    # composite null\"): the depth bins' largest median I_dis + 2 standard errors ("
+      << fixed(e.smooth_depth_m, 2) << " m),\n"
+      << "    # and the fixed pattern over " << e.pattern_pixels << " environment pixels; rounded up.\n"
+      << "    static_bias_mm: " << fixed(r.tuned.static_bias_mm, 1) << "\n"
+      << "    fixed_pattern_sigma_mm: " << fixed(r.tuned.fixed_pattern_sigma_mm, 1) << "\n";
   return out.str();
 }
 

@@ -48,6 +48,9 @@ struct TuneOptions {
   // N(0, 1), so h would not hold its false-stop period.
   double max_frame_to_frame_variance = 1.5;
   int64_t min_scores = 30;
+  // The fixed pattern is measured on environment pixels seen in at least
+  // this many frames (StaticError).
+  int min_pattern_frames = 20;
   // The measured pixels_per_sample replaces the config's when they differ
   // by more than this fraction.
   double pixels_per_sample_change = 0.2;
@@ -68,11 +71,37 @@ struct ParameterScores {
   double max_cusum = 0;
 };
 
+// The error that stays from frame to frame, measured on the recording
+// (docs/safety-chain.md, "Static error: the composite null"; the evidence's
+// static_bias_mm and fixed_pattern_sigma_mm), mm. What the camera's
+// calibration and the model leave, whatever its cause (a residual distance
+// error, reflectivity, multipath, the model's own error); a camera pose off
+// from the config shows here too, as an error the tests then tolerate:
+// calibrate the extrinsics before (docs/camera.md).
+struct StaticError {
+  // The smooth part: the largest |median I_dis| over the bins of rendered
+  // depth (noise-free, unlike the camera's) holding at least 1 % of the
+  // samples, plus twice its standard error (1.2533 sigma / sqrt(n) for a
+  // median); at rendered depth smooth_depth_m.
+  double smooth_bound_mm = 0;
+  double smooth_depth_m = 0;
+  // The fixed pattern: on each environment pixel seen in at least
+  // min_pattern_frames frames, the mean of I_dis less the smooth part at its
+  // rendered depth; sigma^2 = the mean over those pixels of (mean^2 - s^2 / n), s^2
+  // the pixel's own frame-to-frame variance (the noise's share of a mean of
+  // n), kept >= 0.
+  double fixed_pattern_sigma_mm = 0;
+  int64_t pattern_pixels = 0;
+};
+
 // The sequential tests over the recording with one noise model.
 struct EvidenceRun {
   double sigma_at_0m_mm = 0;
   double sigma_per_m2_mm = 0;
   double pixels_per_sample = 1;
+  // The static-error allowance the scores were shrunk by (mm).
+  double static_bias_mm = 0;
+  double fixed_pattern_sigma_mm = 0;
   std::vector<ParameterScores> parameters;
   double max_cusum = 0;
   std::string max_cusum_hypothesis;
@@ -110,6 +139,7 @@ struct TuneResult {
   double rho_u1 = 0, rho_v1 = 0;
   bool pixels_per_sample_changed = false;
   double pixels_per_sample = 1;  // what the tuned config gets
+  StaticError static_error;
 
   double threshold_h = 0;
   double warning_level = 0;
