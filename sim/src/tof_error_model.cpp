@@ -19,11 +19,12 @@ Eigen::Vector3d back_project(const Intrinsics& in, int u, int v, double z) {
 }
 
 // What the true image shows per pixel (row-major): the seen point in the
-// optical frame and the surface's unit normal there, turned towards the
-// camera (zero where unknown: nothing seen, or no neighbour on the same
-// surface in u or v).
+// optical frame, its radial distance (0: nothing seen) and the surface's
+// unit normal there, turned towards the camera (zero where unknown:
+// nothing seen, or no neighbour on the same surface in u or v).
 struct SurfaceGeometry {
   std::vector<Eigen::Vector3d> point_m;
+  std::vector<double> r_m;
   std::vector<Eigen::Vector3d> normal;
 };
 
@@ -37,6 +38,7 @@ SurfaceGeometry surface_geometry(const std::vector<float>& z_true, const Intrins
   auto same_surface = [&](double a, double b) { return a > 0 && b > 0 && std::abs(a - b) <= jump; };
   SurfaceGeometry g;
   g.point_m.assign(z_true.size(), Eigen::Vector3d::Zero());
+  g.r_m.assign(z_true.size(), 0.0);
   g.normal.assign(z_true.size(), Eigen::Vector3d::Zero());
   for (int v = 0; v < h; ++v) {
     for (int u = 0; u < w; ++u) {
@@ -45,6 +47,7 @@ SurfaceGeometry surface_geometry(const std::vector<float>& z_true, const Intrins
       const size_t i = static_cast<size_t>(v) * w + u;
       const Eigen::Vector3d p = back_project(intrinsics, u, v, z);
       g.point_m[i] = p;
+      g.r_m[i] = p.norm();
       // Surface tangents from the neighbours on the same surface (central
       // difference when both sides are, one-sided otherwise).
       auto tangent = [&](int du, int dv, Eigen::Vector3d* t) {
@@ -72,10 +75,9 @@ SurfaceGeometry surface_geometry(const std::vector<float>& z_true, const Intrins
 std::vector<double> ideal_amplitude(const SurfaceGeometry& g, double amplitude_at_1m) {
   std::vector<double> amplitude(g.point_m.size(), 0.0);
   for (size_t i = 0; i < amplitude.size(); ++i) {
-    const Eigen::Vector3d& p = g.point_m[i];
-    if (!(p.z() > 0)) continue;
-    const double cos_incidence = g.normal[i].isZero() ? 1.0 : std::abs(g.normal[i].dot(p.normalized()));
-    const double r = p.norm();
+    const double r = g.r_m[i];
+    if (!(r > 0)) continue;
+    const double cos_incidence = g.normal[i].isZero() ? 1.0 : std::abs(g.normal[i].dot(g.point_m[i] / r));
     amplitude[i] = amplitude_at_1m * cos_incidence / (r * r);
   }
   return amplitude;
@@ -95,14 +97,15 @@ std::vector<double> multipath_m(const SurfaceGeometry& g, int w, int h, double m
   for (int v = 0; v < h; ++v) {
     for (int u = 0; u < w; ++u) {
       const size_t i = static_cast<size_t>(v) * w + u;
+      const double r = g.r_m[i];
+      if (!(r > 0)) continue;
       const Eigen::Vector3d& p = g.point_m[i];
-      if (!(p.z() > 0)) continue;
-      const double r = p.norm();
       double facing_sum = 0;
       for (int vj = std::max(0, v - k); vj <= std::min(h - 1, v + k); ++vj) {
         for (int uj = std::max(0, u - k); uj <= std::min(w - 1, u + k); ++uj) {
           const size_t j = static_cast<size_t>(vj) * w + uj;
-          if (g.normal[j].isZero() || !(g.point_m[j].norm() > r + kMultipathMinStepM)) continue;
+          // Cheapest test first: most neighbours are not farther.
+          if (!(g.r_m[j] > r + kMultipathMinStepM) || g.normal[j].isZero()) continue;
           const Eigen::Vector3d to_pixel = p - g.point_m[j];
           const double distance = to_pixel.norm();
           if (distance > kMultipathRangeM) continue;

@@ -48,7 +48,10 @@
 // other surface's light (distance, albedo), occlusion between the two
 // surfaces and light from outside the window or the image; it does not
 // mix a second return into the amplitude. It is a plausible, bounded
-// bias in the right places, not an optical simulation.
+// bias in the right places, not an optical simulation. Cost, 176x144 on
+// one core of the 2-core VM: +3 ms per frame for a box before a wall, +8 ms
+// for a floor receding over the whole image (where most neighbours are
+// farther); nothing with multipath_max_mm 0.
 //
 // Deterministic: the output depends only on the input, the config's seed,
 // the frame index and the time since start (each frame has its own random
