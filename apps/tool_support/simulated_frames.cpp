@@ -26,7 +26,7 @@ std::vector<float> SimulatedFrames::capture(const robot_model::JointPositions& t
       renderer_->render_at(poses, true_world_from_optical, intrinsics, objects);
   if (!rendered.usable) throw std::runtime_error(rendered.unusable_reason);
   const sim::TofErrorModel model(config_.camera.sim, intrinsics);
-  sim::TofImage image = model.apply(rendered.depth_m, frame_index);
+  sim::TofImage image = model.apply(rendered.depth_m, frame_index, frame_index / config_.camera.rate_hz);
   calibration_.apply_z(&image.depth_m, camera::RadialToZ(intrinsics));
   return image.depth_m;
 }

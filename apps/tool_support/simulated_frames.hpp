@@ -27,7 +27,9 @@ class SimulatedFrames {
   explicit SimulatedFrames(const deployment::Config& config);
 
   // Calibrated Z in metres (0 = no return), row-major, for `intrinsics`.
-  // `frame_index` selects the noise. Throws std::runtime_error when the
+  // `frame_index` selects the noise, and the frame is taken frame_index /
+  // camera.rate_hz seconds after the camera started (the error model's
+  // warm-up drift). Throws std::runtime_error when the
   // scene cannot be rendered.
   std::vector<float> capture(const robot_model::JointPositions& true_joints,
                              const Eigen::Isometry3d& true_world_from_optical, const Intrinsics& intrinsics,

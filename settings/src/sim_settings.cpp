@@ -39,6 +39,24 @@ SimCameraFaultSettings read_sim_fault(YamlMap map) {
   return f;
 }
 
+// camera.sim.residual: every key required (a partial truth of the
+// simulated camera is more likely a typo than a wish).
+SimResidualSettings read_sim_residual(YamlMap map) {
+  SimResidualSettings r;
+  r.wiggle_amplitude_mm = map.number("wiggle_amplitude_mm", 0, 100);
+  r.wiggle_period_m = map.number("wiggle_period_m", 0.1, 100);
+  r.wiggle_phase_rad = map.number("wiggle_phase_rad", -2 * M_PI, 2 * M_PI);
+  r.slope_mm_per_m = map.number("slope_mm_per_m", -100, 100);
+  r.pixel_offset_sigma_mm = map.number("pixel_offset_sigma_mm", 0, 100);
+  r.reflectivity_bias_mm_per_decade = map.number("reflectivity_bias_mm_per_decade", -100, 100);
+  r.reference_amplitude = map.number("reference_amplitude", 1, 32767);
+  r.multipath_max_mm = map.number("multipath_max_mm", 0, 200);
+  r.warmup_drift_mm = map.number("warmup_drift_mm", -100, 100);
+  r.warmup_time_constant_s = map.number("warmup_time_constant_s", 1, 86400);
+  map.finish();
+  return r;
+}
+
 }  // namespace
 
 SimCameraSettings read_sim_camera_settings(YamlMap map) {
@@ -68,6 +86,7 @@ SimCameraSettings read_sim_camera_settings(YamlMap map) {
     c.mixed_pixel_probability = mixed.number("probability", 0, 1);
     mixed.finish();
   }
+  if (auto residual = map.optional_map("residual")) c.residual = read_sim_residual(*residual);
   if (map.optional("faults")) {
     for (YamlMap& fault : map.maps("faults")) c.faults.push_back(read_sim_fault(fault));
   }

@@ -126,7 +126,9 @@ SimulatedCamera::Frame SimulatedCamera::capture(int64_t utime, uint64_t frame_in
     frame.why = "render failed: " + rendered.unusable_reason;
     return frame;
   }
-  frame.image = model_.apply(rendered.depth_m, frame_index);
+  // The camera's own running time, for its warm-up drift.
+  const double time_since_start_s = std::max<int64_t>(0, utime - start_utime_) * 1e-6;
+  frame.image = model_.apply(rendered.depth_m, frame_index, time_since_start_s);
   last_image_ = frame.image;
   return frame;
 }

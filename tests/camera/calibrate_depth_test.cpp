@@ -49,7 +49,7 @@ std::string write_captures(const std::vector<double>& distances_m, const std::st
     fs::create_directories(dir + "/" + folder);
     const std::vector<float> plane(static_cast<size_t>(in.width) * in.height, static_cast<float>(d));
     for (int f = 0; f < kFramesPerDistance; ++f) {
-      const sim::TofImage image = model.apply(plane, frame_index++);
+      const sim::TofImage image = model.apply(plane, frame_index++, 0.0);
       cv::Mat png(in.height, in.width, CV_16UC1);
       for (int i = 0; i < in.width * in.height; ++i) {
         png.at<uint16_t>(i / in.width, i % in.width) =

@@ -82,7 +82,7 @@ TEST(DepthCalibration, RemovesTheSimulatedRadialErrorEverywhereInTheImage) {
   for (const double z : {0.8, 1.5, 2.5, 4.0}) {  // corners: r up to 4.5 m
     SCOPED_TRACE("plane at Z " + std::to_string(z) + " m");
     const std::vector<float> plane(static_cast<size_t>(in.width) * in.height, static_cast<float>(z));
-    const sim::TofImage image = model.apply(plane, 0);
+    const sim::TofImage image = model.apply(plane, 0, 0.0);
     std::vector<float> calibrated = image.depth_m;
     cal.apply_z(&calibrated, rays);
     double worst_mm = 0, worst_z_only_mm = 0;

@@ -3,6 +3,8 @@
 // (The interpolation itself is robot_state::JointHistory's, tested there.)
 #include "tofguard/sim/sim_camera.hpp"
 
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "sim_test_config.hpp"
@@ -89,6 +91,28 @@ TEST(SimulatedCamera, SameSeedSameFrames) {
   EXPECT_EQ(fa.image.depth_m, fb.image.depth_m);
   EXPECT_EQ(fa.image.amplitude, fb.image.amplitude);
   EXPECT_NE(fa.image.depth_m, a.capture(kT0 + 1000, 8).image.depth_m);
+}
+
+// The error model's warm-up drift runs on the camera's own time since it
+// started: the same frame index (the same noise) 5 min later reads the
+// drift's growth farther everywhere.
+TEST(SimulatedCamera, WarmsUpFromItsStart) {
+  deployment::CameraSection config = camera_config();
+  config.sim.residual.warmup_drift_mm = 6;
+  config.sim.residual.warmup_time_constant_s = 300;
+  FakeRenderer renderer;
+  SimulatedCamera sim(config, config.sim, &renderer, kT0);
+  constexpr int64_t kLater = kT0 + 300000000;  // 5 min
+  sim.add_true_joint_state(kT0, {"a1"}, {0.3});
+  const auto start = sim.capture(kT0, 7);
+  sim.add_true_joint_state(kLater, {"a1"}, {0.3});
+  const auto later = sim.capture(kLater, 7);
+  ASSERT_EQ(later.outcome, SimulatedCamera::Frame::Outcome::kImage) << later.why;
+  const camera::RadialToZ to_z(config.intrinsics);
+  const size_t centre = 72 * 176 + 87;  // Z/r = 1 at the principal point
+  ASSERT_GT(start.image.depth_m[centre], 0.0f);
+  EXPECT_NEAR((later.image.depth_m[centre] - start.image.depth_m[centre]) / to_z.factor(87, 72),
+              6e-3 * (1 - std::exp(-1.0)), 1e-6);
 }
 
 TEST(SimulatedCamera, ConfigFaultsStallFreezeDriftAndIntrude) {

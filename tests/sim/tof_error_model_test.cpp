@@ -47,7 +47,7 @@ TEST(TofErrorModel, NoiseStatisticsOverAFlatWallMatchTheModel) {
     double sum = 0, sum2 = 0, expected_mean = 0, expected_var = 0;
     int count = 0;
     for (uint64_t frame = 0; frame < 6; ++frame) {
-      const TofImage image = model.apply(wall(static_cast<float>(d)), frame);
+      const TofImage image = model.apply(wall(static_cast<float>(d)), frame, 0.0);
       for (int v = 52; v < 92; ++v) {
         for (int u = 67; u < 107; ++u) {
           const float z = image.depth_m[static_cast<size_t>(v) * in.width + u];
@@ -85,11 +85,11 @@ TEST(TofErrorModel, SameSeedSameFramesOtherSeedOrFrameDiffers) {
   config.seed = 2;
   const TofErrorModel c(config, in);
   const auto scene = wall(2.0f);
-  const TofImage a3 = a.apply(scene, 3);
-  EXPECT_EQ(a3.depth_m, b.apply(scene, 3).depth_m);
-  EXPECT_EQ(a3.amplitude, b.apply(scene, 3).amplitude);
-  EXPECT_NE(a3.depth_m, a.apply(scene, 4).depth_m);
-  EXPECT_NE(a3.depth_m, c.apply(scene, 3).depth_m);
+  const TofImage a3 = a.apply(scene, 3, 0.0);
+  EXPECT_EQ(a3.depth_m, b.apply(scene, 3, 0.0).depth_m);
+  EXPECT_EQ(a3.amplitude, b.apply(scene, 3, 0.0).amplitude);
+  EXPECT_NE(a3.depth_m, a.apply(scene, 4, 0.0).depth_m);
+  EXPECT_NE(a3.depth_m, c.apply(scene, 3, 0.0).depth_m);
 }
 
 TEST(TofErrorModel, AmplitudeFallsWithDistanceAndLowAmplitudeIsInvalid) {
@@ -97,13 +97,13 @@ TEST(TofErrorModel, AmplitudeFallsWithDistanceAndLowAmplitudeIsInvalid) {
   const TofErrorModel model(test_sim_config(), in);
   const size_t centre = 72 * 176 + 87;
   // Perpendicular at the principal point: 4000 / r^2.
-  EXPECT_NEAR(model.apply(wall(2.0f), 0).amplitude[centre], 1000.0, 10.0);
+  EXPECT_NEAR(model.apply(wall(2.0f), 0, 0.0).amplitude[centre], 1000.0, 10.0);
   // At 9 m the amplitude (about 49) is below min_valid 60: every pixel invalid.
-  const TofImage far = model.apply(wall(9.0f), 0);
+  const TofImage far = model.apply(wall(9.0f), 0, 0.0);
   for (float z : far.depth_m) ASSERT_EQ(z, 0.0f);
   EXPECT_NEAR(far.amplitude[centre], 4000.0 / 81.0, 1.0);
   // Nothing in the scene: no depth, no amplitude.
-  const TofImage empty = model.apply(wall(0.0f), 0);
+  const TofImage empty = model.apply(wall(0.0f), 0, 0.0);
   for (size_t i = 0; i < empty.depth_m.size(); ++i) {
     ASSERT_EQ(empty.depth_m[i], 0.0f);
     ASSERT_EQ(empty.amplitude[i], 0.0f);
@@ -117,7 +117,7 @@ TEST(TofErrorModel, DarkNoiseInvalidatesTheConfiguredFraction) {
   const TofErrorModel model(config, in);
   int invalid = 0, total = 0;
   for (uint64_t frame = 0; frame < 4; ++frame) {
-    for (float z : model.apply(wall(1.5f), frame).depth_m) {
+    for (float z : model.apply(wall(1.5f), frame, 0.0).depth_m) {
       invalid += z == 0.0f;
       ++total;
     }
@@ -144,7 +144,7 @@ TEST(TofErrorModel, MixedPixelsAppearOnlyAtSilhouettes) {
   };
   int mixed = 0, silhouette_pixels = 0;
   for (uint64_t frame = 0; frame < 3; ++frame) {
-    const TofImage image = model.apply(scene, frame);
+    const TofImage image = model.apply(scene, frame, 0.0);
     for (int v = 0; v < in.height; ++v) {
       for (int u = 0; u < in.width; ++u) {
         const size_t i = static_cast<size_t>(v) * in.width + u;

@@ -110,6 +110,43 @@ struct SimCameraFaultSettings {
   double tilt_offset_rad = 0;
 };
 
+// The simulated camera's residual errors (camera.sim.residual): what a
+// real ToF camera still gets wrong after its distance calibration. These
+// are the simulator's truth only; nothing downstream of the camera knows
+// them. All zeros (the mapping absent) is an ideal camera. Distances r are
+// radial (along the pixel's ray), metres; every term adds to the measured r.
+struct SimResidualSettings {
+  // wiggle_{amplitude_mm, period_m, phase_rad}, slope_mm_per_m: an error
+  // smooth in r (what a calibration polynomial leaves of the camera's
+  // periodic "wiggling"), millimetres:
+  //   wiggle_amplitude_mm * sin(2 pi r / wiggle_period_m + wiggle_phase_rad)
+  //   + slope_mm_per_m * r.
+  double wiggle_amplitude_mm = 0;
+  double wiggle_period_m = 1;
+  double wiggle_phase_rad = 0;
+  double slope_mm_per_m = 0;
+  // pixel_offset_sigma_mm: fixed-pattern noise, a per-pixel offset drawn
+  // once per camera (from camera.sim.seed, N(0, sigma)) and the same in
+  // every frame, millimetres.
+  double pixel_offset_sigma_mm = 0;
+  // reflectivity_bias_mm_per_decade, reference_amplitude: a bias with the
+  // pixel's amplitude A (dark or far surfaces return less light),
+  //   reflectivity_bias_mm_per_decade * log10(A / reference_amplitude) mm;
+  // reference_amplitude (camera units, as amplitude.at_1m) is the amplitude
+  // that reads without bias (the calibration target's).
+  double reflectivity_bias_mm_per_decade = 0;
+  double reference_amplitude = 1;
+  // multipath_max_mm: the most a pixel reads farther from light that
+  // reaches its surface over another one (a concave corner), millimetres
+  // (TofErrorModel explains the approximation).
+  double multipath_max_mm = 0;
+  // warmup_{drift_mm, time_constant_s}: common-mode drift while the camera
+  // warms up, t seconds since it started:
+  //   warmup_drift_mm * (1 - exp(-t / warmup_time_constant_s)) mm.
+  double warmup_drift_mm = 0;
+  double warmup_time_constant_s = 1;
+};
+
 // The simulated ToF camera's error model (camera.sim, required when
 // camera.source is sim). Distances r are radial (along the pixel's ray),
 // metres.
@@ -137,6 +174,9 @@ struct SimCameraSettings {
   // surfaces with this probability.
   double mixed_pixel_jump_m = 0;
   double mixed_pixel_probability = 0;
+  // residual (optional): errors left after the distance calibration;
+  // absent: none (an ideal camera).
+  SimResidualSettings residual;
   std::vector<SimCameraFaultSettings> faults;
   // Pan-tilt head (camera.sim.pan_tilt; absent: a fixed camera). The camera
   // turns about the configured pose: pan about the pose frame's z axis
@@ -196,4 +236,5 @@ using settings::SimCameraFaultSettings;
 using settings::SimCameraProcessSettings;
 using settings::SimCameraSettings;
 using settings::SimFaultToolSettings;
+using settings::SimResidualSettings;
 }  // namespace tofguard::sim
