@@ -4,7 +4,10 @@
 // r^2 along the ray (the default's: 4.75 + 1.01 r^2), at 25 Hz (30).
 // discrepancy.noise stays the default's (4 + 1.2 d^2): what tofguard-tune
 // replaces.
+#include <sstream>
 #include <string>
+
+#include "tofguard/settings/sim_settings.hpp"
 
 #include "tool_support.hpp"
 
@@ -19,6 +22,29 @@ inline std::string unseen_camera_config(const std::string& name) {
   return sim_config_variant(name, {{"noise: {sigma0_mm: 4.75, sigma_per_m2_mm: 1.01}",
                                     "noise: {sigma0_mm: 8.0, sigma_per_m2_mm: 2.0}"},
                                    {"  rate_hz: 30\n", "  rate_hz: 25\n"}});
+}
+
+// unseen_camera_config's camera with the static errors `residual` (the
+// simulator's camera.sim.residual; the config's discrepancy section does not
+// know them).
+inline std::string imperfect_camera_config(const std::string& name,
+                                           const sim::SimResidualSettings& residual) {
+  std::ostringstream map;
+  map.precision(10);
+  map << "    residual: {wiggle_amplitude_mm: " << residual.wiggle_amplitude_mm
+      << ", wiggle_period_m: " << residual.wiggle_period_m
+      << ", wiggle_phase_rad: " << residual.wiggle_phase_rad
+      << ", slope_mm_per_m: " << residual.slope_mm_per_m
+      << ", pixel_offset_sigma_mm: " << residual.pixel_offset_sigma_mm
+      << ", reflectivity_bias_mm_per_decade: " << residual.reflectivity_bias_mm_per_decade
+      << ", reference_amplitude: " << residual.reference_amplitude
+      << ", multipath_max_mm: " << residual.multipath_max_mm
+      << ", warmup_drift_mm: " << residual.warmup_drift_mm
+      << ", warmup_time_constant_s: " << residual.warmup_time_constant_s << "}\n";
+  return sim_config_variant(name, {{"noise: {sigma0_mm: 4.75, sigma_per_m2_mm: 1.01}",
+                                    "noise: {sigma0_mm: 8.0, sigma_per_m2_mm: 2.0}"},
+                                   {"  rate_hz: 30\n", "  rate_hz: 25\n"},
+                                   {"    faults: []\n", map.str() + "    faults: []\n"}});
 }
 
 }  // namespace tofguard::test
