@@ -51,7 +51,24 @@ Config load_config(const std::string& path, const char* lcm_default_url_env) {
 
   config.renderer = renderer::read_renderer_settings(root.map("renderer"));
   // Safety chain sections (required: no silent defaults for thresholds).
-  config.discrepancy = discrepancy::read_discrepancy_settings(root.map("discrepancy"));
+  {
+    YamlMap discrepancy = root.map("discrepancy");
+    config.discrepancy = discrepancy::read_discrepancy_settings(discrepancy);
+    // The profile must be this camera's: checked here, once, as a frame of
+    // it would be (profile_mismatch).
+    if (config.discrepancy.camera_profile) {
+      depth_image_t frame;
+      frame.camera_id = config.camera.id;
+      frame.width = config.camera.intrinsics.width;
+      frame.height = config.camera.intrinsics.height;
+      frame.fx = config.camera.intrinsics.fx;
+      frame.fy = config.camera.intrinsics.fy;
+      frame.cx = config.camera.intrinsics.cx;
+      frame.cy = config.camera.intrinsics.cy;
+      if (const std::string why = profile_mismatch(*config.discrepancy.camera_profile, frame); !why.empty())
+        discrepancy.fail("camera_profile", "a profile of the camera section's camera", why);
+    }
+  }
   config.risk = risk::read_risk_settings(root.map("risk"));
   config.estimator = estimator::read_estimator_settings(root.map("estimator"));
   config.joints_sim = sim::read_joints_sim_settings(root.map("joints_sim"));

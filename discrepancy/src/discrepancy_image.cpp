@@ -594,6 +594,7 @@ DiscrepancyOptions discrepancy_options(const DiscrepancySettings& config) {
   p.evidence.search_step_m = config.evidence_search_step_m;
   p.evidence.search_max_points = config.evidence_search_max_points;
   p.evidence.static_bias_mm = config.evidence_static_bias_mm;
+  if (config.camera_profile) p.camera_profile = config.camera_profile;
   p.evidence.fixed_pattern_sigma_mm = config.evidence_fixed_pattern_sigma_mm;
   return p;
 }
@@ -607,9 +608,12 @@ discrepancy_t unusable_summary(const depth_image_t& camera, int8_t kind, const s
   return s;
 }
 
-DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_image_t& rendered,
-                                     const link_labels_t& labels, const DiscrepancyOptions& options,
-                                     WorkerPool* workers) {
+namespace {
+
+// compute_discrepancy on the frame as it is (after the camera profile).
+DiscrepancyFrame compare_frames(const depth_image_t& camera, const depth_image_t& rendered,
+                                const link_labels_t& labels, const DiscrepancyOptions& options,
+                                WorkerPool* workers) {
   // The workers' first call comes after the checks and the silhouettes:
   // woken now, they are awake by then (WorkerPool: a wake-up through the
   // hypervisor is slow).
@@ -694,6 +698,24 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
   pixel_stages.run_once();
   joint_reach(reach, &s);
   return frame;
+}
+
+}  // namespace
+
+DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_image_t& rendered,
+                                     const link_labels_t& labels, const DiscrepancyOptions& options,
+                                     WorkerPool* workers) {
+  if (!options.camera_profile) return compare_frames(camera, rendered, labels, options, workers);
+  // The camera's commissioned profile, checked against the frame (a frame
+  // of another camera, size or intrinsics would be corrected wrongly).
+  if (const std::string why = profile_mismatch(*options.camera_profile, camera); !why.empty()) {
+    DiscrepancyFrame frame;
+    frame.summary = unusable_summary(camera, discrepancy_t::UNUSABLE_MISMATCHED, why);
+    return frame;
+  }
+  depth_image_t corrected = camera;
+  apply_camera_profile(*options.camera_profile, &corrected);
+  return compare_frames(corrected, rendered, labels, options, workers);
 }
 
 int64_t depth_hash(const std::vector<int16_t>& depth_mm) {

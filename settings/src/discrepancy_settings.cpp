@@ -68,6 +68,10 @@ DiscrepancySettings read_discrepancy_settings(YamlMap map) {
     }
     evidence.finish();
   }
+  if (map.optional("camera_profile")) {
+    d.camera_profile =
+        std::make_shared<const CameraProfile>(read_camera_profile(map.existing_path("camera_profile")));
+  }
   if (map.optional("worker_threads")) {
     const std::string text = map.string("worker_threads");
     int threads = 0;

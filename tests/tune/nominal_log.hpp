@@ -33,6 +33,11 @@ struct NominalLogOptions {
   bool still = false;         // the arm holds its centre pose
   double joint_rate_hz = 100;
   std::vector<renderer::ExtraObject> objects;  // in view throughout (not nominal)
+  // Faults throughout (not nominal): the true camera moved by
+  // `camera_offset` (in its optical frame: true = configured * offset), and
+  // each joint of `encoder_offset_rad` reported that much more than it is.
+  Eigen::Isometry3d camera_offset = Eigen::Isometry3d::Identity();
+  std::map<std::string, double> encoder_offset_rad;
 };
 
 // Writes the log to `path`; returns the number of camera frames.
@@ -42,7 +47,7 @@ inline int write_nominal_log(const std::string& path, const deployment::Config& 
   lcm::LogFile log(path, "w");
   if (!log.good()) throw std::runtime_error(path + ": cannot write");
   SimulatedFrames camera(config);
-  const Eigen::Isometry3d pose = config.camera.pose.frame_from_optical();
+  const Eigen::Isometry3d pose = config.camera.pose.frame_from_optical() * options.camera_offset;
   const int64_t base_utime = 1'700'000'000'000'000;
   const auto period_us = static_cast<int64_t>(std::llround(1e6 / config.camera.rate_hz));
   const auto joint_period_us = static_cast<int64_t>(std::llround(1e6 / options.joint_rate_hz));
@@ -79,8 +84,10 @@ inline int write_nominal_log(const std::string& path, const deployment::Config& 
     for (const sim::JointMotion& m : config.joints_sim.motion) {
       const double w = 2 * M_PI / m.period_s;
       state.name.push_back(m.joint);
+      const auto offset = options.encoder_offset_rad.find(m.joint);
       state.position.push_back(m.center +
-                               (options.still ? 0.0 : m.amplitude * std::sin(w * t_s + m.phase_rad)));
+                               (options.still ? 0.0 : m.amplitude * std::sin(w * t_s + m.phase_rad)) +
+                               (offset == options.encoder_offset_rad.end() ? 0.0 : offset->second));
       state.velocity.push_back(options.still ? 0.0 : m.amplitude * w * std::cos(w * t_s + m.phase_rad));
     }
     state.num_joints = static_cast<int32_t>(state.name.size());

@@ -5,7 +5,11 @@
 // the tool runs as the real executable.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <string>
+#include <vector>
+
+#include "tofguard/common/camera_profile.hpp"
 
 #include "nominal_log.hpp"
 #include "tool_support.hpp"
@@ -19,10 +23,12 @@ struct ToolRun {
   std::string out, err;
 };
 
-ToolRun run_tune(const std::string& config, const std::string& log) {
+ToolRun run_tune(const std::string& config, const std::string& log,
+                 const std::vector<std::string>& extra = {}) {
   ToolRun run;
-  run.code = run_command("tofguard-tune", {bin_dir() + "/tofguard-tune", "--config", config, "--log", log},
-                         &run.out, &run.err);
+  std::vector<std::string> argv = {bin_dir() + "/tofguard-tune", "--config", config, "--log", log};
+  argv.insert(argv.end(), extra.begin(), extra.end());
+  run.code = run_command("tofguard-tune", argv, &run.out, &run.err);
   return run;
 }
 
@@ -70,6 +76,53 @@ TEST_F(TuneRecording, RefusesARecordingWithSomethingInView) {
       Eigen::Vector3d(0.10, -0.17, 1.0);  // record-scenario's object, larger
   options.objects.push_back(box);
   expect_refused(run_tune(config_path_, log("object", options)), "not nominal");
+}
+
+// Learning a camera profile (--profile-out) from a recording with an object
+// in view: the object's pixels are not learned as offsets (they are beyond
+// the tolerance in most of their frames), so the corrected frames still
+// show it and the recording is refused; no profile is written.
+TEST_F(TuneRecording, LearnsNoProfileFromARecordingWithSomethingInView) {
+  NominalLogOptions options;
+  options.seconds = 2.4;
+  renderer::ExtraObject box;
+  box.size_m = Eigen::Vector3d(0.3, 0.3, 0.3);
+  box.world_from_object.translation() = Eigen::Vector3d(0.10, -0.17, 1.0);
+  options.objects.push_back(box);
+  const std::string profile = output_dir() + "/tune-object.profile.yaml";
+  std::filesystem::remove(profile);
+  const ToolRun run = run_tune(config_path_, log("object-profile", options), {"--profile-out", profile});
+  expect_refused(run, "not nominal");
+  EXPECT_FALSE(std::filesystem::exists(profile));
+  EXPECT_NE(run.out.find("camera profile learned"), std::string::npos) << run.out;
+}
+
+// A profile of another camera (its id) named in the config: the config is
+// refused when it is read, naming the key and both ids.
+TEST_F(TuneRecording, RefusesAProfileOfAnotherCamera) {
+  CameraProfile profile;
+  profile.camera_id = "another-camera";
+  profile.width = config_.camera.intrinsics.width;
+  profile.height = config_.camera.intrinsics.height;
+  profile.fx = config_.camera.intrinsics.fx;
+  profile.fy = config_.camera.intrinsics.fy;
+  profile.cx = config_.camera.intrinsics.cx;
+  profile.cy = config_.camera.intrinsics.cy;
+  profile.distance_correction_mm = {0.0};
+  profile.measured_on = "nothing: a test of the check";
+  profile.pixel_correction_mm.assign(static_cast<size_t>(profile.width * profile.height), 0.0f);
+  const std::string profile_path = output_dir() + "/tune-another-camera.profile.yaml";
+  write_file(profile_path, camera_profile_yaml(profile));
+  std::string text = read_file(config_path_);
+  const std::string anchor = "\n  max_depth_mm: 8000\n";
+  ASSERT_NE(text.find(anchor), std::string::npos);
+  text.insert(text.find(anchor) + anchor.size(), "  camera_profile: " + profile_path + "\n");
+  const std::string config = output_dir() + "/tune-another-camera.yaml";
+  write_file(config, text);
+  const ToolRun run = run_tune(config, output_dir() + "/no-such.lcmlog");
+  EXPECT_EQ(run.code, 2) << run.out << run.err;
+  EXPECT_NE(run.err.find("discrepancy.camera_profile"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("another-camera"), std::string::npos) << run.err;
 }
 
 TEST_F(TuneRecording, RefusesAMissingLog) {

@@ -19,31 +19,10 @@
 #include "tofguard/renderer/renderer_service.hpp"
 #include "tofguard/risk/sequential_evidence.hpp"
 #include "tofguard/robot_model/kinematic_tree.hpp"
+#include "tofguard/tune/camera_profile_fit.hpp"
 
 namespace tofguard::tune {
 namespace {
-
-// A camera frame with what tofguard-renderer made of it.
-struct RenderedPair {
-  depth_image_t camera;
-  depth_image_t rendered;
-  link_labels_t labels;
-};
-
-// The pixels the noise is measured on: compared (camera and model both have
-// a surface), not beside a silhouette (compute_discrepancy's mask: mixed
-// pixels), on a modelled link. 1 = used.
-std::vector<uint8_t> noise_pixels(const RenderedPair& frame, double silhouette_jump_mm) {
-  const std::vector<uint8_t> silhouette = discrepancy::silhouette_mask(frame.rendered, silhouette_jump_mm);
-  const size_t n = frame.camera.depth_mm.size();
-  std::vector<uint8_t> used(n, 0);
-  for (size_t i = 0; i < n; ++i) {
-    const bool on_link =
-        link_of_label(frame.labels.label[i], frame.labels.num_robot_links, frame.labels.num_links) >= 0;
-    used[i] = frame.camera.depth_mm[i] > 0 && frame.rendered.depth_mm[i] > 0 && !silhouette[i] && on_link;
-  }
-  return used;
-}
 
 const char* const kCameraParameters[6] = {"camera t_x", "camera t_y", "camera t_z",
                                           "camera r_x", "camera r_y", "camera r_z"};
@@ -60,6 +39,8 @@ EvidenceRun run_evidence(const std::vector<RenderedPair>& frames, const TuneSett
   options.evidence.pixels_per_sample = model.pixels_per_sample;
   options.evidence.static_bias_mm = model.static_bias_mm;
   options.evidence.fixed_pattern_sigma_mm = model.fixed_pattern_sigma_mm;
+  // The frames are corrected already (correct_frames).
+  options.camera_profile = nullptr;
   risk::SequentialEvidence evidence(settings.risk, tree, settings.renderer.camera.rate_hz);
   std::map<std::string, ScoreStatistics> statistics;
   std::map<std::string, double> max_cusum;
@@ -225,6 +206,37 @@ class RecordingRenderer {
   std::map<std::string, std::pair<double, double>> joint_range_;  // min, max
 };
 
+// The camera's profile applied to every frame: the one learned from the
+// frames (options.learn_profile) or the config's (discrepancy.camera_profile);
+// frames as recorded without either. Why it cannot be; empty when it can.
+std::string correct_frames(const TuneSettings& settings, const TuneOptions& options,
+                           std::vector<RenderedPair>* frames, TuneResult* result) {
+  const std::shared_ptr<const CameraProfile>& configured = settings.discrepancy.camera_profile;
+  if (options.learn_profile) {
+    if (configured) {
+      return "a profile is learned from the camera's own frames: remove discrepancy.camera_profile (" +
+             configured->file + ") from the config first";
+    }
+    result->profile_fit =
+        fit_camera_profile(*frames, discrepancy::discrepancy_options(settings.discrepancy).tolerance,
+                           settings.discrepancy.silhouette_jump_mm, options.profile);
+    if (!result->profile_fit.ok) return result->log_path + ": " + result->profile_fit.error;
+    result->profile_fit.profile.measured_on =
+        result->log_path + ", " + std::to_string(frames->size()) + " frames";
+    result->has_profile = true;
+  }
+  const CameraProfile* profile = result->has_profile ? &result->profile_fit.profile : configured.get();
+  if (profile == nullptr) return "";
+  for (RenderedPair& frame : *frames) {
+    if (const std::string why = profile_mismatch(*profile, frame.camera); !why.empty()) {
+      return result->log_path + ": " + why;
+    }
+    apply_camera_profile(*profile, &frame.camera);
+  }
+  result->profile_applied = profile->file.empty() ? "learned from this recording" : profile->file;
+  return "";
+}
+
 // Why the recording is too short or too still to tune on; empty when it
 // is not.
 std::string recording_error(const TuneSettings& settings, const TuneOptions& options,
@@ -389,7 +401,7 @@ StaticError measure_static_error(const std::vector<RenderedPair>& frames, const 
 }
 
 // A measured allowance as the config carries it: rounded up to 0.1 mm.
-double rounded_up_mm(double value_mm) { return std::ceil(value_mm * 10 - 1e-9) / 10; }
+double rounded_up_mm(double value_mm) { return std::max(0.0, std::ceil(value_mm * 10 - 1e-9) / 10); }
 
 // Pass 3: the sequential tests with the fitted model and the measured
 // static error (and with the config's).
@@ -455,8 +467,10 @@ TuneResult tune_recording(const TuneSettings& settings, const std::string& log_p
     result.error = log_path + ": cannot open as an LCM log";
     return result;
   }
-  const std::vector<RenderedPair> frames = RecordingRenderer(settings, options, &result).read(&log);
+  std::vector<RenderedPair> frames = RecordingRenderer(settings, options, &result).read(&log);
   result.error = recording_error(settings, options, result);
+  if (!result.error.empty()) return result;
+  result.error = correct_frames(settings, options, &frames, &result);
   if (!result.error.empty()) return result;
   result.fit = fit_noise(frames, settings, options);
   if (!result.fit.ok) {
@@ -507,6 +521,20 @@ std::string tune_report(const TuneResult& r, const TuneSettings& settings) {
       << fixed(r.measured_pixels_per_sample, 2) << " (config "
       << settings.discrepancy.evidence_pixels_per_sample
       << (r.pixels_per_sample_changed ? ", replaced" : ", kept") << ")\n";
+  if (r.has_profile) {
+    const ProfileFit& p = r.profile_fit;
+    out << "camera profile learned: distance correction " << fixed(p.smallest_correction_mm, 1) << ".."
+        << fixed(p.largest_correction_mm, 1) << " mm over " << fixed(p.first_m, 2) << ".."
+        << fixed(p.last_m, 2) << " m radial (" << p.measured_bins << " bins of "
+        << fixed(p.profile.distance_bin_m, 2) << " m), per-pixel offsets on " << p.mapped_pixels
+        << " pixels (sigma " << fixed(p.pixel_sigma_mm, 1) << " mm), " << p.outlier_pixels
+        << " pixels left out (beyond the tolerance in over "
+        << fixed(100 * ProfileFitOptions{}.max_outlier_fraction, 0) << " % of their frames)\n"
+        << "  the figures below are on the recording it was learned from: check it on a second recording "
+        << "(name it in discrepancy.camera_profile, run tofguard-tune on that recording, deploy its lines)\n";
+  } else if (!r.profile_applied.empty()) {
+    out << "camera profile applied: " << r.profile_applied << "\n";
+  }
   const StaticError& e = r.static_error;
   out << "static error (the same in every frame): smooth part within " << fixed(e.smooth_bound_mm, 1)
       << " mm (largest at " << fixed(e.smooth_depth_m, 2)

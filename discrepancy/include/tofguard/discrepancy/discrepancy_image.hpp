@@ -8,11 +8,13 @@
 // Pure computation: no LCM, no clocks. Images are row-major (v*width + u),
 // depth is Z along the camera's optical axis in millimetres, <= 0 = none.
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
 
+#include "tofguard/common/camera_profile.hpp"
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/common/worker_pool.hpp"
 #include "tofguard/depth_image_t.hpp"
@@ -54,6 +56,10 @@ struct DiscrepancyOptions {
   double max_depth_mm = 8000;
   // The evidence stage (evidence.hpp).
   EvidenceOptions evidence;
+  // The camera's commissioned profile (camera_profile.hpp; null: none):
+  // every camera frame is corrected by it before it is compared, and a
+  // frame it does not fit (camera id, size, intrinsics) is unusable.
+  std::shared_ptr<const CameraProfile> camera_profile;
 };
 
 DiscrepancyOptions discrepancy_options(const DiscrepancySettings& config);

@@ -4,8 +4,10 @@
 // compared. Durations are integer microseconds, converted once when the file
 // is read.
 #include <cstdint>
+#include <memory>
 #include <string>
 
+#include "tofguard/common/camera_profile.hpp"
 #include "tofguard/common/lcm_settings.hpp"
 #include "tofguard/common/yaml_reader.hpp"
 
@@ -71,6 +73,12 @@ struct DiscrepancySettings {
   // derivation: docs/safety-chain.md, "Static error: the composite null").
   double evidence_static_bias_mm = 0;
   double evidence_fixed_pattern_sigma_mm = 0;
+  // camera_profile (optional; absent: none): the camera's commissioned
+  // profile file (tofguard-tune --profile-out; docs/camera.md,
+  // "Commissioning a camera"), read with the config: every frame is
+  // corrected by it before it is compared. The evidence's static_bias_mm
+  // and fixed_pattern_sigma_mm are then what is left with it applied.
+  std::shared_ptr<const CameraProfile> camera_profile;
   // evidence.max_pixels (optional; absent: 0, every pixel): at most this
   // many pixels in the evidence sums, every k-th in u and v above it
   // (EvidenceOptions::max_pixels: less information, the same false-stop

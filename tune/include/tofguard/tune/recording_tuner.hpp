@@ -18,6 +18,7 @@
 #include "tofguard/settings/discrepancy_settings.hpp"
 #include "tofguard/settings/renderer_settings.hpp"
 #include "tofguard/settings/risk_settings.hpp"
+#include "tofguard/tune/camera_profile_fit.hpp"
 #include "tofguard/tune/noise_fit.hpp"
 
 namespace tofguard::tune {
@@ -51,6 +52,11 @@ struct TuneOptions {
   // The fixed pattern is measured on environment pixels seen in at least
   // this many frames (StaticError).
   int min_pattern_frames = 20;
+  // Learn the camera's profile from the recording (tofguard-tune
+  // --profile-out; camera_profile_fit.hpp) and tune on the corrected
+  // frames.
+  bool learn_profile = false;
+  ProfileFitOptions profile;
   // The measured pixels_per_sample replaces the config's when they differ
   // by more than this fraction.
   double pixels_per_sample_change = 0.2;
@@ -140,6 +146,11 @@ struct TuneResult {
   bool pixels_per_sample_changed = false;
   double pixels_per_sample = 1;  // what the tuned config gets
   StaticError static_error;
+  // The profile learned (has_profile: options.learn_profile), and which
+  // profile the frames were corrected with (empty: none).
+  bool has_profile = false;
+  ProfileFit profile_fit;
+  std::string profile_applied;
 
   double threshold_h = 0;
   double warning_level = 0;

@@ -1,0 +1,72 @@
+#pragma once
+// A commissioned ToF camera's profile: the static distance error the camera
+// keeps after its own distance calibration, measured on a nominal recording
+// by `tofguard-tune --profile-out` (docs/camera.md, "Commissioning a
+// camera"), and removed from every frame where frames are compared
+// (compute_discrepancy), whichever driver or log the frame came from.
+//
+// The correction of pixel (u, v) whose camera depth is Z (mm, optical
+// frame) is
+//   Z' = Z + f * distance_correction_mm(r) + pixel_correction_mm[v * width + u],
+// r = Z / f the radial distance along the pixel's ray (m) and
+// f = 1 / sqrt(1 + ((u - cx) / fx)^2 + ((v - cy) / fy)^2) its Z per unit of
+// r: a ToF camera errs along the ray, smoothly in r (its "wiggling").
+// distance_correction_mm interpolates linearly between the bins' centres
+// and holds the end bins' values beyond them (the profile says which range
+// it was measured over: beyond it the correction is a guess, and the
+// residual allowance does not cover it).
+//
+// A profile serves one camera: its id, size and intrinsics must be the
+// frame's (profile_mismatch).
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "tofguard/depth_image_t.hpp"
+
+namespace tofguard {
+
+struct CameraProfile {
+  // The file it was read from (messages), empty when built in memory.
+  std::string file;
+  // The camera it was measured on: depth_image_t's camera_id, width,
+  // height, fx, fy, cx, cy (pixels).
+  std::string camera_id;
+  int width = 0;
+  int height = 0;
+  double fx = 0, fy = 0, cx = 0, cy = 0;
+  // The smooth part: added to the measured radial distance, mm, per bin of
+  // radial distance: bin k is centred at distance_first_m + k *
+  // distance_bin_m. At least one bin.
+  double distance_first_m = 0;
+  double distance_bin_m = 0.05;
+  std::vector<double> distance_correction_mm;
+  // The per-pixel part (row-major, width * height), mm in Z; 0 where it
+  // was not measured.
+  std::vector<float> pixel_correction_mm;
+  // What the correction leaves, as measured on a recording with the profile
+  // applied (the evidence's static_bias_mm and fixed_pattern_sigma_mm
+  // belong to that measurement, not to this file): for the report only.
+  std::string measured_on;
+
+  // The smooth correction at radial distance r_m, mm.
+  double distance_correction_at(double r_m) const;
+};
+
+// Why `frame` is not this profile's camera (one line naming the field and
+// both values), or "" when it is.
+std::string profile_mismatch(const CameraProfile& profile, const depth_image_t& frame);
+
+// Corrects `frame`'s depth_mm in place (its valid pixels; a result outside
+// 1..32767 mm becomes 0, invalid). The frame must match (profile_mismatch
+// empty).
+void apply_camera_profile(const CameraProfile& profile, depth_image_t* frame);
+
+// Reads a profile file (YAML); throws ConfigError with a one-line message
+// naming the file and the field.
+CameraProfile read_camera_profile(const std::string& path);
+
+// The profile as the file holds it.
+std::string camera_profile_yaml(const CameraProfile& profile);
+
+}  // namespace tofguard

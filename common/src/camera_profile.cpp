@@ -1,0 +1,137 @@
+#include "tofguard/common/camera_profile.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+#include "tofguard/common/yaml_reader.hpp"
+
+namespace tofguard {
+namespace {
+
+// Intrinsics agree when they differ by less than this (pixels): the
+// profile's pixel map and rays are the camera's own.
+constexpr double kIntrinsicsTolerancePx = 1e-3;
+
+std::string number(double value) {
+  std::ostringstream s;
+  s << std::setprecision(10) << value;
+  return s.str();
+}
+
+// Z per unit of radial distance at pixel (u, v).
+double z_per_radial(const CameraProfile& p, int u, int v) {
+  const double x = (u - p.cx) / p.fx;
+  const double y = (v - p.cy) / p.fy;
+  return 1.0 / std::sqrt(1.0 + x * x + y * y);
+}
+
+}  // namespace
+
+double CameraProfile::distance_correction_at(double r_m) const {
+  const auto n = static_cast<int>(distance_correction_mm.size());
+  if (n == 0) return 0;
+  const double k = (r_m - distance_first_m) / distance_bin_m;
+  if (!(k > 0)) return distance_correction_mm.front();
+  if (k >= n - 1) return distance_correction_mm.back();
+  const int below = static_cast<int>(k);
+  const double w = k - below;
+  return (1 - w) * distance_correction_mm[static_cast<size_t>(below)] +
+         w * distance_correction_mm[static_cast<size_t>(below + 1)];
+}
+
+std::string profile_mismatch(const CameraProfile& p, const depth_image_t& frame) {
+  const std::string head = "camera profile " + (p.file.empty() ? std::string("(in memory)") : p.file) + ": ";
+  if (frame.camera_id != p.camera_id) {
+    return head + "made for camera_id '" + p.camera_id + "', the frame is from '" + frame.camera_id + "'";
+  }
+  if (frame.width != p.width || frame.height != p.height) {
+    return head + "made for " + std::to_string(p.width) + "x" + std::to_string(p.height) + ", the frame is " +
+           std::to_string(frame.width) + "x" + std::to_string(frame.height);
+  }
+  const double mine[4] = {p.fx, p.fy, p.cx, p.cy};
+  const double theirs[4] = {frame.fx, frame.fy, frame.cx, frame.cy};
+  const char* names[4] = {"fx", "fy", "cx", "cy"};
+  for (int k = 0; k < 4; ++k) {
+    if (!(std::abs(mine[k] - theirs[k]) < kIntrinsicsTolerancePx)) {
+      return head + "made for " + names[k] + " " + number(mine[k]) + ", the frame has " + number(theirs[k]);
+    }
+  }
+  return "";
+}
+
+void apply_camera_profile(const CameraProfile& p, depth_image_t* frame) {
+  const size_t pixels = static_cast<size_t>(p.width) * static_cast<size_t>(p.height);
+  if (frame->depth_mm.size() != pixels || p.pixel_correction_mm.size() != pixels) return;
+  for (int v = 0; v < p.height; ++v) {
+    for (int u = 0; u < p.width; ++u) {
+      const size_t i = static_cast<size_t>(v) * p.width + u;
+      const int z_mm = frame->depth_mm[i];
+      if (z_mm <= 0) continue;
+      const double f = z_per_radial(p, u, v);
+      const double r_m = z_mm * 1e-3 / f;
+      const double corrected = z_mm + f * p.distance_correction_at(r_m) + p.pixel_correction_mm[i];
+      frame->depth_mm[i] =
+          corrected >= 1 && corrected <= 32767 ? static_cast<int16_t>(std::lround(corrected)) : 0;
+    }
+  }
+}
+
+CameraProfile read_camera_profile(const std::string& path) {
+  YamlMap map = load_yaml_file(path);
+  CameraProfile p;
+  p.file = path;
+  p.camera_id = map.string("camera_id");
+  p.width = static_cast<int>(map.integer("width", 1, 10000));
+  p.height = static_cast<int>(map.integer("height", 1, 10000));
+  const std::vector<double> intrinsics = map.numbers("intrinsics_fx_fy_cx_cy", 4);
+  p.fx = intrinsics[0];
+  p.fy = intrinsics[1];
+  p.cx = intrinsics[2];
+  p.cy = intrinsics[3];
+  if (!(p.fx > 0) || !(p.fy > 0)) map.fail("intrinsics_fx_fy_cx_cy", "fx and fy > 0");
+  p.distance_first_m = map.number("distance_first_m", 0, 100);
+  p.distance_bin_m = map.number("distance_bin_m", 0.001, 10);
+  p.distance_correction_mm = map.numbers("distance_correction_mm", -1);
+  if (p.distance_correction_mm.empty()) map.fail("distance_correction_mm", "at least one bin");
+  for (double c : p.distance_correction_mm) {
+    if (std::abs(c) > 1000) map.fail("distance_correction_mm", "corrections within +-1000 mm", number(c));
+  }
+  const std::vector<double> pixels = map.numbers("pixel_correction_mm", p.width * p.height);
+  p.pixel_correction_mm.assign(pixels.begin(), pixels.end());
+  for (double c : pixels) {
+    if (std::abs(c) > 1000) map.fail("pixel_correction_mm", "corrections within +-1000 mm", number(c));
+  }
+  p.measured_on = map.string("measured_on");
+  map.finish();
+  return p;
+}
+
+std::string camera_profile_yaml(const CameraProfile& p) {
+  std::ostringstream out;
+  out << "# A ToF camera's profile (docs/camera.md, \"Commissioning a camera\"): added to each frame's\n"
+      << "# depth Z where frames are compared: Z' = Z + f * c(r) + pixel_correction_mm,\n"
+      << "# r = Z / f the radial distance, c interpolated between the bins of distance_correction_mm.\n"
+      << "camera_id: " << p.camera_id << "\n"
+      << "width: " << p.width << "\n"
+      << "height: " << p.height << "\n"
+      << "intrinsics_fx_fy_cx_cy: [" << number(p.fx) << ", " << number(p.fy) << ", " << number(p.cx) << ", "
+      << number(p.cy) << "]\n"
+      << "measured_on: \"" << p.measured_on << "\"\n"
+      << "distance_first_m: " << number(p.distance_first_m) << "\n"
+      << "distance_bin_m: " << number(p.distance_bin_m) << "\n"
+      << "distance_correction_mm: [";
+  for (size_t k = 0; k < p.distance_correction_mm.size(); ++k) {
+    out << (k ? ", " : "") << std::fixed << std::setprecision(2) << p.distance_correction_mm[k];
+  }
+  out << "]\n# Row-major, width x height, mm; 0 where not measured.\npixel_correction_mm: [";
+  for (size_t i = 0; i < p.pixel_correction_mm.size(); ++i) {
+    if (i > 0) out << (i % static_cast<size_t>(std::max(p.width, 1)) == 0 ? ",\n  " : ", ");
+    out << std::fixed << std::setprecision(1) << p.pixel_correction_mm[i];
+  }
+  out << "]\n";
+  return out.str();
+}
+
+}  // namespace tofguard

@@ -1,0 +1,67 @@
+#pragma once
+// Learning a camera's profile (common/camera_profile.hpp) from a nominal
+// recording, the robot and the static scene as the calibration target
+// (docs/camera.md, "Commissioning a camera"). Pure computation on rendered
+// pairs: no LCM, no rendering.
+//
+// 1. The smooth part: per bin of the rendered radial distance r (noise-free;
+//    binned by the camera's own distance a bin at the edge of the scene's
+//    range would hold the pixels whose noise carried them there), the
+//    median of the radial residual I_dis / f (f = Z / r of the pixel's ray)
+//    over the pixels `noise_pixels` uses; bins with too few samples are
+//    interpolated from their neighbours; the correction c(r) is that median
+//    (added to the measured distance, it zeroes it).
+// 2. The per-pixel part: each pixel's mean of I_dis - f c(r) over the frames
+//    where it is within the tolerance (4 sigma + model tolerance: an object
+//    or a fault is not learned as an offset), for pixels seen in at least
+//    min_pixel_frames frames of which at most max_outlier_fraction were
+//    beyond it; 0 elsewhere.
+// What it cannot tell apart: a camera pose error that shifts the whole
+// scene along the rays (mostly along the optical axis) reads as a smooth
+// distance error, and on the static scene any pose error is learned as
+// per-pixel offsets. The extrinsics must be calibrated first
+// (tofguard-calibrate-extrinsics), and the profile checked on a second
+// recording.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "tofguard/common/camera_profile.hpp"
+#include "tofguard/discrepancy/discrepancy_image.hpp"
+#include "tofguard/tune/rendered_pair.hpp"
+
+namespace tofguard::tune {
+
+struct ProfileFitOptions {
+  // Radial distance bins, m, and the samples a bin needs.
+  double bin_m = 0.05;
+  int64_t min_bin_samples = 2000;
+  // A pixel's offset needs this many frames within the tolerance...
+  int min_pixel_frames = 20;
+  // ...and at most this fraction of its frames beyond it.
+  double max_outlier_fraction = 0.1;
+};
+
+struct ProfileFit {
+  bool ok = false;
+  std::string error;  // one line when !ok
+  CameraProfile profile;
+  // The smooth part: the bins measured, their range of radial distance (m)
+  // and of corrections (mm).
+  int measured_bins = 0;
+  double first_m = 0, last_m = 0;
+  double smallest_correction_mm = 0, largest_correction_mm = 0;
+  // The per-pixel part: pixels with an offset, their offsets' sigma (mm),
+  // and pixels left at 0 for too many frames beyond the tolerance.
+  int64_t mapped_pixels = 0;
+  double pixel_sigma_mm = 0;
+  int64_t outlier_pixels = 0;
+};
+
+// `tolerance`: the discrepancy's (what counts as beyond); frames of one
+// camera (the first frame's id, size and intrinsics name the profile).
+ProfileFit fit_camera_profile(const std::vector<RenderedPair>& frames,
+                              const discrepancy::Tolerance& tolerance, double silhouette_jump_mm,
+                              const ProfileFitOptions& options = {});
+
+}  // namespace tofguard::tune
