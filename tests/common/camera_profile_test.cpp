@@ -1,0 +1,127 @@
+// A commissioned camera's profile (common/camera_profile.hpp): the
+// correction it applies (by radial distance and per pixel), the check that
+// a frame is its camera's, and its file's round trip and errors.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "tofguard/common/camera_profile.hpp"
+#include "tofguard/common/config_error.hpp"
+#include "tofguard/common/depth_frame.hpp"
+#include "tool_support.hpp"
+
+namespace tofguard {
+namespace {
+
+Intrinsics small_camera() {
+  Intrinsics in;
+  in.width = 8;
+  in.height = 6;
+  in.fx = 5;
+  in.fy = 5;
+  in.cx = 3.5;
+  in.cy = 2.5;
+  return in;
+}
+
+// A profile of small_camera(): +10 mm at 1.0 m and +30 mm at 2.0 m (bins of
+// 0.5 m: 10, 20, 30), pixel i offset by i / 10 mm.
+CameraProfile profile_of(const Intrinsics& in) {
+  CameraProfile p;
+  p.camera_id = "cam";
+  p.width = in.width;
+  p.height = in.height;
+  p.fx = in.fx;
+  p.fy = in.fy;
+  p.cx = in.cx;
+  p.cy = in.cy;
+  p.distance_first_m = 1.0;
+  p.distance_bin_m = 0.5;
+  p.distance_correction_mm = {10, 20, 30};
+  p.measured_on = "a test";
+  for (int i = 0; i < in.width * in.height; ++i) p.pixel_correction_mm.push_back(static_cast<float>(i) / 10);
+  return p;
+}
+
+TEST(CameraProfile, InterpolatesByRadialDistanceAndHoldsTheEnds) {
+  const CameraProfile p = profile_of(small_camera());
+  EXPECT_DOUBLE_EQ(p.distance_correction_at(0.2), 10);
+  EXPECT_DOUBLE_EQ(p.distance_correction_at(1.25), 15);
+  EXPECT_DOUBLE_EQ(p.distance_correction_at(2.0), 30);
+  EXPECT_DOUBLE_EQ(p.distance_correction_at(9.0), 30);
+}
+
+// Z' = Z + f c(Z / f) + offset, f = Z / r of the pixel's ray.
+TEST(CameraProfile, CorrectsEachPixelAlongItsRay) {
+  const Intrinsics in = small_camera();
+  const CameraProfile p = profile_of(in);
+  depth_image_t frame = make_depth_image("cam", in, 1, 1, true, std::vector<float>(48, 1.5f));
+  frame.depth_mm[5] = 0;  // invalid stays invalid
+  apply_camera_profile(p, &frame);
+  for (int v = 0; v < in.height; ++v) {
+    for (int u = 0; u < in.width; ++u) {
+      const int i = v * in.width + u;
+      if (i == 5) {
+        EXPECT_EQ(frame.depth_mm[5], 0);
+        continue;
+      }
+      const double x = (u - in.cx) / in.fx, y = (v - in.cy) / in.fy;
+      const double f = 1 / std::sqrt(1 + x * x + y * y);
+      const double expected = 1500 + f * p.distance_correction_at(1.5 / f) + i / 10.0;
+      EXPECT_NEAR(frame.depth_mm[static_cast<size_t>(i)], expected, 0.5) << "pixel " << u << ", " << v;
+    }
+  }
+}
+
+TEST(CameraProfile, NamesWhatDiffersFromTheFramesCamera) {
+  const Intrinsics in = small_camera();
+  const CameraProfile p = profile_of(in);
+  depth_image_t frame = make_depth_image("cam", in, 1, 1, true, std::vector<float>(48, 1.5f));
+  EXPECT_EQ(profile_mismatch(p, frame), "");
+  depth_image_t other = frame;
+  other.camera_id = "other";
+  EXPECT_NE(profile_mismatch(p, other).find("camera_id 'cam', the frame is from 'other'"), std::string::npos);
+  other = frame;
+  other.fx += 0.01;
+  EXPECT_NE(profile_mismatch(p, other).find("fx 5, the frame has 5.01"), std::string::npos)
+      << profile_mismatch(p, other);
+  Intrinsics larger = in;
+  larger.width = 16;
+  const depth_image_t wide = make_depth_image("cam", larger, 1, 1, true, std::vector<float>(96, 1.5f));
+  EXPECT_NE(profile_mismatch(p, wide).find("made for 8x6, the frame is 16x6"), std::string::npos);
+}
+
+TEST(CameraProfile, TheFileHoldsWhatWasWritten) {
+  const CameraProfile p = profile_of(small_camera());
+  const std::string path = test::output_dir() + "/camera-profile-roundtrip.yaml";
+  test::write_file(path, camera_profile_yaml(p));
+  const CameraProfile read = read_camera_profile(path);
+  EXPECT_EQ(read.camera_id, "cam");
+  EXPECT_EQ(read.width, 8);
+  EXPECT_DOUBLE_EQ(read.cx, 3.5);
+  EXPECT_EQ(read.distance_correction_mm, p.distance_correction_mm);
+  ASSERT_EQ(read.pixel_correction_mm.size(), 48u);
+  EXPECT_NEAR(read.pixel_correction_mm[47], 4.7, 1e-4);
+  EXPECT_EQ(read.measured_on, "a test");
+}
+
+TEST(CameraProfile, AFileWithTooFewPixelsIsRefusedNamingTheKey) {
+  const CameraProfile p = profile_of(small_camera());
+  std::string text = camera_profile_yaml(p);
+  text.replace(text.find("width: 8"), 8, "width: 9");
+  const std::string path = test::output_dir() + "/camera-profile-short.yaml";
+  test::write_file(path, text);
+  try {
+    read_camera_profile(path);
+    FAIL() << "accepted";
+  } catch (const ConfigError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("pixel_correction_mm: expected a list of 54 numbers, got 48 entries"),
+              std::string::npos)
+        << what;
+  }
+}
+
+}  // namespace
+}  // namespace tofguard
