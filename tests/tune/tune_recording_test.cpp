@@ -6,10 +6,13 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <iostream>
+#include <regex>
 #include <string>
 #include <vector>
 
 #include "tofguard/common/camera_profile.hpp"
+#include "tofguard/sim/tof_error_model.hpp"
 
 #include "nominal_log.hpp"
 #include "tool_support.hpp"
@@ -95,6 +98,32 @@ TEST_F(TuneRecording, LearnsNoProfileFromARecordingWithSomethingInView) {
   expect_refused(run, "not nominal");
   EXPECT_FALSE(std::filesystem::exists(profile));
   EXPECT_NE(run.out.find("camera profile learned"), std::string::npos) << run.out;
+}
+
+// Commissioning a camera whose pose is 2 cm off along its optical axis (the
+// direction a distance error looks most like), on a camera with the static
+// errors of a real one: the pose error is found as a pose error, by how
+// much, and no profile is learned from it.
+TEST_F(TuneRecording, FindsACameraPoseOffAsAPoseErrorNotAsDepth) {
+  const std::string config = imperfect_camera_config("tune-pose-off", sim::draw_imperfect_camera(7, 4000));
+  const deployment::Config loaded = deployment::load_config(config, nullptr);
+  NominalLogOptions options;
+  options.seconds = 2.4;
+  options.camera_offset.translation() = Eigen::Vector3d(0, 0, 0.02);
+  const std::string log = output_dir() + "/tune-pose-off.lcmlog";
+  write_nominal_log(log, loaded, options);
+  const std::string profile = output_dir() + "/tune-pose-off.profile.yaml";
+  std::filesystem::remove(profile);
+  const ToolRun run = run_tune(config, log, {"--profile-out", profile});
+  std::cout << run.err;
+  expect_refused(run, "the camera pose is off, not its depth: t_z (along the optical axis) fitted ");
+  // By how much: the static errors of this camera bias the fit (its nominal
+  // recordings fit t_z -0.7 cm), so 2 cm reads 1.3-1.4 cm.
+  std::smatch fitted;
+  ASSERT_TRUE(std::regex_search(run.err, fitted, std::regex(R"(fitted ([-0-9.]+) cm)"))) << run.err;
+  EXPECT_GT(std::stod(fitted[1]), 1.0);
+  EXPECT_LT(std::stod(fitted[1]), 3.0);
+  EXPECT_FALSE(std::filesystem::exists(profile));
 }
 
 // A profile of another camera (its id) named in the config: the config is

@@ -2,8 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
 
 #include "tofguard/common/depth_frame.hpp"
+#include "tofguard/discrepancy/evidence.hpp"
 #include "tofguard/tune/noise_fit.hpp"
 
 namespace tofguard::tune {
@@ -38,6 +43,147 @@ std::vector<double> z_per_radial(const depth_image_t& frame) {
 bool same_camera(const depth_image_t& a, const depth_image_t& b) {
   return a.camera_id == b.camera_id && a.width == b.width && a.height == b.height && a.fx == b.fx &&
          a.fy == b.fy && a.cx == b.cx && a.cy == b.cy;
+}
+
+// Step 0's sums: the normal equations of I_dis_i = -J_i p + f_i c(r_i) over
+// the static pixels, c piecewise linear on knots first_m + k step_m.
+struct PoseDepthSums {
+  PoseDepthSums(double first, double step, int knots)
+      : first_m(first),
+        step_m(step),
+        normal(Eigen::MatrixXd::Zero(6 + knots, 6 + knots)),
+        right(Eigen::VectorXd::Zero(6 + knots)),
+        row(Eigen::VectorXd::Zero(6 + knots)) {}
+  void add(const double camera_jacobian[6], double f, double r_m, double dis_mm, double weight) {
+    row.setZero();
+    for (int a = 0; a < 6; ++a) row[a] = -camera_jacobian[a];
+    const int knots = static_cast<int>(row.size()) - 6;
+    const double k = std::clamp((r_m - first_m) / step_m, 0.0, knots - 1.0);
+    const int below = std::min(static_cast<int>(k), knots - 2);
+    const double w = k - below;
+    row[6 + below] = f * (1 - w);
+    row[6 + below + 1] = f * w;
+    normal.selfadjointView<Eigen::Upper>().rankUpdate(row, weight);
+    right += weight * dis_mm * row;
+    chi2_zero += weight * dis_mm * dis_mm;
+    ++pixels;
+  }
+  double first_m, step_m;
+  Eigen::MatrixXd normal;  // upper triangle
+  Eigen::VectorXd right;
+  Eigen::VectorXd row;
+  double chi2_zero = 0;
+  int64_t pixels = 0;
+};
+
+// Step 0's pixels: static (the camera Jacobian applies), compared, and
+// within 100 mm (beyond, not the small pose and depth errors the linear
+// model is for).
+constexpr double kPoseFitMaxDisMm = 100;
+
+PoseDepthSums sum_pose_against_depth(const std::vector<RenderedPair>& frames, const std::vector<double>& f,
+                                     const discrepancy::Tolerance& tolerance, double silhouette_jump_mm,
+                                     const ProfileFitOptions& options, double first_m, int knots) {
+  PoseDepthSums sums(first_m, options.pose_knot_m, knots);
+  for (size_t n = 0; n < frames.size(); n += static_cast<size_t>(std::max(options.pose_frame_stride, 1))) {
+    const RenderedPair& frame = frames[n];
+    const discrepancy::EvidenceJacobian jacobian(frame.rendered, frame.labels, silhouette_jump_mm);
+    if (!jacobian.available()) continue;
+    const std::vector<uint8_t> used = noise_pixels(frame, silhouette_jump_mm);
+    std::vector<double> joints(static_cast<size_t>(std::max(jacobian.num_joints(), 1)));
+    for (size_t i = 0; i < used.size(); ++i) {
+      double camera[6];
+      bool moved = false;
+      int link = -1;
+      if (!used[i] || !jacobian.at(static_cast<int>(i), camera, joints.data(), &moved, &link) || moved)
+        continue;
+      const int t = frame.camera.depth_mm[i];
+      const double gen = frame.rendered.depth_mm[i];
+      const double dis = gen - t;
+      if (std::abs(dis) > kPoseFitMaxDisMm) continue;
+      const double sigma = tolerance.noise.sigma_mm(t);
+      sums.add(camera, f[i], gen / f[i] * 1e-3, dis, 1.0 / (sigma * sigma));
+    }
+  }
+  return sums;
+}
+
+const char* const kPoseNames[6] = {
+    "t_x (optical x)", "t_y (optical y)", "t_z (along the optical axis)", "r_x", "r_y", "r_z"};
+
+std::string pose_figure(int a, double value) {
+  std::ostringstream s;
+  s.precision(a < 3 ? 2 : 3);
+  s << std::fixed << (a < 3 ? value * 100 : value * 180 / M_PI) << (a < 3 ? " cm" : " deg");
+  return s.str();
+}
+
+// Step 0's verdict: why the pose and the depth error cannot be learned
+// apart (a pose error, or too little to tell), empty when they can.
+std::string pose_verdict(const PoseAgainstDepth& pose, const ProfileFitOptions& options) {
+  for (int a = 0; a < 6; ++a) {
+    const double delta = a < 3 ? options.pose_translation_m : options.pose_rotation_rad;
+    if (!(delta > 0)) continue;
+    const double p = pose.correction[a], sigma = pose.sigma[a];
+    if (std::abs(p) > delta / 2 && std::abs(p) > 3 * sigma) {
+      return "the camera pose is off, not its depth: " + std::string(kPoseNames[a]) + " fitted " +
+             pose_figure(a, p) + " +- " + pose_figure(a, sigma) +
+             " (seen minus configured; more than half the " + "pose test's " + pose_figure(a, delta) +
+             "): calibrate the extrinsics (tofguard-calibrate-extrinsics) " + "and record again";
+    }
+    if (3 * sigma > delta / 2) {
+      return "cannot tell a pose error from a depth error in " + std::string(kPoseNames[a]) +
+             ": 3 sigma of the " + "fit is " + pose_figure(a, 3 * sigma) +
+             ", more than half the pose test's " + pose_figure(a, delta) +
+             ": record more depth range and surfaces at an angle to the camera";
+    }
+  }
+  return "";
+}
+
+// Step 0: the pose against the depth error, into fit->pose; false (with
+// the error) when they cannot be learned apart.
+bool check_pose_against_depth(const std::vector<RenderedPair>& frames, const std::vector<double>& f,
+                              const discrepancy::Tolerance& tolerance, double silhouette_jump_mm,
+                              const ProfileFitOptions& options, ProfileFit* fit) {
+  if (!(options.pose_translation_m > 0) && !(options.pose_rotation_rad > 0)) return true;
+  // The knots over the radial distances the static pixels show.
+  double r_min = 1e9, r_max = 0;
+  for (const RenderedPair& frame : frames) {
+    for (size_t i = 0; i < frame.rendered.depth_mm.size(); ++i) {
+      if (frame.rendered.depth_mm[i] <= 0) continue;
+      const double r = frame.rendered.depth_mm[i] / f[i] * 1e-3;
+      r_min = std::min(r_min, r);
+      r_max = std::max(r_max, r);
+    }
+    break;  // the static scene: the first frame shows its range
+  }
+  const int knots = std::max(2, static_cast<int>(std::ceil((r_max - r_min) / options.pose_knot_m)) + 1);
+  PoseDepthSums sums =
+      sum_pose_against_depth(frames, f, tolerance, silhouette_jump_mm, options, r_min, knots);
+  const int dimension = 6 + knots;
+  if (sums.pixels <= dimension) {
+    fit->error = "too few static pixels to tell a pose error from a depth error";
+    return false;
+  }
+  Eigen::MatrixXd normal = sums.normal.selfadjointView<Eigen::Upper>();
+  // A knot no pixel reaches: a small ridge keeps it solvable (its c is 0).
+  const double ridge = 1e-9 * normal.diagonal().maxCoeff();
+  for (int k = 6; k < dimension; ++k) normal(k, k) += ridge;
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(normal);
+  const Eigen::VectorXd x = ldlt.solve(sums.right);
+  const Eigen::MatrixXd covariance = ldlt.solve(Eigen::MatrixXd::Identity(dimension, dimension));
+  PoseAgainstDepth& pose = fit->pose;
+  pose.checked = true;
+  pose.pixels = sums.pixels;
+  pose.chi2_per_dof =
+      std::max(0.0, sums.chi2_zero - x.dot(sums.right)) / static_cast<double>(sums.pixels - dimension);
+  for (int a = 0; a < 6; ++a) {
+    pose.correction[a] = x[a];
+    pose.sigma[a] = std::sqrt(std::max(0.0, covariance(a, a)) * std::max(pose.chi2_per_dof, 1.0));
+  }
+  fit->error = pose_verdict(pose, options);
+  return fit->error.empty();
 }
 
 // Step 1: the smooth correction per radial bin, into fit->profile.
@@ -159,6 +305,7 @@ ProfileFit fit_camera_profile(const std::vector<RenderedPair>& frames,
   p.cx = first.cx;
   p.cy = first.cy;
   const std::vector<double> f = z_per_radial(first);
+  if (!check_pose_against_depth(frames, f, tolerance, silhouette_jump_mm, options, &fit)) return fit;
   if (!fit_smooth_part(frames, f, silhouette_jump_mm, options, &fit)) return fit;
   fit_pixel_part(frames, f, tolerance, silhouette_jump_mm, options, &fit);
   fit.ok = true;

@@ -217,9 +217,12 @@ std::string correct_frames(const TuneSettings& settings, const TuneOptions& opti
       return "a profile is learned from the camera's own frames: remove discrepancy.camera_profile (" +
              configured->file + ") from the config first";
     }
+    ProfileFitOptions fit_options = options.profile;
+    fit_options.pose_translation_m = settings.risk.evidence_camera_translation_m;
+    fit_options.pose_rotation_rad = settings.risk.evidence_camera_rotation_rad;
     result->profile_fit =
         fit_camera_profile(*frames, discrepancy::discrepancy_options(settings.discrepancy).tolerance,
-                           settings.discrepancy.silhouette_jump_mm, options.profile);
+                           settings.discrepancy.silhouette_jump_mm, fit_options);
     if (!result->profile_fit.ok) return result->log_path + ": " + result->profile_fit.error;
     result->profile_fit.profile.measured_on =
         result->log_path + ", " + std::to_string(frames->size()) + " frames";
@@ -530,6 +533,14 @@ std::string tune_report(const TuneResult& r, const TuneSettings& settings) {
         << " pixels (sigma " << fixed(p.pixel_sigma_mm, 1) << " mm), " << p.outlier_pixels
         << " pixels left out (beyond the tolerance in over "
         << fixed(100 * ProfileFitOptions{}.max_outlier_fraction, 0) << " % of their frames)\n"
+        << "  the pose against the depth error (" << p.pose.pixels << " static pixels, chi^2/dof "
+        << fixed(p.pose.chi2_per_dof, 2) << "): t " << fixed(100 * p.pose.correction[0], 2) << ", "
+        << fixed(100 * p.pose.correction[1], 2) << ", " << fixed(100 * p.pose.correction[2], 2) << " cm (+- "
+        << fixed(100 * p.pose.sigma[0], 2) << ", " << fixed(100 * p.pose.sigma[1], 2) << ", "
+        << fixed(100 * p.pose.sigma[2], 2) << "), r " << fixed(p.pose.correction[3] * 180 / M_PI, 3) << ", "
+        << fixed(p.pose.correction[4] * 180 / M_PI, 3) << ", " << fixed(p.pose.correction[5] * 180 / M_PI, 3)
+        << " deg (+- " << fixed(p.pose.sigma[3] * 180 / M_PI, 3) << ", "
+        << fixed(p.pose.sigma[4] * 180 / M_PI, 3) << ", " << fixed(p.pose.sigma[5] * 180 / M_PI, 3) << ")\n"
         << "  the figures below are on the recording it was learned from: check it on a second recording "
         << "(name it in discrepancy.camera_profile, run tofguard-tune on that recording, deploy its lines)\n";
   } else if (!r.profile_applied.empty()) {

@@ -16,12 +16,23 @@
 //    or a fault is not learned as an offset), for pixels seen in at least
 //    min_pixel_frames frames of which at most max_outlier_fraction were
 //    beyond it; 0 elsewhere.
-// What it cannot tell apart: a camera pose error that shifts the whole
-// scene along the rays (mostly along the optical axis) reads as a smooth
-// distance error, and on the static scene any pose error is learned as
-// per-pixel offsets. The extrinsics must be calibrated first
-// (tofguard-calibrate-extrinsics), and the profile checked on a second
-// recording.
+// 0. First, a pose error must not be learned as a depth error: on the static
+//    pixels (the evidence's camera Jacobian J, evidence.hpp) of every
+//    pose_frame_stride-th frame, I_dis is fitted jointly to a camera pose
+//    correction p (seen minus configured, optical frame) and a smooth radial
+//    correction c(r) (piecewise linear, knots pose_knot_m apart):
+//      I_dis_i = -J_i p + f_i c(r_i),
+//    weighted by the discrepancy's noise model, the covariance scaled by the
+//    fit's chi-square per degree of freedom. The pose's targets (the risk's
+//    evidence.camera_translation_m / camera_rotation_deg, delta) decide: a
+//    parameter fitted beyond delta / 2 and 3 sigma is a pose error ("the
+//    camera pose is off ..."); one whose 3 sigma exceeds delta / 2 cannot be
+//    told from a depth error with this recording. Either refuses: the pose
+//    must be calibrated (tofguard-calibrate-extrinsics) or the recording
+//    must show more depth and slope. A pose error within delta / 2 is
+//    tolerated by the tests anyway (docs/safety-chain.md).
+// What it still cannot see: a pose error the static scene does not show
+// (a scene of one plane), which the 3-sigma rule then refuses.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -40,6 +51,22 @@ struct ProfileFitOptions {
   int min_pixel_frames = 20;
   // ...and at most this fraction of its frames beyond it.
   double max_outlier_fraction = 0.1;
+  // Step 0: the pose targets delta (m, rad; 0: no pose check), the frames
+  // used (every pose_frame_stride-th) and the knots of c(r).
+  double pose_translation_m = 0;
+  double pose_rotation_rad = 0;
+  int pose_frame_stride = 5;
+  double pose_knot_m = 0.25;
+};
+
+// Step 0's result: the pose correction p (t_x, t_y, t_z in m; r_x, r_y, r_z
+// in rad; seen minus configured, optical frame) and its 1-sigma.
+struct PoseAgainstDepth {
+  bool checked = false;
+  double correction[6] = {0, 0, 0, 0, 0, 0};
+  double sigma[6] = {0, 0, 0, 0, 0, 0};
+  int64_t pixels = 0;
+  double chi2_per_dof = 0;
 };
 
 struct ProfileFit {
@@ -56,6 +83,7 @@ struct ProfileFit {
   int64_t mapped_pixels = 0;
   double pixel_sigma_mm = 0;
   int64_t outlier_pixels = 0;
+  PoseAgainstDepth pose;
 };
 
 // `tolerance`: the discrepancy's (what counts as beyond); frames of one
