@@ -10,6 +10,7 @@
 //                           [--objects-cm 5,10,20,40,80] [--beyond-cm 10]
 //                           [--rates-hz 25,30] [--turns-deg 0,40] [--shared DIR]
 //                           [--tsv FILE] [--plots DIR] [--plots-from FILE]
+//                           [--imperfect-cameras N]
 //
 // --camera-cm / --camera-deg: the camera moved along / turned about each
 // axis of its optical frame by each magnitude (fault_runs).
@@ -24,6 +25,9 @@
 // --rates-hz: each arm at each camera rate (default: the config's).
 // --turns-deg: each arm from each camera placement: its camera turned by
 // that much about the vertical through the robot's root (default 0).
+// --imperfect-cameras: each arm (and variant) watched by N cameras as
+// imperfect as real ones (draw_imperfect_camera(1..N)), each commissioned
+// first (commissioned_camera.hpp), instead of the config's ideal camera.
 // --tsv: every run, a line each (campaign_tsv); --plots: detection rate and
 // latency against magnitude per fault kind (plot_campaign), of this
 // campaign's runs or, with --plots-from FILE, of the runs in FILE (a TSV
@@ -39,6 +43,7 @@
 #include <string>
 #include <vector>
 
+#include "commissioned_camera.hpp"
 #include "judge_campaign.hpp"
 #include "report_format.hpp"
 #include "tool_support.hpp"
@@ -51,7 +56,8 @@ int usage(const std::string& why) {
       << "\nusage: tofguard-judge-campaign [--arms default,iiwa14,kinova] [--offsets-deg 3,5,10] "
          "[--camera-cm 2,3] [--camera-deg 1] [--streams RUNS] [--nominal-s SECONDS] [--passers-s SECONDS] "
          "[--no-faults] [--objects-cm 5,10,20,40,80] [--beyond-cm 10] [--rates-hz 25,30] "
-         "[--turns-deg 0,40] [--shared DIR] [--tsv FILE] [--plots DIR] [--plots-from FILE]\n";
+         "[--turns-deg 0,40] [--shared DIR] [--tsv FILE] [--plots DIR] [--plots-from FILE] "
+         "[--imperfect-cameras N]\n";
   return 2;
 }
 
@@ -71,6 +77,7 @@ struct Options {
   std::string plots_dir;
   std::string plots_from;
   std::string shared = tofguard::test::shared_dir();
+  int imperfect_cameras = 0;
 };
 
 // Option `option`'s value into *o; false for an unknown option. Throws
@@ -101,6 +108,8 @@ bool set_option(const std::string& option, const std::string& value, Options* o)
     o->turns_deg = number_list(value);
   } else if (option == "--shared") {
     o->shared = value;
+  } else if (option == "--imperfect-cameras") {
+    o->imperfect_cameras = static_cast<int>(number_list(value).at(0));
   } else if (option == "--tsv") {
     o->tsv_path = value;
   } else if (option == "--plots") {
@@ -210,7 +219,22 @@ int run_campaigns(const Options& o) {
         std::cout << name << ": skipped, its URDF is not under " << o.shared << "/robots\n";
         continue;
       }
-      for (const CampaignArm& arm : variants_of(*base, o)) run_arm(arm, o, &tsv);
+      for (const CampaignArm& arm : variants_of(*base, o)) {
+        if (o.imperfect_cameras <= 0) {
+          run_arm(arm, o, &tsv);
+          continue;
+        }
+        for (int seed = 1; seed <= o.imperfect_cameras; ++seed) {
+          const CommissionedCamera camera = commission_imperfect_camera(arm, static_cast<uint64_t>(seed));
+          if (!camera.ok) {
+            std::cout << arm.name << " camera " << seed << ": commissioning refused: " << camera.error
+                      << "\n";
+            continue;
+          }
+          std::cout << camera.summary << "\n";
+          run_arm(camera.arm, o, &tsv);
+        }
+      }
     }
     if (!o.tsv_path.empty()) {
       std::ofstream out(o.tsv_path);

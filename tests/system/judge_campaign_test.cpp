@@ -16,6 +16,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "commissioned_camera.hpp"
 #include "judge_campaign.hpp"
 #include "tofguard/risk_t.hpp"
 #include "tofguard/settings/risk_settings.hpp"
@@ -117,6 +118,20 @@ void expect_targets(const CampaignArm& arm) {
 }
 
 TEST(JudgeCampaign, DefaultArm) { expect_targets(default_campaign_arm()); }
+
+// The default arm watched by a camera as imperfect as a real one
+// (draw_imperfect_camera(1): wiggle, slope, fixed pattern, amplitude bias,
+// multipath), commissioned first (commissioned_camera.hpp: its profile
+// learned on one recording, the noise and the static error left measured on
+// a second, the config carrying them): the same targets as the ideal
+// camera's.
+TEST(JudgeCampaign, DefaultArmWithACommissionedImperfectCamera) {
+  const CommissionedCamera camera = commission_imperfect_camera(default_campaign_arm(), 1);
+  ASSERT_TRUE(camera.ok) << camera.error;
+  std::cout << camera.summary << "\n";
+  EXPECT_GT(camera.arm.config.discrepancy.evidence_static_bias_mm, 0);
+  expect_targets(camera.arm);
+}
 
 // Frozen and stalled streams (arm-independent: the default arm): each
 // stopped as a sensor fault naming its stream, a stall within its

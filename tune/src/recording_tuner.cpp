@@ -461,6 +461,27 @@ std::string not_nominal_error(const TuneOptions& options, const TuneResult& resu
 
 }  // namespace
 
+namespace {
+
+// The passes on rendered frames (the recording's checks passed).
+void tune_frames(const TuneSettings& settings, const TuneOptions& options, std::vector<RenderedPair>* frames,
+                 TuneResult* result) {
+  result->error = correct_frames(settings, options, frames, result);
+  if (!result->error.empty()) return;
+  result->fit = fit_noise(*frames, settings, options);
+  if (!result->fit.ok) {
+    result->error = result->log_path + ": cannot fit the noise: " + result->fit.error;
+    return;
+  }
+  choose_pixels_per_sample(measure_correlation(*frames, settings, result->fit), settings, options, result);
+  result->static_error = measure_static_error(*frames, settings, options);
+  run_sequential_tests(*frames, settings, options, result);
+  result->error = not_nominal_error(options, *result);
+  result->usable = result->error.empty();
+}
+
+}  // namespace
+
 TuneResult tune_recording(const TuneSettings& settings, const std::string& log_path,
                           const TuneOptions& options) {
   TuneResult result;
@@ -473,18 +494,21 @@ TuneResult tune_recording(const TuneSettings& settings, const std::string& log_p
   std::vector<RenderedPair> frames = RecordingRenderer(settings, options, &result).read(&log);
   result.error = recording_error(settings, options, result);
   if (!result.error.empty()) return result;
-  result.error = correct_frames(settings, options, &frames, &result);
-  if (!result.error.empty()) return result;
-  result.fit = fit_noise(frames, settings, options);
-  if (!result.fit.ok) {
-    result.error = log_path + ": cannot fit the noise: " + result.fit.error;
+  tune_frames(settings, options, &frames, &result);
+  return result;
+}
+
+TuneResult tune_rendered_frames(const TuneSettings& settings, std::vector<RenderedPair> frames,
+                                const std::string& source, const TuneOptions& options) {
+  TuneResult result;
+  result.log_path = source;
+  result.depth_frames = result.used_frames = static_cast<int>(frames.size());
+  if (result.used_frames < options.min_frames) {
+    result.error = source + ": too few frames to tune on: " + std::to_string(result.used_frames) + "; need " +
+                   std::to_string(options.min_frames);
     return result;
   }
-  choose_pixels_per_sample(measure_correlation(frames, settings, result.fit), settings, options, &result);
-  result.static_error = measure_static_error(frames, settings, options);
-  run_sequential_tests(frames, settings, options, &result);
-  result.error = not_nominal_error(options, result);
-  result.usable = result.error.empty();
+  tune_frames(settings, options, &frames, &result);
   return result;
 }
 

@@ -20,6 +20,7 @@
 #include "tofguard/settings/risk_settings.hpp"
 #include "tofguard/tune/camera_profile_fit.hpp"
 #include "tofguard/tune/noise_fit.hpp"
+#include "tofguard/tune/rendered_pair.hpp"
 
 namespace tofguard::tune {
 
@@ -165,6 +166,13 @@ struct TuneResult {
 // (ModelError, RenderError).
 TuneResult tune_recording(const TuneSettings& settings, const std::string& log_path,
                           const TuneOptions& options = {});
+
+// The same passes on frames already rendered (as tofguard-renderer would
+// render them; a tool's in-process frames), `source` naming them in
+// messages: no recording checks beyond options.min_frames (the caller's
+// frames move the arm).
+TuneResult tune_rendered_frames(const TuneSettings& settings, std::vector<RenderedPair> frames,
+                                const std::string& source, const TuneOptions& options = {});
 
 // The report for people: the recording, the fit per depth bin against the
 // model, the correlation, the per-pixel false-mismatch rate, and per

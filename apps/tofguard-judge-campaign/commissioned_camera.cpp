@@ -1,0 +1,122 @@
+#include "commissioned_camera.hpp"
+
+#include <cmath>
+#include <memory>
+#include <sstream>
+#include <vector>
+
+#include "joint_motion.hpp"
+#include "simulated_frames.hpp"
+#include "tofguard/common/depth_frame.hpp"
+#include "tofguard/deployment/process_settings.hpp"
+#include "tofguard/renderer/depth_renderer.hpp"
+#include "tofguard/renderer/rendered_kinematics.hpp"
+#include "tofguard/renderer/renderer_service.hpp"
+#include "tofguard/robot_model/arm_spheres.hpp"
+#include "tofguard/robot_model/scene_model.hpp"
+#include "tofguard/sim/tof_error_model.hpp"
+#include "tofguard/tune/recording_tuner.hpp"
+
+namespace tofguard::test {
+namespace {
+
+// `seconds` of the arm's nominal motion from motion time `start_s`, every
+// frame captured by the (imperfect) simulated camera with noise stream
+// `noise_seed` and rendered as tofguard-renderer renders it.
+std::vector<tune::RenderedPair> nominal_frames(const deployment::Config& config, double seconds,
+                                               double start_s, uint64_t noise_seed) {
+  SimulatedFrames truth(config);
+  const robot_model::SceneModel model_scene =
+      robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths,
+                              renderer::scene_options(config.renderer, config.robot));
+  renderer::DepthRenderer model(model_scene, config.renderer.near_m, config.renderer.far_m);
+  const robot_model::ArmSpheres arm_cover =
+      robot_model::cover_arm_with_spheres(model_scene, config.renderer.arm_cover_cell_m);
+  const Eigen::Isometry3d pose = config.camera.pose.frame_from_optical();
+  const Intrinsics& in = config.camera.intrinsics;
+  const int frames = static_cast<int>(std::floor(seconds * config.camera.rate_hz));
+  std::vector<tune::RenderedPair> pairs;
+  for (int k = 0; k < frames; ++k) {
+    const double t_s = start_s + k / config.camera.rate_hz;
+    robot_model::JointPositions q;
+    for (const sim::JointMotion& m : config.joints_sim.motion) q[m.joint] = joint_position(m, t_s);
+    const int64_t utime = 1'700'000'000'000'000 + static_cast<int64_t>(std::llround(t_s * 1e6));
+    const depth_image_t camera = make_depth_image(config.camera.id, in, utime, k, /*calibrated=*/true,
+                                                  truth.capture(q, pose, in, noise_seed * 100000 + k));
+    const robot_model::LinkPoses poses = robot_model::forward_kinematics(model_scene, q);
+    const renderer::RenderResult rendered = model.render_at(poses, pose, in);
+    if (!rendered.usable) throw std::runtime_error(rendered.unusable_reason);
+    tune::RenderedPair pair;
+    pair.camera = camera;
+    pair.rendered = make_depth_image(config.camera.id, in, utime, k, /*calibrated=*/true, rendered.depth_m);
+    pair.labels = renderer::make_rendered_link_labels(camera, rendered, model_scene, arm_cover);
+    pairs.push_back(std::move(pair));
+  }
+  return pairs;
+}
+
+tune::TuneSettings tune_settings(const deployment::Config& config) {
+  tune::TuneSettings settings;
+  settings.renderer = deployment::renderer_process_settings(config);
+  settings.discrepancy = config.discrepancy;
+  settings.risk = config.risk;
+  return settings;
+}
+
+std::string fixed(double value, int decimals) {
+  std::ostringstream s;
+  s.precision(decimals);
+  s << std::fixed << value;
+  return s.str();
+}
+
+}  // namespace
+
+CommissionedCamera commission_imperfect_camera(const CampaignArm& arm, uint64_t seed, double seconds) {
+  CommissionedCamera out;
+  out.arm = arm;
+  out.arm.name = arm.name + " camera " + std::to_string(seed);
+  deployment::Config& config = out.arm.config;
+  const sim::SimResidualSettings truth = sim::draw_imperfect_camera(seed, config.camera.sim.amplitude_at_1m);
+  config.camera.sim.residual = truth;
+  // Learn the profile on one recording (motion from 50 s on)...
+  tune::TuneOptions learn;
+  learn.learn_profile = true;
+  const tune::TuneResult learned =
+      tune::tune_rendered_frames(tune_settings(config), nominal_frames(config, seconds, 50, 1000 + seed),
+                                 out.arm.name + " learning", learn);
+  if (!learned.usable) {
+    out.error = learned.error;
+    return out;
+  }
+  config.discrepancy.camera_profile = std::make_shared<const CameraProfile>(learned.profile_fit.profile);
+  // ...and measure what is left with it on a second (from 90 s on).
+  const tune::TuneResult checked = tune::tune_rendered_frames(
+      tune_settings(config), nominal_frames(config, seconds, 90, 2000 + seed), out.arm.name + " checking");
+  if (!checked.usable) {
+    out.error = checked.error;
+    return out;
+  }
+  config.discrepancy.noise_sigma_at_0m_mm = checked.fit.sigma_at_0m_mm;
+  config.discrepancy.noise_sigma_per_m2_mm = checked.fit.sigma_per_m2_mm;
+  config.discrepancy.evidence_pixels_per_sample = checked.pixels_per_sample;
+  config.discrepancy.evidence_static_bias_mm = checked.tuned.static_bias_mm;
+  config.discrepancy.evidence_fixed_pattern_sigma_mm = checked.tuned.fixed_pattern_sigma_mm;
+  std::ostringstream summary;
+  summary << out.arm.name << ": wiggle " << fixed(truth.wiggle_amplitude_mm, 1) << " mm / "
+          << fixed(truth.wiggle_period_m, 2) << " m, slope " << fixed(truth.slope_mm_per_m, 1)
+          << " mm/m, fixed pattern " << fixed(truth.pixel_offset_sigma_mm, 1) << " mm, amplitude bias "
+          << fixed(truth.reflectivity_bias_mm_per_decade, 1) << " mm/decade, multipath "
+          << fixed(truth.multipath_max_mm, 1)
+          << " mm; profile: " << fixed(learned.profile_fit.smallest_correction_mm, 1) << ".."
+          << fixed(learned.profile_fit.largest_correction_mm, 1) << " mm by distance, pixel offsets sigma "
+          << fixed(learned.profile_fit.pixel_sigma_mm, 1) << " mm; deployed noise "
+          << fixed(checked.fit.sigma_at_0m_mm, 2) << " + " << fixed(checked.fit.sigma_per_m2_mm, 3)
+          << " d^2 mm, static_bias " << fixed(checked.tuned.static_bias_mm, 1) << " mm, fixed pattern "
+          << fixed(checked.tuned.fixed_pattern_sigma_mm, 1) << " mm";
+  out.summary = summary.str();
+  out.ok = true;
+  return out;
+}
+
+}  // namespace tofguard::test
