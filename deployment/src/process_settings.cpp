@@ -44,6 +44,7 @@ estimator::EstimatorProcessSettings estimator_process_settings(const Config& con
   s.renderer = config.renderer;
   s.noise_sigma_at_0m_mm = config.discrepancy.noise_sigma_at_0m_mm;
   s.noise_sigma_per_m2_mm = config.discrepancy.noise_sigma_per_m2_mm;
+  s.camera_profile = config.discrepancy.camera_profile;
   s.estimator = config.estimator;
   return s;
 }

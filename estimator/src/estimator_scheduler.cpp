@@ -26,7 +26,17 @@ void EstimatorScheduler::on_camera_pose(const camera_pose_t& message) { state_.a
 
 bool EstimatorScheduler::on_depth(const depth_image_t& frame) {
   if (frame.camera_id != settings_.camera.id) return false;
-  frames_[frame.seq] = frame;
+  if (settings_.camera_profile) {
+    // Corrected by the camera's profile as tofguard-discrepancy corrects it;
+    // a frame the profile does not fit is not estimated (tofguard-discrepancy
+    // reports it unusable).
+    if (!profile_mismatch(*settings_.camera_profile, frame).empty()) return false;
+    depth_image_t corrected = frame;
+    apply_camera_profile(*settings_.camera_profile, &corrected);
+    frames_[frame.seq] = std::move(corrected);
+  } else {
+    frames_[frame.seq] = frame;
+  }
   while (static_cast<int>(frames_.size()) > settings_.estimator.max_pending_frames) {
     const int64_t oldest = frames_.begin()->first;
     if (wanted_.count(oldest) > 0) {

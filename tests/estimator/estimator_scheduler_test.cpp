@@ -2,7 +2,10 @@
 // estimate is made of (estimator.frames_per_estimate, docs/estimator.md).
 #include <gtest/gtest.h>
 
+#include <memory>
+
 #include "estimator_test_support.hpp"
+#include "tofguard/common/camera_profile.hpp"
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/estimator/estimator_process.hpp"
@@ -84,6 +87,48 @@ TEST_F(SchedulerTest, APeriodicEstimateTakesTheFramesJustBefore) {
   EXPECT_TRUE(scheduler_.take_ready().empty());
   scheduler_.request_newest();
   EXPECT_EQ(job_seqs(), (std::vector<int>{5, 4, 3}));
+}
+
+// The camera's profile (discrepancy.camera_profile) corrects the frames the
+// estimator compares, as tofguard-discrepancy's; a frame it does not fit
+// (another camera's intrinsics) is not estimated.
+TEST_F(SchedulerTest, FramesAreCorrectedByTheCamerasProfile) {
+  const Intrinsics& in = config_.camera.intrinsics;
+  CameraProfile profile;
+  profile.camera_id = config_.camera.id;
+  profile.width = in.width;
+  profile.height = in.height;
+  profile.fx = in.fx;
+  profile.fy = in.fy;
+  profile.cx = in.cx;
+  profile.cy = in.cy;
+  profile.distance_correction_mm = {0.0};
+  profile.pixel_correction_mm.assign(static_cast<size_t>(in.width) * in.height, 7.0f);
+  config_.camera_profile = std::make_shared<const CameraProfile>(profile);
+  EstimatorScheduler scheduler(config_, scene_);
+  for (int64_t t = kStartUtime - 100'000; t <= kStartUtime + 20 * kFramePeriodUs; t += 10'000) {
+    joint_state_t s{};
+    s.utime = t;
+    s.robot_id = config_.robot.id;
+    for (const auto& [name, position] : test::side_reach_pose()) {
+      s.name.push_back(name);
+      s.position.push_back(position);
+      s.velocity.push_back(0);
+    }
+    s.num_joints = static_cast<int32_t>(s.name.size());
+    ASSERT_TRUE(scheduler.on_joint_state(s));
+  }
+  depth_image_t other = frame(1);
+  other.fx += 1;
+  EXPECT_FALSE(scheduler.on_depth(other));
+  ASSERT_TRUE(scheduler.on_depth(frame(2)));
+  scheduler.request_newest();
+  const std::vector<ScheduledWork> ready = scheduler.take_ready();
+  ASSERT_EQ(ready.size(), 1u);
+  ASSERT_TRUE(ready[0].job);
+  ASSERT_FALSE(ready[0].job->frames.empty());
+  // Every pixel at 1002 mm, plus the profile's 7 mm.
+  EXPECT_NEAR(ready[0].job->frames[0].depth_m[0], 1.009, 1e-6);
 }
 
 // A fault begins at frame 4: the first warning frame is estimated alone,

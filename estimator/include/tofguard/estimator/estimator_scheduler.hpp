@@ -63,7 +63,9 @@ class EstimatorScheduler {
   // last.
   bool on_joint_state(const joint_state_t& state);
   void on_camera_pose(const camera_pose_t& pose);
-  // Frames of other cameras are ignored (false).
+  // Frames of other cameras, and frames the camera's profile
+  // (settings.camera_profile) does not fit, are ignored (false); the others
+  // are kept corrected by the profile.
   bool on_depth(const depth_image_t& frame);
   void on_discrepancy(const discrepancy_t& discrepancy);
   // tofguard-risk's verdict (check_risk passed): a model mismatch on a

@@ -4,8 +4,10 @@
 // correction that best explain a camera frame. Durations are integer
 // microseconds, converted once when the file is read.
 #include <cstdint>
+#include <memory>
 #include <string>
 
+#include "tofguard/common/camera_profile.hpp"
 #include "tofguard/common/camera_settings.hpp"
 #include "tofguard/common/lcm_settings.hpp"
 #include "tofguard/common/robot_settings.hpp"
@@ -63,6 +65,10 @@ struct EstimatorProcessSettings {
   // model the estimator weighs residuals with, millimetres.
   double noise_sigma_at_0m_mm = 0;
   double noise_sigma_per_m2_mm = 0;
+  // discrepancy.camera_profile (null: none): each frame is corrected by it
+  // before the estimator compares it, as tofguard-discrepancy does; a frame
+  // it does not fit is not estimated.
+  std::shared_ptr<const CameraProfile> camera_profile;
   EstimatorSettings estimator;
 };
 
