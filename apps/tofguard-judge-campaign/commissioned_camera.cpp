@@ -110,7 +110,13 @@ CommissionedCamera commission_imperfect_camera(const CampaignArm& arm, uint64_t 
           << fixed(truth.multipath_max_mm, 1)
           << " mm; profile: " << fixed(learned.profile_fit.smallest_correction_mm, 1) << ".."
           << fixed(learned.profile_fit.largest_correction_mm, 1) << " mm by distance, pixel offsets sigma "
-          << fixed(learned.profile_fit.pixel_sigma_mm, 1) << " mm; deployed noise "
+          << fixed(learned.profile_fit.pixel_sigma_mm, 1) << " mm; pose against depth: t ("
+          << fixed(100 * learned.profile_fit.pose.correction[0], 2) << ", "
+          << fixed(100 * learned.profile_fit.pose.correction[1], 2) << ", "
+          << fixed(100 * learned.profile_fit.pose.correction[2], 2) << ") cm, r ("
+          << fixed(learned.profile_fit.pose.correction[3] * 180 / M_PI, 2) << ", "
+          << fixed(learned.profile_fit.pose.correction[4] * 180 / M_PI, 2) << ", "
+          << fixed(learned.profile_fit.pose.correction[5] * 180 / M_PI, 2) << ") deg; deployed noise "
           << fixed(checked.fit.sigma_at_0m_mm, 2) << " + " << fixed(checked.fit.sigma_per_m2_mm, 3)
           << " d^2 mm, static_bias " << fixed(checked.tuned.static_bias_mm, 1) << " mm, fixed pattern "
           << fixed(checked.tuned.fixed_pattern_sigma_mm, 1) << " mm";

@@ -125,11 +125,17 @@ std::string pose_verdict(const PoseAgainstDepth& pose, const ProfileFitOptions& 
     const double delta = a < 3 ? options.pose_translation_m : options.pose_rotation_rad;
     if (!(delta > 0)) continue;
     const double p = pose.correction[a], sigma = pose.sigma[a];
-    if (std::abs(p) > delta / 2 && std::abs(p) > 3 * sigma) {
+    // t_z against a common distance offset: told apart only by the scene's
+    // slopes, and the camera's unmodelled static errors (amplitude bias,
+    // multipath) shift its fit by up to 1.3 cm on pose-true cameras
+    // (docs/camera.md, "Commissioning a camera"): refused from delta on.
+    const double limit = a == 2 ? delta : delta / 2;
+    if (std::abs(p) > limit && std::abs(p) > 3 * sigma) {
       return "the camera pose is off, not its depth: " + std::string(kPoseNames[a]) + " fitted " +
-             pose_figure(a, p) + " +- " + pose_figure(a, sigma) +
-             " (seen minus configured; more than half the " + "pose test's " + pose_figure(a, delta) +
-             "): calibrate the extrinsics (tofguard-calibrate-extrinsics) " + "and record again";
+             pose_figure(a, p) + " +- " + pose_figure(a, sigma) + " (seen minus configured; beyond " +
+             pose_figure(a, limit) + ", " + (a == 2 ? "the" : "half the") + " pose test's " +
+             pose_figure(a, delta) +
+             "): calibrate the extrinsics (tofguard-calibrate-extrinsics) and record again";
     }
     if (3 * sigma > delta / 2) {
       return "cannot tell a pose error from a depth error in " + std::string(kPoseNames[a]) +

@@ -548,6 +548,17 @@ std::string tune_report(const TuneResult& r, const TuneSettings& settings) {
       << fixed(r.measured_pixels_per_sample, 2) << " (config "
       << settings.discrepancy.evidence_pixels_per_sample
       << (r.pixels_per_sample_changed ? ", replaced" : ", kept") << ")\n";
+  if (r.profile_fit.pose.checked) {
+    const ProfileFit& p = r.profile_fit;
+    out << "the pose against the depth error (" << p.pose.pixels << " static pixels, chi^2/dof "
+        << fixed(p.pose.chi2_per_dof, 2) << "): t " << fixed(100 * p.pose.correction[0], 2) << ", "
+        << fixed(100 * p.pose.correction[1], 2) << ", " << fixed(100 * p.pose.correction[2], 2) << " cm (+- "
+        << fixed(100 * p.pose.sigma[0], 2) << ", " << fixed(100 * p.pose.sigma[1], 2) << ", "
+        << fixed(100 * p.pose.sigma[2], 2) << "), r " << fixed(p.pose.correction[3] * 180 / M_PI, 3) << ", "
+        << fixed(p.pose.correction[4] * 180 / M_PI, 3) << ", " << fixed(p.pose.correction[5] * 180 / M_PI, 3)
+        << " deg (+- " << fixed(p.pose.sigma[3] * 180 / M_PI, 3) << ", "
+        << fixed(p.pose.sigma[4] * 180 / M_PI, 3) << ", " << fixed(p.pose.sigma[5] * 180 / M_PI, 3) << ")\n";
+  }
   if (r.has_profile) {
     const ProfileFit& p = r.profile_fit;
     out << "camera profile learned: distance correction " << fixed(p.smallest_correction_mm, 1) << ".."
@@ -557,14 +568,6 @@ std::string tune_report(const TuneResult& r, const TuneSettings& settings) {
         << " pixels (sigma " << fixed(p.pixel_sigma_mm, 1) << " mm), " << p.outlier_pixels
         << " pixels left out (beyond the tolerance in over "
         << fixed(100 * ProfileFitOptions{}.max_outlier_fraction, 0) << " % of their frames)\n"
-        << "  the pose against the depth error (" << p.pose.pixels << " static pixels, chi^2/dof "
-        << fixed(p.pose.chi2_per_dof, 2) << "): t " << fixed(100 * p.pose.correction[0], 2) << ", "
-        << fixed(100 * p.pose.correction[1], 2) << ", " << fixed(100 * p.pose.correction[2], 2) << " cm (+- "
-        << fixed(100 * p.pose.sigma[0], 2) << ", " << fixed(100 * p.pose.sigma[1], 2) << ", "
-        << fixed(100 * p.pose.sigma[2], 2) << "), r " << fixed(p.pose.correction[3] * 180 / M_PI, 3) << ", "
-        << fixed(p.pose.correction[4] * 180 / M_PI, 3) << ", " << fixed(p.pose.correction[5] * 180 / M_PI, 3)
-        << " deg (+- " << fixed(p.pose.sigma[3] * 180 / M_PI, 3) << ", "
-        << fixed(p.pose.sigma[4] * 180 / M_PI, 3) << ", " << fixed(p.pose.sigma[5] * 180 / M_PI, 3) << ")\n"
         << "  the figures below are on the recording it was learned from: check it on a second recording "
         << "(name it in discrepancy.camera_profile, run tofguard-tune on that recording, deploy its lines)\n";
   } else if (!r.profile_applied.empty()) {
