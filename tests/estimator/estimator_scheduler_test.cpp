@@ -28,19 +28,23 @@ class SchedulerTest : public ::testing::Test {
       : config_(deployment::estimator_process_settings(test::sim_config())),
         scene_(load_estimator_scene(config_)),
         scheduler_(config_, scene_) {
-    // Joint states every 10 ms over the whole test, a4 turning at
-    // kA4RadPerS.
+    feed_joint_states(&scheduler_, /*a4_turning=*/true);
+  }
+
+  // Joint states every 10 ms over the whole test, a4 turning at kA4RadPerS
+  // when `a4_turning`.
+  void feed_joint_states(EstimatorScheduler* scheduler, bool a4_turning) const {
     for (int64_t t = kStartUtime - 100'000; t <= kStartUtime + 20 * kFramePeriodUs; t += 10'000) {
       joint_state_t s{};
       s.utime = t;
       s.robot_id = config_.robot.id;
       for (const auto& [name, position] : test::side_reach_pose()) {
         s.name.push_back(name);
-        s.position.push_back(name == "a4" ? a4_at(t) : position);
+        s.position.push_back(name == "a4" && a4_turning ? a4_at(t) : position);
         s.velocity.push_back(0);
       }
       s.num_joints = static_cast<int32_t>(s.name.size());
-      EXPECT_TRUE(scheduler_.on_joint_state(s));
+      EXPECT_TRUE(scheduler->on_joint_state(s));
     }
   }
 
@@ -106,18 +110,7 @@ TEST_F(SchedulerTest, FramesAreCorrectedByTheCamerasProfile) {
   profile.pixel_correction_mm.assign(static_cast<size_t>(in.width) * in.height, 7.0f);
   config_.camera_profile = std::make_shared<const CameraProfile>(profile);
   EstimatorScheduler scheduler(config_, scene_);
-  for (int64_t t = kStartUtime - 100'000; t <= kStartUtime + 20 * kFramePeriodUs; t += 10'000) {
-    joint_state_t s{};
-    s.utime = t;
-    s.robot_id = config_.robot.id;
-    for (const auto& [name, position] : test::side_reach_pose()) {
-      s.name.push_back(name);
-      s.position.push_back(position);
-      s.velocity.push_back(0);
-    }
-    s.num_joints = static_cast<int32_t>(s.name.size());
-    ASSERT_TRUE(scheduler.on_joint_state(s));
-  }
+  feed_joint_states(&scheduler, /*a4_turning=*/false);
   depth_image_t other = frame(1);
   other.fx += 1;
   EXPECT_FALSE(scheduler.on_depth(other));
