@@ -215,6 +215,13 @@ std::string check_evidence(const discrepancy_t& d) {
                       d.camera_region_information[k]);
     }
   }
+  if (!std::isfinite(d.distance_offset_score))
+    return expected("distance_offset_score", "a finite score", d.distance_offset_score);
+  if (!(std::isfinite(d.distance_offset_information) && d.distance_offset_information >= 0)) {
+    return expected("distance_offset_information", "a finite information >= 0",
+                    d.distance_offset_information);
+  }
+  if (auto p = finite_array(d.distance_offset_cross, 6, "distance_offset_cross"); !p.empty()) return p;
   if (auto p = check_count(d.num_joints, d.joint_name, "joint_name", "num_joints"); !p.empty()) return p;
   if (auto p = check_count(d.num_joints, d.joint_fit_pixels, "joint_fit_pixels", "num_joints"); !p.empty())
     return p;

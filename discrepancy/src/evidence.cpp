@@ -185,6 +185,9 @@ void clear_evidence(discrepancy_t* s) {
   std::fill(s->camera_region_fit_pixels, s->camera_region_fit_pixels + 4, 0);
   std::fill(s->camera_region_score, s->camera_region_score + 24, 0.0);
   std::fill(s->camera_region_information, s->camera_region_information + 24, 0.0);
+  s->distance_offset_score = 0;
+  s->distance_offset_information = 0;
+  std::fill(s->distance_offset_cross, s->distance_offset_cross + 6, 0.0);
   s->num_joints = 0;
   s->joint_name.clear();
   s->joint_fit_pixels.clear();
@@ -245,6 +248,9 @@ struct EvidenceSums {
       camera_region_bias_abs[k] += o.camera_region_bias_abs[k];
       camera_region_bias_square[k] += o.camera_region_bias_square[k];
     }
+    distance_offset_score += o.distance_offset_score;
+    distance_offset_information += o.distance_offset_information;
+    for (int a = 0; a < 6; ++a) distance_offset_cross[a] += o.distance_offset_cross[a];
   }
   std::vector<double> link_sum_wr;
   std::vector<double> link_sum_w;
@@ -270,6 +276,11 @@ struct EvidenceSums {
   // (the whole image's: the four regions' together).
   double camera_region_bias_abs[24] = {};
   double camera_region_bias_square[24] = {};
+  // The common distance offset over the camera fit's pixels
+  // (discrepancy_t.distance_offset_*): J = f, Z per radial mm.
+  double distance_offset_score = 0;
+  double distance_offset_information = 0;
+  double distance_offset_cross[6] = {};
 };
 
 // The static error's reach into the camera fit of pixels n_first ..
@@ -442,7 +453,8 @@ void add_robot_pixel(double w, double r, bool in_naming_fit, const std::vector<d
 
 // A static pixel's weighted residual into the static chi2 and, inside the
 // gate, into the row's camera fit (its Jacobian already in the row's slot).
-void add_static_pixel(double w, double r, bool in_naming_fit, bool left_half, RowFit* row, EvidenceSums* b) {
+void add_static_pixel(double w, double r, bool in_naming_fit, bool left_half, double z_per_radial,
+                      RowFit* row, EvidenceSums* b) {
   b->static_chi2 += w * r * r;
   // A static pixel beyond the gate is outside the camera's linear model
   // as the naming fit's are outside the joints': a pose off by the
@@ -452,6 +464,12 @@ void add_static_pixel(double w, double r, bool in_naming_fit, bool left_half, Ro
   // would say only that something is there, and the protective fields
   // judge that; in the camera fit it would pull the pose.
   if (!in_naming_fit) return;
+  // The common distance offset: J = f (a distance read d mm farther
+  // changes Z by f d), with the pixel's camera Jacobian for the cross terms.
+  const double* camera_jacobian = row->jacobian.data() + 6 * row->fit;
+  b->distance_offset_score -= w * z_per_radial * r;
+  b->distance_offset_information += w * z_per_radial * z_per_radial;
+  for (int a = 0; a < 6; ++a) b->distance_offset_cross[a] += w * z_per_radial * camera_jacobian[a];
   // Into the row's camera fit (added at the row's end, sum_row).
   row->weight[static_cast<size_t>(row->fit)] = w;
   row->residual[static_cast<size_t>(row->fit)] = r;
@@ -485,7 +503,9 @@ void add_pixel(const EvidenceFrame& f, int u, int v, int i, std::vector<double>*
   if (moved) {
     add_robot_pixel(w, r, in_naming_fit, *joint_row, b);
   } else {
-    add_static_pixel(w, r, in_naming_fit, u < f.camera.width / 2, row, b);
+    const double x = (u - f.camera.cx) / f.camera.fx, y = (v - f.camera.cy) / f.camera.fy;
+    add_static_pixel(w, r, in_naming_fit, u < f.camera.width / 2, 1.0 / std::sqrt(1.0 + x * x + y * y), row,
+                     b);
   }
 }
 
@@ -557,6 +577,9 @@ void store_sums(const EvidenceSums& total, discrepancy_t* s) {
   std::copy(total.camera_region_score, total.camera_region_score + 24, s->camera_region_score);
   std::copy(total.camera_region_information, total.camera_region_information + 24,
             s->camera_region_information);
+  s->distance_offset_score = total.distance_offset_score;
+  s->distance_offset_information = total.distance_offset_information;
+  std::copy(total.distance_offset_cross, total.distance_offset_cross + 6, s->distance_offset_cross);
 }
 
 // The camera fit: its score, its information (both halves) and the

@@ -4,6 +4,9 @@
 #include <cmath>
 #include <limits>
 
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+
 #include "tofguard/common/demand.hpp"
 #include "tofguard/risk_t.hpp"
 
@@ -150,7 +153,54 @@ double naming_chi2(const discrepancy_t& f, int i) {
   return f.joint_naming_score[i] * f.joint_naming_score[i] / f.joint_naming_information[i];
 }
 
+DistanceDrift distance_drift(const discrepancy_t& f, double threshold_chi2) {
+  DistanceDrift d;
+  const double info_d = f.distance_offset_information;
+  if (!(info_d > 0)) return d;
+  using Matrix6 = Eigen::Matrix<double, 6, 6, Eigen::RowMajor>;
+  const Eigen::Map<const Matrix6> info(f.camera_information);
+  const Eigen::Map<const Eigen::Matrix<double, 6, 1>> correction(f.camera_correction);
+  // The plain camera score (the wire's is shrunk; the correction is the
+  // plain fit's: I c).
+  const Eigen::Matrix<double, 6, 1> score = info * correction;
+  const double pose_chi2 = correction.dot(score);
+  const double offset_chi2 = f.distance_offset_score * f.distance_offset_score / info_d;
+  Eigen::Matrix<double, 7, 7> joint;
+  joint.topLeftCorner<6, 6>() = info;
+  for (int a = 0; a < 6; ++a) joint(a, 6) = joint(6, a) = f.distance_offset_cross[a];
+  joint(6, 6) = info_d;
+  Eigen::Matrix<double, 7, 1> joint_score;
+  joint_score << score, f.distance_offset_score;
+  const Eigen::LDLT<Eigen::Matrix<double, 7, 7>> ldlt(joint);
+  if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return d;
+  const double joint_chi2 = joint_score.dot(ldlt.solve(joint_score));
+  if (!std::isfinite(joint_chi2)) return d;
+  d.offset_mm = f.distance_offset_score / info_d;
+  d.offset_sigma_mm = 1.0 / std::sqrt(info_d);
+  d.offset_beyond_pose_chi2 = joint_chi2 - pose_chi2;
+  d.pose_beyond_offset_chi2 = joint_chi2 - offset_chi2;
+  d.drift = d.offset_beyond_pose_chi2 > threshold_chi2 && d.pose_beyond_offset_chi2 <= threshold_chi2;
+  return d;
+}
+
+FrameFinding SequentialEvidence::drift_finding(const DistanceDrift& d) const {
+  FrameFinding finding;
+  finding.cause = risk_t::CAUSE_SENSOR_FAULT;
+  finding.score = camera_cusum_;
+  finding.threshold = h_;
+  finding.detail =
+      "camera needs recommissioning: its distances read " + fixed(d.offset_mm, 1) + " mm (± " +
+      fixed(d.offset_sigma_mm, 1) + ") farther than its profile (sequential evidence: the camera test at " +
+      fixed(camera_cusum_, 1) + " of h " + fixed(h_, 1) + "; a common distance offset explains chi^2 " +
+      fixed(d.offset_beyond_pose_chi2, 0) + " beyond a moved camera, a moved camera " +
+      fixed(d.pose_beyond_offset_chi2, 0) + " beyond the offset)";
+  return finding;
+}
+
 FrameFinding SequentialEvidence::camera_finding(const discrepancy_t& f) const {
+  // As for naming a joint: a difference of two hypotheses' chi-squares is
+  // twice their log-likelihood ratio, so 2h is the threshold's own level.
+  if (const DistanceDrift drift = distance_drift(f, 2 * h_); drift.drift) return drift_finding(drift);
   const double* c = f.camera_correction;
   FrameFinding finding;
   finding.cause = risk_t::CAUSE_CALIBRATION_ERROR;

@@ -844,6 +844,14 @@ TEST_F(EvidenceTest, AStaticErrorWithinItsBoundScoresAsNoise) {
   EXPECT_LT(largest_joint_z(bounded), 5.0);
   // The fitted correction stays the plain fit's: what the pose looks like.
   EXPECT_EQ(plain.camera_correction[2], bounded.camera_correction[2]);
+  // The common distance offset (discrepancy_t.distance_offset_*): 12 mm in
+  // Z is 12 / f along the rays (f 0.89..1 over this image), and the
+  // allowance does not touch it.
+  const double offset_mm = bounded.distance_offset_score / bounded.distance_offset_information;
+  std::cout << "12 mm in Z: common distance offset " << offset_mm << " mm\n";
+  EXPECT_GT(offset_mm, 12.0);
+  EXPECT_LT(offset_mm, 13.5);
+  EXPECT_EQ(plain.distance_offset_score, bounded.distance_offset_score);
 
   Eigen::Isometry3d moved = Eigen::Isometry3d::Identity();
   moved.translation().z() = 0.04;

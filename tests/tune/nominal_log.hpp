@@ -38,7 +38,23 @@ struct NominalLogOptions {
   // each joint of `encoder_offset_rad` reported that much more than it is.
   Eigen::Isometry3d camera_offset = Eigen::Isometry3d::Identity();
   std::map<std::string, double> encoder_offset_rad;
+  // A drift of the camera's distances after commissioning: every distance
+  // read this much farther along its ray, mm.
+  double distance_offset_mm = 0;
 };
+
+// Every valid Z of `depth_m` moved `offset_mm` farther along its pixel's
+// ray: Z + offset f, f = Z / r = 1 / sqrt(1 + x^2 + y^2).
+inline void add_distance_offset(const Intrinsics& in, double offset_mm, std::vector<float>* depth_m) {
+  if (offset_mm == 0) return;
+  for (int v = 0; v < in.height; ++v) {
+    for (int u = 0; u < in.width; ++u) {
+      float& z = (*depth_m)[static_cast<size_t>(v) * in.width + u];
+      const double x = (u - in.cx) / in.fx, y = (v - in.cy) / in.fy;
+      if (z > 0) z += static_cast<float>(offset_mm * 1e-3 / std::sqrt(1 + x * x + y * y));
+    }
+  }
+}
 
 // Writes the log to `path`; returns the number of camera frames.
 inline int write_nominal_log(const std::string& path, const deployment::Config& config,
@@ -69,9 +85,10 @@ inline int write_nominal_log(const std::string& path, const deployment::Config& 
   for (int64_t t = 0; t <= end_us; t += joint_period_us) {
     while (next_frame < frames && lead_in_us + next_frame * period_us + period_us <= t) {
       const int64_t capture = base_utime + lead_in_us + next_frame * period_us;
-      const std::vector<float> depth_m =
+      std::vector<float> depth_m =
           camera.capture(joints_at(capture), pose, config.camera.intrinsics,
                          options.noise_seed * 1'000'000 + static_cast<uint64_t>(next_frame), options.objects);
+      add_distance_offset(config.camera.intrinsics, options.distance_offset_mm, &depth_m);
       const depth_image_t frame = make_depth_image(config.camera.id, config.camera.intrinsics, capture,
                                                    next_frame, /*calibrated=*/true, depth_m);
       write_log_event(&log, capture + period_us, config.channels.depth, frame);

@@ -22,6 +22,22 @@
 
 namespace tofguard::risk {
 
+// A drift of the camera's distances since commissioning against a moved
+// camera (docs/safety-chain.md, "A drift of the camera's distances"), from
+// a frame's camera fit and its common distance offset
+// (discrepancy_t.distance_offset_*): the chi-squares the fit of both
+// together explains beyond each alone. A drift when the offset explains
+// more than `threshold_chi2` beyond the pose and the pose no more than that
+// beyond the offset.
+struct DistanceDrift {
+  bool drift = false;
+  double offset_mm = 0;  // the camera reads this much farther (mm, along each ray)
+  double offset_sigma_mm = 0;
+  double offset_beyond_pose_chi2 = 0;
+  double pose_beyond_offset_chi2 = 0;
+};
+DistanceDrift distance_drift(const discrepancy_t& frame, double threshold_chi2);
+
 // log(cosh(x)), stable for any finite x: |x| + log1p(exp(-2|x|)) - log 2.
 double log_cosh(double x);
 
@@ -150,6 +166,9 @@ class SequentialEvidence {
   // The finding of a warning for the `largest` CUSUM.
   FrameFinding warning_finding(const discrepancy_t& frame, const NamedCusum& largest) const;
   FrameFinding camera_finding(const discrepancy_t& frame) const;
+  // The camera test's finding when a drift of the camera's distances
+  // explains the frame (distance_drift), not a moved camera.
+  FrameFinding drift_finding(const DistanceDrift& drift) const;
   FrameFinding joint_finding(const discrepancy_t& frame, int index) const;
 
   std::set<std::string> prismatic_;
