@@ -222,6 +222,16 @@ std::string check_evidence(const discrepancy_t& d) {
                     d.distance_offset_information);
   }
   if (auto p = finite_array(d.distance_offset_cross, 6, "distance_offset_cross"); !p.empty()) return p;
+  for (int k = 0; k < 24; ++k) {
+    if (k < 6 && !(std::isfinite(d.camera_static_bound[k]) && d.camera_static_bound[k] >= 0)) {
+      return expected("camera_static_bound[" + std::to_string(k) + "]", "a finite bound >= 0",
+                      d.camera_static_bound[k]);
+    }
+    if (!(std::isfinite(d.camera_region_static_bound[k]) && d.camera_region_static_bound[k] >= 0)) {
+      return expected("camera_region_static_bound[" + std::to_string(k) + "]", "a finite bound >= 0",
+                      d.camera_region_static_bound[k]);
+    }
+  }
   if (auto p = check_count(d.num_joints, d.joint_name, "joint_name", "num_joints"); !p.empty()) return p;
   if (auto p = check_count(d.num_joints, d.joint_fit_pixels, "joint_fit_pixels", "num_joints"); !p.empty())
     return p;
@@ -237,6 +247,7 @@ std::string check_evidence(const discrepancy_t& d) {
         std::tuple{&d.joint_information, "joint_information", true},
         std::tuple{&d.joint_naming_score, "joint_naming_score", false},
         std::tuple{&d.joint_naming_information, "joint_naming_information", true},
+        std::tuple{&d.joint_static_bound, "joint_static_bound", true},
         std::tuple{&d.joint_search_offset, "joint_search_offset", false},
         std::tuple{&d.joint_search_gain, "joint_search_gain", true},
         std::tuple{&d.joint_reach_m, "joint_reach_m", true}}) {

@@ -188,6 +188,9 @@ void clear_evidence(discrepancy_t* s) {
   s->distance_offset_score = 0;
   s->distance_offset_information = 0;
   std::fill(s->distance_offset_cross, s->distance_offset_cross + 6, 0.0);
+  std::fill(s->camera_static_bound, s->camera_static_bound + 6, 0.0);
+  std::fill(s->camera_region_static_bound, s->camera_region_static_bound + 24, 0.0);
+  s->joint_static_bound.clear();
   s->num_joints = 0;
   s->joint_name.clear();
   s->joint_fit_pixels.clear();
@@ -615,13 +618,14 @@ void store_camera_fit(const EvidenceSums& total, discrepancy_t* s) {
 void shrink_by_static_error(const EvidenceSums& total, const EvidenceOptions& options, discrepancy_t* s) {
   const double b = options.static_bias_mm;
   const double fp = kFixedPatternSigmas * options.fixed_pattern_sigma_mm;
+  s->joint_static_bound.assign(s->joint_score.size(), 0.0);
   if (!(b > 0) && !(fp > 0)) return;
   const auto bound = [&](double bias_abs, double bias_square) {
     return b * bias_abs + fp * std::sqrt(bias_square);
   };
   for (size_t j = 0; j < s->joint_score.size(); ++j) {
-    s->joint_score[j] =
-        shrink_score(s->joint_score[j], bound(total.joint_bias_abs[j], total.joint_bias_square[j]));
+    s->joint_static_bound[j] = bound(total.joint_bias_abs[j], total.joint_bias_square[j]);
+    s->joint_score[j] = shrink_score(s->joint_score[j], s->joint_static_bound[j]);
   }
   for (int a = 0; a < 6; ++a) {
     double image_abs = 0, image_square = 0;
@@ -629,11 +633,12 @@ void shrink_by_static_error(const EvidenceSums& total, const EvidenceOptions& op
       const int k = 6 * r + a;
       image_abs += total.camera_region_bias_abs[k];
       image_square += total.camera_region_bias_square[k];
-      s->camera_region_score[k] =
-          shrink_score(s->camera_region_score[k],
-                       bound(total.camera_region_bias_abs[k], total.camera_region_bias_square[k]));
+      s->camera_region_static_bound[k] =
+          bound(total.camera_region_bias_abs[k], total.camera_region_bias_square[k]);
+      s->camera_region_score[k] = shrink_score(s->camera_region_score[k], s->camera_region_static_bound[k]);
     }
-    s->camera_score[a] = shrink_score(s->camera_score[a], bound(image_abs, image_square));
+    s->camera_static_bound[a] = bound(image_abs, image_square);
+    s->camera_score[a] = shrink_score(s->camera_score[a], s->camera_static_bound[a]);
   }
 }
 

@@ -21,6 +21,11 @@ double joint_llr(double score, double information, double delta) {
   return log_cosh(delta * score) - delta * delta * information / 2;
 }
 
+double effective_delta(double delta, double information, double static_bound) {
+  if (!(information > 0) || !(static_bound > 0)) return delta;
+  return std::max(0.0, delta - static_bound / information);
+}
+
 namespace {
 
 // The diagonal of a row-major 6x6 information matrix.
@@ -58,13 +63,28 @@ bool camera_region_votes(const double* information_diagonal, const std::array<do
   return divergence >= kCameraRegionVoteNats;
 }
 
+namespace {
+
+// Each axis's delta beyond what the static error can give its score
+// (effective_delta), for the scores `score`, information diagonal and bounds.
+std::array<double, 6> effective_camera_delta(const std::array<double, 6>& delta,
+                                             const double* information_diagonal, const double* static_bound) {
+  std::array<double, 6> out = delta;
+  for (int a = 0; a < 6; ++a) out[a] = effective_delta(delta[a], information_diagonal[a], static_bound[a]);
+  return out;
+}
+
+}  // namespace
+
 CameraRegionRatio camera_region_llr(const discrepancy_t& f, const std::array<double, 6>& delta) {
   std::array<double, 4> ratios{};
   int voters = 0;
   for (int r = 0; r < 4; ++r) {
     const double* information = f.camera_region_information + 6 * r;
-    if (!camera_region_votes(information, delta)) continue;
-    ratios[voters++] = camera_llr_diagonal(f.camera_region_score + 6 * r, information, delta);
+    const std::array<double, 6> region_delta =
+        effective_camera_delta(delta, information, f.camera_region_static_bound + 6 * r);
+    if (!camera_region_votes(information, region_delta)) continue;
+    ratios[voters++] = camera_llr_diagonal(f.camera_region_score + 6 * r, information, region_delta);
   }
   CameraRegionRatio result;
   result.voters = voters;
@@ -72,7 +92,9 @@ CameraRegionRatio camera_region_llr(const discrepancy_t& f, const std::array<dou
     // No region carries a nat at delta (a frame without regions, from an
     // older tofguard-discrepancy, or a scene with hardly any static
     // surface): the whole image's ratio, on its information's diagonal.
-    result.llr = camera_llr_diagonal(f.camera_score, diagonal_of(f.camera_information).data(), delta);
+    const std::array<double, 6> diagonal = diagonal_of(f.camera_information);
+    result.llr = camera_llr_diagonal(f.camera_score, diagonal.data(),
+                                     effective_camera_delta(delta, diagonal.data(), f.camera_static_bound));
     return result;
   }
   // The m-th largest of the n voters' ratios, m = min(n, 3): with
@@ -304,7 +326,11 @@ void SequentialEvidence::add_frame(const discrepancy_t& f) {
     const auto it = joint_cusum_.find(f.joint_name[i]);
     if (it == joint_cusum_.end()) continue;  // not a moving joint of the robot: not a hypothesis
     const double delta = prismatic_.count(it->first) > 0 ? joint_delta_m_ : joint_delta_rad_;
-    it->second = step(it->second, joint_llr(f.joint_score[i], f.joint_information[i], delta), h_);
+    const double bound = static_cast<size_t>(i) < f.joint_static_bound.size() ? f.joint_static_bound[i] : 0.0;
+    it->second = step(it->second,
+                      joint_llr(f.joint_score[i], f.joint_information[i],
+                                effective_delta(delta, f.joint_information[i], bound)),
+                      h_);
   }
 }
 

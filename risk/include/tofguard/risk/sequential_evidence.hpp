@@ -45,6 +45,12 @@ double log_cosh(double x);
 // -delta (1/2 each)" against "it is not", for score s and information I:
 // log cosh(delta s) - delta^2 I / 2.
 double joint_llr(double score, double information, double delta);
+// The alternative a shrunk score is tested against (docs/safety-chain.md,
+// "Static error: the composite null"): a fault of delta moves the plain
+// score by delta * information, the shrunk one by that less the static
+// bound, i.e. as a fault of delta - bound / information (>= 0; 0: the fault
+// cannot show beyond the allowance, the ratio is 1). With no bound: delta.
+double effective_delta(double delta, double information, double static_bound);
 
 // The camera's: the mixture over the 12 alternatives "+-delta_a along
 // parameter a" (tx, ty, tz, rx, ry, rz), with the diagonal of the 6x6
