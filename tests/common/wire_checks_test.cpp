@@ -93,6 +93,7 @@ discrepancy_t discrepancy_with_evidence() {
   d.joint_information = {1e5, 2e3};
   d.joint_naming_score = {90, -2};
   d.joint_naming_information = {9e4, 2e3};
+  d.joint_static_bound = {0, 0};
   d.robot_fit_pixels = 10;
   d.robot_chi2 = 9;
   d.search_points = 10;
@@ -169,6 +170,15 @@ TEST(WireChecks, DiscrepancyEvidence) {
   d = discrepancy_with_evidence();
   d.joint_search_gain[0] = -0.5;
   EXPECT_EQ(field_of(d), "joint_search_gain[0]");
+  d = discrepancy_with_evidence();
+  d.joint_static_bound[1] = -1;
+  EXPECT_EQ(field_of(d), "joint_static_bound[1]");
+  d = discrepancy_with_evidence();
+  d.camera_region_static_bound[5] = kNaN;
+  EXPECT_EQ(field_of(d), "camera_region_static_bound[5]");
+  d = discrepancy_with_evidence();
+  d.distance_offset_information = -1;
+  EXPECT_EQ(field_of(d), "distance_offset_information");
 }
 
 TEST(WireChecks, DiscrepancyProtectiveField) {
