@@ -164,6 +164,7 @@ void discrepancies() {
   m.joint_information = {1, 2, 3};
   m.joint_naming_score = {0, 0, 0};
   m.joint_naming_information = {1, 1, 1};
+  m.joint_static_bound = {0, 0.5, 0};
   m.joint_search_offset = {0, 0.01, 0};
   m.joint_search_gain = {0, 1, 0};
   m.joint_reach_m = {0.9, 0.6, 0.2};
