@@ -20,13 +20,6 @@ std::string number(double value) {
   return s.str();
 }
 
-// Z per unit of radial distance at pixel (u, v).
-double z_per_radial(const CameraProfile& p, int u, int v) {
-  const double x = (u - p.cx) / p.fx;
-  const double y = (v - p.cy) / p.fy;
-  return 1.0 / std::sqrt(1.0 + x * x + y * y);
-}
-
 }  // namespace
 
 double CameraProfile::distance_correction_at(double r_m) const {
@@ -69,7 +62,7 @@ void apply_camera_profile(const CameraProfile& p, depth_image_t* frame) {
       const size_t i = static_cast<size_t>(v) * p.width + u;
       const int z_mm = frame->depth_mm[i];
       if (z_mm <= 0) continue;
-      const double f = z_per_radial(p, u, v);
+      const double f = z_per_radial(p.fx, p.fy, p.cx, p.cy, u, v);
       const double r_m = z_mm * 1e-3 / f;
       const double corrected = z_mm + f * p.distance_correction_at(r_m) + p.pixel_correction_mm[i];
       frame->depth_mm[i] =

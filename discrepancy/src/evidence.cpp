@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 
 #include "double2.hpp"
+#include "tofguard/common/camera_profile.hpp"
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/discrepancy/joint_search.hpp"
 
@@ -506,9 +507,8 @@ void add_pixel(const EvidenceFrame& f, int u, int v, int i, std::vector<double>*
   if (moved) {
     add_robot_pixel(w, r, in_naming_fit, *joint_row, b);
   } else {
-    const double x = (u - f.camera.cx) / f.camera.fx, y = (v - f.camera.cy) / f.camera.fy;
-    add_static_pixel(w, r, in_naming_fit, u < f.camera.width / 2, 1.0 / std::sqrt(1.0 + x * x + y * y), row,
-                     b);
+    add_static_pixel(w, r, in_naming_fit, u < f.camera.width / 2,
+                     z_per_radial(f.camera.fx, f.camera.fy, f.camera.cx, f.camera.cy, u, v), row, b);
   }
 }
 

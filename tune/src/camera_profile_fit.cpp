@@ -28,13 +28,12 @@ std::vector<uint8_t> noise_pixels(const RenderedPair& frame, double silhouette_j
 namespace {
 
 // Z per unit of radial distance of each pixel of `frame`'s camera.
-std::vector<double> z_per_radial(const depth_image_t& frame) {
+std::vector<double> z_per_radial_image(const depth_image_t& frame) {
   std::vector<double> f(static_cast<size_t>(frame.width) * frame.height);
   for (int v = 0; v < frame.height; ++v) {
     for (int u = 0; u < frame.width; ++u) {
-      const double x = (u - frame.cx) / frame.fx;
-      const double y = (v - frame.cy) / frame.fy;
-      f[static_cast<size_t>(v) * frame.width + u] = 1.0 / std::sqrt(1.0 + x * x + y * y);
+      f[static_cast<size_t>(v) * frame.width + u] =
+          z_per_radial(frame.fx, frame.fy, frame.cx, frame.cy, u, v);
     }
   }
   return f;
@@ -310,7 +309,7 @@ ProfileFit fit_camera_profile(const std::vector<RenderedPair>& frames,
   p.fy = first.fy;
   p.cx = first.cx;
   p.cy = first.cy;
-  const std::vector<double> f = z_per_radial(first);
+  const std::vector<double> f = z_per_radial_image(first);
   if (!check_pose_against_depth(frames, f, tolerance, silhouette_jump_mm, options, &fit)) return fit;
   if (!fit_smooth_part(frames, f, silhouette_jump_mm, options, &fit)) return fit;
   fit_pixel_part(frames, f, tolerance, silhouette_jump_mm, options, &fit);

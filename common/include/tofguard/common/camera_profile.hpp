@@ -18,6 +18,7 @@
 //
 // A profile serves one camera: its id, size and intrinsics must be the
 // frame's (profile_mismatch).
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -52,6 +53,16 @@ struct CameraProfile {
   // The smooth correction at radial distance r_m, mm.
   double distance_correction_at(double r_m) const;
 };
+
+// Z per unit of radial distance of pixel (u, v) for intrinsics fx, fy, cx,
+// cy (pixels): f = 1 / sqrt(1 + ((u - cx) / fx)^2 + ((v - cy) / fy)^2). The
+// camera library's RadialToZ tabulates the same for a whole image; this is
+// for the layers below it (the profile, the evidence, commissioning).
+inline double z_per_radial(double fx, double fy, double cx, double cy, int u, int v) {
+  const double x = (u - cx) / fx;
+  const double y = (v - cy) / fy;
+  return 1.0 / std::sqrt(1.0 + x * x + y * y);
+}
 
 // Why `frame` is not this profile's camera (one line naming the field and
 // both values), or "" when it is.
