@@ -96,8 +96,10 @@ std::vector<risk_t> RiskMonitor::judge(std::vector<ClassifiedFrame> released, in
       }
     }
     const bool was_open = decision_.diagnosis_open();
+    // Clean for the diagnosis: every CUSUM below its warning level, and
+    // every test that crossed shows evidence that its fault is gone.
     verdicts.push_back(decision_.decide(c.frame, std::move(finding), deadlines_.first_expired(now_us),
-                                        evidence_.quiet(), evidence.summary));
+                                        evidence_.quiet() && evidence_.cleared(), evidence.summary));
     // A closed diagnosis starts the tests afresh.
     if (was_open && !decision_.diagnosis_open()) evidence_.reset();
   }

@@ -74,9 +74,15 @@ std::array<double, 6> effective_camera_delta(const std::array<double, 6>& delta,
   return out;
 }
 
+std::array<double, 6> scaled(std::array<double, 6> delta, double fraction) {
+  for (double& d : delta) d *= fraction;
+  return delta;
+}
+
 }  // namespace
 
-CameraRegionRatio camera_region_llr(const discrepancy_t& f, const std::array<double, 6>& delta) {
+CameraRegionRatio camera_region_llr(const discrepancy_t& f, const std::array<double, 6>& delta,
+                                    double alternative_fraction) {
   std::array<double, 4> ratios{};
   int voters = 0;
   for (int r = 0; r < 4; ++r) {
@@ -84,7 +90,8 @@ CameraRegionRatio camera_region_llr(const discrepancy_t& f, const std::array<dou
     const std::array<double, 6> region_delta =
         effective_camera_delta(delta, information, f.camera_region_static_bound + 6 * r);
     if (!camera_region_votes(information, region_delta)) continue;
-    ratios[voters++] = camera_llr_diagonal(f.camera_region_score + 6 * r, information, region_delta);
+    ratios[voters++] = camera_llr_diagonal(f.camera_region_score + 6 * r, information,
+                                           scaled(region_delta, alternative_fraction));
   }
   CameraRegionRatio result;
   result.voters = voters;
@@ -93,8 +100,9 @@ CameraRegionRatio camera_region_llr(const discrepancy_t& f, const std::array<dou
     // older tofguard-discrepancy, or a scene with hardly any static
     // surface): the whole image's ratio, on its information's diagonal.
     const std::array<double, 6> diagonal = diagonal_of(f.camera_information);
-    result.llr = camera_llr_diagonal(f.camera_score, diagonal.data(),
-                                     effective_camera_delta(delta, diagonal.data(), f.camera_static_bound));
+    result.llr = camera_llr_diagonal(
+        f.camera_score, diagonal.data(),
+        scaled(effective_camera_delta(delta, diagonal.data(), f.camera_static_bound), alternative_fraction));
     return result;
   }
   // The m-th largest of the n voters' ratios, m = min(n, 3): with
@@ -128,7 +136,11 @@ SequentialEvidence::SequentialEvidence(const RiskSettings& risk, const robot_mod
                     risk.evidence_camera_translation_m, risk.evidence_camera_rotation_rad,
                     risk.evidence_camera_rotation_rad,  risk.evidence_camera_rotation_rad},
       warning_fraction_(risk.evidence_warning_fraction) {
-  for (const std::string& joint : robot.movable_joint_names) joint_cusum_[joint] = 0;
+  clearing_cusum_["camera"] = 0;
+  for (const std::string& joint : robot.movable_joint_names) {
+    joint_cusum_[joint] = 0;
+    clearing_cusum_[joint] = 0;
+  }
   h_ = cusum_threshold(hypotheses(), camera_rate_hz, risk.evidence_false_stop_period_h);
 }
 
@@ -145,9 +157,23 @@ bool SequentialEvidence::quiet() const {
   return true;
 }
 
+bool SequentialEvidence::cleared() const {
+  for (const std::string& hypothesis : crossed_) {
+    if (clearing_cusum(hypothesis) < h_) return false;
+  }
+  return true;
+}
+
+double SequentialEvidence::clearing_cusum(const std::string& hypothesis) const {
+  const auto it = clearing_cusum_.find(hypothesis);
+  return it == clearing_cusum_.end() ? 0 : it->second;
+}
+
 void SequentialEvidence::reset() {
   camera_cusum_ = 0;
   for (auto& [joint, s] : joint_cusum_) s = 0;
+  for (auto& [hypothesis, g] : clearing_cusum_) g = 0;
+  crossed_.clear();
 }
 
 namespace {
@@ -160,6 +186,14 @@ constexpr double kDeg = 180.0 / M_PI;
 double step(double cusum, double llr, double h) {
   if (!std::isfinite(llr)) return h;
   return std::min(h, std::max(0.0, cusum + llr));
+}
+
+// One step of a clearing test, on the stop test's ratio `llr` at the
+// clearing alternative: evidence against the fault adds, capped at h. A
+// non-finite ratio is no evidence that a fault is gone: back to 0.
+double clearing_step(double clearing, double llr, double h) {
+  if (!std::isfinite(llr)) return 0;
+  return std::min(h, std::max(0.0, clearing - llr));
 }
 
 }  // namespace
@@ -298,8 +332,10 @@ EvidenceStep SequentialEvidence::update(const discrepancy_t& f) {
   // The largest CUSUM relative to h, for warnings and the summary.
   const NamedCusum largest = largest_cusum();
   result.quiet = quiet();
+  result.cleared = cleared();
   result.summary =
       "evidence: largest CUSUM " + largest.name + " " + fixed(largest.value, 1) + " of h " + fixed(h_, 1);
+  if (!crossed_.empty()) result.summary += "; " + clearing_summary();
   if (!f.evidence_available) return result;
 
   if (camera_cusum_ >= h_) {
@@ -322,16 +358,37 @@ EvidenceStep SequentialEvidence::update(const discrepancy_t& f) {
 
 void SequentialEvidence::add_frame(const discrepancy_t& f) {
   camera_cusum_ = step(camera_cusum_, camera_region_llr(f, camera_delta_).llr, h_);
+  double& camera_clearing = clearing_cusum_["camera"];
+  camera_clearing = clearing_step(camera_clearing,
+                                  camera_region_llr(f, camera_delta_, kClearingAlternativeFraction).llr, h_);
+  if (camera_cusum_ >= h_) {
+    crossed_.insert("camera");
+    camera_clearing = 0;
+  }
   for (int i = 0; i < f.num_joints; ++i) {
     const auto it = joint_cusum_.find(f.joint_name[i]);
     if (it == joint_cusum_.end()) continue;  // not a moving joint of the robot: not a hypothesis
     const double delta = prismatic_.count(it->first) > 0 ? joint_delta_m_ : joint_delta_rad_;
     const double bound = static_cast<size_t>(i) < f.joint_static_bound.size() ? f.joint_static_bound[i] : 0.0;
-    it->second = step(it->second,
-                      joint_llr(f.joint_score[i], f.joint_information[i],
-                                effective_delta(delta, f.joint_information[i], bound)),
-                      h_);
+    const double information = f.joint_information[i];
+    const double tested = effective_delta(delta, information, bound);
+    it->second = step(it->second, joint_llr(f.joint_score[i], information, tested), h_);
+    double& clearing = clearing_cusum_[it->first];
+    clearing = clearing_step(
+        clearing, joint_llr(f.joint_score[i], information, kClearingAlternativeFraction * tested), h_);
+    if (it->second >= h_) {
+      crossed_.insert(it->first);
+      clearing = 0;
+    }
   }
+}
+
+std::string SequentialEvidence::clearing_summary() const {
+  std::string line;
+  for (const std::string& hypothesis : crossed_) {
+    line += (line.empty() ? "" : ", ") + hypothesis + " " + fixed(clearing_cusum(hypothesis), 1);
+  }
+  return "evidence the fault is gone (clearing test at delta/2): " + line + " of h " + fixed(h_, 1);
 }
 
 SequentialEvidence::NamedCusum SequentialEvidence::largest_cusum() const {

@@ -423,6 +423,52 @@ TEST(EvidenceTests, GrowingEvidenceWarnsBeforeItCrosses) {
   EXPECT_DOUBLE_EQ(evidence.joint_cusum("a5"), 0);
 }
 
+// A fault that the fit reads smaller than half the test's delta (a large
+// offset outside the fit's linear range, as the arm moves) turns the stop
+// test against it, so its CUSUM falls below the warning level; the
+// clearing test, at delta/2, still sees it, and only a fault gone clears.
+TEST(EvidenceTests, OnlyEvidenceThatTheFaultIsGoneClearsACrossedTest) {
+  SequentialEvidence evidence(sim_config().risk, friend_arm(), kRateHz);
+  ScoreSource source(21);
+  int64_t seq = 1;
+  // a3 (I = 1e4, delta 3 deg: 5.2 sigma per frame) 6 deg off: crosses at once.
+  EvidenceStep step = evidence.update(source.frame(seq++, {{"a3", 6 * kDeg}}));
+  ASSERT_TRUE(step.crossed);
+  EXPECT_FALSE(evidence.cleared());
+  // Read as 1.2 deg (0.4 delta) for 300 frames: the stop test's drift is
+  // delta I (0.4 - 0.5) delta = -2.7 per frame, the clearing test's
+  // (delta/2) I (0.4 - 0.25) delta = +2.1 against clearing.
+  int quiet_frames = 0;
+  for (int k = 0; k < 300; ++k) {
+    step = evidence.update(source.frame(seq++, {{"a3", 0.4 * 3 * kDeg}}));
+    if (step.quiet) ++quiet_frames;
+    EXPECT_FALSE(step.cleared) << "frame " << k << ": " << step.summary;
+    EXPECT_FALSE(evidence.cleared());
+  }
+  EXPECT_GE(quiet_frames, 290) << "the stop test alone would have let the diagnosis close";
+  EXPECT_LT(evidence.clearing_cusum("a3"), evidence.warning_level());
+  EXPECT_NE(step.summary.find("evidence the fault is gone (clearing test at delta/2): a3 "),
+            std::string::npos)
+      << step.summary;
+  // The fault gone: the clearing test gains (delta/2)^2 I / 2 = 3.4 per
+  // frame and reaches h (20.6) within about 6 frames.
+  int frames_to_clear = 0;
+  while (!evidence.cleared()) {
+    ASSERT_LT(frames_to_clear, 20) << step.summary;
+    step = evidence.update(source.frame(seq++));
+    ++frames_to_clear;
+  }
+  EXPECT_GE(frames_to_clear, 4);
+  EXPECT_TRUE(step.cleared);
+  // A new crossing restarts its clearing test.
+  step = evidence.update(source.frame(seq++, {{"a3", 6 * kDeg}}));
+  ASSERT_TRUE(step.crossed);
+  EXPECT_DOUBLE_EQ(evidence.clearing_cusum("a3"), 0);
+  EXPECT_FALSE(evidence.cleared());
+  evidence.reset();
+  EXPECT_TRUE(evidence.cleared());
+}
+
 // ---- Through RiskMonitor: judged in frame order ----
 
 constexpr int64_t kStart = 5'000'000'000;  // monotonic
@@ -528,6 +574,35 @@ TEST(RiskMonitorEvidence, TheDiagnosisClosesOnlyAfterClearFramesWithoutAnyFindin
   EXPECT_EQ(r.level, risk_t::SAFE) << r.detail;
   EXPECT_FALSE(m.diagnosis_open());
   EXPECT_DOUBLE_EQ(m.evidence().camera_cusum(), 0);
+}
+
+// Through the decision rule: a diagnosis stays open while its fault is read
+// below delta/2 (every CUSUM below its warning level), and closes once the
+// fault is gone.
+TEST(RiskMonitorEvidence, ADiagnosisStaysOpenWhileItsFaultIsReadSmallerThanTheTestsDelta) {
+  risk::RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kRateHz, kStart);
+  ScoreSource source(23);
+  int64_t now = kStart;
+  int64_t seq = 1;
+  risk_t r = judge(&m, source.frame(seq++, {{"a3", 6 * kDeg}}), &now);
+  ASSERT_EQ(r.level, risk_t::DANGEROUS);
+  EXPECT_EQ(r.suspect, "a3");
+  for (int k = 0; k < 300; ++k) {
+    r = judge(&m, source.frame(seq++, {{"a3", 0.4 * 3 * kDeg}}), &now);
+    EXPECT_EQ(r.level, risk_t::DANGEROUS) << r.detail;
+    EXPECT_EQ(r.suspect, "a3");
+  }
+  EXPECT_TRUE(m.evidence().quiet());
+  EXPECT_NE(r.detail.find("[clean 0/10 frames]"), std::string::npos) << r.detail;
+  int frames = 0;
+  while (r.level != risk_t::SAFE) {
+    ASSERT_LT(frames, 40) << r.detail;
+    r = judge(&m, source.frame(seq++), &now);
+    ++frames;
+  }
+  // The clearing test's ~6 frames, then clear_frames clean ones.
+  EXPECT_GE(frames, sim_config().risk.evidence_clear_frames + 3);
+  EXPECT_FALSE(m.diagnosis_open());
 }
 
 // A sensor fault's diagnosis stays open too.

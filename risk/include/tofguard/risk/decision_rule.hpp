@@ -11,7 +11,8 @@
 // A DANGEROUS frame verdict opens a diagnosis: its cause, suspect and
 // detail are latched, and every verdict after it is DANGEROUS with them
 // until risk.evidence.clear_frames consecutive frames had no finding at all
-// (no rule finding, every CUSUM below its warning level, no expired
+// (no rule finding, the evidence quiet: every CUSUM below its warning level
+// and every test that crossed showing that its fault is gone, no expired
 // deadline); the last of them closes it and is SAFE.
 #include <cstdint>
 #include <optional>
@@ -33,7 +34,8 @@ class DecisionRule {
   // frame order: every call counts one frame for the debounce and the
   // diagnosis, also while `expired_input` (the first expired deadline)
   // overrides the verdict. `evidence_quiet`: every CUSUM below its warning
-  // level; `evidence_summary`: one line on them for an open diagnosis.
+  // level and every crossed test cleared (SequentialEvidence::cleared);
+  // `evidence_summary`: one line on them for an open diagnosis.
   risk_t decide(const discrepancy_t& frame, FrameFinding finding,
                 const std::optional<FrameFinding>& expired_input, bool evidence_quiet = true,
                 const std::string& evidence_summary = "");

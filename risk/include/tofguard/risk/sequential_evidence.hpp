@@ -84,8 +84,20 @@ struct CameraRegionRatio {
 // m = min(n, 3), minus log(n / m) (so that E_0[LR] <= 1 still holds: the
 // m-th largest LR is at most the mean of the m largest); with no region
 // voting, the whole image's camera_llr. docs/safety-chain.md, "Sequential
-// evidence and its thresholds".
-CameraRegionRatio camera_region_llr(const discrepancy_t& frame, const std::array<double, 6>& delta);
+// evidence and its thresholds". `alternative_fraction` scales the
+// alternatives the ratio is computed at (each axis's effective delta),
+// not the regions' votes: the clearing test's ratio at half of them.
+CameraRegionRatio camera_region_llr(const discrepancy_t& frame, const std::array<double, 6>& delta,
+                                    double alternative_fraction = 1.0);
+
+// The clearing test's alternative as a fraction of the stop test's
+// (docs/safety-chain.md, "How long a diagnosis stays open"): a diagnosis
+// closes only on evidence that the fault is smaller than half of what the
+// stop test looks for. The stop test's ratio turns against a fault read
+// below delta/2, so a large fault that the linear fit reads smaller as
+// the arm moves (a6 3 deg off read as 1-2.5 deg) looks like no fault to
+// it; the clearing test's turns against it only below delta/4.
+constexpr double kClearingAlternativeFraction = 0.5;
 
 // The CUSUM threshold for `hypotheses` tests on frames at `rate_hz` and at
 // most one false stop per `false_stop_period_h` hours:
@@ -115,6 +127,9 @@ struct EvidenceStep {
   FrameFinding finding;
   // Every CUSUM below warning_fraction * h after this frame.
   bool quiet = true;
+  // Every test that crossed since the last reset has its clearing test at
+  // h (cleared()).
+  bool cleared = true;
   // One line with the frame's evidence: the largest CUSUM and h.
   std::string summary;
 };
@@ -130,7 +145,7 @@ class SequentialEvidence {
   // The next frame in frame order. A frame without evidence changes
   // nothing (updated false; quiet tells the CUSUMs' state).
   EvidenceStep update(const discrepancy_t& frame);
-  // Every CUSUM back to 0 (a closed diagnosis).
+  // Every CUSUM back to 0, no test crossed (a closed diagnosis).
   void reset();
 
   double threshold() const { return h_; }
@@ -141,6 +156,14 @@ class SequentialEvidence {
   double joint_cusum(const std::string& joint) const;
   // Every CUSUM below warning_level().
   bool quiet() const;
+  // Every hypothesis whose test crossed since the last reset shows evidence
+  // that its fault is gone: its clearing test, a CUSUM on the negated
+  // log-likelihood ratio at kClearingAlternativeFraction of the stop
+  // test's (effective) delta, restarted at each crossing, is at h.
+  bool cleared() const;
+  // The clearing test of a hypothesis ("camera" or a joint): 0 for one that
+  // is not a hypothesis.
+  double clearing_cusum(const std::string& hypothesis) const;
 
  private:
   // A hypothesis's name ("camera" or a joint's) and its CUSUM.
@@ -149,8 +172,11 @@ class SequentialEvidence {
     double value;
   };
 
-  // A frame's log-likelihood ratios into the CUSUMs.
+  // A frame's log-likelihood ratios into the CUSUMs and the clearing
+  // tests; a test that crossed joins crossed_.
   void add_frame(const discrepancy_t& frame);
+  // One line on the clearing tests of the crossed hypotheses.
+  std::string clearing_summary() const;
   // The largest CUSUM (the camera's among equals).
   NamedCusum largest_cusum() const;
   // The joint test that crossed with the largest CUSUM (name empty: none).
@@ -185,6 +211,10 @@ class SequentialEvidence {
   double h_;
   double camera_cusum_ = 0;
   std::map<std::string, double> joint_cusum_;  // every moving joint of the robot
+  // The clearing tests: "camera" and every moving joint.
+  std::map<std::string, double> clearing_cusum_;
+  // The hypotheses whose test crossed since the last reset.
+  std::set<std::string> crossed_;
 };
 
 }  // namespace tofguard::risk
