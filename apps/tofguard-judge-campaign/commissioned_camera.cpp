@@ -92,7 +92,8 @@ CommissionedCamera commission_imperfect_camera(const CampaignArm& arm, uint64_t 
   config.discrepancy.camera_profile = std::make_shared<const CameraProfile>(learned.profile_fit.profile);
   // ...and measure what is left with it on a second (from 90 s on).
   const tune::TuneResult checked = tune::tune_rendered_frames(
-      tune_settings(config), nominal_frames(config, seconds, 90, 2000 + seed), out.arm.name + " checking");
+      tune_settings(config), nominal_frames(config, seconds, 50 + seconds + 28, 2000 + seed),
+      out.arm.name + " checking");
   if (!checked.usable) {
     out.error = checked.error;
     return out;
@@ -102,6 +103,8 @@ CommissionedCamera commission_imperfect_camera(const CampaignArm& arm, uint64_t 
   config.discrepancy.evidence_pixels_per_sample = checked.pixels_per_sample;
   config.discrepancy.evidence_static_bias_mm = checked.tuned.static_bias_mm;
   config.discrepancy.evidence_fixed_pattern_sigma_mm = checked.tuned.fixed_pattern_sigma_mm;
+  config.discrepancy.evidence_silhouette_band_px = checked.tuned.silhouette_band_px;
+  config.discrepancy.evidence_silhouette_bias_mm = checked.tuned.silhouette_bias_mm;
   std::ostringstream summary;
   summary << out.arm.name << ": wiggle " << fixed(truth.wiggle_amplitude_mm, 1) << " mm / "
           << fixed(truth.wiggle_period_m, 2) << " m, slope " << fixed(truth.slope_mm_per_m, 1)
@@ -119,7 +122,13 @@ CommissionedCamera commission_imperfect_camera(const CampaignArm& arm, uint64_t 
           << fixed(learned.profile_fit.pose.correction[5] * 180 / M_PI, 2) << ") deg; deployed noise "
           << fixed(checked.fit.sigma_at_0m_mm, 2) << " + " << fixed(checked.fit.sigma_per_m2_mm, 3)
           << " d^2 mm, static_bias " << fixed(checked.tuned.static_bias_mm, 1) << " mm, fixed pattern "
-          << fixed(checked.tuned.fixed_pattern_sigma_mm, 1) << " mm";
+          << fixed(checked.tuned.fixed_pattern_sigma_mm, 1) << " mm, near steps "
+          << fixed(checked.tuned.silhouette_bias_mm, 1) << " mm within " << checked.tuned.silhouette_band_px
+          << " px";
+  if (!checked.allowance_raised.empty()) {
+    summary << " (static_bias raised from " << fixed(checked.measured_static_bias_mm, 1)
+            << " mm: " << checked.allowance_raised << ")";
+  }
   out.summary = summary.str();
   out.ok = true;
   return out;

@@ -4,7 +4,8 @@
 // simulated camera gets the static errors of draw_imperfect_camera(seed)
 // (camera.sim.residual: nothing downstream of the camera knows them); the
 // arm moves through its nominal motion for `seconds` (the frames rendered
-// as tofguard-renderer renders them); tofguard-tune's passes learn the
+// as tofguard-renderer renders them; the learning one from motion time
+// 50 s, the checking one 28 s after it ends); tofguard-tune's passes learn the
 // camera's profile on one such recording and measure, with the profile
 // applied, the noise, its correlation and the static error left on a
 // second; the arm's config then carries what a user would deploy:

@@ -10,7 +10,7 @@
 //                           [--objects-cm 5,10,20,40,80] [--beyond-cm 10]
 //                           [--rates-hz 25,30] [--turns-deg 0,40] [--shared DIR]
 //                           [--tsv FILE] [--plots DIR] [--plots-from FILE]
-//                           [--imperfect-cameras N]
+//                           [--imperfect-cameras N] [--commission-s SECONDS]
 //
 // --camera-cm / --camera-deg: the camera moved along / turned about each
 // axis of its optical frame by each magnitude (fault_runs).
@@ -27,7 +27,8 @@
 // that much about the vertical through the robot's root (default 0).
 // --imperfect-cameras: each arm (and variant) watched by N cameras as
 // imperfect as real ones (draw_imperfect_camera(1..N)), each commissioned
-// first (commissioned_camera.hpp), instead of the config's ideal camera.
+// first (commissioned_camera.hpp), instead of the config's ideal camera;
+// --commission-s: how long each of its two recordings is (default 12 s).
 // --tsv: every run, a line each (campaign_tsv); --plots: detection rate and
 // latency against magnitude per fault kind (plot_campaign), of this
 // campaign's runs or, with --plots-from FILE, of the runs in FILE (a TSV
@@ -57,7 +58,7 @@ int usage(const std::string& why) {
          "[--camera-cm 2,3] [--camera-deg 1] [--streams RUNS] [--nominal-s SECONDS] [--passers-s SECONDS] "
          "[--no-faults] [--objects-cm 5,10,20,40,80] [--beyond-cm 10] [--rates-hz 25,30] "
          "[--turns-deg 0,40] [--shared DIR] [--tsv FILE] [--plots DIR] [--plots-from FILE] "
-         "[--imperfect-cameras N]\n";
+         "[--imperfect-cameras N] [--commission-s SECONDS]\n";
   return 2;
 }
 
@@ -78,6 +79,7 @@ struct Options {
   std::string plots_from;
   std::string shared = tofguard::test::shared_dir();
   int imperfect_cameras = 0;
+  double commission_s = 12;
 };
 
 // Option `option`'s value into *o; false for an unknown option. Throws
@@ -110,6 +112,8 @@ bool set_option(const std::string& option, const std::string& value, Options* o)
     o->shared = value;
   } else if (option == "--imperfect-cameras") {
     o->imperfect_cameras = static_cast<int>(number_list(value).at(0));
+  } else if (option == "--commission-s") {
+    o->commission_s = number_list(value).at(0);
   } else if (option == "--tsv") {
     o->tsv_path = value;
   } else if (option == "--plots") {
@@ -225,7 +229,8 @@ int run_campaigns(const Options& o) {
           continue;
         }
         for (int seed = 1; seed <= o.imperfect_cameras; ++seed) {
-          const CommissionedCamera camera = commission_imperfect_camera(arm, static_cast<uint64_t>(seed));
+          const CommissionedCamera camera =
+              commission_imperfect_camera(arm, static_cast<uint64_t>(seed), o.commission_s);
           if (!camera.ok) {
             std::cout << arm.name << " camera " << seed << ": commissioning refused: " << camera.error
                       << "\n";

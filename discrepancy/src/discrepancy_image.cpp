@@ -596,6 +596,8 @@ DiscrepancyOptions discrepancy_options(const DiscrepancySettings& config) {
   p.evidence.static_bias_mm = config.evidence_static_bias_mm;
   if (config.camera_profile) p.camera_profile = config.camera_profile;
   p.evidence.fixed_pattern_sigma_mm = config.evidence_fixed_pattern_sigma_mm;
+  p.evidence.silhouette_band_px = config.evidence_silhouette_band_px;
+  p.evidence.silhouette_bias_mm = config.evidence_silhouette_bias_mm;
   return p;
 }
 

@@ -224,7 +224,8 @@ struct EvidenceSums {
         joint_naming_score(num_joints, 0.0),
         joint_naming_information(num_joints, 0.0),
         joint_bias_abs(num_joints, 0.0),
-        joint_bias_square(num_joints, 0.0) {}
+        joint_bias_square(num_joints, 0.0),
+        joint_near_step_abs(num_joints, 0.0) {}
   void add(const EvidenceSums& o) {
     for (size_t l = 0; l < link_sum_wr.size(); ++l) {
       link_sum_wr[l] += o.link_sum_wr[l];
@@ -240,6 +241,7 @@ struct EvidenceSums {
       joint_naming_information[j] += o.joint_naming_information[j];
       joint_bias_abs[j] += o.joint_bias_abs[j];
       joint_bias_square[j] += o.joint_bias_square[j];
+      joint_near_step_abs[j] += o.joint_near_step_abs[j];
     }
     static_chi2 += o.static_chi2;
     camera_fit_pixels += o.camera_fit_pixels;
@@ -251,6 +253,7 @@ struct EvidenceSums {
       camera_region_information[k] += o.camera_region_information[k];
       camera_region_bias_abs[k] += o.camera_region_bias_abs[k];
       camera_region_bias_square[k] += o.camera_region_bias_square[k];
+      camera_region_near_step_abs[k] += o.camera_region_near_step_abs[k];
     }
     distance_offset_score += o.distance_offset_score;
     distance_offset_information += o.distance_offset_information;
@@ -269,6 +272,9 @@ struct EvidenceSums {
   // static_bias_mm): sum w |J| and sum w^2 J^2 over the fit's pixels.
   std::vector<double> joint_bias_abs;
   std::vector<double> joint_bias_square;
+  // sum w |J| over the pixels on the near side of a step
+  // (EvidenceOptions::silhouette_bias_mm).
+  std::vector<double> joint_near_step_abs;
   double static_chi2 = 0;
   int32_t camera_fit_pixels = 0;
   Eigen::Matrix<double, 6, 1> camera_score = Eigen::Matrix<double, 6, 1>::Zero();
@@ -280,6 +286,7 @@ struct EvidenceSums {
   // (the whole image's: the four regions' together).
   double camera_region_bias_abs[24] = {};
   double camera_region_bias_square[24] = {};
+  double camera_region_near_step_abs[24] = {};
   // The common distance offset over the camera fit's pixels
   // (discrepancy_t.distance_offset_*): J = f, Z per radial mm.
   double distance_offset_score = 0;
@@ -290,14 +297,16 @@ struct EvidenceSums {
 // The static error's reach into the camera fit of pixels n_first ..
 // n_end - 1 (as add_camera_fit's): bias_abs[a] += w |J_a|, bias_square[a]
 // += (w J_a)^2.
-void add_camera_bias_reach(const double* jacobian, const double* weight, int n_first, int n_end,
-                           double* bias_abs, double* bias_square) {
+void add_camera_bias_reach(const double* jacobian, const double* weight, const uint8_t* near_step,
+                           int n_first, int n_end, double* bias_abs, double* bias_square,
+                           double* near_step_abs) {
   for (int n = n_first; n < n_end; ++n) {
     const double* j = jacobian + 6 * n;
     for (int a = 0; a < 6; ++a) {
       const double wj = weight[n] * j[a];
       bias_abs[a] += std::abs(wj);
       bias_square[a] += wj * wj;
+      if (near_step[n]) near_step_abs[a] += std::abs(wj);
     }
   }
 }
@@ -395,6 +404,9 @@ struct EvidenceFrame {
   const depth_image_t& camera;
   const depth_image_t& rendered;
   const std::vector<uint8_t>& silhouette;
+  // The pixels on the near side of a step (near_side_of_steps; empty: no
+  // silhouette allowance).
+  const std::vector<uint8_t>& near_step;
   // The static pixels the naming search explains (when have_explained):
   // the arm's evidence, kept out of the camera fit.
   const std::vector<uint8_t>& explained_static;
@@ -418,7 +430,8 @@ struct RowFit {
   explicit RowFit(int width)
       : jacobian(static_cast<size_t>(6 * (width + 1))),
         weight(static_cast<size_t>(width)),
-        residual(static_cast<size_t>(width)) {}
+        residual(static_cast<size_t>(width)),
+        near_step(static_cast<size_t>(width)) {}
   // Pixels n_first..n_end of the row into image region `region`'s sums.
   void add_to(int n_first, int n_end, int region, EvidenceSums* b) const {
     if (n_first >= n_end) return;
@@ -426,19 +439,21 @@ struct RowFit {
     add_camera_fit(jacobian.data(), weight.data(), residual.data(), n_first, n_end, b->camera_score.data(),
                    b->camera_information.data(), b->camera_region_score + 6 * region,
                    b->camera_region_information + 6 * region);
-    add_camera_bias_reach(jacobian.data(), weight.data(), n_first, n_end,
-                          b->camera_region_bias_abs + 6 * region, b->camera_region_bias_square + 6 * region);
+    add_camera_bias_reach(jacobian.data(), weight.data(), near_step.data(), n_first, n_end,
+                          b->camera_region_bias_abs + 6 * region, b->camera_region_bias_square + 6 * region,
+                          b->camera_region_near_step_abs + 6 * region);
   }
   std::vector<double> jacobian;
   std::vector<double> weight;
   std::vector<double> residual;
+  std::vector<uint8_t> near_step;
   int fit = 0;
   int left = 0;
 };
 
 // A robot pixel's weighted residual into the joints it moves.
-void add_robot_pixel(double w, double r, bool in_naming_fit, const std::vector<double>& joint_row,
-                     EvidenceSums* b) {
+void add_robot_pixel(double w, double r, bool in_naming_fit, bool near_step,
+                     const std::vector<double>& joint_row, EvidenceSums* b) {
   ++b->robot_fit_pixels;
   b->robot_chi2 += w * r * r;
   for (size_t j = 0; j < joint_row.size(); ++j) {
@@ -449,6 +464,7 @@ void add_robot_pixel(double w, double r, bool in_naming_fit, const std::vector<d
     b->joint_information[j] += w * jj * jj;
     b->joint_bias_abs[j] += w * std::abs(jj);
     b->joint_bias_square[j] += w * w * jj * jj;
+    if (near_step) b->joint_near_step_abs[j] += w * std::abs(jj);
     if (!in_naming_fit) continue;
     b->joint_naming_score[j] -= w * jj * r;
     b->joint_naming_information[j] += w * jj * jj;
@@ -457,8 +473,8 @@ void add_robot_pixel(double w, double r, bool in_naming_fit, const std::vector<d
 
 // A static pixel's weighted residual into the static chi2 and, inside the
 // gate, into the row's camera fit (its Jacobian already in the row's slot).
-void add_static_pixel(double w, double r, bool in_naming_fit, bool left_half, double z_per_radial,
-                      RowFit* row, EvidenceSums* b) {
+void add_static_pixel(double w, double r, bool in_naming_fit, bool near_step, bool left_half,
+                      double z_per_radial, RowFit* row, EvidenceSums* b) {
   b->static_chi2 += w * r * r;
   // A static pixel beyond the gate is outside the camera's linear model
   // as the naming fit's are outside the joints': a pose off by the
@@ -477,6 +493,7 @@ void add_static_pixel(double w, double r, bool in_naming_fit, bool left_half, do
   // Into the row's camera fit (added at the row's end, sum_row).
   row->weight[static_cast<size_t>(row->fit)] = w;
   row->residual[static_cast<size_t>(row->fit)] = r;
+  row->near_step[static_cast<size_t>(row->fit)] = near_step ? 1 : 0;
   if (left_half) row->left = row->fit + 1;
   ++row->fit;
 }
@@ -504,10 +521,11 @@ void add_pixel(const EvidenceFrame& f, int u, int v, int i, std::vector<double>*
   const double w = f.inv_pps / var;
   b->link_sum_wr[link] += w * r;
   b->link_sum_w[link] += w;
+  const bool near_step = !f.near_step.empty() && f.near_step[static_cast<size_t>(i)];
   if (moved) {
-    add_robot_pixel(w, r, in_naming_fit, *joint_row, b);
+    add_robot_pixel(w, r, in_naming_fit, near_step, *joint_row, b);
   } else {
-    add_static_pixel(w, r, in_naming_fit, u < f.camera.width / 2,
+    add_static_pixel(w, r, in_naming_fit, near_step, u < f.camera.width / 2,
                      z_per_radial(f.camera.fx, f.camera.fy, f.camera.cx, f.camera.cy, u, v), row, b);
   }
 }
@@ -618,26 +636,30 @@ void store_camera_fit(const EvidenceSums& total, discrepancy_t* s) {
 void shrink_by_static_error(const EvidenceSums& total, const EvidenceOptions& options, discrepancy_t* s) {
   const double b = options.static_bias_mm;
   const double fp = kFixedPatternSigmas * options.fixed_pattern_sigma_mm;
+  const double b_step = options.silhouette_band_px > 0 ? options.silhouette_bias_mm : 0.0;
   s->joint_static_bound.assign(s->joint_score.size(), 0.0);
-  if (!(b > 0) && !(fp > 0)) return;
-  const auto bound = [&](double bias_abs, double bias_square) {
-    return b * bias_abs + fp * std::sqrt(bias_square);
+  if (!(b > 0) && !(fp > 0) && !(b_step > 0)) return;
+  const auto bound = [&](double bias_abs, double bias_square, double near_step_abs) {
+    return b * bias_abs + b_step * near_step_abs + fp * std::sqrt(bias_square);
   };
   for (size_t j = 0; j < s->joint_score.size(); ++j) {
-    s->joint_static_bound[j] = bound(total.joint_bias_abs[j], total.joint_bias_square[j]);
+    s->joint_static_bound[j] =
+        bound(total.joint_bias_abs[j], total.joint_bias_square[j], total.joint_near_step_abs[j]);
     s->joint_score[j] = shrink_score(s->joint_score[j], s->joint_static_bound[j]);
   }
   for (int a = 0; a < 6; ++a) {
-    double image_abs = 0, image_square = 0;
+    double image_abs = 0, image_square = 0, image_near_step = 0;
     for (int r = 0; r < 4; ++r) {
       const int k = 6 * r + a;
       image_abs += total.camera_region_bias_abs[k];
       image_square += total.camera_region_bias_square[k];
+      image_near_step += total.camera_region_near_step_abs[k];
       s->camera_region_static_bound[k] =
-          bound(total.camera_region_bias_abs[k], total.camera_region_bias_square[k]);
+          bound(total.camera_region_bias_abs[k], total.camera_region_bias_square[k],
+                total.camera_region_near_step_abs[k]);
       s->camera_region_score[k] = shrink_score(s->camera_region_score[k], s->camera_region_static_bound[k]);
     }
-    s->camera_static_bound[a] = bound(image_abs, image_square);
+    s->camera_static_bound[a] = bound(image_abs, image_square, image_near_step);
     s->camera_score[a] = shrink_score(s->camera_score[a], s->camera_static_bound[a]);
   }
 }
@@ -655,6 +677,46 @@ void store_link_bias(const EvidenceSums& total, int num_links, discrepancy_t* s)
 }
 
 }  // namespace
+
+std::vector<uint8_t> step_distance_px(const depth_image_t& rendered, int max_px, double silhouette_jump_mm) {
+  const int width = rendered.width;
+  const int height = rendered.height;
+  const size_t pixels = static_cast<size_t>(std::max(width, 0)) * static_cast<size_t>(std::max(height, 0));
+  std::vector<uint8_t> distance(pixels, 0);
+  if (max_px <= 0 || pixels == 0 || rendered.depth_mm.size() != pixels) return distance;
+  max_px = std::min(max_px, 255);
+  const int limit = silhouette_step_limit_mm(silhouette_jump_mm);
+  // farthest: the farthest rendered depth within k pixels (Chebyshev), one
+  // 3x3 maximum per k.
+  std::vector<int> farthest(rendered.depth_mm.begin(), rendered.depth_mm.end());
+  std::vector<int> next(pixels, 0);
+  for (int k = 1; k <= max_px; ++k) {
+    for (int v = 0; v < height; ++v) {
+      for (int u = 0; u < width; ++u) {
+        int m = 0;
+        for (int vj = std::max(0, v - 1); vj <= std::min(height - 1, v + 1); ++vj) {
+          for (int uj = std::max(0, u - 1); uj <= std::min(width - 1, u + 1); ++uj) {
+            m = std::max(m, farthest[static_cast<size_t>(vj * width + uj)]);
+          }
+        }
+        next[static_cast<size_t>(v * width + u)] = m;
+      }
+    }
+    farthest.swap(next);
+    for (size_t i = 0; i < pixels; ++i) {
+      const int gen = rendered.depth_mm[i];
+      if (distance[i] == 0 && gen > 0 && farthest[i] - gen > limit) distance[i] = static_cast<uint8_t>(k);
+    }
+  }
+  return distance;
+}
+
+std::vector<uint8_t> near_side_of_steps(const depth_image_t& rendered, int band_px,
+                                        double silhouette_jump_mm) {
+  std::vector<uint8_t> near = step_distance_px(rendered, band_px, silhouette_jump_mm);
+  for (uint8_t& n : near) n = n > 0 ? 1 : 0;
+  return near;
+}
 
 void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered, const link_labels_t& labels,
                       const std::vector<uint8_t>& silhouette, double silhouette_jump_mm,
@@ -675,9 +737,14 @@ void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered
   search_joint_offsets(camera, rendered, labels, jacobian.kinematics(), noise, options, &s, &explained_static,
                        workers, beside);
   const int stride = evidence_stride(camera.width, camera.height, options.max_pixels);
+  const std::vector<uint8_t> near_step =
+      options.silhouette_bias_mm > 0
+          ? near_side_of_steps(rendered, options.silhouette_band_px, silhouette_jump_mm)
+          : std::vector<uint8_t>();
   const EvidenceFrame frame{camera,
                             rendered,
                             silhouette,
+                            near_step,
                             explained_static,
                             explained_static.size() == static_cast<size_t>(num_pixels),
                             jacobian,

@@ -76,6 +76,21 @@ ClassifiedFrame RiskMonitor::classify(const discrepancy_t& frame) const {
   return c;
 }
 
+namespace {
+
+// The hypothesis of the sequential evidence an open diagnosis names when
+// a sequential test crossed for it (FrameFinding::at_once): its suspect
+// joint for a joint error, the camera for a calibration error; empty for a
+// rule's finding or none open.
+std::string diagnosed_hypothesis(const FrameFinding* diagnosis) {
+  if (diagnosis == nullptr || !diagnosis->at_once) return "";
+  if (diagnosis->cause == risk_t::CAUSE_CALIBRATION_ERROR) return "camera";
+  if (diagnosis->cause == risk_t::CAUSE_JOINT_ERROR) return diagnosis->suspect;
+  return "";
+}
+
+}  // namespace
+
 std::vector<risk_t> RiskMonitor::judge(std::vector<ClassifiedFrame> released, int64_t now_us) {
   std::vector<risk_t> verdicts;
   verdicts.reserve(released.size());
@@ -96,10 +111,12 @@ std::vector<risk_t> RiskMonitor::judge(std::vector<ClassifiedFrame> released, in
       }
     }
     const bool was_open = decision_.diagnosis_open();
-    // Clean for the diagnosis: every CUSUM below its warning level, and
-    // every test that crossed shows evidence that its fault is gone.
+    // Clean for the diagnosis: every CUSUM below its warning level, and the
+    // diagnosis's own hypothesis shows evidence that its fault is gone.
+    const std::string latched = diagnosed_hypothesis(decision_.open_finding());
+    if (!latched.empty()) evidence.summary += "; " + evidence_.clearing_summary(latched);
     verdicts.push_back(decision_.decide(c.frame, std::move(finding), deadlines_.first_expired(now_us),
-                                        evidence_.quiet() && evidence_.cleared(), evidence.summary));
+                                        evidence_.quiet() && evidence_.cleared(latched), evidence.summary));
     // A closed diagnosis starts the tests afresh.
     if (was_open && !decision_.diagnosis_open()) evidence_.reset();
   }

@@ -157,11 +157,8 @@ bool SequentialEvidence::quiet() const {
   return true;
 }
 
-bool SequentialEvidence::cleared() const {
-  for (const std::string& hypothesis : crossed_) {
-    if (clearing_cusum(hypothesis) < h_) return false;
-  }
-  return true;
+bool SequentialEvidence::cleared(const std::string& hypothesis) const {
+  return clearing_cusum_.count(hypothesis) == 0 || clearing_cusum(hypothesis) >= clearing_level();
 }
 
 double SequentialEvidence::clearing_cusum(const std::string& hypothesis) const {
@@ -173,7 +170,6 @@ void SequentialEvidence::reset() {
   camera_cusum_ = 0;
   for (auto& [joint, s] : joint_cusum_) s = 0;
   for (auto& [hypothesis, g] : clearing_cusum_) g = 0;
-  crossed_.clear();
 }
 
 namespace {
@@ -189,11 +185,11 @@ double step(double cusum, double llr, double h) {
 }
 
 // One step of a clearing test, on the stop test's ratio `llr` at the
-// clearing alternative: evidence against the fault adds, capped at h. A
+// clearing alternative: evidence against the fault adds, capped at `level`. A
 // non-finite ratio is no evidence that a fault is gone: back to 0.
-double clearing_step(double clearing, double llr, double h) {
+double clearing_step(double clearing, double llr, double level) {
   if (!std::isfinite(llr)) return 0;
-  return std::min(h, std::max(0.0, clearing - llr));
+  return std::min(level, std::max(0.0, clearing - llr));
 }
 
 }  // namespace
@@ -332,10 +328,8 @@ EvidenceStep SequentialEvidence::update(const discrepancy_t& f) {
   // The largest CUSUM relative to h, for warnings and the summary.
   const NamedCusum largest = largest_cusum();
   result.quiet = quiet();
-  result.cleared = cleared();
   result.summary =
       "evidence: largest CUSUM " + largest.name + " " + fixed(largest.value, 1) + " of h " + fixed(h_, 1);
-  if (!crossed_.empty()) result.summary += "; " + clearing_summary();
   if (!f.evidence_available) return result;
 
   if (camera_cusum_ >= h_) {
@@ -359,12 +353,10 @@ EvidenceStep SequentialEvidence::update(const discrepancy_t& f) {
 void SequentialEvidence::add_frame(const discrepancy_t& f) {
   camera_cusum_ = step(camera_cusum_, camera_region_llr(f, camera_delta_).llr, h_);
   double& camera_clearing = clearing_cusum_["camera"];
-  camera_clearing = clearing_step(camera_clearing,
-                                  camera_region_llr(f, camera_delta_, kClearingAlternativeFraction).llr, h_);
-  if (camera_cusum_ >= h_) {
-    crossed_.insert("camera");
-    camera_clearing = 0;
-  }
+  camera_clearing =
+      clearing_step(camera_clearing, camera_region_llr(f, camera_delta_, kClearingAlternativeFraction).llr,
+                    clearing_level());
+  if (camera_cusum_ >= h_) camera_clearing = 0;
   for (int i = 0; i < f.num_joints; ++i) {
     const auto it = joint_cusum_.find(f.joint_name[i]);
     if (it == joint_cusum_.end()) continue;  // not a moving joint of the robot: not a hypothesis
@@ -374,21 +366,17 @@ void SequentialEvidence::add_frame(const discrepancy_t& f) {
     const double tested = effective_delta(delta, information, bound);
     it->second = step(it->second, joint_llr(f.joint_score[i], information, tested), h_);
     double& clearing = clearing_cusum_[it->first];
-    clearing = clearing_step(
-        clearing, joint_llr(f.joint_score[i], information, kClearingAlternativeFraction * tested), h_);
-    if (it->second >= h_) {
-      crossed_.insert(it->first);
-      clearing = 0;
-    }
+    clearing = clearing_step(clearing,
+                             joint_llr(f.joint_score[i], information, kClearingAlternativeFraction * tested),
+                             clearing_level());
+    if (it->second >= h_) clearing = 0;
   }
 }
 
-std::string SequentialEvidence::clearing_summary() const {
-  std::string line;
-  for (const std::string& hypothesis : crossed_) {
-    line += (line.empty() ? "" : ", ") + hypothesis + " " + fixed(clearing_cusum(hypothesis), 1);
-  }
-  return "evidence the fault is gone (clearing test at delta/2): " + line + " of h " + fixed(h_, 1);
+std::string SequentialEvidence::clearing_summary(const std::string& hypothesis) const {
+  return "evidence " + hypothesis +
+         "'s fault is gone (clearing test at delta/2): " + fixed(clearing_cusum(hypothesis), 1) + " of " +
+         fixed(clearing_level(), 1);
 }
 
 SequentialEvidence::NamedCusum SequentialEvidence::largest_cusum() const {

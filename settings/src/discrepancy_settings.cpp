@@ -50,6 +50,12 @@ DiscrepancySettings read_discrepancy_settings(YamlMap map) {
     d.evidence_naming_gate_sigmas = evidence.number("naming_gate_sigmas", 1, 100);
     d.evidence_static_bias_mm = evidence.number("static_bias_mm", 0, 1000);
     d.evidence_fixed_pattern_sigma_mm = evidence.number("fixed_pattern_sigma_mm", 0, 1000);
+    if (evidence.optional("silhouette_allowance")) {
+      YamlMap allowance = evidence.map("silhouette_allowance");
+      d.evidence_silhouette_band_px = static_cast<int>(allowance.integer("band_px", 1, 64));
+      d.evidence_silhouette_bias_mm = allowance.number("bias_mm", 0, 1000);
+      allowance.finish();
+    }
     if (evidence.optional("max_pixels"))
       d.evidence_max_pixels = static_cast<int>(evidence.integer("max_pixels", 1000, 100000000));
     {

@@ -770,6 +770,37 @@ TEST(SilhouetteStep, TheIntegerLimitGivesTheSameSteps) {
   }
 }
 
+// A rendered step: columns 0..9 at 1000 mm, 10..19 at 2000 mm (a link
+// before a wall), 4 rows; pixel (0, 0) without a surface.
+TEST(StepDistance, CountsPixelsToTheNearestFartherSurface) {
+  depth_image_t rendered{};
+  rendered.width = 20;
+  rendered.height = 4;
+  rendered.depth_mm.assign(80, 1000);
+  for (int v = 0; v < 4; ++v) {
+    for (int u = 10; u < 20; ++u) rendered.depth_mm[static_cast<size_t>(v * 20 + u)] = 2000;
+  }
+  rendered.depth_mm[0] = 0;
+  const std::vector<uint8_t> distance = step_distance_px(rendered, 4, 50);
+  for (int v = 0; v < 4; ++v) {
+    EXPECT_EQ(distance[static_cast<size_t>(v * 20 + 9)], 1);
+    EXPECT_EQ(distance[static_cast<size_t>(v * 20 + 7)], 3);
+    EXPECT_EQ(distance[static_cast<size_t>(v * 20 + 6)], 4);
+    EXPECT_EQ(distance[static_cast<size_t>(v * 20 + 5)], 0) << "beyond max_px";
+    EXPECT_EQ(distance[static_cast<size_t>(v * 20 + 10)], 0) << "the far side is no near side";
+  }
+  EXPECT_EQ(distance[0], 0);
+  // A step within the jump is no step.
+  EXPECT_EQ(step_distance_px(rendered, 4, 1500)[9], 0);
+  const std::vector<uint8_t> band = near_side_of_steps(rendered, 2, 50);
+  EXPECT_EQ(band[9], 1);
+  EXPECT_EQ(band[8], 1);
+  EXPECT_EQ(band[7], 0);
+  EXPECT_EQ(std::count(band.begin(), band.end(), 1), 8);
+  const std::vector<uint8_t> no_band = near_side_of_steps(rendered, 0, 50);
+  EXPECT_EQ(std::count(no_band.begin(), no_band.end(), 1), 0);
+}
+
 TEST_F(EvidenceTest, AStillArmShowsNoJointOffsetFromOneMixedPixel) {
   // The default arm halted where safety_chain_e2e_test's arm once stopped
   // (JOINT_STATE of the run): a pixel of link7 lies beside a scene step of
@@ -860,6 +891,51 @@ TEST_F(EvidenceTest, AStaticErrorWithinItsBoundScoresAsNoise) {
   const double z = fault.camera_score[2] / std::sqrt(fault.camera_information[14]);
   std::cout << "camera 4 cm off with the 13 mm bound: t_z z " << z << "\n";
   EXPECT_GT(std::abs(z), 30.0);
+}
+
+// The silhouette allowance (EvidenceOptions::silhouette_bias_mm) reaches a
+// score only through the pixels on the near side of a step: with the same
+// bias it bounds each joint's score by no more than an allowance of every
+// pixel does (less for a large link that reaches beyond the band), and by
+// more the wider its band.
+TEST_F(EvidenceTest, TheSilhouetteAllowanceBoundsOnlyThePixelsNearSteps) {
+  const JointPositions q = estimator::test::reach_pose();
+  const Intrinsics& in = config_->camera.intrinsics;
+  const depth_image_t seen = make_depth_image("cam", in, 1, 1, true, frames_->capture(q, camera(), in, 93));
+  const Frame model = render_frame(&frames_->renderer(), frames_->scene(), q, camera(), in);
+  auto bounds_with = [&](double static_bias_mm, int band_px, double silhouette_bias_mm) {
+    DiscrepancyOptions options = options_of(*config_);
+    options.evidence.static_bias_mm = static_bias_mm;
+    options.evidence.silhouette_band_px = band_px;
+    options.evidence.silhouette_bias_mm = silhouette_bias_mm;
+    return compute_discrepancy(seen, model.depth, model.labels, options).summary;
+  };
+  const discrepancy_t everywhere = bounds_with(2.0, 0, 0);
+  const discrepancy_t narrow = bounds_with(0, 2, 2.0);
+  const discrepancy_t wide = bounds_with(0, 8, 2.0);
+  const discrepancy_t none = bounds_with(0, 0, 2.0);
+  int joints_seen = 0;
+  int joints_partly_near = 0;
+  for (size_t j = 0; j < everywhere.joint_static_bound.size(); ++j) {
+    if (!(everywhere.joint_information[j] > 0)) continue;
+    ++joints_seen;
+    EXPECT_GT(narrow.joint_static_bound[j], 0) << everywhere.joint_name[j];
+    EXPECT_LT(narrow.joint_static_bound[j], wide.joint_static_bound[j]) << everywhere.joint_name[j];
+    // At 176x144 a link lies mostly within 8 px of its silhouette.
+    EXPECT_LE(wide.joint_static_bound[j], everywhere.joint_static_bound[j] * (1 + 1e-12))
+        << everywhere.joint_name[j];
+    std::cout << everywhere.joint_name[j] << ": the band's share of the bound, 2 px "
+              << narrow.joint_static_bound[j] / everywhere.joint_static_bound[j] << ", 8 px "
+              << wide.joint_static_bound[j] / everywhere.joint_static_bound[j] << "\n";
+    if (narrow.joint_static_bound[j] < 0.9 * everywhere.joint_static_bound[j]) ++joints_partly_near;
+    EXPECT_EQ(none.joint_static_bound[j], 0) << everywhere.joint_name[j];
+  }
+  EXPECT_GE(joints_seen, 5);
+  EXPECT_GE(joints_partly_near, 2) << "links reach beyond a 2 px band";
+  for (int a = 0; a < 6; ++a) {
+    EXPECT_GT(wide.camera_static_bound[a], 0);
+    EXPECT_LT(wide.camera_static_bound[a], everywhere.camera_static_bound[a]);
+  }
 }
 
 }  // namespace

@@ -434,7 +434,8 @@ TEST(EvidenceTests, OnlyEvidenceThatTheFaultIsGoneClearsACrossedTest) {
   // a3 (I = 1e4, delta 3 deg: 5.2 sigma per frame) 6 deg off: crosses at once.
   EvidenceStep step = evidence.update(source.frame(seq++, {{"a3", 6 * kDeg}}));
   ASSERT_TRUE(step.crossed);
-  EXPECT_FALSE(evidence.cleared());
+  EXPECT_FALSE(evidence.cleared("a3"));
+  EXPECT_TRUE(evidence.cleared("no such joint"));
   // Read as 1.2 deg (0.4 delta) for 300 frames: the stop test's drift is
   // delta I (0.4 - 0.5) delta = -2.7 per frame, the clearing test's
   // (delta/2) I (0.4 - 0.25) delta = +2.1 against clearing.
@@ -442,31 +443,31 @@ TEST(EvidenceTests, OnlyEvidenceThatTheFaultIsGoneClearsACrossedTest) {
   for (int k = 0; k < 300; ++k) {
     step = evidence.update(source.frame(seq++, {{"a3", 0.4 * 3 * kDeg}}));
     if (step.quiet) ++quiet_frames;
-    EXPECT_FALSE(step.cleared) << "frame " << k << ": " << step.summary;
-    EXPECT_FALSE(evidence.cleared());
+    EXPECT_FALSE(evidence.cleared("a3")) << "frame " << k << ": " << evidence.clearing_summary("a3");
   }
   EXPECT_GE(quiet_frames, 290) << "the stop test alone would have let the diagnosis close";
   EXPECT_LT(evidence.clearing_cusum("a3"), evidence.warning_level());
-  EXPECT_NE(step.summary.find("evidence the fault is gone (clearing test at delta/2): a3 "),
-            std::string::npos)
-      << step.summary;
+  EXPECT_EQ(
+      evidence.clearing_summary("a3").rfind("evidence a3's fault is gone (clearing test at delta/2): ", 0),
+      0u)
+      << evidence.clearing_summary("a3");
   // The fault gone: the clearing test gains (delta/2)^2 I / 2 = 3.4 per
-  // frame and reaches h (20.6) within about 6 frames.
+  // frame and reaches its level (h = 20.6) within about 6 frames.
   int frames_to_clear = 0;
-  while (!evidence.cleared()) {
-    ASSERT_LT(frames_to_clear, 20) << step.summary;
+  while (!evidence.cleared("a3")) {
+    ASSERT_LT(frames_to_clear, 20) << evidence.clearing_summary("a3");
     step = evidence.update(source.frame(seq++));
     ++frames_to_clear;
   }
   EXPECT_GE(frames_to_clear, 4);
-  EXPECT_TRUE(step.cleared);
+  EXPECT_DOUBLE_EQ(evidence.clearing_level(), evidence.threshold());
   // A new crossing restarts its clearing test.
   step = evidence.update(source.frame(seq++, {{"a3", 6 * kDeg}}));
   ASSERT_TRUE(step.crossed);
   EXPECT_DOUBLE_EQ(evidence.clearing_cusum("a3"), 0);
-  EXPECT_FALSE(evidence.cleared());
+  EXPECT_FALSE(evidence.cleared("a3"));
   evidence.reset();
-  EXPECT_TRUE(evidence.cleared());
+  EXPECT_FALSE(evidence.cleared("a3")) << "a closed diagnosis's tests start afresh, at 0";
 }
 
 // ---- Through RiskMonitor: judged in frame order ----
@@ -594,6 +595,8 @@ TEST(RiskMonitorEvidence, ADiagnosisStaysOpenWhileItsFaultIsReadSmallerThanTheTe
   }
   EXPECT_TRUE(m.evidence().quiet());
   EXPECT_NE(r.detail.find("[clean 0/10 frames]"), std::string::npos) << r.detail;
+  EXPECT_NE(r.detail.find("evidence a3's fault is gone (clearing test at delta/2): "), std::string::npos)
+      << r.detail;
   int frames = 0;
   while (r.level != risk_t::SAFE) {
     ASSERT_LT(frames, 40) << r.detail;

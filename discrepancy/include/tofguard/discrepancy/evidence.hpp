@@ -84,7 +84,28 @@ struct EvidenceOptions {
   // keep their false-stop rate. 0 and 0: an ideal camera, the plain scores.
   double static_bias_mm = 0.0;
   double fixed_pattern_sigma_mm = 0.0;
+  //  - silhouette_bias_mm within silhouette_band_px: a bound on the error
+  //    of the pixels on the near side of a rendered step (within
+  //    silhouette_band_px of a surface farther by more than the silhouette
+  //    jump), beyond static_bias_mm. What a ToF camera's multipath gives a
+  //    surface in front of another (a link before a wall, the gripper
+  //    before the arm): it moves with the arm, so no per-pixel profile
+  //    learns it. Such pixels add silhouette_bias_mm * w |J| to B.
+  //    0 and 0: none.
+  double silhouette_bias_mm = 0.0;
+  int silhouette_band_px = 0;
 };
+
+// The pixels on the near side of a rendered step (row-major, 1 = within
+// `band_px` pixels, Chebyshev, of a rendered surface farther by more than
+// silhouette_step's jump): EvidenceOptions::silhouette_band_px. All 0 for
+// band_px <= 0. A pixel without a rendered surface is no step.
+std::vector<uint8_t> near_side_of_steps(const depth_image_t& rendered, int band_px,
+                                        double silhouette_jump_mm);
+// Per pixel, how far (pixels, Chebyshev, 1..max_px) the nearest rendered
+// surface farther than it by more than silhouette_step's jump is; 0: none
+// within max_px (or no rendered surface). max_px at most 255.
+std::vector<uint8_t> step_distance_px(const depth_image_t& rendered, int max_px, double silhouette_jump_mm);
 
 // How many sigmas of a fixed pattern's score offset the shrinking allows
 // (EvidenceOptions::fixed_pattern_sigma_mm): the offset is one draw per

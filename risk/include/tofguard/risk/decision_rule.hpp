@@ -12,8 +12,8 @@
 // detail are latched, and every verdict after it is DANGEROUS with them
 // until risk.evidence.clear_frames consecutive frames had no finding at all
 // (no rule finding, the evidence quiet: every CUSUM below its warning level
-// and every test that crossed showing that its fault is gone, no expired
-// deadline); the last of them closes it and is SAFE.
+// and the diagnosis's own hypothesis showing that its fault is gone, no
+// expired deadline); the last of them closes it and is SAFE.
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -34,7 +34,7 @@ class DecisionRule {
   // frame order: every call counts one frame for the debounce and the
   // diagnosis, also while `expired_input` (the first expired deadline)
   // overrides the verdict. `evidence_quiet`: every CUSUM below its warning
-  // level and every crossed test cleared (SequentialEvidence::cleared);
+  // level and the diagnosis's hypothesis cleared (SequentialEvidence::cleared);
   // `evidence_summary`: one line on them for an open diagnosis.
   risk_t decide(const discrepancy_t& frame, FrameFinding finding,
                 const std::optional<FrameFinding>& expired_input, bool evidence_quiet = true,
@@ -44,6 +44,8 @@ class DecisionRule {
   int consecutive_findings() const { return consecutive_; }
   // A diagnosis is open (a DANGEROUS verdict not yet cleared).
   bool diagnosis_open() const { return open_.has_value(); }
+  // The open diagnosis's finding as latched at the stop (nullptr: none open).
+  const FrameFinding* open_finding() const { return open_ ? &open_->finding : nullptr; }
   // Consecutive clean frames since the last finding while a diagnosis is open.
   int clean_frames() const { return clean_frames_; }
 

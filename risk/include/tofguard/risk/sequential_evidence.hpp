@@ -127,9 +127,6 @@ struct EvidenceStep {
   FrameFinding finding;
   // Every CUSUM below warning_fraction * h after this frame.
   bool quiet = true;
-  // Every test that crossed since the last reset has its clearing test at
-  // h (cleared()).
-  bool cleared = true;
   // One line with the frame's evidence: the largest CUSUM and h.
   std::string summary;
 };
@@ -145,25 +142,31 @@ class SequentialEvidence {
   // The next frame in frame order. A frame without evidence changes
   // nothing (updated false; quiet tells the CUSUMs' state).
   EvidenceStep update(const discrepancy_t& frame);
-  // Every CUSUM back to 0, no test crossed (a closed diagnosis).
+  // Every CUSUM and clearing test back to 0 (a closed diagnosis).
   void reset();
 
   double threshold() const { return h_; }
   double warning_level() const { return warning_fraction_ * h_; }
+  // The level a clearing test must reach: h, as a stop test's
+  // (docs/safety-chain.md, "How long a diagnosis stays open").
+  double clearing_level() const { return h_; }
   int hypotheses() const { return static_cast<int>(joint_cusum_.size()) + 1; }
   double camera_cusum() const { return camera_cusum_; }
   // 0 for a joint that is not a moving joint of the robot.
   double joint_cusum(const std::string& joint) const;
   // Every CUSUM below warning_level().
   bool quiet() const;
-  // Every hypothesis whose test crossed since the last reset shows evidence
-  // that its fault is gone: its clearing test, a CUSUM on the negated
-  // log-likelihood ratio at kClearingAlternativeFraction of the stop
-  // test's (effective) delta, restarted at each crossing, is at h.
-  bool cleared() const;
+  // Hypothesis `hypothesis` ("camera" or a joint) shows evidence that its
+  // fault is gone: its clearing test, a CUSUM on the negated log-likelihood
+  // ratio at kClearingAlternativeFraction of the stop test's (effective)
+  // delta, restarted at each crossing of its stop test, is at
+  // clearing_level(). True for a name that is not a hypothesis.
+  bool cleared(const std::string& hypothesis) const;
   // The clearing test of a hypothesis ("camera" or a joint): 0 for one that
   // is not a hypothesis.
   double clearing_cusum(const std::string& hypothesis) const;
+  // One line on hypothesis's clearing test.
+  std::string clearing_summary(const std::string& hypothesis) const;
 
  private:
   // A hypothesis's name ("camera" or a joint's) and its CUSUM.
@@ -172,11 +175,8 @@ class SequentialEvidence {
     double value;
   };
 
-  // A frame's log-likelihood ratios into the CUSUMs and the clearing
-  // tests; a test that crossed joins crossed_.
+  // A frame's log-likelihood ratios into the CUSUMs and the clearing tests.
   void add_frame(const discrepancy_t& frame);
-  // One line on the clearing tests of the crossed hypotheses.
-  std::string clearing_summary() const;
   // The largest CUSUM (the camera's among equals).
   NamedCusum largest_cusum() const;
   // The joint test that crossed with the largest CUSUM (name empty: none).
@@ -213,8 +213,6 @@ class SequentialEvidence {
   std::map<std::string, double> joint_cusum_;  // every moving joint of the robot
   // The clearing tests: "camera" and every moving joint.
   std::map<std::string, double> clearing_cusum_;
-  // The hypotheses whose test crossed since the last reset.
-  std::set<std::string> crossed_;
 };
 
 }  // namespace tofguard::risk

@@ -73,6 +73,12 @@ struct DiscrepancySettings {
   // derivation: docs/safety-chain.md, "Static error: the composite null").
   double evidence_static_bias_mm = 0;
   double evidence_fixed_pattern_sigma_mm = 0;
+  // evidence.silhouette_allowance (optional; absent: none, band 0): the
+  // error of the pixels on the near side of a rendered step, within
+  // band_px of it, beyond static_bias_mm (a camera's multipath in front of
+  // a farther surface: it moves with the arm, no profile learns it), mm.
+  int evidence_silhouette_band_px = 0;
+  double evidence_silhouette_bias_mm = 0;
   // camera_profile (optional; absent: none): the camera's commissioned
   // profile file (tofguard-tune --profile-out; docs/camera.md,
   // "Commissioning a camera"), read with the config: every frame is

@@ -99,7 +99,25 @@ struct StaticError {
   // n), kept >= 0.
   double fixed_pattern_sigma_mm = 0;
   int64_t pattern_pixels = 0;
+  // The near side of rendered steps (evidence.silhouette_allowance): on
+  // each of the arm's links, its pixels used as the noise fit's and within
+  // the naming gate, the mean of I_dis less the smooth part per ring of
+  // distance 1..kStepRingsPx pixels from the nearest rendered surface
+  // farther by more than the silhouette jump (a camera's multipath there
+  // moves with the arm). A link's ring with at least kMinStepRingSamples
+  // samples whose |mean| + 2 standard errors exceeds the smooth allowance
+  // joins the band (band_px: the farthest such ring); bias_mm: the largest
+  // such bound less the smooth allowance (silhouette_link: whose). Per
+  // ring: the largest |mean| of a link and its samples.
+  std::vector<double> step_ring_mean_mm;
+  std::vector<int64_t> step_ring_samples;
+  int silhouette_band_px = 0;
+  double silhouette_bias_mm = 0;
+  std::string silhouette_link;
 };
+
+constexpr int kStepRingsPx = 12;
+constexpr int64_t kMinStepRingSamples = 200;
 
 // The sequential tests over the recording with one noise model.
 struct EvidenceRun {
@@ -109,6 +127,8 @@ struct EvidenceRun {
   // The static-error allowance the scores were shrunk by (mm).
   double static_bias_mm = 0;
   double fixed_pattern_sigma_mm = 0;
+  int silhouette_band_px = 0;
+  double silhouette_bias_mm = 0;
   std::vector<ParameterScores> parameters;
   double max_cusum = 0;
   std::string max_cusum_hypothesis;
@@ -147,6 +167,12 @@ struct TuneResult {
   bool pixels_per_sample_changed = false;
   double pixels_per_sample = 1;  // what the tuned config gets
   StaticError static_error;
+  // The allowance from static_error (static_bias_mm, rounded up), and why it
+  // was raised to tuned.static_bias_mm (empty: it was not): a test reached
+  // its warning level on this nominal recording, so the static error on
+  // the arm's own pixels exceeds it (recording_tuner.cpp, "Pass 3b").
+  double measured_static_bias_mm = 0;
+  std::string allowance_raised;
   // The profile learned (has_profile: options.learn_profile), and which
   // profile the frames were corrected with (empty: none).
   bool has_profile = false;
