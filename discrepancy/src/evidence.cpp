@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
@@ -678,6 +679,25 @@ void store_link_bias(const EvidenceSums& total, int num_links, discrepancy_t* s)
 
 }  // namespace
 
+namespace {
+
+// out[i] = the largest of in[i - 1], in[i], in[i + 1] along a line of `n`
+// values `stride` apart (the ends take the two they have).
+void max_of_three(const int* in, int* out, int n, int stride) {
+  if (n == 1) {
+    out[0] = in[0];
+    return;
+  }
+  out[0] = std::max(in[0], in[stride]);
+  for (int k = 1; k + 1 < n; ++k) {
+    const int* c = in + k * stride;
+    out[k * stride] = std::max(std::max(c[-stride], c[0]), c[stride]);
+  }
+  out[(n - 1) * stride] = std::max(in[(n - 2) * stride], in[(n - 1) * stride]);
+}
+
+}  // namespace
+
 std::vector<uint8_t> step_distance_px(const depth_image_t& rendered, int max_px, double silhouette_jump_mm) {
   const int width = rendered.width;
   const int height = rendered.height;
@@ -687,25 +707,28 @@ std::vector<uint8_t> step_distance_px(const depth_image_t& rendered, int max_px,
   max_px = std::min(max_px, 255);
   const int limit = silhouette_step_limit_mm(silhouette_jump_mm);
   // farthest: the farthest rendered depth within k pixels (Chebyshev), one
-  // 3x3 maximum per k.
+  // 3x3 maximum per k, by rows then by columns.
   std::vector<int> farthest(rendered.depth_mm.begin(), rendered.depth_mm.end());
-  std::vector<int> next(pixels, 0);
-  for (int k = 1; k <= max_px; ++k) {
-    for (int v = 0; v < height; ++v) {
-      for (int u = 0; u < width; ++u) {
-        int m = 0;
-        for (int vj = std::max(0, v - 1); vj <= std::min(height - 1, v + 1); ++vj) {
-          for (int uj = std::max(0, u - 1); uj <= std::min(width - 1, u + 1); ++uj) {
-            m = std::max(m, farthest[static_cast<size_t>(vj * width + uj)]);
-          }
-        }
-        next[static_cast<size_t>(v * width + u)] = m;
-      }
-    }
-    farthest.swap(next);
+  std::vector<int> by_rows(pixels, 0);
+  // reach[i]: the depth a surface within k must exceed to be a step.
+  std::vector<int> reach(pixels, 0);
+  size_t open = 0;  // pixels with a surface and no step found yet
+  for (size_t i = 0; i < pixels; ++i) {
+    const int gen = rendered.depth_mm[i];
+    reach[i] = gen > 0 ? gen + limit : std::numeric_limits<int>::max();
+    if (gen > 0) ++open;
+  }
+  for (int k = 1; k <= max_px && open > 0; ++k) {
+    for (int v = 0; v < height; ++v)
+      max_of_three(&farthest[static_cast<size_t>(v) * width], &by_rows[static_cast<size_t>(v) * width], width,
+                   1);
+    for (int u = 0; u < width; ++u)
+      max_of_three(&by_rows[static_cast<size_t>(u)], &farthest[static_cast<size_t>(u)], height, width);
     for (size_t i = 0; i < pixels; ++i) {
-      const int gen = rendered.depth_mm[i];
-      if (distance[i] == 0 && gen > 0 && farthest[i] - gen > limit) distance[i] = static_cast<uint8_t>(k);
+      if (distance[i] == 0 && farthest[i] > reach[i]) {
+        distance[i] = static_cast<uint8_t>(k);
+        --open;
+      }
     }
   }
   return distance;
