@@ -142,6 +142,7 @@ SequentialEvidence::SequentialEvidence(const RiskSettings& risk, const robot_mod
     clearing_cusum_[joint] = 0;
   }
   h_ = cusum_threshold(hypotheses(), camera_rate_hz, risk.evidence_false_stop_period_h);
+  memory_decay_ = h_ / (camera_rate_hz * kEvidenceMemoryS);
 }
 
 double SequentialEvidence::joint_cusum(const std::string& joint) const {
@@ -351,7 +352,7 @@ EvidenceStep SequentialEvidence::update(const discrepancy_t& f) {
 }
 
 void SequentialEvidence::add_frame(const discrepancy_t& f) {
-  camera_cusum_ = step(camera_cusum_, camera_region_llr(f, camera_delta_).llr, h_);
+  camera_cusum_ = step(camera_cusum_, camera_region_llr(f, camera_delta_).llr - memory_decay_, h_);
   double& camera_clearing = clearing_cusum_["camera"];
   camera_clearing =
       clearing_step(camera_clearing, camera_region_llr(f, camera_delta_, kClearingAlternativeFraction).llr,
@@ -364,7 +365,7 @@ void SequentialEvidence::add_frame(const discrepancy_t& f) {
     const double bound = static_cast<size_t>(i) < f.joint_static_bound.size() ? f.joint_static_bound[i] : 0.0;
     const double information = f.joint_information[i];
     const double tested = effective_delta(delta, information, bound);
-    it->second = step(it->second, joint_llr(f.joint_score[i], information, tested), h_);
+    it->second = step(it->second, joint_llr(f.joint_score[i], information, tested) - memory_decay_, h_);
     double& clearing = clearing_cusum_[it->first];
     clearing = clearing_step(clearing,
                              joint_llr(f.joint_score[i], information, kClearingAlternativeFraction * tested),

@@ -423,6 +423,40 @@ TEST(EvidenceTests, GrowingEvidenceWarnsBeforeItCrosses) {
   EXPECT_DOUBLE_EQ(evidence.joint_cusum("a5"), 0);
 }
 
+// A hardly informed test (a7: I = 1 / rad^2, delta^2 I = 0.003 per frame)
+// raised by one outlying frame keeps it without the memory decay: the
+// mixture's drift without a fault is -(delta^2 I)^2 / 4 = -2e-6 per frame,
+// 20 000 hours from the warning level back to 0. With it the CUSUM falls by
+// h / (rate * kEvidenceMemoryS) = 0.011 per frame: below the warning level
+// within about 400 frames, and to 0 within the memory's 1800 frames.
+TEST(EvidenceTests, AHardlyInformedTestForgetsWithinItsMemory) {
+  SequentialEvidence evidence(sim_config().risk, friend_arm(), kRateHz);
+  EXPECT_NEAR(evidence.memory_decay(), evidence.threshold() / (kRateHz * risk::kEvidenceMemoryS), 1e-12);
+  ScoreSource source(8);
+  discrepancy_t outlier = source.frame(1);
+  // 300 sigma in one frame: LLR = log cosh(0.0524 * 300) - ... = 15.0.
+  outlier.joint_score[joint_index("a7")] = 300;
+  evidence.update(outlier);
+  const double raised = evidence.joint_cusum("a7");
+  ASSERT_GT(raised, evidence.warning_level());
+  ASSERT_LT(raised, evidence.threshold());
+  const double expected_frames = (raised - evidence.warning_level()) / evidence.memory_decay();
+  int frames = 0;
+  while (!evidence.quiet()) {
+    ASSERT_LT(frames, 1.05 * expected_frames) << "a7 at " << evidence.joint_cusum("a7");
+    evidence.update(source.frame(2 + frames));
+    ++frames;
+  }
+  EXPECT_GE(frames, 0.95 * expected_frames);
+  while (evidence.joint_cusum("a7") > 0) {
+    ASSERT_LT(frames, kRateHz * risk::kEvidenceMemoryS) << "a7 at " << evidence.joint_cusum("a7");
+    evidence.update(source.frame(2 + frames));
+    ++frames;
+  }
+  std::cout << "a7 raised to " << raised << " of h " << evidence.threshold() << ": below the warning level "
+            << expected_frames << " frames later (derived), at 0 after " << frames << " frames\n";
+}
+
 // A fault that the fit reads smaller than half the test's delta (a large
 // offset outside the fit's linear range, as the arm moves) turns the stop
 // test against it, so its CUSUM falls below the warning level; the

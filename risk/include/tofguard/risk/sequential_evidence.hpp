@@ -99,6 +99,19 @@ CameraRegionRatio camera_region_llr(const discrepancy_t& frame, const std::array
 // it; the clearing test's turns against it only below delta/4.
 constexpr double kClearingAlternativeFraction = 0.5;
 
+// How long a stop test remembers, in seconds of frames: every test's
+// per-frame ratio is lowered by h / (camera rate * kEvidenceMemoryS) nats
+// (SequentialEvidence::memory_decay), so a CUSUM at h with nothing behind
+// it falls to 0 within this time. Without it a hypothesis that frames
+// hardly inform (a joint seen over a few pixels, or one whose fault cannot
+// show beyond the static allowance: effective delta 0) keeps what earlier
+// frames gave it: the mixture's drift under no fault is -(delta^2 I)^2 / 4
+// per frame, so a CUSUM at the warning level stays there for hours and no
+// reset is accepted. The price: a fault whose test would need more than
+// this long to cross is not found by it, and one that needs t seconds needs
+// t / (1 - t / kEvidenceMemoryS) (docs/safety-chain.md, "A bounded memory").
+constexpr double kEvidenceMemoryS = 60.0;
+
 // The CUSUM threshold for `hypotheses` tests on frames at `rate_hz` and at
 // most one false stop per `false_stop_period_h` hours:
 // h = ln(hypotheses * rate_hz * 3600 * false_stop_period_h).
@@ -151,6 +164,9 @@ class SequentialEvidence {
   // (docs/safety-chain.md, "How long a diagnosis stays open").
   double clearing_level() const { return h_; }
   int hypotheses() const { return static_cast<int>(joint_cusum_.size()) + 1; }
+  // What every stop test's per-frame ratio is lowered by, nats:
+  // h / (camera rate * kEvidenceMemoryS).
+  double memory_decay() const { return memory_decay_; }
   double camera_cusum() const { return camera_cusum_; }
   // 0 for a joint that is not a moving joint of the robot.
   double joint_cusum(const std::string& joint) const;
@@ -209,6 +225,7 @@ class SequentialEvidence {
   std::array<double, 6> camera_delta_;
   double warning_fraction_;
   double h_;
+  double memory_decay_;
   double camera_cusum_ = 0;
   std::map<std::string, double> joint_cusum_;  // every moving joint of the robot
   // The clearing tests: "camera" and every moving joint.
