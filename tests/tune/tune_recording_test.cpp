@@ -7,7 +7,6 @@
 
 #include <filesystem>
 #include <iostream>
-#include <map>
 #include <regex>
 #include <string>
 #include <vector>
@@ -99,34 +98,6 @@ TEST_F(TuneRecording, LearnsNoProfileFromARecordingWithSomethingInView) {
   expect_refused(run, "not nominal");
   EXPECT_FALSE(std::filesystem::exists(profile));
   EXPECT_NE(run.out.find("camera profile learned"), std::string::npos) << run.out;
-}
-
-// The silhouette allowance (evidence.silhouette_allowance) measured on
-// the arm's pixels near its rendered steps: "allowance beyond the smooth
-// one X mm within N px" of the report, as {mm, px}.
-std::pair<double, int> silhouette_allowance(const std::string& report) {
-  std::smatch m;
-  const std::regex line("allowance beyond the smooth one ([0-9.]+) mm within ([0-9]+) px");
-  if (!std::regex_search(report, m, line)) return {-1, -1};
-  return {std::stod(m[1]), std::stoi(m[2])};
-}
-
-// A camera without multipath or any static error (the unseen one: only
-// its noise, 8 mm + 2 mm/m^2 d^2, and the mixed pixels of its silhouettes):
-// no ring near the arm's rendered steps is significantly beyond the smooth
-// allowance, so there is no silhouette allowance. The rings' means scatter
-// by their standard errors (0.6 mm for a ring of 200 samples here): with
-// |mean| + 2 SE > b as the rule (b 0.6 mm on this recording) noise alone
-// made it 2.2 mm within 12 px.
-TEST_F(TuneRecording, MeasuresNoSilhouetteAllowanceFromNoise) {
-  NominalLogOptions options;
-  options.seconds = 8;
-  const ToolRun run = run_tune(config_path_, log("silhouette-noise", options));
-  ASSERT_EQ(run.code, 0) << run.err;
-  const std::pair<double, int> allowance = silhouette_allowance(run.out);
-  std::cout << "silhouette allowance: " << allowance.first << " mm within " << allowance.second << " px\n";
-  EXPECT_EQ(allowance.second, 0) << run.out;
-  EXPECT_DOUBLE_EQ(allowance.first, 0) << run.out;
 }
 
 // Commissioning a camera whose pose is off, on a camera with the static
