@@ -412,15 +412,8 @@ void measure_near_step_error(const std::vector<RenderedPair>& frames, const Tune
         error->step_ring_mean_mm[k] = mean;
         error->step_ring_samples[k] = static_cast<int64_t>(n);
       }
-      // A ring joins the band when its excess beyond the smooth allowance
-      // is significant (|mean| - 2 SE > it): with |mean| + 2 SE, on an
-      // ideal camera's noise (SE 0.3-0.4 mm at 200 samples) a ring
-      // whose error is 0 joined whenever its mean came within 0.7 mm of the
-      // allowance, and the band reached 12 px. What it allows for is the
-      // conservative |mean| + 2 SE.
-      const double standard_error = std::sqrt(variance / n);
-      if (std::abs(mean) - 2 * standard_error <= smooth_allowance_mm) continue;
-      const double bound = std::abs(mean) + 2 * standard_error;
+      const double bound = std::abs(mean) + 2 * std::sqrt(variance / n);
+      if (bound <= smooth_allowance_mm) continue;
       error->silhouette_band_px = std::max(error->silhouette_band_px, k + 1);
       if (bound > largest_mm) {
         largest_mm = bound;

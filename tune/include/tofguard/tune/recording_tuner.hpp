@@ -105,10 +105,9 @@ struct StaticError {
   // distance 1..kStepRingsPx pixels from the nearest rendered surface
   // farther by more than the silhouette jump (a camera's multipath there
   // moves with the arm). A link's ring with at least kMinStepRingSamples
-  // samples whose |mean| less 2 standard errors exceeds the smooth
-  // allowance (significantly beyond it) joins the band (band_px: the
-  // farthest such ring); bias_mm: the largest |mean| + 2 standard errors of
-  // those rings less the smooth allowance (silhouette_link: whose). Per
+  // samples whose |mean| + 2 standard errors exceeds the smooth allowance
+  // joins the band (band_px: the farthest such ring); bias_mm: the largest
+  // such bound less the smooth allowance (silhouette_link: whose). Per
   // ring: the largest |mean| of a link and its samples.
   std::vector<double> step_ring_mean_mm;
   std::vector<int64_t> step_ring_samples;
