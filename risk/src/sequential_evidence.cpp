@@ -236,23 +236,6 @@ DistanceDrift distance_drift(const discrepancy_t& f, double threshold_chi2) {
   return d;
 }
 
-double camera_chi2_beyond_joints(const discrepancy_t& f) {
-  using Matrix6 = Eigen::Matrix<double, 6, 6, Eigen::RowMajor>;
-  const Eigen::Map<const Matrix6> information(f.camera_information);
-  const Eigen::Map<const Eigen::Matrix<double, 6, 1>> score(f.camera_score);
-  const Eigen::LDLT<Matrix6> ldlt(information);
-  if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return 0;
-  const double camera = score.dot(ldlt.solve(score));
-  if (!std::isfinite(camera)) return 0;
-  double joints = 0;
-  for (int i = 0; i < f.num_joints; ++i) {
-    joints = std::max(joints, naming_chi2(f, i));
-    if (f.joint_information[i] > 0)
-      joints = std::max(joints, f.joint_score[i] * f.joint_score[i] / f.joint_information[i]);
-  }
-  return camera - joints;
-}
-
 FrameFinding SequentialEvidence::drift_finding(const DistanceDrift& d) const {
   FrameFinding finding;
   finding.cause = risk_t::CAUSE_SENSOR_FAULT;
@@ -359,19 +342,6 @@ EvidenceStep SequentialEvidence::update(const discrepancy_t& f) {
   if (!crossed.name.empty()) {
     result.crossed = true;
     result.finding = joint_stop_finding(f, crossed);
-    const double beyond = camera_chi2_beyond_joints(f);
-    if (camera_cusum_ >= warning_level() && beyond > 2 * h_) {
-      // A moved camera moves the arm in the image too, and a joint that
-      // the frames hardly inform (the gripper's a7) can cross a frame
-      // before the camera's test, which asks three regions to agree. When
-      // the camera's test is itself at its warning level and its pose
-      // explains this frame by 2h more than any joint (a chi-square
-      // difference is twice a log-likelihood ratio), the camera it is.
-      result.finding = camera_finding(f);
-      result.finding.detail += " (the test that crossed: " + crossed.name + "'s, " + fixed(crossed.value, 1) +
-                               " of h " + fixed(h_, 1) + "; the camera's pose explains chi^2 " +
-                               fixed(beyond, 0) + " more of this frame than any joint)";
-    }
     return result;
   }
   if (largest.value >= warning_level()) {

@@ -126,14 +126,6 @@ bool searched(const discrepancy_t& frame);
 // naming fit's s^2 / I (0 without information).
 double naming_chi2(const discrepancy_t& frame, int index);
 
-// How much more of frame's residual the camera's pose explains than any
-// joint, chi^2: s^T I^-1 s on the camera's (shrunk) scores and whole
-// information matrix, less the largest of every joint's naming_chi2 and
-// (shrunk) s^2 / I. 0 when the camera's information is singular. A joint's
-// crossing on a frame where the camera's test is at its warning level and
-// this exceeds 2h is called a calibration error.
-double camera_chi2_beyond_joints(const discrepancy_t& frame);
-
 // What one frame's evidence says.
 struct EvidenceStep {
   // The frame carried evidence (discrepancy_t.evidence_available) and the
