@@ -6,6 +6,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
+#include <opencv2/imgproc.hpp>
 
 #include "double2.hpp"
 #include "tofguard/common/camera_profile.hpp"
@@ -679,25 +680,6 @@ void store_link_bias(const EvidenceSums& total, int num_links, discrepancy_t* s)
 
 }  // namespace
 
-namespace {
-
-// out[i] = the largest of in[i - 1], in[i], in[i + 1] along a line of `n`
-// values `stride` apart (the ends take the two they have).
-void max_of_three(const int* in, int* out, int n, int stride) {
-  if (n == 1) {
-    out[0] = in[0];
-    return;
-  }
-  out[0] = std::max(in[0], in[stride]);
-  for (int k = 1; k + 1 < n; ++k) {
-    const int* c = in + k * stride;
-    out[k * stride] = std::max(std::max(c[-stride], c[0]), c[stride]);
-  }
-  out[(n - 1) * stride] = std::max(in[(n - 2) * stride], in[(n - 1) * stride]);
-}
-
-}  // namespace
-
 std::vector<uint8_t> step_distance_px(const depth_image_t& rendered, int max_px, double silhouette_jump_mm) {
   const int width = rendered.width;
   const int height = rendered.height;
@@ -707,25 +689,25 @@ std::vector<uint8_t> step_distance_px(const depth_image_t& rendered, int max_px,
   max_px = std::min(max_px, 255);
   const int limit = silhouette_step_limit_mm(silhouette_jump_mm);
   // farthest: the farthest rendered depth within k pixels (Chebyshev), one
-  // 3x3 maximum per k, by rows then by columns.
-  std::vector<int> farthest(rendered.depth_mm.begin(), rendered.depth_mm.end());
-  std::vector<int> by_rows(pixels, 0);
-  // reach[i]: the depth a surface within k must exceed to be a step.
-  std::vector<int> reach(pixels, 0);
+  // 3x3 dilation per k (pixels outside the image take no part). In float:
+  // depths in mm up to 65535 and reach below 2^24 are exact.
+  cv::Mat1f farthest(height, width);
+  // reach: the depth a surface within k must exceed to be a step.
+  cv::Mat1f reach(height, width);
+  float* far = farthest.ptr<float>(0);
+  float* beyond = reach.ptr<float>(0);
   size_t open = 0;  // pixels with a surface and no step found yet
   for (size_t i = 0; i < pixels; ++i) {
     const int gen = rendered.depth_mm[i];
-    reach[i] = gen > 0 ? gen + limit : std::numeric_limits<int>::max();
+    far[i] = static_cast<float>(gen);
+    beyond[i] = gen > 0 ? static_cast<float>(gen + limit) : std::numeric_limits<float>::infinity();
     if (gen > 0) ++open;
   }
+  const cv::Mat square = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3));
   for (int k = 1; k <= max_px && open > 0; ++k) {
-    for (int v = 0; v < height; ++v)
-      max_of_three(&farthest[static_cast<size_t>(v) * width], &by_rows[static_cast<size_t>(v) * width], width,
-                   1);
-    for (int u = 0; u < width; ++u)
-      max_of_three(&by_rows[static_cast<size_t>(u)], &farthest[static_cast<size_t>(u)], height, width);
+    cv::dilate(farthest, farthest, square);
     for (size_t i = 0; i < pixels; ++i) {
-      if (distance[i] == 0 && farthest[i] > reach[i]) {
+      if (distance[i] == 0 && far[i] > beyond[i]) {
         distance[i] = static_cast<uint8_t>(k);
         --open;
       }
