@@ -1,20 +1,20 @@
 // A thread of the test process that asks to wake every kPeriodUs on the
-// monotonic clock and records each wake-up later than kLateUs: a witness of
-// the machine itself stalling (a virtual machine's CPUs descheduled by its
-// host, or every process starved at once), which the chain's processes,
-// at the same priority, suffer alike. A stop of the chain within
-// kWindowUs after such a stall is the deadline rules doing their job on a
-// stalled machine (fail safe), not a false stop of the judgement.
+// monotonic clock (monotonic_us, the clock of LiveChain's arrival times) and records each wake-up later than
+// kLateUs: a witness of the machine itself stalling (a virtual machine's CPUs descheduled by its host, or
+// every process starved at once), which the chain's processes, at the same priority, suffer alike. A stop of
+// the chain within kWindowUs after such a stall is the deadline rules doing their job on a stalled machine
+// (fail safe), not a false stop of the judgement.
 #pragma once
-
-#include <time.h>
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <mutex>
 #include <thread>
 #include <vector>
+
+#include "tofguard/common/clock.hpp"
 
 namespace tofguard::test {
 
@@ -60,18 +60,12 @@ class StallWitness {
   }
 
  private:
-  static int64_t now_us() {
-    timespec t{};
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return static_cast<int64_t>(t.tv_sec) * 1'000'000 + t.tv_nsec / 1000;
-  }
   void run() {
-    int64_t wanted_us = now_us() + kPeriodUs;
+    int64_t wanted_us = monotonic_us() + kPeriodUs;
     while (!stop_) {
-      timespec until{static_cast<time_t>(wanted_us / 1'000'000),
-                     static_cast<long>(wanted_us % 1'000'000) * 1000};
-      clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &until, nullptr);
-      const int64_t woke_us = now_us();
+      std::this_thread::sleep_until(
+          std::chrono::steady_clock::time_point(std::chrono::microseconds(wanted_us)));
+      const int64_t woke_us = monotonic_us();
       if (woke_us - wanted_us > kLateUs) {
         std::lock_guard<std::mutex> lock(mutex_);
         stalls_.push_back({woke_us, woke_us - wanted_us});
