@@ -1048,30 +1048,34 @@ std::string write_bench_config(const CampaignArm& arm, const Intrinsics& intrins
   environment += "]";
   const CameraPose& pose = c.camera.pose;
   const Eigen::Quaterniond q = pose.rotation;
-  return sim_config_variant(
-      name,
-      {{"urdf: models/friend_arm.urdf", robot},
-       {"urdfs: [models/wheelchair_environment.urdf]", environment},
-       {"rate_hz: 30\n  intrinsics: {width: 176, height: 144, fx: 221.0, fy: 220.5, cx: 87.3, cy: 71.8}",
-        "rate_hz: " + number_text(c.camera.rate_hz) + "\n  intrinsics: {width: " +
-            std::to_string(intrinsics.width) + ", height: " + std::to_string(intrinsics.height) +
-            ", fx: " + number_text(intrinsics.fx) + ", fy: " + number_text(intrinsics.fy) +
-            ", cx: " + number_text(intrinsics.cx) + ", cy: " + number_text(intrinsics.cy) + "}"},
-       {"frame: world\n    translation_m: [-0.90, -0.20, 1.80]\n    rotation_wxyz: [0.302934347, "
-        "-0.581931466, "
-        "0.669435574, -0.348486102]",
-        "frame: " + pose.frame_id + "\n    translation_m: [" + number_text(pose.translation_m.x()) + ", " +
-            number_text(pose.translation_m.y()) + ", " + number_text(pose.translation_m.z()) +
-            "]\n    rotation_wxyz: [" + number_text(q.w()) + ", " + number_text(q.x()) + ", " +
-            number_text(q.y()) + ", " + number_text(q.z()) + "]"},
-       // The bench stands in for tofguard-camera (it publishes the frames,
-       // not a heartbeat), and no tofguard-estimator runs: the observer
-       // chain alone, judged by its rules.
-       {"required_heartbeats: [tofguard-camera, tofguard-renderer, tofguard-discrepancy]",
-        "required_heartbeats: [tofguard-renderer, tofguard-discrepancy]"},
-       {"estimate:\n    enabled: true", "estimate:\n    enabled: false"},
-       {"from_joint_states: true",
-        joint_prediction ? "from_joint_states: true" : "from_joint_states: false"}});
+  // The bench's frames are the campaign arm's ideal camera's, at sizes no
+  // profile was commissioned for: the ideal camera's lines, no profile (a
+  // profile costs one pass over the frame's pixels).
+  std::vector<std::pair<std::string, std::string>> replacements = ideal_camera_replacements();
+  const std::vector<std::pair<std::string, std::string>> bench = {
+      {"urdf: models/friend_arm.urdf", robot},
+      {"urdfs: [models/wheelchair_environment.urdf]", environment},
+      {"rate_hz: 30\n  intrinsics: {width: 176, height: 144, fx: 221.0, fy: 220.5, cx: 87.3, cy: 71.8}",
+       "rate_hz: " + number_text(c.camera.rate_hz) + "\n  intrinsics: {width: " +
+           std::to_string(intrinsics.width) + ", height: " + std::to_string(intrinsics.height) +
+           ", fx: " + number_text(intrinsics.fx) + ", fy: " + number_text(intrinsics.fy) +
+           ", cx: " + number_text(intrinsics.cx) + ", cy: " + number_text(intrinsics.cy) + "}"},
+      {"frame: world\n    translation_m: [-0.90, -0.20, 1.80]\n    rotation_wxyz: [0.302934347, "
+       "-0.581931466, "
+       "0.669435574, -0.348486102]",
+       "frame: " + pose.frame_id + "\n    translation_m: [" + number_text(pose.translation_m.x()) + ", " +
+           number_text(pose.translation_m.y()) + ", " + number_text(pose.translation_m.z()) +
+           "]\n    rotation_wxyz: [" + number_text(q.w()) + ", " + number_text(q.x()) + ", " +
+           number_text(q.y()) + ", " + number_text(q.z()) + "]"},
+      // The bench stands in for tofguard-camera (it publishes the frames,
+      // not a heartbeat), and no tofguard-estimator runs: the observer
+      // chain alone, judged by its rules.
+      {"required_heartbeats: [tofguard-camera, tofguard-renderer, tofguard-discrepancy]",
+       "required_heartbeats: [tofguard-renderer, tofguard-discrepancy]"},
+      {"estimate:\n    enabled: true", "estimate:\n    enabled: false"},
+      {"from_joint_states: true", joint_prediction ? "from_joint_states: true" : "from_joint_states: false"}};
+  replacements.insert(replacements.end(), bench.begin(), bench.end());
+  return sim_config_variant(name, replacements);
 }
 
 BenchReport run_bench(const BenchOptions& options, std::ostream& log) {

@@ -29,6 +29,7 @@
 #include "tofguard/robot_model/arm_spheres.hpp"
 #include "tofguard/robot_model/kinematic_tree.hpp"
 #include "tofguard/robot_model/kinematics.hpp"
+#include "tool_support.hpp"
 
 namespace tofguard::test {
 namespace {
@@ -71,7 +72,7 @@ Eigen::Isometry3d look_at(const Eigen::Vector3d& eye, const Eigen::Vector3d& tar
 }
 
 deployment::Config embedded_config() {
-  return deployment::load_config(std::string(TOFGUARD_SOURCE_DIR) + "/config/sim.yaml", nullptr);
+  return deployment::load_config(ideal_camera_config("judge-campaign"), nullptr);
 }
 
 // The campaign judges frames only: no deadlines to feed, no estimate, no

@@ -125,6 +125,12 @@ std::string sim_config_variant(const std::string& name,
     if (p > 0 && text[p - 1] == '/') continue;
     text.replace(p, 7, models);
   }
+  // The embedded default's camera profile, by absolute path.
+  const std::string profile_key = "\n  camera_profile: ";
+  if (const auto at = text.find(profile_key);
+      at != std::string::npos && text[at + profile_key.size()] != '/') {
+    text.insert(at + profile_key.size(), source_dir() + "/config/");
+  }
   // The embedded default's key (made by scripts/build), by absolute path.
   const std::string key_line = "key_file: auth.key";
   if (const auto at = text.find(key_line); at != std::string::npos) {
@@ -148,6 +154,41 @@ std::string sim_config_variant(const std::string& name,
   const std::string path = output_dir() + "/" + name + ".yaml";
   write_file(path, text);
   return path;
+}
+
+namespace {
+
+// The whole line of `text` that starts with `prefix` (after a newline),
+// with its newline; the mapping's continuation lines too when it opens a
+// `{` that the line does not close. Throws when there is none or more.
+std::string config_line(const std::string& text, const std::string& prefix) {
+  const auto at = text.find("\n" + prefix);
+  if (at == std::string::npos || text.find("\n" + prefix, at + 1) != std::string::npos) {
+    throw std::runtime_error("sim.yaml no longer contains exactly one line starting with: " + prefix);
+  }
+  size_t end = text.find('\n', at + 1);
+  if (text.substr(at, end - at).find('{') != std::string::npos) end = text.find("}\n", at) + 1;
+  return text.substr(at + 1, end - at);
+}
+
+}  // namespace
+
+std::vector<std::pair<std::string, std::string>> ideal_camera_replacements() {
+  const std::string text = read_file(source_dir() + "/config/sim.yaml");
+  return {{config_line(text, "    residual: {"), ""},
+          {config_line(text, "  camera_profile: "), ""},
+          {config_line(text, "  noise: {sigma_at_0m_mm: "),
+           "  noise: {sigma_at_0m_mm: 4.0, sigma_per_m2_mm: 1.2}\n"},
+          {config_line(text, "    static_bias_mm: "), "    static_bias_mm: 0\n"},
+          {config_line(text, "    fixed_pattern_sigma_mm: "), "    fixed_pattern_sigma_mm: 0\n"},
+          {config_line(text, "    silhouette_allowance: "), ""}};
+}
+
+std::string ideal_camera_config(const std::string& name,
+                                const std::vector<std::pair<std::string, std::string>>& replacements) {
+  std::vector<std::pair<std::string, std::string>> all = ideal_camera_replacements();
+  all.insert(all.end(), replacements.begin(), replacements.end());
+  return sim_config_variant(name + "-" + std::to_string(::getpid()), all);
 }
 
 std::string read_file(const std::string& path) {

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace tofguard::test {
@@ -58,11 +59,24 @@ int run_command(const std::string& name, const std::vector<std::string>& argv,
 
 // config/sim.yaml copied to output_dir()/<name>.yaml with `replacements`
 // (each `from` must occur) applied and `appended` added at the end; the
-// model paths are made absolute so the copy works from anywhere. Returns
+// model, key and camera profile paths are made absolute so the copy works from anywhere. Returns
 // the copy's path.
 std::string sim_config_variant(const std::string& name,
                                const std::vector<std::pair<std::string, std::string>>& replacements = {},
                                const std::string& appended = "");
+
+// config/sim.yaml with its simulated camera ideal after its distance
+// calibration, for the tests and tools that make their own frames or judge
+// an ideal camera beside imperfect ones: no camera.sim.residual, no
+// discrepancy.camera_profile, the ideal camera's noise as tofguard-tune
+// fitted it (4.0 + 1.2 d^2 mm) and no static allowance. The lines are
+// found by their keys, so a re-commissioned profile's values need no change
+// here; a key that is gone throws. `replacements` as sim_config_variant's,
+// applied after these; written as output_dir()/<name>-<pid>.yaml (tests
+// run in parallel).
+std::vector<std::pair<std::string, std::string>> ideal_camera_replacements();
+std::string ideal_camera_config(const std::string& name = "ideal-camera",
+                                const std::vector<std::pair<std::string, std::string>>& replacements = {});
 
 std::string read_file(const std::string& path);
 void write_file(const std::string& path, const std::string& text);

@@ -39,8 +39,9 @@ SimCameraFaultSettings read_sim_fault(YamlMap map) {
   return f;
 }
 
-// camera.sim.residual: every key required (a partial truth of the
-// simulated camera is more likely a typo than a wish).
+// camera.sim.residual: every key of the error required (a partial truth of
+// the simulated camera is more likely a typo than a wish); only the camera's
+// time on before the process started is optional.
 SimResidualSettings read_sim_residual(YamlMap map) {
   SimResidualSettings r;
   r.wiggle_amplitude_mm = map.number("wiggle_amplitude_mm", 0, 100);
@@ -53,6 +54,7 @@ SimResidualSettings read_sim_residual(YamlMap map) {
   r.multipath_max_mm = map.number("multipath_max_mm", 0, 200);
   r.warmup_drift_mm = map.number("warmup_drift_mm", -100, 100);
   r.warmup_time_constant_s = map.number("warmup_time_constant_s", 1, 86400);
+  if (map.optional("on_before_start_s")) r.on_before_start_s = map.number("on_before_start_s", 0, 1e7);
   map.finish();
   return r;
 }

@@ -121,7 +121,8 @@ class JointsSimWiring {
   void step() {
     const int64_t now_us = monotonic_us();
     const bool allowed =
-        status_allows_ && status_arrival_us_ >= 0 && now_us - status_arrival_us_ <= sim_.status_deadline_us;
+        settings_.moves_without_permission ||
+        (status_allows_ && status_arrival_us_ >= 0 && now_us - status_arrival_us_ <= sim_.status_deadline_us);
     arm_.step((now_us - last_step_us_) * 1e-6, allowed);
     last_step_us_ = now_us;
     const int64_t utime = wall_utime();
@@ -139,7 +140,10 @@ class JointsSimWiring {
     node_.safety().publish(settings_.channels.joint_state, &reported);
     node_.safety().publish(settings_.channels.sim_true_joint_state, &truth);
     node_.counters().frames_out++;
-    node_.heartbeat().set_status(allowed ? "moving" : "halted: no permission to move");
+    node_.heartbeat().set_status(settings_.moves_without_permission
+                                     ? "moving without a permission (commissioning)"
+                                 : allowed ? "moving"
+                                           : "halted: no permission to move");
   }
 
   const JointsSimProcessSettings& settings_;
@@ -166,6 +170,8 @@ ProcessInfo joints_sim_info() {
           "SIM_TRUE_JOINT_STATE (the truth) at joints_sim.rate_hz, following the periodic\n"
           "motion of the config, and its plan on PLANNED_TRAJECTORY (joints_sim.plan);\n"
           "halts while SAFETY_STATUS withdraws permission or is stale.\n"
+          "--commissioning: moves without a permission (a commissioning recording,\n"
+          "docs/camera.md); never with a safety chain in charge.\n"
           "Encoder faults: joints_sim.faults in the config, or sim_joint_fault_t on SIM_JOINT_FAULT."};
 }
 

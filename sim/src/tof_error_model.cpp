@@ -193,7 +193,8 @@ double TofErrorModel::amplitude_bias_m(double amplitude) const {
 
 double TofErrorModel::warmup_drift_m(double time_since_start_s) const {
   const SimResidualSettings& c = config_.residual;
-  return c.warmup_drift_mm * (1 - std::exp(-time_since_start_s / c.warmup_time_constant_s)) * 1e-3;
+  const double on_s = c.on_before_start_s + time_since_start_s;
+  return c.warmup_drift_mm * (1 - std::exp(-on_s / c.warmup_time_constant_s)) * 1e-3;
 }
 
 double TofErrorModel::pixel_offset_m(int u, int v) const {

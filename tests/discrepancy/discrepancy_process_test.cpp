@@ -18,7 +18,7 @@ class DiscrepancyProcess : public ::testing::Test {
   void SetUp() override {
     process_ = std::make_unique<Subprocess>(
         "discrepancy-process", std::vector<std::string>{bin_dir() + "/tofguard-discrepancy", "--config",
-                                                        chain_config("discrepancy")});
+                                                        ideal_camera_config("discrepancy")});
     // Up when its heartbeat comes.
     ASSERT_TRUE(wait_until([&] { return !bus_.last_heartbeat("tofguard-discrepancy").process.empty(); },
                            kDeadline, [&] { bus_.poll(); }))

@@ -2,8 +2,8 @@
 # scripts/record-scenario end to end: records a short encoder-offset scenario
 # (the script enters its own private network namespace and runs the whole
 # simulated group), checks what the log holds and that the recording's chain
-# stopped the arm with the expected cause; the replay config variant; a bad
-# scenario name. TOFGUARD_BIN names the build's bin folder.
+# stopped the arm with the expected cause; a commissioning recording; the
+# replay config variant; a bad scenario name. TOFGUARD_BIN names the build's bin folder.
 set -euo pipefail
 root="$1"
 work=$(mktemp -d)
@@ -40,6 +40,18 @@ grep -q '^  pair_timeout_ms: 300$' "$work/replay.yaml" || fail "discrepancy pair
 grep -q 'deadlines_ms: {depth: 450, discrepancy: 500,' "$work/replay.yaml" || fail "risk deadlines"
 grep -q '^  risk_deadline_ms: 500$' "$work/replay.yaml" || fail "intervention risk deadline"
 grep -q '^  required_heartbeats: \[tofguard-renderer, tofguard-discrepancy\]' "$work/replay.yaml" || fail "heartbeats"
+
+# A commissioning recording: no safety chain (tofguard-joints-sim
+# --commissioning moves without one: joints_sim_process_test), so nothing
+# of a chain is in the log; 1 s at 10 Hz, about 10 frames. The replay variant names the config's camera
+# profile by its absolute path.
+"$root/scripts/record-scenario" commissioning --seconds 1 --after-s 0.5 --out "$work/c.lcmlog" > "$work/c.txt" 2>&1 ||
+  fail "commissioning exited $?: $(cat "$work/c.txt")"
+size=$(stat -c %s "$work/c.lcmlog")
+(( size > 700000 && size < 1600000 )) || fail "commissioning log of $size bytes, expected about 10 frames' worth"
+grep -aq TOF_DEPTH "$work/c.lcmlog" && grep -aq JOINT_STATE "$work/c.lcmlog" || fail "commissioning log without frames or joints"
+! grep -aq SAFETY_STATUS "$work/c.lcmlog" || fail "the commissioning log holds a permission"
+grep -q "^  camera_profile: $root/config/sim-camera-profile.yaml$" "$work/replay.yaml" || fail "replay camera_profile path"
 
 code=0
 "$root/scripts/record-scenario" melted-camera > "$work/bad.txt" 2>&1 || code=$?

@@ -34,7 +34,7 @@ constexpr int64_t kMs = 1000;
 // waits 0 ms; these tests are about the wait).
 const deployment::Config& sim_config() {
   static const deployment::Config config = [] {
-    deployment::Config c = deployment::load_config(source_dir() + "/config/sim.yaml", nullptr);
+    deployment::Config c = deployment::load_config(ideal_camera_config(), nullptr);
     c.risk.estimate_wait_us = 60000;
     return c;
   }();

@@ -64,8 +64,7 @@ using risk::FrameFinding;
 using risk::RiskMonitor;
 
 const deployment::Config& sim_config() {
-  static const deployment::Config config =
-      deployment::load_config(source_dir() + "/config/sim.yaml", nullptr);
+  static const deployment::Config config = deployment::load_config(ideal_camera_config(), nullptr);
   return config;
 }
 

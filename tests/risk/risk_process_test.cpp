@@ -26,7 +26,7 @@ constexpr int kFramePeriodMs = 33;
 
 discrepancy_t summary(int64_t seq, int shift_px) {
   const SyntheticImage model = draw(default_arm());
-  const deployment::Config config = deployment::load_config(source_dir() + "/config/sim.yaml", nullptr);
+  const deployment::Config config = deployment::load_config(ideal_camera_config(), nullptr);
   return discrepancy::compute_discrepancy(
              depth_frame(with_noise(draw(default_arm(shift_px)).depth_mm, seq), seq),
              depth_frame(model.depth_mm, seq), labels_frame(model.label, seq),

@@ -18,7 +18,8 @@ const auto kDeadline = std::chrono::seconds(10);
 class SafetyChain : public ::testing::Test {
  protected:
   void SetUp() override {
-    const std::string config = chain_config("chain");
+    // Its frames are made here, an ideal camera's of other intrinsics.
+    const std::string config = ideal_camera_config("chain");
     discrepancy_ = std::make_unique<Subprocess>(
         "chain-discrepancy",
         std::vector<std::string>{bin_dir() + "/tofguard-discrepancy", "--config", config});

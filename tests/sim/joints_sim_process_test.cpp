@@ -1,6 +1,7 @@
 // tofguard-joints-sim as a real process over real LCM (private network
 // namespace): halted without permission, moving with it, halted again when
-// the permission goes stale; run-time encoder faults.
+// the permission goes stale, moving without one only when commissioning;
+// run-time encoder faults.
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
@@ -139,6 +140,26 @@ TEST(JointsSimProcess, PublishesThePlanItFollows) {
     }
   }
   EXPECT_GT(compared, 50);
+}
+
+// --commissioning: the arm moves with no SAFETY_STATUS at all (a camera's
+// commissioning recording), and says so in its heartbeat; any other
+// argument is a usage error.
+TEST(JointsSimProcess, MovesWithoutPermissionOnlyWhenCommissioning) {
+  Subprocess sim("joints-sim-commissioning", {bin_dir() + "/tofguard-joints-sim", "--config",
+                                              source_dir() + "/config/sim.yaml", "--commissioning"});
+  Listener l;
+  ASSERT_TRUE(wait_until([&] { return l.max_speed() > 0.05; }, std::chrono::seconds(5), [&] { l.pump(); }))
+      << "no motion without a permission: " << sim.stderr_text();
+  EXPECT_EQ(l.last_status_us, 0) << "the test published a status";
+
+  std::string out, err;
+  EXPECT_EQ(run_command("joints-sim-bad-argument",
+                        {bin_dir() + "/tofguard-joints-sim", "--config", source_dir() + "/config/sim.yaml",
+                         "--commision"},
+                        &out, &err),
+            2);
+  EXPECT_NE(err.find("unknown argument '--commision' (expected --commissioning)"), std::string::npos) << err;
 }
 
 }  // namespace

@@ -217,6 +217,13 @@ TEST(TofResidual, WarmupDriftFollowsItsTimeConstant) {
   EXPECT_NEAR(central_error_mm(model.apply(scene, 2, 1200.0), scene), 6 * (1 - std::exp(-4.0)),
               1e-3);  // 5.89
   EXPECT_NEAR(model.warmup_drift_m(1200.0), 5.890e-3, 1e-6);
+
+  // On for 900 s before the process started: its first frame has drifted
+  // as the cold camera's does at 900 s, and 300 s on as at 1200 s.
+  config.residual.on_before_start_s = 900;
+  const TofErrorModel warm(config, test_intrinsics());
+  EXPECT_NEAR(central_error_mm(warm.apply(scene, 0, 0.0), scene), 6 * (1 - std::exp(-3.0)), 1e-3);  // 5.70
+  EXPECT_NEAR(warm.warmup_drift_m(300.0), 5.890e-3, 1e-6);
 }
 
 SimCameraSettings read(const std::string& residual) {
@@ -266,6 +273,16 @@ TEST(TofResidual, SettingsReadEveryKeyAndRefuseMissingOrOutOfRange) {
   EXPECT_EQ(r.multipath_max_mm, 15);
   EXPECT_EQ(r.warmup_drift_mm, 5);
   EXPECT_EQ(r.warmup_time_constant_s, 240);
+  EXPECT_EQ(r.on_before_start_s, 0) << "optional: switched on with the process";
+  EXPECT_EQ(
+      read(replaced("warmup_time_constant_s: 240", "warmup_time_constant_s: 240, on_before_start_s: 1200"))
+          .residual.on_before_start_s,
+      1200);
+  const std::string negative =
+      error_of(replaced("warmup_time_constant_s: 240", "warmup_time_constant_s: 240, on_before_start_s: -1"));
+  EXPECT_NE(negative.find("camera.sim.residual.on_before_start_s: expected a number in [0, 1e+07]"),
+            std::string::npos)
+      << negative;
 
   const std::string missing = error_of(replaced(", warmup_time_constant_s: 240", ""));
   EXPECT_NE(missing.find(

@@ -16,8 +16,9 @@ namespace tofguard::estimator::test {
 inline double deg(double degrees) { return degrees * M_PI / 180.0; }
 inline double to_deg(double radians) { return radians * 180.0 / M_PI; }
 
+// config/sim.yaml with its camera ideal: the estimator tests make their own frames.
 inline deployment::Config sim_config() {
-  return deployment::load_config(tofguard::test::source_dir() + "/config/sim.yaml", nullptr);
+  return deployment::load_config(tofguard::test::ideal_camera_config(), nullptr);
 }
 
 inline Eigen::Isometry3d pose_of(const CameraPose& pose) { return pose.frame_from_optical(); }

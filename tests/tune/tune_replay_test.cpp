@@ -126,7 +126,8 @@ void tune_and_replay(const std::string& name, std::string config_path, TunedRepl
 
   // The replay config at the camera's rate (config/sim.yaml's as
   // docs/replay.md makes it: the camera's own settings do not matter, no
-  // camera runs) with the tuned lines in place of the default's. (--config
+  // camera runs) with the tuned lines in place of the default's commissioned
+  // ones and no camera profile but the test's own. (--config
   // with this test's variant would not do: record-scenario rewrites
   // "models/" inside its absolute paths.)
   const std::string replay_config = output_dir() + "/" + name + "-replay.yaml";
@@ -138,15 +139,19 @@ void tune_and_replay(const std::string& name, std::string config_path, TunedRepl
       0)
       << out << err;
   std::string text = read_file(replay_config);
-  const auto replace_line = [&](const std::string& from, const std::string& to) {
-    const size_t at = text.find(from);
-    ASSERT_NE(at, std::string::npos) << replay_config << ": no " << from;
-    text.replace(at, from.size(), to);
+  // The line starting with `key` (config/sim.yaml's commissioned values,
+  // whatever they are) replaced by `to` ("": removed).
+  const auto replace_line = [&](const std::string& key, const std::string& to) {
+    const size_t at = text.find("\n" + key);
+    ASSERT_NE(at, std::string::npos) << replay_config << ": no line starting with " << key;
+    text.replace(at + 1, text.find('\n', at + 1) - at, to);
   };
-  replace_line("  noise: {sigma_at_0m_mm: 4.0, sigma_per_m2_mm: 1.2}\n", r->noise[0].str().substr(1));
-  replace_line("    static_bias_mm: 0\n", "    static_bias_mm: " + std::to_string(r->static_bias_mm) + "\n");
-  replace_line("    fixed_pattern_sigma_mm: 0\n",
+  replace_line("  noise: {sigma_at_0m_mm: ", r->noise[0].str().substr(1));
+  replace_line("    static_bias_mm: ", "    static_bias_mm: " + std::to_string(r->static_bias_mm) + "\n");
+  replace_line("    fixed_pattern_sigma_mm: ",
                "    fixed_pattern_sigma_mm: " + std::to_string(r->fixed_pattern_sigma_mm) + "\n");
+  replace_line("    silhouette_allowance: ", "");
+  replace_line("  camera_profile: ", "");
   if (!profile.empty()) text = with_camera_profile(text, profile);
   write_file(replay_config, text);
   r->replay_config = replay_config;

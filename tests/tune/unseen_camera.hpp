@@ -1,11 +1,13 @@
 #pragma once
-// The camera tofguard-tune's tests tune: config/sim.yaml's simulated camera
-// with noise the default config has never seen, sigma(r) = 8 mm + 2.0 mm/m^2
+// The camera tofguard-tune's tests tune: config/sim.yaml's simulated camera,
+// ideal (ideal_camera_config) but with noise the default config has never seen, sigma(r) = 8 mm + 2.0 mm/m^2
 // r^2 along the ray (the default's: 4.75 + 1.01 r^2), at 25 Hz (30).
-// discrepancy.noise stays the default's (4 + 1.2 d^2): what tofguard-tune
+// discrepancy.noise stays the ideal camera's (4 + 1.2 d^2): what tofguard-tune
 // replaces.
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "tofguard/settings/sim_settings.hpp"
 
@@ -19,9 +21,11 @@ inline constexpr double kUnseenRateHz = 25;
 
 // The config's path (output_dir()/<name>.yaml).
 inline std::string unseen_camera_config(const std::string& name) {
-  return sim_config_variant(name, {{"noise: {sigma0_mm: 4.75, sigma_per_m2_mm: 1.01}",
-                                    "noise: {sigma0_mm: 8.0, sigma_per_m2_mm: 2.0}"},
-                                   {"  rate_hz: 30\n", "  rate_hz: 25\n"}});
+  std::vector<std::pair<std::string, std::string>> replacements = ideal_camera_replacements();
+  replacements.push_back(
+      {"noise: {sigma0_mm: 4.75, sigma_per_m2_mm: 1.01}", "noise: {sigma0_mm: 8.0, sigma_per_m2_mm: 2.0}"});
+  replacements.push_back({"  rate_hz: 30\n", "  rate_hz: 25\n"});
+  return sim_config_variant(name, replacements);
 }
 
 // unseen_camera_config's camera with the static errors `residual` (the
@@ -41,10 +45,12 @@ inline std::string imperfect_camera_config(const std::string& name,
       << ", multipath_max_mm: " << residual.multipath_max_mm
       << ", warmup_drift_mm: " << residual.warmup_drift_mm
       << ", warmup_time_constant_s: " << residual.warmup_time_constant_s << "}\n";
-  return sim_config_variant(name, {{"noise: {sigma0_mm: 4.75, sigma_per_m2_mm: 1.01}",
-                                    "noise: {sigma0_mm: 8.0, sigma_per_m2_mm: 2.0}"},
-                                   {"  rate_hz: 30\n", "  rate_hz: 25\n"},
-                                   {"    faults: []\n", map.str() + "    faults: []\n"}});
+  std::vector<std::pair<std::string, std::string>> replacements = ideal_camera_replacements();
+  replacements.push_back(
+      {"noise: {sigma0_mm: 4.75, sigma_per_m2_mm: 1.01}", "noise: {sigma0_mm: 8.0, sigma_per_m2_mm: 2.0}"});
+  replacements.push_back({"  rate_hz: 30\n", "  rate_hz: 25\n"});
+  replacements.push_back({"    faults: []\n", map.str() + "    faults: []\n"});
+  return sim_config_variant(name, replacements);
 }
 
 }  // namespace tofguard::test

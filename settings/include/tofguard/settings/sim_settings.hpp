@@ -79,6 +79,12 @@ struct JointsSimProcessSettings {
   // from the verified SAFETY_STATUS_AUTH.
   auth::AuthSettings auth;
   JointsSimSettings joints_sim;
+  // tofguard-joints-sim --commissioning: the arm moves without a permission
+  // to move, as a real arm moves under its own controller (and a person's
+  // eyes) while a camera is commissioned and tofguard does not yet judge
+  // its frames (docs/camera.md, "Commissioning a camera"). Never in a
+  // deployment: the simulator's alone.
+  bool moves_without_permission = false;
 };
 
 // ---- The simulated ToF camera (camera.sim) ----
@@ -141,10 +147,15 @@ struct SimResidualSettings {
   // (TofErrorModel explains the approximation).
   double multipath_max_mm = 0;
   // warmup_{drift_mm, time_constant_s}: common-mode drift while the camera
-  // warms up, t seconds since it started:
+  // warms up, t seconds since it was switched on:
   //   warmup_drift_mm * (1 - exp(-t / warmup_time_constant_s)) mm.
+  // on_before_start_s (optional; absent: 0, switched on with the process):
+  // how long the camera had been on when tofguard-camera started, t then
+  // counts from there; a camera warmed up before it is commissioned and
+  // used (docs/camera.md) has drifted most of the way.
   double warmup_drift_mm = 0;
   double warmup_time_constant_s = 1;
+  double on_before_start_s = 0;
 };
 
 // The simulated ToF camera's error model (camera.sim, required when
