@@ -59,8 +59,8 @@ int run_command(const std::string& name, const std::vector<std::string>& argv,
 
 // config/sim.yaml copied to output_dir()/<name>.yaml with `replacements`
 // (each `from` must occur) applied and `appended` added at the end; the
-// model, key and camera profile paths are made absolute so the copy works from anywhere. Returns
-// the copy's path.
+// model, key and camera profile paths are made absolute so the copy works
+// from anywhere. Returns the copy's path.
 std::string sim_config_variant(const std::string& name,
                                const std::vector<std::pair<std::string, std::string>>& replacements = {},
                                const std::string& appended = "");

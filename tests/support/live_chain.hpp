@@ -10,12 +10,14 @@
 
 #include <chrono>
 #include <functional>
+#include <iostream>
 #include <map>
 #include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "recovery_deadline.hpp"
 #include "tofguard/common/clock.hpp"
 #include "tofguard/common/risk_names.hpp"
 #include "tofguard/deployment/config.hpp"
@@ -86,9 +88,12 @@ class LiveChain {
   // until accepted and motion is allowed.
   void bring_to_motion(const std::string& why) {
     safe_streak_ = 0;
-    ASSERT_TRUE(wait([&] { return safe_streak_ >= 15; }, std::chrono::seconds(30)))
+    const int64_t waiting_since_us = monotonic_us();
+    ASSERT_TRUE(wait([&] { return safe_streak_ >= 15; }, kRecoveryDeadline))
         << "never SAFE: last risk " << describe_last_risk() << "\n"
         << stderr_of_all();
+    std::cout << "15 SAFE verdicts in a row " << (monotonic_us() - waiting_since_us) / 1000
+              << " ms after the wait began (" << why << ")" << std::endl;
     std::string out;
     int code = -1;
     for (int attempt = 0; attempt < 5 && code != 0; ++attempt) {

@@ -15,10 +15,12 @@
 #include <cmath>
 #include <cstdlib>
 #include <deque>
+#include <iostream>
 #include <map>
 #include <memory>
 #include <thread>
 
+#include "recovery_deadline.hpp"
 #include "tofguard/authenticated_message_t.hpp"
 #include "tofguard/camera_pose_t.hpp"
 #include "tofguard/common/clock.hpp"
@@ -164,9 +166,12 @@ class Chain {
   // Waits for `frames` SAFE verdicts in a row, then resets until accepted.
   void bring_to_motion(const std::string& why) {
     safe_streak_ = 0;
-    ASSERT_TRUE(wait([&] { return safe_streak_ >= 15; }, std::chrono::seconds(30)))
+    const int64_t waiting_since_us = monotonic_us();
+    ASSERT_TRUE(wait([&] { return safe_streak_ >= 15; }, kRecoveryDeadline))
         << "never SAFE: last risk " << describe_last_risk() << "\n"
         << stderr_of_all();
+    std::cout << "15 SAFE verdicts in a row " << (monotonic_us() - waiting_since_us) / 1000
+              << " ms after the wait began (" << why << ")" << std::endl;
     std::string out;
     int code = -1;
     for (int attempt = 0; attempt < 5 && code != 0; ++attempt) {

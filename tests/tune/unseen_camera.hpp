@@ -1,9 +1,9 @@
 #pragma once
-// The camera tofguard-tune's tests tune: config/sim.yaml's simulated camera,
-// ideal (ideal_camera_config) but with noise the default config has never seen, sigma(r) = 8 mm + 2.0 mm/m^2
-// r^2 along the ray (the default's: 4.75 + 1.01 r^2), at 25 Hz (30).
-// discrepancy.noise stays the ideal camera's (4 + 1.2 d^2): what tofguard-tune
-// replaces.
+// The camera tofguard-tune's tests tune: config/sim.yaml's simulated camera
+// made ideal (ideal_camera_replacements), with noise the default config has
+// never seen, sigma(r) = 8 mm + 2.0 mm/m^2 r^2 along the ray (the
+// default's: 4.75 + 1.01 r^2), at 25 Hz (30). discrepancy.noise stays the
+// ideal camera's (4 + 1.2 d^2): what tofguard-tune replaces.
 #include <sstream>
 #include <string>
 #include <utility>
