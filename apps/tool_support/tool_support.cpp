@@ -156,22 +156,15 @@ std::string sim_config_variant(const std::string& name,
   return path;
 }
 
-namespace {
-
-// The whole line of `text` that starts with `prefix` (after a newline),
-// with its newline; the mapping's continuation lines too when it opens a
-// `{` that the line does not close. Throws when there is none or more.
 std::string config_line(const std::string& text, const std::string& prefix) {
   const auto at = text.find("\n" + prefix);
   if (at == std::string::npos || text.find("\n" + prefix, at + 1) != std::string::npos) {
-    throw std::runtime_error("sim.yaml no longer contains exactly one line starting with: " + prefix);
+    throw std::runtime_error("the config no longer contains exactly one line starting with: " + prefix);
   }
   size_t end = text.find('\n', at + 1);
   if (text.substr(at, end - at).find('{') != std::string::npos) end = text.find("}\n", at) + 1;
   return text.substr(at + 1, end - at);
 }
-
-}  // namespace
 
 std::vector<std::pair<std::string, std::string>> ideal_camera_replacements() {
   const std::string text = read_file(source_dir() + "/config/sim.yaml");

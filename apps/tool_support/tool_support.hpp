@@ -65,6 +65,12 @@ std::string sim_config_variant(const std::string& name,
                                const std::vector<std::pair<std::string, std::string>>& replacements = {},
                                const std::string& appended = "");
 
+// The whole line of a config's `text` that starts with `prefix` (after a
+// newline), with its newline; the mapping's continuation lines too when it
+// opens a `{` that the line does not close. Throws unless there is exactly
+// one.
+std::string config_line(const std::string& text, const std::string& prefix);
+
 // config/sim.yaml with its simulated camera ideal after its distance
 // calibration, for the tests and tools that make their own frames or judge
 // an ideal camera beside imperfect ones: no camera.sim.residual, no

@@ -142,9 +142,8 @@ void tune_and_replay(const std::string& name, std::string config_path, TunedRepl
   // The line starting with `key` (config/sim.yaml's commissioned values,
   // whatever they are) replaced by `to` ("": removed).
   const auto replace_line = [&](const std::string& key, const std::string& to) {
-    const size_t at = text.find("\n" + key);
-    ASSERT_NE(at, std::string::npos) << replay_config << ": no line starting with " << key;
-    text.replace(at + 1, text.find('\n', at + 1) - at, to);
+    const std::string line = config_line(text, key);
+    text.replace(text.find("\n" + line) + 1, line.size(), to);
   };
   replace_line("  noise: {sigma_at_0m_mm: ", r->noise[0].str().substr(1));
   replace_line("    static_bias_mm: ", "    static_bias_mm: " + std::to_string(r->static_bias_mm) + "\n");
