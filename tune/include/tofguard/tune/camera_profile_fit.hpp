@@ -8,9 +8,11 @@
 //    binned by the camera's own distance a bin at the edge of the scene's
 //    range would hold the pixels whose noise carried them there), the
 //    median of the radial residual I_dis / f (f = Z / r of the pixel's ray)
-//    over the pixels `noise_pixels` uses; bins with too few samples are
-//    interpolated from their neighbours; the correction c(r) is that median
-//    (added to the measured distance, it zeroes it).
+//    over the pixels `noise_pixels` uses, placed at the mean distance of the
+//    bin's samples (where they crowd at one end of a bin, its centre would
+//    take that end's value); the correction c(r) is the line through those
+//    points, bins with too few samples between them interpolated (added to
+//    the measured distance, it zeroes it).
 // 2. The per-pixel part: each pixel's mean of I_dis - f c(r) over the frames
 //    where it is within the tolerance (4 sigma + model tolerance: an object
 //    or a fault is not learned as an offset), for pixels seen in at least
