@@ -258,6 +258,18 @@ std::string check_evidence(const discrepancy_t& d) {
     return expected("robot_chi2", "a finite sum >= 0", d.robot_chi2);
   }
   if (d.search_points < 0) return expected("search_points", "a count >= 0", d.search_points);
+  if (d.camera_search_static_points < 0) {
+    return expected("camera_search_static_points", "a count >= 0", d.camera_search_static_points);
+  }
+  if (d.camera_search_axis < -1 || d.camera_search_axis > 5) {
+    return expected("camera_search_axis", "-1 (none) or an optical axis 0..5", d.camera_search_axis);
+  }
+  if (!std::isfinite(d.camera_search_offset)) {
+    return expected("camera_search_offset", "a finite number", d.camera_search_offset);
+  }
+  if (!(std::isfinite(d.camera_search_gain) && d.camera_search_gain >= 0)) {
+    return expected("camera_search_gain", "a finite gain >= 0", d.camera_search_gain);
+  }
   return "";
 }
 

@@ -527,6 +527,7 @@ discrepancy_t summary_of_frame(const depth_image_t& camera) {
   s.height = camera.height;
   s.num_pixels = camera.num_pixels;
   s.near_arm_min_distance_m = -1;
+  s.camera_search_axis = -1;
   return s;
 }
 

@@ -206,6 +206,10 @@ void clear_evidence(discrepancy_t* s) {
   s->search_points = 0;
   s->joint_search_offset.clear();
   s->joint_search_gain.clear();
+  s->camera_search_static_points = 0;
+  s->camera_search_axis = -1;
+  s->camera_search_offset = 0;
+  s->camera_search_gain = 0;
 }
 
 namespace {

@@ -530,6 +530,176 @@ int best_joint(const discrepancy_t& s, int num_joints) {
   return best;
 }
 
+// The camera as a candidate (discrepancy_t.camera_search_*): one axis of
+// its optical frame at a time, as the joints are one at a time, so that
+// the gains compare one parameter with one. Translations over the joints'
+// prismatic range in twice their step; rotations over +-5 deg in 0.5 deg
+// steps (the camera tests' delta is 0.5-1 deg; a larger tilt moves the arm
+// out of the search's reach anyway). The fine trials as the joints'.
+constexpr int kCameraAxes = 6;
+// The camera candidate is tried when the best joint's gain reaches this
+// (chi^2): 5 sigma of one parameter (noise alone, chi^2 with 1 degree of
+// freedom, reaches it on 6e-7 of frames; nominal frames' gains stay below
+// 20, evidence_test). It decides nothing by itself: it keeps the 6 x 20
+// camera trials off nominal frames, where a joint's gain of a few (a wrist
+// at 1 deg for chi^2 2) is common.
+constexpr double kCameraCandidateMinGain = 25.0;
+constexpr double kCameraSearchRangeRad = 5.0 * M_PI / 180.0;
+constexpr double kCameraSearchStepRad = 0.5 * M_PI / 180.0;
+
+// How the configured optical frame's points look from a camera moved by
+// `amount` along (axes 0..2, m) or about (3..5, rad) axis `axis`, seen -
+// configured: the camera at configured * M sees the point p at M^-1 p (mm).
+Eigen::Isometry3d camera_move_seen(int axis, double amount) {
+  Eigen::Isometry3d seen = Eigen::Isometry3d::Identity();
+  if (axis < 3) {
+    seen.translation()[axis] = -1000.0 * amount;
+  } else {
+    seen.linear() = Eigen::AngleAxisd(-amount, Eigen::Vector3d::Unit(axis - 3)).toRotationMatrix();
+  }
+  return seen;
+}
+
+// The rendered pixels no joint moves (the environment, fixed links) every
+// `stride`-th row and column, back-projected as sample_points does.
+std::vector<SearchPoint> sample_static_points(const depth_image_t& rendered, const MovedLinkOf& moved_link,
+                                              const DepthNoise& noise, const EvidenceOptions& options,
+                                              int stride) {
+  std::vector<SearchPoint> points;
+  const int16_t* gen = rendered.depth_mm.data();
+  const double model_var = options.model_sigma_mm * options.model_sigma_mm;
+  for (int v = 0; v < rendered.height; v += stride) {
+    for (int u = 0; u < rendered.width; u += stride) {
+      const size_t i = static_cast<size_t>(v) * rendered.width + u;
+      if (gen[i] <= 0 || moved_link(i) >= 0) continue;
+      const double z = gen[i];
+      const double sigma_d = noise.sigma_mm(z);
+      points.push_back(SearchPoint{
+          Eigen::Vector3d((u - rendered.cx) * z / rendered.fx, (v - rendered.cy) * z / rendered.fy, z),
+          1.0 / std::sqrt(sigma_d * sigma_d + model_var)});
+    }
+  }
+  return points;
+}
+
+// The static pixels' stride that keeps them within `max_points`.
+int static_stride(const depth_image_t& rendered, const MovedLinkOf& moved_link, int max_points) {
+  int64_t pixels = 0;
+  for (size_t i = 0; i < rendered.depth_mm.size(); ++i) {
+    pixels += rendered.depth_mm[i] > 0 && moved_link(i) < 0 ? 1 : 0;
+  }
+  int stride = 1;
+  while (pixels > int64_t{max_points} * stride * stride) ++stride;
+  return stride;
+}
+
+// The points a camera move is tried on, each set with its own cost (its
+// own sampling weight), and every how many of them a coarse trial takes.
+struct CameraCandidatePoints {
+  std::vector<SearchPoint> robot;
+  std::vector<SearchPoint> scene;
+  size_t robot_every = 1;
+  size_t scene_every = 1;
+};
+
+struct CameraTrial {
+  int axis;
+  double amount;
+  bool coarse;
+};
+
+// The costs of `trials`, each one task (on the workers when there are
+// some); no pruning, so each is the whole sum.
+std::vector<double> camera_trial_costs(const std::vector<CameraTrial>& trials, const CameraCandidatePoints& p,
+                                       const PointCost& robot_cost, const PointCost& scene_cost,
+                                       WorkerPool* workers) {
+  std::vector<double> costs(trials.size(), 0.0);
+  const double never = std::numeric_limits<double>::infinity();
+  const auto one = [&](int task) {
+    thread_local std::vector<double> point_cost;
+    const CameraTrial& t = trials[static_cast<size_t>(task)];
+    const Eigen::Isometry3d seen = camera_move_seen(t.axis, t.amount);
+    double robot = 0, scene = 0;
+    robot_cost.link_cost(p.robot, seen, t.coarse ? p.robot_every : 1, 0, never, &point_cost, &robot);
+    scene_cost.link_cost(p.scene, seen, t.coarse ? p.scene_every : 1, 0, never, &point_cost, &scene);
+    costs[static_cast<size_t>(task)] = robot + scene;
+  };
+  const int tasks = static_cast<int>(trials.size());
+  if (workers != nullptr) {
+    workers->run(tasks, one);
+  } else {
+    for (int task = 0; task < tasks; ++task) one(task);
+  }
+  return costs;
+}
+
+// The step of a camera axis's trials (m or rad) and their number each side.
+double camera_step(int axis, const EvidenceOptions& options, int* steps) {
+  const double range = axis < 3 ? options.search_range_m : kCameraSearchRangeRad;
+  const double step = axis < 3 ? 2 * options.search_step_m : kCameraSearchStepRad;
+  *steps = step > 0 ? static_cast<int>(std::floor(range / step + 1e-9)) : 0;
+  return step;
+}
+
+// The camera candidate (see kCameraAxes): coarse trials per axis, then the
+// fine ones about each axis's best, into s->camera_search_*.
+void search_camera_move(const depth_image_t& camera, const depth_image_t& rendered,
+                        const MovedLinkOf& moved_link, const PointsOfLink& points_of_link,
+                        const PointCost& robot_cost, const DepthNoise& noise, const EvidenceOptions& options,
+                        WorkerPool* workers, discrepancy_t* s) {
+  CameraCandidatePoints p;
+  for (const std::vector<SearchPoint>& link : points_of_link)
+    p.robot.insert(p.robot.end(), link.begin(), link.end());
+  const int stride = static_stride(rendered, moved_link, options.search_max_points);
+  p.scene = sample_static_points(rendered, moved_link, noise, options, stride);
+  s->camera_search_static_points = static_cast<int32_t>(p.scene.size());
+  p.robot_every = std::max<size_t>(1, (p.robot.size() + kCoarsePoints - 1) / kCoarsePoints);
+  p.scene_every = std::max<size_t>(1, (p.scene.size() + kCoarsePoints - 1) / kCoarsePoints);
+  const PointCost scene_cost(camera, rendered, options.clip_sigmas,
+                             static_cast<double>(stride) * stride / options.pixels_per_sample);
+  // Coarse: no move first, then each axis's steps.
+  std::vector<CameraTrial> coarse{{0, 0.0, true}};
+  for (int axis = 0; axis < kCameraAxes; ++axis) {
+    int steps = 0;
+    const double step = camera_step(axis, options, &steps);
+    for (int g = -steps; g <= steps; ++g) {
+      if (g != 0) coarse.push_back(CameraTrial{axis, g * step, true});
+    }
+  }
+  const std::vector<double> coarse_cost = camera_trial_costs(coarse, p, robot_cost, scene_cost, workers);
+  // Fine: no move first, then kFine about each axis's coarse best (none
+  // for an axis where no move beat none).
+  std::vector<CameraTrial> fine{{0, 0.0, false}};
+  size_t n = 1;
+  for (int axis = 0; axis < kCameraAxes; ++axis) {
+    int steps = 0;
+    const double step = camera_step(axis, options, &steps);
+    double best = coarse_cost[0];
+    double centre = 0;
+    for (int g = -steps; g <= steps; ++g) {
+      if (g == 0) continue;
+      if (coarse_cost[n] < best) {
+        best = coarse_cost[n];
+        centre = g * step;
+      }
+      ++n;
+    }
+    if (centre == 0) continue;
+    for (double f : kFine) fine.push_back(CameraTrial{axis, centre + f * step, false});
+  }
+  if (fine.size() == 1) return;
+  const std::vector<double> fine_cost = camera_trial_costs(fine, p, robot_cost, scene_cost, workers);
+  // The least cost of all (the first of equals), its gain over no move.
+  size_t best = 0;
+  for (size_t k = 1; k < fine.size(); ++k) {
+    if (fine_cost[k] < fine_cost[best]) best = k;
+  }
+  if (best == 0) return;
+  s->camera_search_axis = static_cast<int8_t>(fine[best].axis);
+  s->camera_search_offset = fine[best].amount;
+  s->camera_search_gain = std::max(0.0, fine_cost[0] - fine_cost[best]);
+}
+
 }  // namespace
 
 void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rendered,
@@ -541,6 +711,10 @@ void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rend
   s.search_points = 0;
   s.joint_search_offset.assign(k.num_joints, 0.0);
   s.joint_search_gain.assign(k.num_joints, 0.0);
+  s.camera_search_static_points = 0;
+  s.camera_search_axis = -1;
+  s.camera_search_offset = 0;
+  s.camera_search_gain = 0;
   const size_t pixels =
       static_cast<size_t>(std::max(rendered.width, 0)) * static_cast<size_t>(std::max(rendered.height, 0));
   if (!inputs_usable(camera, rendered, labels, k, pixels)) return;
@@ -564,12 +738,16 @@ void search_joint_offsets(const depth_image_t& camera, const depth_image_t& rend
   std::vector<double> fine_cost;
   runner.run(fine, &fine_cost, nullptr, exact_fine_trials(trials_of, fine.size()));
   choose_offsets(trials_of, centre_of, fine_cost, &s);
+  const int joint = best_joint(s, k.num_joints);
+  // The camera as a candidate, where a joint's offset explains much.
+  if (joint >= 0 && s.joint_search_gain[joint] >= kCameraCandidateMinGain) {
+    search_camera_move(camera, rendered, moved_link, points_of_link, cost, noise, options, workers, &s);
+  }
 
   // The static pixels the best joint's offset explains: where its moved
   // points land and match the measured depth.
   if (explained_static == nullptr) return;
   explained_static->assign(pixels, 0);
-  const int joint = best_joint(s, k.num_joints);
   if (joint < 0) return;
   const auto is_static = [&](int i) { return moved_link(static_cast<size_t>(i)) < 0; };
   for (const MovedLink& m : trials_of[joint].moved) {

@@ -79,11 +79,13 @@ ClassifiedFrame RiskMonitor::classify(const discrepancy_t& frame) const {
 namespace {
 
 // The hypothesis of the sequential evidence an open diagnosis names when
-// a sequential test crossed for it (FrameFinding::at_once): its suspect
-// joint for a joint error, the camera for a calibration error; empty for a
-// rule's finding or none open.
+// a sequential test crossed for it (FrameFinding::at_once): the test that
+// crossed where the cause names another (FrameFinding::crossed_test), else
+// its suspect joint for a joint error, the camera for a calibration error;
+// empty for a rule's finding or none open.
 std::string diagnosed_hypothesis(const FrameFinding* diagnosis) {
   if (diagnosis == nullptr || !diagnosis->at_once) return "";
+  if (!diagnosis->crossed_test.empty()) return diagnosis->crossed_test;
   if (diagnosis->cause == risk_t::CAUSE_CALIBRATION_ERROR) return "camera";
   if (diagnosis->cause == risk_t::CAUSE_JOINT_ERROR) return diagnosis->suspect;
   return "";

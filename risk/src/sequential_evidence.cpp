@@ -206,6 +206,14 @@ double naming_chi2(const discrepancy_t& f, int i) {
   return f.joint_naming_score[i] * f.joint_naming_score[i] / f.joint_naming_information[i];
 }
 
+double camera_beyond_joints_chi2(const discrepancy_t& f) {
+  if (!searched(f) || f.camera_search_axis < 0 || f.camera_search_axis > 5 || !(f.camera_search_gain > 0))
+    return -std::numeric_limits<double>::infinity();
+  double best_joint = 0;
+  for (const double gain : f.joint_search_gain) best_joint = std::max(best_joint, gain);
+  return f.camera_search_gain - best_joint;
+}
+
 DistanceDrift distance_drift(const discrepancy_t& f, double threshold_chi2) {
   DistanceDrift d;
   const double info_d = f.distance_offset_information;
@@ -264,6 +272,27 @@ FrameFinding SequentialEvidence::camera_finding(const discrepancy_t& f) const {
       " of h " + fixed(h_, 1) + "; fitted correction (" + fixed(100 * c[0], 1) + ", " + fixed(100 * c[1], 1) +
       ", " + fixed(100 * c[2], 1) + ") cm, (" + fixed(kDeg * c[3], 2) + ", " + fixed(kDeg * c[4], 2) + ", " +
       fixed(kDeg * c[5], 2) + ")° about the optical x, y, z axes (seen vs configured)";
+  return finding;
+}
+
+FrameFinding SequentialEvidence::search_camera_finding(const discrepancy_t& f,
+                                                       const NamedCusum& crossed) const {
+  static const char* const kAxes[6] = {"along optical x", "along optical y", "along the optical axis",
+                                       "about optical x", "about optical y", "about the optical axis"};
+  const int axis = f.camera_search_axis;
+  const double amount = axis < 3 ? 100 * f.camera_search_offset : kDeg * f.camera_search_offset;
+  FrameFinding finding;
+  finding.cause = risk_t::CAUSE_CALIBRATION_ERROR;
+  finding.score = crossed.value;
+  finding.threshold = h_;
+  finding.crossed_test = crossed.name;
+  finding.detail = "camera pose off (named by the search: the camera moved " +
+                   fixed(amount, axis < 3 ? 1 : 2) + (axis < 3 ? " cm " : "° ") + kAxes[axis] +
+                   " (seen vs configured) explains chi^2 " + fixed(f.camera_search_gain, 0) + ", " +
+                   fixed(camera_beyond_joints_chi2(f), 0) +
+                   " more than any joint's offset; the test that crossed: " + crossed.name + "'s, " +
+                   fixed(crossed.value, 1) + " of h " + fixed(h_, 1) + "; the camera's own test at " +
+                   fixed(camera_cusum_, 1) + ")";
   return finding;
 }
 
@@ -341,7 +370,10 @@ EvidenceStep SequentialEvidence::update(const discrepancy_t& f) {
   const NamedCusum crossed = crossed_joint();
   if (!crossed.name.empty()) {
     result.crossed = true;
-    result.finding = joint_stop_finding(f, crossed);
+    // As for naming a joint: a difference of two hypotheses' chi-squares
+    // is twice their log-likelihood ratio, so 2h is the threshold's own level.
+    result.finding = camera_beyond_joints_chi2(f) >= 2 * h_ ? search_camera_finding(f, crossed)
+                                                            : joint_stop_finding(f, crossed);
     return result;
   }
   if (largest.value >= warning_level()) {

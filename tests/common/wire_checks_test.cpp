@@ -99,6 +99,10 @@ discrepancy_t discrepancy_with_evidence() {
   d.search_points = 10;
   d.joint_search_offset = {0.05, -0.002};
   d.joint_search_gain = {40, 0};
+  d.camera_search_static_points = 12;
+  d.camera_search_axis = 3;
+  d.camera_search_offset = -0.01;
+  d.camera_search_gain = 55;
   d.joint_reach_m = {0.8, 0.5};
   return d;
 }
@@ -170,6 +174,18 @@ TEST(WireChecks, DiscrepancyEvidence) {
   d = discrepancy_with_evidence();
   d.joint_search_gain[0] = -0.5;
   EXPECT_EQ(field_of(d), "joint_search_gain[0]");
+  d = discrepancy_with_evidence();
+  d.camera_search_axis = 6;
+  EXPECT_EQ(field_of(d), "camera_search_axis");
+  d = discrepancy_with_evidence();
+  d.camera_search_gain = -1;
+  EXPECT_EQ(field_of(d), "camera_search_gain");
+  d = discrepancy_with_evidence();
+  d.camera_search_offset = kNaN;
+  EXPECT_EQ(field_of(d), "camera_search_offset");
+  d = discrepancy_with_evidence();
+  d.camera_search_static_points = -2;
+  EXPECT_EQ(field_of(d), "camera_search_static_points");
   d = discrepancy_with_evidence();
   d.joint_static_bound[1] = -1;
   EXPECT_EQ(field_of(d), "joint_static_bound[1]");

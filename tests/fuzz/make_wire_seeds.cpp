@@ -167,6 +167,7 @@ void discrepancies() {
   m.joint_static_bound = {0, 0.5, 0};
   m.joint_search_offset = {0, 0.01, 0};
   m.joint_search_gain = {0, 1, 0};
+  m.camera_search_axis = -1;
   m.joint_reach_m = {0.9, 0.6, 0.2};
   m.robot_fit_pixels = 5;
   m.search_points = 3;

@@ -385,6 +385,46 @@ TEST(EvidenceTests, TheNamingSearchOutranksTheLinearNamingFit) {
   EXPECT_EQ(step.finding.suspect, "a3");
 }
 
+// The naming search's camera candidate: a joint's test crossed, and a camera
+// move explains the frame 2h better than any joint's offset (a camera
+// shifted sideways moves the arm as a1 turns it): a calibration error,
+// with the joint's test as the one that crossed; by less, the joint.
+TEST(EvidenceTests, ACameraMoveTheSearchPrefersBy2hIsACalibrationError) {
+  discrepancy_t d = evidence_frame(1);
+  d.joint_score[joint_index("a1")] = 1e6 * 3 * kDeg;  // a1's test crosses
+  d.joint_naming_score = d.joint_score;
+  d.search_points = 2000;
+  d.joint_search_offset.assign(d.num_joints, 0.0);
+  d.joint_search_gain.assign(d.num_joints, 0.0);
+  d.joint_search_offset[joint_index("a1")] = 5.5 * kDeg;
+  d.joint_search_gain[joint_index("a1")] = 4000;
+  d.camera_search_static_points = 2500;
+  d.camera_search_axis = 0;
+  d.camera_search_offset = 0.02;
+  SequentialEvidence below(sim_config().risk, friend_arm(), kRateHz);
+  const double h = below.threshold();
+  d.camera_search_gain = 4000 + 1.5 * h;
+  EvidenceStep step = below.update(d);
+  ASSERT_TRUE(step.crossed);
+  EXPECT_EQ(step.finding.cause, risk_t::CAUSE_JOINT_ERROR);
+  EXPECT_EQ(step.finding.suspect, "a1");
+  SequentialEvidence beyond(sim_config().risk, friend_arm(), kRateHz);
+  d.camera_search_gain = 4000 + 2.5 * h;
+  step = beyond.update(d);
+  ASSERT_TRUE(step.crossed);
+  EXPECT_EQ(step.finding.cause, risk_t::CAUSE_CALIBRATION_ERROR);
+  EXPECT_EQ(step.finding.crossed_test, "a1");
+  EXPECT_NE(step.finding.detail.find("the camera moved 2.0 cm along optical x"), std::string::npos)
+      << step.finding.detail;
+  EXPECT_NE(step.finding.detail.find("the test that crossed: a1's"), std::string::npos)
+      << step.finding.detail;
+  // No camera candidate (axis -1): the joint, however large the gain field.
+  SequentialEvidence none(sim_config().risk, friend_arm(), kRateHz);
+  d.camera_search_axis = -1;
+  step = none.update(d);
+  EXPECT_EQ(step.finding.cause, risk_t::CAUSE_JOINT_ERROR);
+}
+
 // A joint's test crossed but no joint is in this frame's naming fit (every
 // robot pixel beyond the gate: a gross offset): still a stop, blaming the
 // joint whose test crossed.
@@ -640,6 +680,31 @@ TEST(RiskMonitorEvidence, ADiagnosisStaysOpenWhileItsFaultIsReadSmallerThanTheTe
   // The clearing test's ~6 frames, then clear_frames clean ones.
   EXPECT_GE(frames, sim_config().risk.evidence_clear_frames + 3);
   EXPECT_FALSE(m.diagnosis_open());
+}
+
+// A calibration error the naming search named while a joint's test crossed
+// (ACameraMoveTheSearchPrefersBy2hIsACalibrationError): the diagnosis closes
+// on that joint's clearing test, the evidence that crossed.
+TEST(RiskMonitorEvidence, ACameraNamedByTheSearchClosesOnTheCrossedJointsClearingTest) {
+  risk::RiskMonitor m(sim_config().risk, sim_config().channels, friend_arm(), kRateHz, kStart);
+  ScoreSource source(29);
+  int64_t now = kStart;
+  int64_t seq = 1;
+  discrepancy_t d = source.frame(seq++, {{"a1", 3 * kDeg}});
+  d.search_points = 2000;
+  d.joint_search_offset.assign(d.num_joints, 0.0);
+  d.joint_search_gain.assign(d.num_joints, 0.0);
+  d.joint_search_gain[joint_index("a1")] = 4000;
+  d.camera_search_axis = 0;
+  d.camera_search_offset = 0.02;
+  d.camera_search_gain = 9000;
+  risk_t r = judge(&m, d, &now);
+  ASSERT_EQ(r.level, risk_t::DANGEROUS);
+  EXPECT_EQ(r.cause, risk_t::CAUSE_CALIBRATION_ERROR) << r.detail;
+  r = judge(&m, source.frame(seq++), &now);
+  EXPECT_EQ(r.level, risk_t::DANGEROUS);
+  EXPECT_NE(r.detail.find("evidence a1's fault is gone (clearing test at delta/2): "), std::string::npos)
+      << r.detail;
 }
 
 // A sensor fault's diagnosis stays open too.

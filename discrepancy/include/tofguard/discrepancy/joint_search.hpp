@@ -14,6 +14,14 @@
 // offset would hide behind another link still counts (the same for every
 // joint, so it does not favour one).
 //
+// The camera is a candidate too (discrepancy_t.camera_search_*), on frames
+// where some joint's offset lowers the cost by 25 or more: moved along or about one axis
+// of its optical frame at a time, it moves the robot points and points of
+// the surfaces no joint moves (the scene, fixed links) as the moved camera
+// would see them. A camera moved sideways shifts the arm as a base joint's
+// offset turns it; only the scene's points, which a joint leaves where
+// they are, tell the two apart.
+//
 // Frames and units: the camera's optical frame (x right, y down, z
 // forward), millimetres; offsets in radians (metres for prismatic joints),
 // seen minus reported. Pure computation: no LCM, no clocks.
@@ -30,7 +38,8 @@ namespace tofguard::discrepancy {
 
 // Fills summary's search_points, joint_search_offset and joint_search_gain
 // (num_joints entries each; every gain 0 when the labels carry no
-// kinematics or no robot point is seen). `kinematics` must be `labels`'
+// kinematics or no robot point is seen) and camera_search_* (axis -1 and
+// gain 0 when no joint's offset helps that much or no camera move does). `kinematics` must be `labels`'
 // (read_label_kinematics).
 //
 // explained_static (optional): set to one entry per pixel, 1 where a point

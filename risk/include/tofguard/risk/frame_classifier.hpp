@@ -32,6 +32,10 @@ struct FrameFinding {
   // WARNING, never DANGEROUS by itself: a sequential test's evidence is
   // growing but has not crossed.
   bool warning_only = false;
+  // The sequential test that crossed when it is not the one the cause
+  // names ("camera" or a joint; empty: the cause's own): its clearing test
+  // closes the diagnosis.
+  std::string crossed_test = {};
 };
 
 struct ClassifierContext {

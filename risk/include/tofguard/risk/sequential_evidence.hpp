@@ -126,6 +126,11 @@ bool searched(const discrepancy_t& frame);
 // naming fit's s^2 / I (0 without information).
 double naming_chi2(const discrepancy_t& frame, int index);
 
+// The naming search's camera candidate (discrepancy_t.camera_search_*)
+// against its joints: the camera move's gain less the best joint's, chi^2
+// (-infinity when the frame carries no camera candidate).
+double camera_beyond_joints_chi2(const discrepancy_t& frame);
+
 // What one frame's evidence says.
 struct EvidenceStep {
   // The frame carried evidence (discrepancy_t.evidence_available) and the
@@ -211,6 +216,13 @@ class SequentialEvidence {
   // The finding of a stop for a joint: `crossed` is the joint test that
   // crossed.
   FrameFinding joint_stop_finding(const discrepancy_t& frame, const NamedCusum& crossed) const;
+  // The finding of a stop a joint's test crossed for when the naming
+  // search's camera move explains the frame 2h better than any joint's
+  // offset (a camera moved sideways moves the arm as a base joint does, and
+  // the arm's edges cross a joint's test before the scene's slopes cross
+  // the camera's): a calibration error; the test that crossed stays the
+  // diagnosis's (FrameFinding::crossed_test).
+  FrameFinding search_camera_finding(const discrepancy_t& frame, const NamedCusum& crossed) const;
   // The finding of a warning for the `largest` CUSUM.
   FrameFinding warning_finding(const discrepancy_t& frame, const NamedCusum& largest) const;
   FrameFinding camera_finding(const discrepancy_t& frame) const;
