@@ -410,6 +410,8 @@ TEST_F(EvidenceTest, TheSummaryDoesNotDependOnTheWorkerThreads) {
     }
     if (std::string(c.what) == "camera 3 cm off") {
       EXPECT_GT(alone.summary.camera_fit_pixels, 1000);
+      // The search's camera candidate ran (its trials on the workers too).
+      EXPECT_EQ(alone.summary.camera_search_axis, 0);
     }
   }
 }
