@@ -1,7 +1,7 @@
 // Commissioning's profile fit (camera_profile_fit.hpp) on synthetic rendered
 // pairs of known residual distance error: the smooth correction where the
 // samples crowd at one end of each distance bin, as a wall or a table
-// makes them.
+// makes them, applied where the camera measures.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -78,10 +78,15 @@ TEST(CameraProfileFit, SmoothCorrectionHoldsWhereTheSamplesCrowdAtOneEndOfEachBi
   const ProfileFit fit = fit_camera_profile(crowded_frames(24), tolerance, 0.0, options);
   ASSERT_TRUE(fit.ok) << fit.error;
   // Between the surfaces' distances, the correction (I_dis / f: true minus
-  // measured) is the residual's negative. Taking each bin's median at the
-  // bin's centre (2 cm above the samples) would be 2 mm off everywhere.
+  // measured), applied at the distance the camera measures, is the
+  // residual's negative. Taking each bin's median at the bin's centre (2 cm
+  // above the samples) would be 2 mm off everywhere, and at the rendered
+  // distance instead of the measured one up to 9 mm (the residual reaches
+  // 95 mm, at 0.1 mm per mm).
   for (double r_m = 1.02; r_m < 1.95; r_m += 0.037) {
-    EXPECT_NEAR(fit.profile.distance_correction_at(r_m), -residual_mm(r_m), 0.25) << "at " << r_m << " m";
+    const double measured_m = r_m + residual_mm(r_m) * 1e-3;
+    EXPECT_NEAR(fit.profile.distance_correction_at(measured_m), -residual_mm(r_m), 0.25)
+        << "at " << r_m << " m";
   }
   // Nothing left for the per-pixel offsets to take up but the noise of a
   // 24-frame mean (3 / sqrt(24) = 0.6 mm) and the whole millimetres (0.3

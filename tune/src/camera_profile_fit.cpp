@@ -221,10 +221,25 @@ bool fit_smooth_part(const std::vector<RenderedPair>& frames, const std::vector<
   // grid (values at bin centres, read linearly between them) spans the
   // points and takes its values off the line through them, the end
   // segments extended to the grid's end centres (less than a bin beyond).
+  //
+  // And the profile is applied at the distance the camera measures
+  // (camera_profile.hpp: r = Z / f of the camera's Z), which differs from
+  // the rendered one by the error itself: up to 3 cm, where a wiggle's slope
+  // of 0.1 mm per mm makes the correction 3 mm off. So each point sits at the
+  // measured distance of its bin's pixels, their rendered mean less the
+  // median residual (I_dis / f: rendered minus measured). A wiggle's slope
+  // is far below 1 mm per mm, so the points keep their order; one that
+  // would not is left out.
   std::vector<double> at_m, median;
   for (const DepthBin& b : measured.bins) {
-    at_m.push_back(b.depth_m);
+    const double measured_m = b.depth_m - b.median_mm * 1e-3;
+    if (!at_m.empty() && !(measured_m > at_m.back())) continue;
+    at_m.push_back(measured_m);
     median.push_back(b.median_mm);
+  }
+  if (at_m.size() < 2) {
+    fit->error = "the distance correction's bins do not keep their order at the measured distances";
+    return false;
   }
   const int first_bin = static_cast<int>(std::floor(at_m.front() / options.bin_m - 0.5));
   const int last_bin = static_cast<int>(std::ceil(at_m.back() / options.bin_m - 0.5));
@@ -262,7 +277,8 @@ void fit_pixel_part(const std::vector<RenderedPair>& frames, const std::vector<d
       if (!used[i]) continue;
       const double gen = frame.rendered.depth_mm[i];
       const int t = frame.camera.depth_mm[i];
-      const double e = gen - t - f[i] * p.distance_correction_at(gen / f[i] * 1e-3);
+      // The smooth part as it is applied: at the measured distance.
+      const double e = gen - t - f[i] * p.distance_correction_at(t / f[i] * 1e-3);
       if (std::abs(e) > tolerance.at(t)) {
         ++beyond[i];
         continue;

@@ -8,16 +8,19 @@
 //    binned by the camera's own distance a bin at the edge of the scene's
 //    range would hold the pixels whose noise carried them there), the
 //    median of the radial residual I_dis / f (f = Z / r of the pixel's ray)
-//    over the pixels `noise_pixels` uses, placed at the mean distance of the
-//    bin's samples (where they crowd at one end of a bin, its centre would
-//    take that end's value); the correction c(r) is the line through those
-//    points, bins with too few samples between them interpolated (added to
-//    the measured distance, it zeroes it).
-// 2. The per-pixel part: each pixel's mean of I_dis - f c(r) over the frames
-//    where it is within the tolerance (4 sigma + model tolerance: an object
-//    or a fault is not learned as an offset), for pixels seen in at least
-//    min_pixel_frames frames of which at most max_outlier_fraction were
-//    beyond it; 0 elsewhere.
+//    over the pixels `noise_pixels` uses, placed at the distance the camera
+//    measures for the bin's samples: their mean rendered distance less that
+//    median (where the samples crowd at one end of a bin, its centre would
+//    take that end's value; and the profile is applied at the measured
+//    distance, which the error itself moves by centimetres); the correction
+//    c(r) is the line through those points, bins with too few samples
+//    between them interpolated (added to the measured distance, it zeroes
+//    it).
+// 2. The per-pixel part: each pixel's mean of I_dis - f c(r) (r measured)
+//    over the frames where it is within the tolerance (4 sigma + model
+//    tolerance: an object or a fault is not learned as an offset), for
+//    pixels seen in at least min_pixel_frames frames of which at most
+//    max_outlier_fraction were beyond it; 0 elsewhere.
 // 0. First, a pose error must not be learned as a depth error: on the static
 //    pixels (the evidence's camera Jacobian J, evidence.hpp) of every
 //    pose_frame_stride-th frame, I_dis is fitted jointly to a camera pose
