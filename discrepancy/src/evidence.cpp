@@ -579,11 +579,7 @@ EvidenceSums sum_frame(const EvidenceFrame& f, int num_links, WorkerPool* worker
   const int num_joints = f.jacobian.num_joints();
   std::vector<EvidenceSums> bands(kEvidenceBands, EvidenceSums(num_links, num_joints));
   const auto one = [&](int band) { sum_band(f, band, &bands[static_cast<size_t>(band)]); };
-  if (workers != nullptr) {
-    workers->run(kEvidenceBands, one);
-  } else {
-    for (int band = 0; band < kEvidenceBands; ++band) one(band);
-  }
+  run_tasks(workers, kEvidenceBands, one);
   EvidenceSums total(num_links, num_joints);
   for (const EvidenceSums& b : bands) total.add(b);
   return total;

@@ -253,15 +253,33 @@ bool inputs_usable(const depth_image_t& camera, const depth_image_t& rendered, c
          rendered.fy > 0;
 }
 
+// The smallest pixel stride (every k-th row and column) that keeps
+// `pixels` within `max_points`.
+int stride_within(int64_t pixels, int max_points) {
+  int stride = 1;
+  while (pixels > int64_t{max_points} * stride * stride) ++stride;
+  return stride;
+}
+
 // The pixel stride that keeps the moved robot pixels within `max_points`;
 // 0 when no pixel shows a moved link.
 int sampling_stride(const MovedLinkOf& moved_link, size_t pixels, int max_points) {
   int64_t moved_pixels = 0;
   for (size_t i = 0; i < pixels; ++i) moved_pixels += moved_link(i) >= 0 ? 1 : 0;
   if (moved_pixels == 0) return 0;
-  int stride = 1;
-  while (moved_pixels > int64_t{max_points} * stride * stride) ++stride;
-  return stride;
+  return stride_within(moved_pixels, max_points);
+}
+
+// Rendered pixel (u, v) back-projected (optical frame, mm) with its
+// 1 / sigma_i: the camera's noise at its depth and the model's own
+// (`model_var`, mm^2).
+SearchPoint search_point(const depth_image_t& rendered, int u, int v, const DepthNoise& noise,
+                         double model_var) {
+  const double z = rendered.depth_mm[static_cast<size_t>(v) * rendered.width + u];
+  const double sigma_d = noise.sigma_mm(z);
+  return SearchPoint{
+      Eigen::Vector3d((u - rendered.cx) * z / rendered.fx, (v - rendered.cy) * z / rendered.fy, z),
+      1.0 / std::sqrt(sigma_d * sigma_d + model_var)};
 }
 
 using PointsOfLink = std::vector<std::vector<SearchPoint>>;
@@ -273,18 +291,13 @@ PointsOfLink sample_points(const depth_image_t& rendered, const MovedLinkOf& mov
                            const DepthNoise& noise, const EvidenceOptions& options, int stride,
                            int32_t* search_points) {
   PointsOfLink points_of_link(num_robot_links);
-  const int16_t* gen = rendered.depth_mm.data();
   const double model_var = options.model_sigma_mm * options.model_sigma_mm;
   for (int v = 0; v < rendered.height; v += stride) {
     for (int u = 0; u < rendered.width; u += stride) {
       const size_t i = static_cast<size_t>(v) * rendered.width + u;
       const int link = moved_link(i);
       if (link < 0) continue;
-      const double z = gen[i];
-      const double sigma_d = noise.sigma_mm(z);
-      points_of_link[link].push_back(SearchPoint{
-          Eigen::Vector3d((u - rendered.cx) * z / rendered.fx, (v - rendered.cy) * z / rendered.fy, z),
-          1.0 / std::sqrt(sigma_d * sigma_d + model_var)});
+      points_of_link[link].push_back(search_point(rendered, u, v, noise, model_var));
       ++*search_points;
     }
   }
@@ -420,12 +433,7 @@ class TrialRunner {
       while (sum < least_now && !joint_least.compare_exchange_weak(least_now, sum)) {
       }
     };
-    const int tasks = first + static_cast<int>(trials.size());
-    if (workers_ != nullptr) {
-      workers_->run(tasks, one);
-    } else {
-      for (int task = 0; task < tasks; ++task) one(task);
-    }
+    run_tasks(workers_, first + static_cast<int>(trials.size()), one);
   }
 
  private:
@@ -561,7 +569,7 @@ Eigen::Isometry3d camera_move_seen(int axis, double amount) {
 }
 
 // The rendered pixels no joint moves (the environment, fixed links) every
-// `stride`-th row and column, back-projected as sample_points does.
+// `stride`-th row and column, back-projected (search_point).
 std::vector<SearchPoint> sample_static_points(const depth_image_t& rendered, const MovedLinkOf& moved_link,
                                               const DepthNoise& noise, const EvidenceOptions& options,
                                               int stride) {
@@ -572,11 +580,7 @@ std::vector<SearchPoint> sample_static_points(const depth_image_t& rendered, con
     for (int u = 0; u < rendered.width; u += stride) {
       const size_t i = static_cast<size_t>(v) * rendered.width + u;
       if (gen[i] <= 0 || moved_link(i) >= 0) continue;
-      const double z = gen[i];
-      const double sigma_d = noise.sigma_mm(z);
-      points.push_back(SearchPoint{
-          Eigen::Vector3d((u - rendered.cx) * z / rendered.fx, (v - rendered.cy) * z / rendered.fy, z),
-          1.0 / std::sqrt(sigma_d * sigma_d + model_var)});
+      points.push_back(search_point(rendered, u, v, noise, model_var));
     }
   }
   return points;
@@ -588,9 +592,7 @@ int static_stride(const depth_image_t& rendered, const MovedLinkOf& moved_link, 
   for (size_t i = 0; i < rendered.depth_mm.size(); ++i) {
     pixels += rendered.depth_mm[i] > 0 && moved_link(i) < 0 ? 1 : 0;
   }
-  int stride = 1;
-  while (pixels > int64_t{max_points} * stride * stride) ++stride;
-  return stride;
+  return stride_within(pixels, max_points);
 }
 
 // The points a camera move is tried on, each set with its own cost (its
@@ -624,12 +626,7 @@ std::vector<double> camera_trial_costs(const std::vector<CameraTrial>& trials, c
     scene_cost.link_cost(p.scene, seen, t.coarse ? p.scene_every : 1, 0, never, &point_cost, &scene);
     costs[static_cast<size_t>(task)] = robot + scene;
   };
-  const int tasks = static_cast<int>(trials.size());
-  if (workers != nullptr) {
-    workers->run(tasks, one);
-  } else {
-    for (int task = 0; task < tasks; ++task) one(task);
-  }
+  run_tasks(workers, static_cast<int>(trials.size()), one);
   return costs;
 }
 

@@ -86,6 +86,14 @@ discrepancy_t evidence_frame(int64_t seq) {
   return d;
 }
 
+// The naming search's fields on `d` (2000 points searched), every joint's
+// offset and gain 0: a test sets the gains it needs.
+void add_search(discrepancy_t* d) {
+  d->search_points = 2000;
+  d->joint_search_offset.assign(d->num_joints, 0.0);
+  d->joint_search_gain.assign(d->num_joints, 0.0);
+}
+
 int joint_index(const std::string& joint) {
   return static_cast<int>(std::find(kJoints.begin(), kJoints.end(), joint) - kJoints.begin());
 }
@@ -347,9 +355,7 @@ TEST(EvidenceTests, TheNamingSearchOutranksTheLinearNamingFit) {
   discrepancy_t d = evidence_frame(1);
   d.joint_score[joint_index("a3")] = 1e5 * 6 * kDeg;  // a3's test crosses
   d.joint_naming_score = d.joint_score;               // and its linear fit explains most
-  d.search_points = 2000;
-  d.joint_search_offset.assign(d.num_joints, 0.0);
-  d.joint_search_gain.assign(d.num_joints, 0.0);
+  add_search(&d);
   d.joint_search_offset[joint_index("a2")] = -10 * kDeg;
   d.joint_search_gain[joint_index("a2")] = 9000;
   d.joint_search_offset[joint_index("a3")] = 4 * kDeg;
@@ -393,9 +399,7 @@ TEST(EvidenceTests, ACameraMoveTheSearchPrefersBy2hIsACalibrationError) {
   discrepancy_t d = evidence_frame(1);
   d.joint_score[joint_index("a1")] = 1e6 * 3 * kDeg;  // a1's test crosses
   d.joint_naming_score = d.joint_score;
-  d.search_points = 2000;
-  d.joint_search_offset.assign(d.num_joints, 0.0);
-  d.joint_search_gain.assign(d.num_joints, 0.0);
+  add_search(&d);
   d.joint_search_offset[joint_index("a1")] = 5.5 * kDeg;
   d.joint_search_gain[joint_index("a1")] = 4000;
   d.camera_search_static_points = 2500;
@@ -691,9 +695,7 @@ TEST(RiskMonitorEvidence, ACameraNamedByTheSearchClosesOnTheCrossedJointsClearin
   int64_t now = kStart;
   int64_t seq = 1;
   discrepancy_t d = source.frame(seq++, {{"a1", 3 * kDeg}});
-  d.search_points = 2000;
-  d.joint_search_offset.assign(d.num_joints, 0.0);
-  d.joint_search_gain.assign(d.num_joints, 0.0);
+  add_search(&d);
   d.joint_search_gain[joint_index("a1")] = 4000;
   d.camera_search_axis = 0;
   d.camera_search_offset = 0.02;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 
+#include "synthetic_frames.hpp"
 #include "tofguard/common/camera_profile.hpp"
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/tune/camera_profile_fit.hpp"
@@ -14,28 +15,14 @@
 namespace tofguard::tune {
 namespace {
 
-constexpr int kWidth = 160, kHeight = 120;
+// 160 x 120 pixels (synthetic_frames.hpp's intrinsics: fx = fy = 200,
+// the principal point at the centre).
+constexpr int kImageWidth = 160, kImageHeight = 120;
 constexpr int kRowsPerSurface = 6;
-constexpr double kFx = 200, kFy = 200, kCx = 79.5, kCy = 59.5;
 
 // The residual radial error (measured minus true), mm: 10 mm per 0.1 m, the
 // steepest a 25 mm wiggle of 1.6 m period reaches.
 double residual_mm(double r_m) { return 100 * (r_m - 1.0); }
-
-depth_image_t image(int64_t seq) {
-  depth_image_t d{};
-  d.seq = seq;
-  d.camera_id = "synthetic";
-  d.width = kWidth;
-  d.height = kHeight;
-  d.fx = kFx;
-  d.fy = kFy;
-  d.cx = kCx;
-  d.cy = kCy;
-  d.num_pixels = kWidth * kHeight;
-  d.depth_mm.assign(static_cast<size_t>(d.num_pixels), 0);
-  return d;
-}
 
 // Twenty surfaces of six rows each, surface k at a radial distance of
 // 1.005 + 0.05 k m: every sample sits 5 mm above its 5 cm bin's lower edge.
@@ -46,20 +33,22 @@ std::vector<RenderedPair> crowded_frames(int count) {
   std::vector<RenderedPair> frames;
   for (int n = 0; n < count; ++n) {
     RenderedPair pair;
-    pair.camera = image(n);
-    pair.rendered = image(n);
-    pair.labels.width = kWidth;
-    pair.labels.height = kHeight;
+    const std::vector<int16_t> nothing(static_cast<size_t>(kImageWidth * kImageHeight), 0);
+    pair.camera = test::depth_frame(nothing, n, kImageWidth, kImageHeight);
+    pair.rendered = pair.camera;
+    const depth_image_t& in = pair.rendered;
+    pair.labels.width = kImageWidth;
+    pair.labels.height = kImageHeight;
     pair.labels.num_robot_links = 0;
     pair.labels.num_links = 1;
     pair.labels.link_name = {"wall"};
-    pair.labels.num_pixels = kWidth * kHeight;
-    pair.labels.label.assign(static_cast<size_t>(kWidth * kHeight), kLabelEnvironmentFirst);
-    for (int v = 0; v < kHeight; ++v) {
+    pair.labels.num_pixels = kImageWidth * kImageHeight;
+    pair.labels.label.assign(static_cast<size_t>(kImageWidth * kImageHeight), kLabelEnvironmentFirst);
+    for (int v = 0; v < kImageHeight; ++v) {
       const double r_m = 1.005 + 0.05 * (v / kRowsPerSurface);
-      for (int u = 0; u < kWidth; ++u) {
-        const size_t i = static_cast<size_t>(v) * kWidth + u;
-        const double f = z_per_radial(kFx, kFy, kCx, kCy, u, v);
+      for (int u = 0; u < kImageWidth; ++u) {
+        const size_t i = static_cast<size_t>(v) * kImageWidth + u;
+        const double f = z_per_radial(in.fx, in.fy, in.cx, in.cy, u, v);
         pair.rendered.depth_mm[i] = static_cast<int16_t>(std::lround(1000 * r_m * f));
         pair.camera.depth_mm[i] =
             static_cast<int16_t>(std::lround(1000 * r_m * f + f * residual_mm(r_m) + noise(random)));
@@ -91,7 +80,7 @@ TEST(CameraProfileFit, SmoothCorrectionHoldsWhereTheSamplesCrowdAtOneEndOfEachBi
   // Nothing left for the per-pixel offsets to take up but the noise of a
   // 24-frame mean (3 / sqrt(24) = 0.6 mm) and the whole millimetres (0.3
   // mm): the 2 mm a bin's centre would be off by would show here as well.
-  EXPECT_GT(fit.mapped_pixels, kWidth * kHeight / 2);
+  EXPECT_GT(fit.mapped_pixels, kImageWidth * kImageHeight / 2);
   EXPECT_LT(fit.pixel_sigma_mm, 0.9);
 }
 

@@ -129,6 +129,17 @@ class WorkerPool {
 // calls run_once() after the call: either way exactly once. Not thread-safe
 // by itself: run_once() is called by one task of one run, or by the owner
 // after that run has returned (run's return orders the two).
+// Tasks 0..num_tasks-1 on `workers`, or one after the other on the calling
+// thread when there are none (nullptr).
+template <typename Task>
+void run_tasks(WorkerPool* workers, int num_tasks, const Task& task) {
+  if (workers != nullptr) {
+    workers->run(num_tasks, task);
+  } else {
+    for (int i = 0; i < num_tasks; ++i) task(i);
+  }
+}
+
 class SideTask {
  public:
   explicit SideTask(std::function<void()> work) : work_(std::move(work)) {}
