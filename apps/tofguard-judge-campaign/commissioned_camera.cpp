@@ -1,5 +1,6 @@
 #include "commissioned_camera.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <sstream>
@@ -105,6 +106,7 @@ CommissionedCamera commission_imperfect_camera(const CampaignArm& arm, uint64_t 
   config.discrepancy.evidence_fixed_pattern_sigma_mm = checked.tuned.fixed_pattern_sigma_mm;
   config.discrepancy.evidence_silhouette_band_px = checked.tuned.silhouette_band_px;
   config.discrepancy.evidence_silhouette_bias_mm = checked.tuned.silhouette_bias_mm;
+  config.discrepancy.evidence_silhouette_bias_by_link_mm = checked.tuned.silhouette_bias_by_link_mm;
   std::ostringstream summary;
   summary << out.arm.name << ": wiggle " << fixed(truth.wiggle_amplitude_mm, 1) << " mm / "
           << fixed(truth.wiggle_period_m, 2) << " m, slope " << fixed(truth.slope_mm_per_m, 1)
@@ -112,9 +114,10 @@ CommissionedCamera commission_imperfect_camera(const CampaignArm& arm, uint64_t 
           << fixed(truth.reflectivity_bias_mm_per_decade, 1) << " mm/decade, multipath "
           << fixed(truth.multipath_max_mm, 1)
           << " mm; profile: " << fixed(learned.profile_fit.smallest_correction_mm, 1) << ".."
-          << fixed(learned.profile_fit.largest_correction_mm, 1) << " mm by distance, pixel offsets sigma "
-          << fixed(learned.profile_fit.pixel_sigma_mm, 1) << " mm; pose against depth: t ("
-          << fixed(100 * learned.profile_fit.pose.correction[0], 2) << ", "
+          << fixed(learned.profile_fit.largest_correction_mm, 1) << " mm over "
+          << fixed(learned.profile_fit.first_m, 2) << "-" << fixed(learned.profile_fit.last_m, 2)
+          << " m, pixel offsets sigma " << fixed(learned.profile_fit.pixel_sigma_mm, 1)
+          << " mm; pose against depth: t (" << fixed(100 * learned.profile_fit.pose.correction[0], 2) << ", "
           << fixed(100 * learned.profile_fit.pose.correction[1], 2) << ", "
           << fixed(100 * learned.profile_fit.pose.correction[2], 2) << ") cm, r ("
           << fixed(learned.profile_fit.pose.correction[3] * 180 / M_PI, 2) << ", "
@@ -125,6 +128,15 @@ CommissionedCamera commission_imperfect_camera(const CampaignArm& arm, uint64_t 
           << fixed(checked.tuned.fixed_pattern_sigma_mm, 1) << " mm, near steps "
           << fixed(checked.tuned.silhouette_bias_mm, 1) << " mm within " << checked.tuned.silhouette_band_px
           << " px";
+  if (!checked.static_error.silhouette_link.empty()) {
+    double least_mm = checked.tuned.silhouette_bias_mm;
+    for (const auto& link : checked.tuned.silhouette_bias_by_link_mm)
+      least_mm = std::min(least_mm, link.second);
+    summary << " (" << checked.static_error.silhouette_link << "; its links " << fixed(least_mm, 1) << ".."
+            << fixed(checked.tuned.silhouette_bias_mm, 1) << " mm)";
+  }
+  summary << ", arm pixels outside the profile's range "
+          << fixed(100 * checked.profile_coverage.outside_share(), 2) << " %";
   if (!checked.allowance_raised.empty()) {
     summary << " (static_bias raised from " << fixed(checked.measured_static_bias_mm, 1)
             << " mm: " << checked.allowance_raised << ")";

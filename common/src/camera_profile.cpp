@@ -5,6 +5,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "tofguard/common/depth_frame.hpp"
 #include "tofguard/common/yaml_reader.hpp"
 
 namespace tofguard {
@@ -54,9 +55,43 @@ std::string profile_mismatch(const CameraProfile& p, const depth_image_t& frame)
   return "";
 }
 
-void apply_camera_profile(const CameraProfile& p, depth_image_t* frame) {
+void derive_fixed_pattern(CameraProfile* p) {
+  const size_t pixels = p->pixel_correction_mm.size();
+  p->fixed_pattern_mm.assign(pixels, 0.0f);
+  if (pixels != static_cast<size_t>(p->width) * static_cast<size_t>(p->height)) return;
+  std::vector<float> window;
+  for (int v = 0; v < p->height; ++v) {
+    for (int u = 0; u < p->width; ++u) {
+      const size_t i = static_cast<size_t>(v) * p->width + u;
+      if (p->pixel_correction_mm[i] == 0.0f) continue;
+      window.clear();
+      for (int b = std::max(v - 2, 0); b <= std::min(v + 2, p->height - 1); ++b) {
+        for (int a = std::max(u - 2, 0); a <= std::min(u + 2, p->width - 1); ++a) {
+          const float c = p->pixel_correction_mm[static_cast<size_t>(b) * p->width + a];
+          if (c != 0.0f) window.push_back(c);
+        }
+      }
+      if (static_cast<int>(window.size()) < kFixedPatternMinNeighbours) continue;
+      const auto middle = window.begin() + static_cast<std::ptrdiff_t>(window.size() / 2);
+      std::nth_element(window.begin(), middle, window.end());
+      p->fixed_pattern_mm[i] = p->pixel_correction_mm[i] - *middle;
+    }
+  }
+}
+
+void apply_camera_profile(const CameraProfile& p, depth_image_t* frame, const link_labels_t* labels) {
   const size_t pixels = static_cast<size_t>(p.width) * static_cast<size_t>(p.height);
   if (frame->depth_mm.size() != pixels || p.pixel_correction_mm.size() != pixels) return;
+  const bool by_label = labels != nullptr && labels->label.size() == pixels;
+  CameraProfile derived;
+  const std::vector<float>* fixed_pattern = &p.fixed_pattern_mm;
+  if (by_label && fixed_pattern->size() != pixels) {
+    derived.width = p.width;
+    derived.height = p.height;
+    derived.pixel_correction_mm = p.pixel_correction_mm;
+    derive_fixed_pattern(&derived);
+    fixed_pattern = &derived.fixed_pattern_mm;
+  }
   for (int v = 0; v < p.height; ++v) {
     for (int u = 0; u < p.width; ++u) {
       const size_t i = static_cast<size_t>(v) * p.width + u;
@@ -64,7 +99,9 @@ void apply_camera_profile(const CameraProfile& p, depth_image_t* frame) {
       if (z_mm <= 0) continue;
       const double f = z_per_radial(p.fx, p.fy, p.cx, p.cy, u, v);
       const double r_m = z_mm * 1e-3 / f;
-      const double corrected = z_mm + f * p.distance_correction_at(r_m) + p.pixel_correction_mm[i];
+      const bool moving = by_label && on_moving_link(*labels, labels->label[i]);
+      const double pixel_mm = moving ? (*fixed_pattern)[i] : p.pixel_correction_mm[i];
+      const double corrected = z_mm + f * p.distance_correction_at(r_m) + pixel_mm;
       frame->depth_mm[i] =
           corrected >= 1 && corrected <= 32767 ? static_cast<int16_t>(std::lround(corrected)) : 0;
     }
@@ -98,6 +135,7 @@ CameraProfile read_camera_profile(const std::string& path) {
   }
   p.measured_on = map.string("measured_on");
   map.finish();
+  derive_fixed_pattern(&p);
   return p;
 }
 

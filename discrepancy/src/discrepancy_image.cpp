@@ -599,6 +599,7 @@ DiscrepancyOptions discrepancy_options(const DiscrepancySettings& config) {
   p.evidence.fixed_pattern_sigma_mm = config.evidence_fixed_pattern_sigma_mm;
   p.evidence.silhouette_band_px = config.evidence_silhouette_band_px;
   p.evidence.silhouette_bias_mm = config.evidence_silhouette_bias_mm;
+  p.evidence.silhouette_bias_by_link_mm = config.evidence_silhouette_bias_by_link_mm;
   return p;
 }
 
@@ -717,7 +718,7 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
     return frame;
   }
   depth_image_t corrected = camera;
-  apply_camera_profile(*options.camera_profile, &corrected);
+  apply_camera_profile(*options.camera_profile, &corrected, &labels);
   return compare_frames(corrected, rendered, labels, options, workers);
 }
 

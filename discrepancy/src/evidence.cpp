@@ -303,7 +303,7 @@ struct EvidenceSums {
 // The static error's reach into the camera fit of pixels n_first ..
 // n_end - 1 (as add_camera_fit's): bias_abs[a] += w |J_a|, bias_square[a]
 // += (w J_a)^2.
-void add_camera_bias_reach(const double* jacobian, const double* weight, const uint8_t* near_step,
+void add_camera_bias_reach(const double* jacobian, const double* weight, const float* near_step_mm,
                            int n_first, int n_end, double* bias_abs, double* bias_square,
                            double* near_step_abs) {
   for (int n = n_first; n < n_end; ++n) {
@@ -312,7 +312,7 @@ void add_camera_bias_reach(const double* jacobian, const double* weight, const u
       const double wj = weight[n] * j[a];
       bias_abs[a] += std::abs(wj);
       bias_square[a] += wj * wj;
-      if (near_step[n]) near_step_abs[a] += std::abs(wj);
+      near_step_abs[a] += near_step_mm[n] * std::abs(wj);
     }
   }
 }
@@ -410,9 +410,9 @@ struct EvidenceFrame {
   const depth_image_t& camera;
   const depth_image_t& rendered;
   const std::vector<uint8_t>& silhouette;
-  // The pixels on the near side of a step (near_side_of_steps; empty: no
-  // silhouette allowance).
-  const std::vector<uint8_t>& near_step;
+  // Per pixel, the silhouette allowance on the near side of a step (mm;
+  // near_step_allowance_mm; empty: none).
+  const std::vector<float>& near_step_mm;
   // The static pixels the naming search explains (when have_explained):
   // the arm's evidence, kept out of the camera fit.
   const std::vector<uint8_t>& explained_static;
@@ -437,7 +437,7 @@ struct RowFit {
       : jacobian(static_cast<size_t>(6 * (width + 1))),
         weight(static_cast<size_t>(width)),
         residual(static_cast<size_t>(width)),
-        near_step(static_cast<size_t>(width)) {}
+        near_step_mm(static_cast<size_t>(width)) {}
   // Pixels n_first..n_end of the row into image region `region`'s sums.
   void add_to(int n_first, int n_end, int region, EvidenceSums* b) const {
     if (n_first >= n_end) return;
@@ -445,20 +445,20 @@ struct RowFit {
     add_camera_fit(jacobian.data(), weight.data(), residual.data(), n_first, n_end, b->camera_score.data(),
                    b->camera_information.data(), b->camera_region_score + 6 * region,
                    b->camera_region_information + 6 * region);
-    add_camera_bias_reach(jacobian.data(), weight.data(), near_step.data(), n_first, n_end,
+    add_camera_bias_reach(jacobian.data(), weight.data(), near_step_mm.data(), n_first, n_end,
                           b->camera_region_bias_abs + 6 * region, b->camera_region_bias_square + 6 * region,
                           b->camera_region_near_step_abs + 6 * region);
   }
   std::vector<double> jacobian;
   std::vector<double> weight;
   std::vector<double> residual;
-  std::vector<uint8_t> near_step;
+  std::vector<float> near_step_mm;
   int fit = 0;
   int left = 0;
 };
 
 // A robot pixel's weighted residual into the joints it moves.
-void add_robot_pixel(double w, double r, bool in_naming_fit, bool near_step,
+void add_robot_pixel(double w, double r, bool in_naming_fit, double near_step_mm,
                      const std::vector<double>& joint_row, EvidenceSums* b) {
   ++b->robot_fit_pixels;
   b->robot_chi2 += w * r * r;
@@ -470,7 +470,7 @@ void add_robot_pixel(double w, double r, bool in_naming_fit, bool near_step,
     b->joint_information[j] += w * jj * jj;
     b->joint_bias_abs[j] += w * std::abs(jj);
     b->joint_bias_square[j] += w * w * jj * jj;
-    if (near_step) b->joint_near_step_abs[j] += w * std::abs(jj);
+    b->joint_near_step_abs[j] += near_step_mm * w * std::abs(jj);
     if (!in_naming_fit) continue;
     b->joint_naming_score[j] -= w * jj * r;
     b->joint_naming_information[j] += w * jj * jj;
@@ -479,7 +479,7 @@ void add_robot_pixel(double w, double r, bool in_naming_fit, bool near_step,
 
 // A static pixel's weighted residual into the static chi2 and, inside the
 // gate, into the row's camera fit (its Jacobian already in the row's slot).
-void add_static_pixel(double w, double r, bool in_naming_fit, bool near_step, bool left_half,
+void add_static_pixel(double w, double r, bool in_naming_fit, float near_step_mm, bool left_half,
                       double z_per_radial, RowFit* row, EvidenceSums* b) {
   b->static_chi2 += w * r * r;
   // A static pixel beyond the gate is outside the camera's linear model
@@ -499,7 +499,7 @@ void add_static_pixel(double w, double r, bool in_naming_fit, bool near_step, bo
   // Into the row's camera fit (added at the row's end, sum_row).
   row->weight[static_cast<size_t>(row->fit)] = w;
   row->residual[static_cast<size_t>(row->fit)] = r;
-  row->near_step[static_cast<size_t>(row->fit)] = near_step ? 1 : 0;
+  row->near_step_mm[static_cast<size_t>(row->fit)] = near_step_mm;
   if (left_half) row->left = row->fit + 1;
   ++row->fit;
 }
@@ -527,11 +527,11 @@ void add_pixel(const EvidenceFrame& f, int u, int v, int i, std::vector<double>*
   const double w = f.inv_pps / var;
   b->link_sum_wr[link] += w * r;
   b->link_sum_w[link] += w;
-  const bool near_step = !f.near_step.empty() && f.near_step[static_cast<size_t>(i)];
+  const float near_step_mm = f.near_step_mm.empty() ? 0.0f : f.near_step_mm[static_cast<size_t>(i)];
   if (moved) {
-    add_robot_pixel(w, r, in_naming_fit, near_step, *joint_row, b);
+    add_robot_pixel(w, r, in_naming_fit, near_step_mm, *joint_row, b);
   } else {
-    add_static_pixel(w, r, in_naming_fit, near_step, u < f.camera.width / 2,
+    add_static_pixel(w, r, in_naming_fit, near_step_mm, u < f.camera.width / 2,
                      z_per_radial(f.camera.fx, f.camera.fy, f.camera.cx, f.camera.cy, u, v), row, b);
   }
 }
@@ -638,11 +638,11 @@ void store_camera_fit(const EvidenceSums& total, discrepancy_t* s) {
 void shrink_by_static_error(const EvidenceSums& total, const EvidenceOptions& options, discrepancy_t* s) {
   const double b = options.static_bias_mm;
   const double fp = kFixedPatternSigmas * options.fixed_pattern_sigma_mm;
-  const double b_step = options.silhouette_band_px > 0 ? options.silhouette_bias_mm : 0.0;
   s->joint_static_bound.assign(s->joint_score.size(), 0.0);
-  if (!(b > 0) && !(fp > 0) && !(b_step > 0)) return;
+  if (!(b > 0) && !(fp > 0) && options.silhouette_band_px <= 0) return;
+  // near_step_abs carries each pixel's silhouette allowance already.
   const auto bound = [&](double bias_abs, double bias_square, double near_step_abs) {
-    return b * bias_abs + b_step * near_step_abs + fp * std::sqrt(bias_square);
+    return b * bias_abs + near_step_abs + fp * std::sqrt(bias_square);
   };
   for (size_t j = 0; j < s->joint_score.size(); ++j) {
     s->joint_static_bound[j] =
@@ -723,6 +723,30 @@ std::vector<uint8_t> near_side_of_steps(const depth_image_t& rendered, int band_
   return near;
 }
 
+std::vector<float> near_step_allowance_mm(const depth_image_t& rendered, const link_labels_t& labels,
+                                          const EvidenceOptions& options, double silhouette_jump_mm) {
+  if (options.silhouette_band_px <= 0) return {};
+  // Per link (labels' order): its own allowance where commissioning
+  // measured one, silhouette_bias_mm otherwise.
+  std::vector<float> by_link(static_cast<size_t>(std::max(labels.num_links, 0)),
+                             static_cast<float>(options.silhouette_bias_mm));
+  for (size_t k = 0; k < by_link.size() && k < labels.link_name.size(); ++k) {
+    const auto own = options.silhouette_bias_by_link_mm.find(labels.link_name[k]);
+    if (own != options.silhouette_bias_by_link_mm.end()) by_link[k] = static_cast<float>(own->second);
+  }
+  const std::vector<uint8_t> near =
+      near_side_of_steps(rendered, options.silhouette_band_px, silhouette_jump_mm);
+  std::vector<float> allowance(near.size(), 0.0f);
+  const bool labelled = labels.label.size() == near.size();
+  for (size_t i = 0; i < near.size(); ++i) {
+    if (!near[i]) continue;
+    const int link = labelled ? link_of_label(labels.label[i], labels.num_robot_links, labels.num_links) : -1;
+    allowance[i] =
+        link >= 0 ? by_link[static_cast<size_t>(link)] : static_cast<float>(options.silhouette_bias_mm);
+  }
+  return allowance;
+}
+
 void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered, const link_labels_t& labels,
                       const std::vector<uint8_t>& silhouette, double silhouette_jump_mm,
                       const DepthNoise& noise, const EvidenceOptions& options, discrepancy_t* summary,
@@ -742,14 +766,12 @@ void compute_evidence(const depth_image_t& camera, const depth_image_t& rendered
   search_joint_offsets(camera, rendered, labels, jacobian.kinematics(), noise, options, &s, &explained_static,
                        workers, beside);
   const int stride = evidence_stride(camera.width, camera.height, options.max_pixels);
-  const std::vector<uint8_t> near_step =
-      options.silhouette_bias_mm > 0
-          ? near_side_of_steps(rendered, options.silhouette_band_px, silhouette_jump_mm)
-          : std::vector<uint8_t>();
+  const std::vector<float> near_step_mm =
+      near_step_allowance_mm(rendered, labels, options, silhouette_jump_mm);
   const EvidenceFrame frame{camera,
                             rendered,
                             silhouette,
-                            near_step,
+                            near_step_mm,
                             explained_static,
                             explained_static.size() == static_cast<size_t>(num_pixels),
                             jacobian,

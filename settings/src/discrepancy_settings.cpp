@@ -54,6 +54,12 @@ DiscrepancySettings read_discrepancy_settings(YamlMap map) {
       YamlMap allowance = evidence.map("silhouette_allowance");
       d.evidence_silhouette_band_px = static_cast<int>(allowance.integer("band_px", 1, 64));
       d.evidence_silhouette_bias_mm = allowance.number("bias_mm", 0, 1000);
+      if (allowance.optional("by_link")) {
+        YamlMap by_link = allowance.map("by_link");
+        for (const std::string& link : by_link.keys())
+          d.evidence_silhouette_bias_by_link_mm[link] = by_link.number(link, 0, 1000);
+        by_link.finish();
+      }
       allowance.finish();
     }
     if (evidence.optional("max_pixels"))

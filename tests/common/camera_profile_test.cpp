@@ -74,6 +74,44 @@ TEST(CameraProfile, CorrectsEachPixelAlongItsRay) {
   }
 }
 
+// The map learned on the static scene is smooth over the image (here the
+// ramp i / 10) where the scene's surfaces add to it; the sensor's fixed
+// pattern is what stands out of its 5x5 neighbours (here +5 mm at (3, 2)).
+// A moving link's pixels get only that; the scene's and the robot's base's
+// the whole map.
+TEST(CameraProfile, AMovingLinksPixelGetsTheFixedPatternAndTheSceneTheWholeMap) {
+  const Intrinsics in = small_camera();
+  CameraProfile p = profile_of(in);
+  const size_t spike = 2 * 8 + 3, beside = spike + 1;
+  p.pixel_correction_mm[spike] += 5.0f;
+  derive_fixed_pattern(&p);
+  // The ramp's median within the window is the next value above the spike's.
+  EXPECT_NEAR(p.fixed_pattern_mm[spike], 6.9 - 2.0, 1e-4);
+  EXPECT_NEAR(p.fixed_pattern_mm[beside], 2.0 - 2.1, 1e-4);
+  EXPECT_EQ(p.fixed_pattern_mm[0], 0.0f) << "pixel 0 is unmapped (0)";
+
+  link_labels_t labels;
+  labels.num_robot_links = 2;
+  labels.num_links = 3;
+  labels.num_pixels = 48;
+  labels.label.assign(48, kLabelEnvironmentFirst);
+  labels.link_axis = {-1, 0};  // link 0 a base no joint moves, link 1 moved by axis 0
+  labels.num_link_axes = 2;
+  labels.label[spike] = kLabelRobotFirst + 1;
+  labels.label[beside] = kLabelRobotFirst + 0;
+  const depth_image_t measured = make_depth_image("cam", in, 1, 1, true, std::vector<float>(48, 1.5f));
+  depth_image_t by_label = measured, whole = measured, derived_here = measured;
+  apply_camera_profile(p, &by_label, &labels);
+  apply_camera_profile(p, &whole);
+  CameraProfile not_derived = p;
+  not_derived.fixed_pattern_mm.clear();
+  apply_camera_profile(not_derived, &derived_here, &labels);
+  EXPECT_EQ(by_label.depth_mm[spike] - whole.depth_mm[spike], -2) << "6.9 mm of map, 4.9 of fixed pattern";
+  EXPECT_EQ(by_label.depth_mm[beside], whole.depth_mm[beside]) << "the base keeps the whole map";
+  EXPECT_EQ(by_label.depth_mm[beside + 1], whole.depth_mm[beside + 1]) << "the scene keeps the whole map";
+  EXPECT_EQ(derived_here.depth_mm, by_label.depth_mm);
+}
+
 TEST(CameraProfile, NamesWhatDiffersFromTheFramesCamera) {
   const Intrinsics in = small_camera();
   const CameraProfile p = profile_of(in);

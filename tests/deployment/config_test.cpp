@@ -6,6 +6,7 @@
 #include <sys/stat.h>
 
 #include <algorithm>
+#include <map>
 #include <string>
 
 #include "tofguard/deployment/config.hpp"
@@ -198,6 +199,10 @@ INSTANTIATE_TEST_SUITE_P(
                   "    silhouette_allowance: {band_px: 11, bias_mm: 2.3}\n",
                   "    silhouette_allowance: {bias_mm: 2.3}\n",
                   {"discrepancy.evidence.silhouette_allowance.band_px", "missing key"}},
+        BadConfig{"silhouette-allowance-by-link-not-a-number",
+                  "    silhouette_allowance: {band_px: 11, bias_mm: 2.3}\n",
+                  "    silhouette_allowance: {band_px: 11, bias_mm: 2.3, by_link: {link7: wide}}\n",
+                  {"discrepancy.evidence.silhouette_allowance.by_link.link7", "'wide'"}},
         BadConfig{"worker-threads-zero",
                   "  worker_threads: auto\n",
                   "  worker_threads: 0\n",
@@ -244,6 +249,17 @@ INSTANTIATE_TEST_SUITE_P(
         if (c == '-') c = '_';
       return name;
     });
+
+TEST(Config, TheSilhouetteAllowanceTakesEachLinksOwnBound) {
+  const std::string path =
+      sim_variant("silhouette-by-link", "    silhouette_allowance: {band_px: 11, bias_mm: 2.3}\n",
+                  "    silhouette_allowance: {band_px: 11, bias_mm: 2.3, by_link: "
+                  "{link1: 2.3, link7: 0.4}}\n");
+  const deployment::Config config = deployment::load_config(path, nullptr);
+  EXPECT_EQ(config.discrepancy.evidence_silhouette_bias_mm, 2.3);
+  const std::map<std::string, double> expected = {{"link1", 2.3}, {"link7", 0.4}};
+  EXPECT_EQ(config.discrepancy.evidence_silhouette_bias_by_link_mm, expected);
+}
 
 TEST(Config, AKeyFileOpenToOthersIsAConfigError) {
   const std::string key = output_dir() + "/config-open.key";

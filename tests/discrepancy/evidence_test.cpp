@@ -991,6 +991,35 @@ TEST_F(EvidenceTest, TheSilhouetteAllowanceBoundsOnlyThePixelsNearSteps) {
     EXPECT_GT(wide.camera_static_bound[a], 0);
     EXPECT_LT(wide.camera_static_bound[a], everywhere.camera_static_bound[a]);
   }
+
+  // A link's own allowance (silhouette_bias_by_link_mm) serves its pixels:
+  // every link but the last at 0, the last's at 2 mm, bounds only the
+  // joints that move the last link, and those by its share of the 2 mm
+  // allowance of every link.
+  DiscrepancyOptions own = options_of(*config_);
+  own.evidence.silhouette_band_px = 8;
+  own.evidence.silhouette_bias_mm = 2.0;
+  for (size_t k = 0; k + 1 < static_cast<size_t>(model.labels.num_robot_links); ++k)
+    own.evidence.silhouette_bias_by_link_mm[model.labels.link_name[k]] = 0.0;
+  const std::string last = model.labels.link_name[static_cast<size_t>(model.labels.num_robot_links - 1)];
+  own.evidence.silhouette_bias_by_link_mm[last] = 2.0;
+  const discrepancy_t by_link = compute_discrepancy(seen, model.depth, model.labels, own).summary;
+  int joints_bounded = 0;
+  for (size_t j = 0; j < wide.joint_static_bound.size(); ++j) {
+    EXPECT_LE(by_link.joint_static_bound[j], wide.joint_static_bound[j] * (1 + 1e-12)) << wide.joint_name[j];
+    if (by_link.joint_static_bound[j] > 0) ++joints_bounded;
+  }
+  EXPECT_GE(joints_bounded, 1) << last << " is seen";
+  EXPECT_LT(by_link.joint_static_bound[0], wide.joint_static_bound[0]) << "the first joint moves more links";
+  const std::vector<float> allowance = near_step_allowance_mm(model.depth, model.labels, own.evidence,
+                                                              config_->discrepancy.silhouette_jump_mm);
+  for (size_t i = 0; i < allowance.size(); ++i) {
+    const int link =
+        link_of_label(model.labels.label[i], model.labels.num_robot_links, model.labels.num_links);
+    if (allowance[i] == 0.0f) continue;
+    ASSERT_TRUE(link < 0 || link >= model.labels.num_robot_links - 1) << "pixel " << i << " of link " << link;
+    ASSERT_EQ(allowance[i], 2.0f);
+  }
 }
 
 }  // namespace

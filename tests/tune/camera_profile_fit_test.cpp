@@ -84,5 +84,71 @@ TEST(CameraProfileFit, SmoothCorrectionHoldsWhereTheSamplesCrowdAtOneEndOfEachBi
   EXPECT_LT(fit.pixel_sigma_mm, 0.9);
 }
 
+// The per-pixel map is learned on surfaces no joint moves: a link's own
+// error (here 8 mm of multipath on rows 0-5) moves with it and would be
+// wrong for the scene behind when the link has gone.
+TEST(CameraProfileFit, LearnsNoPixelOffsetFromAMovingLink) {
+  discrepancy::Tolerance tolerance;
+  tolerance.noise = DepthNoise{3.0, 0.0};
+  ProfileFitOptions options;
+  options.min_bin_samples = 1000;
+  std::vector<RenderedPair> frames = crowded_frames(24);
+  for (RenderedPair& pair : frames) {
+    pair.labels.num_robot_links = 1;
+    pair.labels.num_links = 2;
+    pair.labels.link_name = {"forearm", "wall"};
+    for (size_t i = 0; i < static_cast<size_t>(kRowsPerSurface * kImageWidth); ++i) {
+      pair.labels.label[i] = kLabelRobotFirst;
+      pair.camera.depth_mm[i] = static_cast<int16_t>(pair.camera.depth_mm[i] + 8);
+    }
+  }
+  const ProfileFit fit = fit_camera_profile(frames, tolerance, 0.0, options);
+  ASSERT_TRUE(fit.ok) << fit.error;
+  for (size_t i = 0; i < static_cast<size_t>(kRowsPerSurface * kImageWidth); ++i)
+    ASSERT_EQ(fit.profile.pixel_correction_mm[i], 0.0f) << "pixel " << i;
+  EXPECT_GT(fit.mapped_pixels, kImageWidth * (kImageHeight - kRowsPerSurface) / 2);
+  EXPECT_LE(fit.mapped_pixels, kImageWidth * (kImageHeight - kRowsPerSurface));
+}
+
+// A checking recording whose arm comes nearer the camera than the learning
+// one went: its pixels there get the correction's end value, a guess.
+TEST(CameraProfileFit, CoverageCountsTheArmsPixelsOutsideTheProfilesRange) {
+  discrepancy::Tolerance tolerance;
+  tolerance.noise = DepthNoise{3.0, 0.0};
+  ProfileFitOptions options;
+  options.min_bin_samples = 1000;
+  const ProfileFit fit = fit_camera_profile(crowded_frames(24), tolerance, 0.0, options);
+  ASSERT_TRUE(fit.ok) << fit.error;
+  // An arm link (moved by a joint: no link_axis given) on the first 12
+  // rows: at 0.90 m on rows 0-5, outside the profile's 1.0-1.95 m; at
+  // 1.30 m on rows 6-11, inside.
+  std::vector<RenderedPair> checking = crowded_frames(2);
+  for (RenderedPair& pair : checking) {
+    pair.labels.num_robot_links = 1;
+    pair.labels.num_links = 2;
+    pair.labels.link_name = {"forearm", "wall"};
+    const depth_image_t& in = pair.rendered;
+    for (int v = 0; v < 2 * kRowsPerSurface; ++v) {
+      const double r_m = v < kRowsPerSurface ? 0.90 : 1.30;
+      for (int u = 0; u < kImageWidth; ++u) {
+        const size_t i = static_cast<size_t>(v) * kImageWidth + u;
+        const double f = z_per_radial(in.fx, in.fy, in.cx, in.cy, u, v);
+        pair.labels.label[i] = kLabelRobotFirst;
+        pair.rendered.depth_mm[i] = static_cast<int16_t>(std::lround(1000 * r_m * f));
+        pair.camera.depth_mm[i] = static_cast<int16_t>(std::lround(1000 * r_m * f + f * residual_mm(r_m)));
+      }
+    }
+  }
+  const ProfileCoverage coverage = profile_coverage(fit.profile, checking, 0.0);
+  EXPECT_EQ(coverage.pixels, 2 * 2 * kRowsPerSurface * kImageWidth) << "the arm's pixels only";
+  EXPECT_EQ(coverage.outside, 2 * kRowsPerSurface * kImageWidth);
+  EXPECT_NEAR(coverage.outside_share(), 0.5, 1e-9);
+  EXPECT_GT(coverage.first_m, 0.95);
+  EXPECT_NEAR(coverage.nearest_m, 0.89, 0.01) << "0.90 m read 10 mm nearer";
+  EXPECT_GT(coverage.outside_share(), kMaxShareOutsideProfile);
+  // The learning recording itself is inside (its arm-free frames: none).
+  EXPECT_EQ(profile_coverage(fit.profile, crowded_frames(2), 0.0).pixels, 0);
+}
+
 }  // namespace
 }  // namespace tofguard::tune

@@ -263,7 +263,8 @@ bool fit_smooth_part(const std::vector<RenderedPair>& frames, const std::vector<
   return true;
 }
 
-// Step 2: the per-pixel offsets after the smooth part, into fit->profile.
+// Step 2: the per-pixel offsets after the smooth part, on the pixels of
+// surfaces no joint moves, into fit->profile.
 void fit_pixel_part(const std::vector<RenderedPair>& frames, const std::vector<double>& f,
                     const discrepancy::Tolerance& tolerance, double silhouette_jump_mm,
                     const ProfileFitOptions& options, ProfileFit* fit) {
@@ -274,7 +275,10 @@ void fit_pixel_part(const std::vector<RenderedPair>& frames, const std::vector<d
   for (const RenderedPair& frame : frames) {
     const std::vector<uint8_t> used = noise_pixels(frame, silhouette_jump_mm);
     for (size_t i = 0; i < n; ++i) {
-      if (!used[i]) continue;
+      // The pixels of surfaces no joint moves only: a moving link's own
+      // multipath and reflectivity move with it (the fixed pattern serves
+      // its pixels).
+      if (!used[i] || on_moving_link(frame.labels, frame.labels.label[i])) continue;
       const double gen = frame.rendered.depth_mm[i];
       const int t = frame.camera.depth_mm[i];
       // The smooth part as it is applied: at the measured distance.
@@ -304,9 +308,35 @@ void fit_pixel_part(const std::vector<RenderedPair>& frames, const std::vector<d
   }
   if (fit->mapped_pixels > 0)
     fit->pixel_sigma_mm = std::sqrt(sum_squares / static_cast<double>(fit->mapped_pixels));
+  derive_fixed_pattern(&p);
 }
 
 }  // namespace
+
+ProfileCoverage profile_coverage(const CameraProfile& profile, const std::vector<RenderedPair>& frames,
+                                 double silhouette_jump_mm) {
+  ProfileCoverage coverage;
+  coverage.first_m = profile.distance_first_m;
+  coverage.last_m = profile.distance_first_m +
+                    profile.distance_bin_m * static_cast<double>(profile.distance_correction_mm.size() - 1);
+  const double margin_m = profile.distance_bin_m;
+  std::vector<double> f;
+  for (const RenderedPair& frame : frames) {
+    if (!profile_mismatch(profile, frame.camera).empty()) continue;
+    if (f.empty()) f = z_per_radial_image(frame.camera);
+    const std::vector<uint8_t> used = noise_pixels(frame, silhouette_jump_mm);
+    for (size_t i = 0; i < used.size(); ++i) {
+      if (!used[i] || !on_moving_link(frame.labels, frame.labels.label[i])) continue;
+      const double r_m = frame.camera.depth_mm[i] * 1e-3 / f[i];
+      ++coverage.pixels;
+      if (r_m >= coverage.first_m - margin_m && r_m <= coverage.last_m + margin_m) continue;
+      ++coverage.outside;
+      if (coverage.nearest_m == 0 || r_m < coverage.nearest_m) coverage.nearest_m = r_m;
+      coverage.farthest_m = std::max(coverage.farthest_m, r_m);
+    }
+  }
+  return coverage;
+}
 
 ProfileFit fit_camera_profile(const std::vector<RenderedPair>& frames,
                               const discrepancy::Tolerance& tolerance, double silhouette_jump_mm,

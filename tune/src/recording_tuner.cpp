@@ -43,6 +43,7 @@ EvidenceRun run_evidence(const std::vector<RenderedPair>& frames, const TuneSett
   options.evidence.fixed_pattern_sigma_mm = model.fixed_pattern_sigma_mm;
   options.evidence.silhouette_band_px = model.silhouette_band_px;
   options.evidence.silhouette_bias_mm = model.silhouette_bias_mm;
+  options.evidence.silhouette_bias_by_link_mm = model.silhouette_bias_by_link_mm;
   // The frames are corrected already (correct_frames).
   options.camera_profile = nullptr;
   risk::SequentialEvidence evidence(settings.risk, tree, settings.renderer.camera.rate_hz);
@@ -210,6 +211,24 @@ class RecordingRenderer {
   std::map<std::string, std::pair<double, double>> joint_range_;  // min, max
 };
 
+// Why the configured `profile` does not cover the distances of `frames`
+// (ProfileCoverage, into result->profile_coverage); empty when it does.
+std::string coverage_error(const CameraProfile& profile, const std::vector<RenderedPair>& frames,
+                           const TuneSettings& settings, TuneResult* result) {
+  const ProfileCoverage c = profile_coverage(profile, frames, settings.discrepancy.silhouette_jump_mm);
+  result->profile_coverage = c;
+  if (c.outside_share() <= kMaxShareOutsideProfile) return "";
+  std::ostringstream why;
+  why << std::fixed << std::setprecision(2) << result->log_path << ": " << profile.file
+      << ": its distance correction was measured over " << c.first_m << "-" << c.last_m << " m (radial), and "
+      << std::setprecision(1) << 100 * c.outside_share()
+      << " % of this recording's arm pixels lie more than a bin (" << std::setprecision(2)
+      << profile.distance_bin_m << " m) outside it (" << std::setprecision(2) << c.nearest_m << "-"
+      << c.farthest_m << " m; at most " << std::setprecision(1) << 100 * kMaxShareOutsideProfile
+      << " %): learn the profile on a recording that takes the arm through its whole workspace";
+  return why.str();
+}
+
 // The camera's profile applied to every frame: the one learned from the
 // frames (options.learn_profile) or the config's (discrepancy.camera_profile);
 // frames as recorded without either. Why it cannot be; empty when it can.
@@ -234,11 +253,14 @@ std::string correct_frames(const TuneSettings& settings, const TuneOptions& opti
   }
   const CameraProfile* profile = result->has_profile ? &result->profile_fit.profile : configured.get();
   if (profile == nullptr) return "";
+  if (!result->has_profile) {
+    if (const std::string why = coverage_error(*profile, *frames, settings, result); !why.empty()) return why;
+  }
   for (RenderedPair& frame : *frames) {
     if (const std::string why = profile_mismatch(*profile, frame.camera); !why.empty()) {
       return result->log_path + ": " + why;
     }
-    apply_camera_profile(*profile, &frame.camera);
+    apply_camera_profile(*profile, &frame.camera, &frame.labels);
   }
   result->profile_applied = profile->file.empty() ? "learned from this recording" : profile->file;
   return "";
@@ -403,9 +425,12 @@ void measure_near_step_error(const std::vector<RenderedPair>& frames, const Tune
   error->step_ring_samples.assign(rings, 0);
   double largest_mm = 0;
   for (const auto& [link, by_ring] : sums) {
+    bool measured = false;
+    double link_largest_mm = smooth_allowance_mm;
     for (int k = 0; k < rings; ++k) {
       const auto& [n, sum, sum_squares] = by_ring[static_cast<size_t>(k)];
       if (n < kMinStepRingSamples) continue;
+      measured = true;
       const double mean = sum / n;
       const double variance = std::max(0.0, (sum_squares - n * mean * mean) / (n - 1));
       if (std::abs(mean) > std::abs(error->step_ring_mean_mm[k])) {
@@ -415,12 +440,15 @@ void measure_near_step_error(const std::vector<RenderedPair>& frames, const Tune
       const double bound = std::abs(mean) + 2 * std::sqrt(variance / n);
       if (bound <= smooth_allowance_mm) continue;
       error->silhouette_band_px = std::max(error->silhouette_band_px, k + 1);
+      link_largest_mm = std::max(link_largest_mm, bound);
       if (bound > largest_mm) {
         largest_mm = bound;
         error->silhouette_link = link;
       }
     }
+    if (measured) error->silhouette_bias_by_link_mm[link] = link_largest_mm - smooth_allowance_mm;
   }
+  if (error->silhouette_band_px == 0) error->silhouette_bias_by_link_mm.clear();
   error->silhouette_bias_mm = error->silhouette_band_px > 0 ? largest_mm - smooth_allowance_mm : 0.0;
 }
 
@@ -536,6 +564,8 @@ void run_sequential_tests(const std::vector<RenderedPair>& frames, const TuneSet
   tuned.fixed_pattern_sigma_mm = rounded_up_mm(result->static_error.fixed_pattern_sigma_mm);
   tuned.silhouette_band_px = result->static_error.silhouette_band_px;
   tuned.silhouette_bias_mm = rounded_up_mm(result->static_error.silhouette_bias_mm);
+  for (const auto& [link, bias_mm] : result->static_error.silhouette_bias_by_link_mm)
+    tuned.silhouette_bias_by_link_mm[link] = rounded_up_mm(bias_mm);
   result->tuned = run_evidence(frames, settings, tree, tuned);
   result->measured_static_bias_mm = tuned.static_bias_mm;
   raise_allowance_to_the_warning_level(frames, settings, tree, result);
@@ -549,6 +579,7 @@ void run_sequential_tests(const std::vector<RenderedPair>& frames, const TuneSet
     configured.fixed_pattern_sigma_mm = settings.discrepancy.evidence_fixed_pattern_sigma_mm;
     configured.silhouette_band_px = settings.discrepancy.evidence_silhouette_band_px;
     configured.silhouette_bias_mm = settings.discrepancy.evidence_silhouette_bias_mm;
+    configured.silhouette_bias_by_link_mm = settings.discrepancy.evidence_silhouette_bias_by_link_mm;
     result->configured = run_evidence(frames, settings, tree, configured);
   }
 }
@@ -694,7 +725,12 @@ std::string tune_report(const TuneResult& r, const TuneSettings& settings) {
         << "  the figures below are on the recording it was learned from: check it on a second recording "
         << "(name it in discrepancy.camera_profile, run tofguard-tune on that recording, deploy its lines)\n";
   } else if (!r.profile_applied.empty()) {
-    out << "camera profile applied: " << r.profile_applied << "\n";
+    const ProfileCoverage& c = r.profile_coverage;
+    out << "camera profile applied: " << r.profile_applied << "; its distance correction covers "
+        << fixed(c.first_m, 2) << ".." << fixed(c.last_m, 2) << " m radial, "
+        << fixed(100 * c.outside_share(), 2)
+        << " % of the arm's compared pixels more than a bin outside it (at most "
+        << fixed(100 * kMaxShareOutsideProfile, 1) << " %)\n";
   }
   const StaticError& e = r.static_error;
   out << "static error (the same in every frame): smooth part within " << fixed(e.smooth_bound_mm, 1)
@@ -788,9 +824,20 @@ std::string tuned_config_lines(const TuneResult& r, const std::string& date) {
       << "    fixed_pattern_sigma_mm: " << fixed(r.tuned.fixed_pattern_sigma_mm, 1) << "\n";
   if (r.tuned.silhouette_band_px > 0) {
     out << "    # The arm's pixels within band_px of a farther surface read this much more\n"
-        << "    # (multipath), their rings' largest |mean| + 2 standard errors beyond static_bias_mm.\n"
+        << "    # (multipath), their rings' largest |mean| + 2 standard errors beyond static_bias_mm;\n"
+        << "    # by_link: each measured link's own, bias_mm the largest (other links, the scene).\n"
         << "    silhouette_allowance: {band_px: " << r.tuned.silhouette_band_px
-        << ", bias_mm: " << fixed(r.tuned.silhouette_bias_mm, 1) << "}\n";
+        << ", bias_mm: " << fixed(r.tuned.silhouette_bias_mm, 1);
+    if (!r.tuned.silhouette_bias_by_link_mm.empty()) {
+      out << ", by_link: {";
+      const char* separator = "";
+      for (const auto& [link, bias_mm] : r.tuned.silhouette_bias_by_link_mm) {
+        out << separator << link << ": " << fixed(bias_mm, 1);
+        separator = ", ";
+      }
+      out << "}";
+    }
+    out << "}\n";
   }
   return out.str();
 }

@@ -7,7 +7,11 @@
 //
 // The correction of pixel (u, v) whose camera depth is Z (mm, optical
 // frame) is
-//   Z' = Z + f * distance_correction_mm(r) + pixel_correction_mm[v * width + u],
+//   Z' = Z + f * distance_correction_mm(r) + pixel_correction_mm[v * width + u]
+// where the rendered frame shows a surface no joint moves (the scene, the
+// robot's base) or nothing, and
+//   Z' = Z + f * distance_correction_mm(r) + fixed_pattern_mm[v * width + u]
+// where it shows a link a joint moves (apply_camera_profile with labels),
 // r = Z / f the radial distance along the pixel's ray (m) and
 // f = 1 / sqrt(1 + ((u - cx) / fx)^2 + ((v - cy) / fy)^2) its Z per unit of
 // r: a ToF camera errs along the ray, smoothly in r (its "wiggling").
@@ -24,6 +28,7 @@
 #include <vector>
 
 #include "tofguard/depth_image_t.hpp"
+#include "tofguard/link_labels_t.hpp"
 
 namespace tofguard {
 
@@ -43,8 +48,18 @@ struct CameraProfile {
   double distance_bin_m = 0.05;
   std::vector<double> distance_correction_mm;
   // The per-pixel part (row-major, width * height), mm in Z; 0 where it
-  // was not measured.
+  // was not measured. Learned on the pixels of surfaces no joint moves
+  // (the scene, the robot's base): it holds the sensor's fixed pattern and,
+  // smooth over the image, what those surfaces add there (their multipath,
+  // their reflectivity), which is wrong for a link passing in front.
   std::vector<float> pixel_correction_mm;
+  // The sensor's part of it, applied to the moving links' pixels: each mapped
+  // pixel's correction less the median of the mapped ones within 2 pixels
+  // (5x5, itself included; a median keeps the scene's edges out of it), mm
+  // in Z; 0 where unmapped or with fewer than kFixedPatternMinNeighbours
+  // mapped. Not in the file: derive_fixed_pattern fills it from
+  // pixel_correction_mm (read_camera_profile and commissioning call it).
+  std::vector<float> fixed_pattern_mm;
   // What the correction leaves, as measured on a recording with the profile
   // applied (the evidence's static_bias_mm and fixed_pattern_sigma_mm
   // belong to that measurement, not to this file): for the report only.
@@ -68,10 +83,23 @@ inline double z_per_radial(double fx, double fy, double cx, double cy, int u, in
 // both values), or "" when it is.
 std::string profile_mismatch(const CameraProfile& profile, const depth_image_t& frame);
 
+// The fewest mapped pixels of a 5x5 window whose median the fixed pattern
+// is taken against.
+constexpr int kFixedPatternMinNeighbours = 9;
+
+// Fills profile->fixed_pattern_mm from its pixel_correction_mm.
+void derive_fixed_pattern(CameraProfile* profile);
+
 // Corrects `frame`'s depth_mm in place (its valid pixels; a result outside
 // 1..32767 mm becomes 0, invalid). The frame must match (profile_mismatch
-// empty).
-void apply_camera_profile(const CameraProfile& profile, depth_image_t* frame);
+// empty). `labels`: the rendered frame's link labels for the same pixels;
+// the pixels of links a joint moves (on_moving_link) get the fixed pattern
+// instead of the whole map.
+// Without labels (or labels of another size) every pixel gets the whole
+// map. A profile whose fixed_pattern_mm is not filled has it derived here
+// (for each call: fill it once with derive_fixed_pattern).
+void apply_camera_profile(const CameraProfile& profile, depth_image_t* frame,
+                          const link_labels_t* labels = nullptr);
 
 // Reads a profile file (YAML); throws ConfigError with a one-line message
 // naming the file and the field.

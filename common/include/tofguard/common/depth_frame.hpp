@@ -90,6 +90,18 @@ constexpr int link_of_label(int label, int num_robot_links, int num_links) {
   return -1;
 }
 
+// Whether `label` is a robot link that a joint moves: its link_axis (the
+// nearest moving axis above it) is >= 0. The environment's links, the
+// robot's links fixed to its root (a base), nothing and extra objects are
+// not. Labels without a link_axis per robot link: every robot link moves.
+// Called per pixel: inline.
+inline bool on_moving_link(const link_labels_t& labels, int label) {
+  const int link = link_of_label(label, labels.num_robot_links, labels.num_robot_links);
+  if (link < 0) return false;
+  if (labels.link_axis.size() != static_cast<size_t>(labels.num_robot_links)) return true;
+  return labels.link_axis[static_cast<size_t>(link)] >= 0;
+}
+
 // A robot link's label / an environment link's label (whatever the number
 // of links).
 constexpr bool is_robot_label(int label) {

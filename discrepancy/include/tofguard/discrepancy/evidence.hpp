@@ -24,6 +24,8 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <map>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -92,8 +94,12 @@ struct EvidenceOptions {
   //    before the arm): it moves with the arm, so no per-pixel profile
   //    learns it. Such pixels add silhouette_bias_mm * w |J| to B.
   //    0 and 0: none.
+  //    silhouette_bias_by_link_mm: the bound of a link's own pixels (by
+  //    link name), where commissioning measured it; the other links' and
+  //    the scene's pixels take silhouette_bias_mm (the largest measured).
   double silhouette_bias_mm = 0.0;
   int silhouette_band_px = 0;
+  std::map<std::string, double> silhouette_bias_by_link_mm;
 };
 
 // The pixels on the near side of a rendered step (row-major, 1 = within
@@ -102,6 +108,12 @@ struct EvidenceOptions {
 // band_px <= 0. A pixel without a rendered surface is no step.
 std::vector<uint8_t> near_side_of_steps(const depth_image_t& rendered, int band_px,
                                         double silhouette_jump_mm);
+// Per pixel (row-major), the silhouette allowance of `rendered`'s pixels on
+// the near side of a step (near_side_of_steps within silhouette_band_px):
+// silhouette_bias_by_link_mm of its link where given, silhouette_bias_mm
+// otherwise; 0 elsewhere. Empty when silhouette_band_px <= 0.
+std::vector<float> near_step_allowance_mm(const depth_image_t& rendered, const link_labels_t& labels,
+                                          const EvidenceOptions& options, double silhouette_jump_mm);
 // Per pixel, how far (pixels, Chebyshev, 1..max_px) the nearest rendered
 // surface farther than it by more than silhouette_step's jump is; 0: none
 // within max_px (or no rendered surface). max_px at most 255.

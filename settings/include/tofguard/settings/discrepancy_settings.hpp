@@ -4,6 +4,7 @@
 // compared. Durations are integer microseconds, converted once when the file
 // is read.
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <string>
 
@@ -77,8 +78,11 @@ struct DiscrepancySettings {
   // error of the pixels on the near side of a rendered step, within
   // band_px of it, beyond static_bias_mm (a camera's multipath in front of
   // a farther surface: it moves with the arm, no profile learns it), mm.
+  // by_link (optional): a link's own bound, by link name, where
+  // commissioning measured it; other links and the scene take bias_mm.
   int evidence_silhouette_band_px = 0;
   double evidence_silhouette_bias_mm = 0;
+  std::map<std::string, double> evidence_silhouette_bias_by_link_mm;
   // camera_profile (optional; absent: none): the camera's commissioned
   // profile file (tofguard-tune --profile-out; docs/camera.md,
   // "Commissioning a camera"), read with the config: every frame is

@@ -17,7 +17,9 @@
 //    between them interpolated (added to the measured distance, it zeroes
 //    it).
 // 2. The per-pixel part: each pixel's mean of I_dis - f c(r) (r measured)
-//    over the frames where it is within the tolerance (4 sigma + model
+//    over the frames where it sees a surface no joint moves (the scene, the
+//    robot's base; a link's own multipath moves with it) and is within the
+//    tolerance (4 sigma + model
 //    tolerance: an object or a fault is not learned as an offset), for
 //    pixels seen in at least min_pixel_frames frames of which at most
 //    max_outlier_fraction were beyond it; 0 elsewhere.
@@ -102,5 +104,32 @@ struct ProfileFit {
 ProfileFit fit_camera_profile(const std::vector<RenderedPair>& frames,
                               const discrepancy::Tolerance& tolerance, double silhouette_jump_mm,
                               const ProfileFitOptions& options = {});
+
+// How `frames` (a recording the profile was not learned on) stay within the
+// distances `profile`'s smooth correction was measured over: of the
+// compared pixels (noise_pixels) of links a joint moves, how many the
+// camera measured at a radial distance more than one bin beyond the
+// profile's end bins' centres (which lie within a bin of its outermost
+// measured points), where the correction holds its end value: a guess
+// that the allowances measured on a recording inside the range do not
+// cover. A
+// profile learned on a recording that kept the arm farther from the camera
+// than it goes misleads the evidence there (on the Kinova Gen3's camera 5,
+// a 12 s recording: joint 5 read 1.2 deg off 0.86-0.96 m from the camera).
+struct ProfileCoverage {
+  int64_t pixels = 0;                    // compared pixels of moving links
+  int64_t outside = 0;                   // of them, outside [first_m - bin, last_m + bin]
+  double first_m = 0, last_m = 0;        // the profile's range (radial, m)
+  double nearest_m = 0, farthest_m = 0;  // of the pixels outside (radial, m; 0: none)
+  double outside_share() const { return pixels > 0 ? static_cast<double>(outside) / pixels : 0.0; }
+};
+ProfileCoverage profile_coverage(const CameraProfile& profile, const std::vector<RenderedPair>& frames,
+                                 double silhouette_jump_mm);
+
+// The largest share of a checking recording's moving-link pixels that may
+// lie outside the profile's range (ProfileCoverage::outside_share): more
+// refuses the profile (tofguard-tune on a checking recording): the
+// allowances measured on the rest would not hold there.
+constexpr double kMaxShareOutsideProfile = 0.005;
 
 }  // namespace tofguard::tune

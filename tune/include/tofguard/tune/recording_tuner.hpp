@@ -12,6 +12,7 @@
 //
 // No LCM traffic (the log is read from its file), no clocks.
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -107,13 +108,16 @@ struct StaticError {
   // moves with the arm). A link's ring with at least kMinStepRingSamples
   // samples whose |mean| + 2 standard errors exceeds the smooth allowance
   // joins the band (band_px: the farthest such ring); bias_mm: the largest
-  // such bound less the smooth allowance (silhouette_link: whose). Per
-  // ring: the largest |mean| of a link and its samples.
+  // such bound less the smooth allowance (silhouette_link: whose);
+  // silhouette_bias_by_link_mm: each measured link's own (0 for a link
+  // none of whose rings exceeds it). Per ring: the largest |mean| of a
+  // link and its samples.
   std::vector<double> step_ring_mean_mm;
   std::vector<int64_t> step_ring_samples;
   int silhouette_band_px = 0;
   double silhouette_bias_mm = 0;
   std::string silhouette_link;
+  std::map<std::string, double> silhouette_bias_by_link_mm;
 };
 
 constexpr int kStepRingsPx = 12;
@@ -129,6 +133,7 @@ struct EvidenceRun {
   double fixed_pattern_sigma_mm = 0;
   int silhouette_band_px = 0;
   double silhouette_bias_mm = 0;
+  std::map<std::string, double> silhouette_bias_by_link_mm;
   std::vector<ParameterScores> parameters;
   double max_cusum = 0;
   std::string max_cusum_hypothesis;
@@ -178,6 +183,9 @@ struct TuneResult {
   bool has_profile = false;
   ProfileFit profile_fit;
   std::string profile_applied;
+  // A configured profile's range against the recording's distances
+  // (checking recordings only; pixels 0 when it was learned here).
+  ProfileCoverage profile_coverage;
 
   double threshold_h = 0;
   double warning_level = 0;
