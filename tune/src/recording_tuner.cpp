@@ -219,7 +219,8 @@ std::string coverage_error(const CameraProfile& profile, const std::vector<Rende
   result->profile_coverage = c;
   if (c.outside_share() <= kMaxShareOutsideProfile) return "";
   std::ostringstream why;
-  why << std::fixed << std::setprecision(2) << result->log_path << ": " << profile.file
+  why << std::fixed << std::setprecision(2) << result->log_path << ": "
+      << (profile.file.empty() ? std::string("the camera profile (in memory)") : profile.file)
       << ": its distance correction was measured over " << c.first_m << "-" << c.last_m << " m (radial), and "
       << std::setprecision(1) << 100 * c.outside_share()
       << " % of this recording's arm pixels lie more than a bin (" << std::setprecision(2)
