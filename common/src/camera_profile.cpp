@@ -55,43 +55,47 @@ std::string profile_mismatch(const CameraProfile& p, const depth_image_t& frame)
   return "";
 }
 
-void derive_fixed_pattern(CameraProfile* p) {
-  const size_t pixels = p->pixel_correction_mm.size();
-  p->fixed_pattern_mm.assign(pixels, 0.0f);
-  if (pixels != static_cast<size_t>(p->width) * static_cast<size_t>(p->height)) return;
+namespace {
+
+// CameraProfile::fixed_pattern_mm of a width x height map.
+std::vector<float> fixed_pattern_of(const std::vector<float>& map, int width, int height) {
+  std::vector<float> pattern(map.size(), 0.0f);
+  if (map.size() != static_cast<size_t>(width) * static_cast<size_t>(height)) return pattern;
   std::vector<float> window;
-  for (int v = 0; v < p->height; ++v) {
-    for (int u = 0; u < p->width; ++u) {
-      const size_t i = static_cast<size_t>(v) * p->width + u;
-      if (p->pixel_correction_mm[i] == 0.0f) continue;
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      const size_t i = static_cast<size_t>(v) * width + u;
+      if (map[i] == 0.0f) continue;
       window.clear();
-      for (int b = std::max(v - 2, 0); b <= std::min(v + 2, p->height - 1); ++b) {
-        for (int a = std::max(u - 2, 0); a <= std::min(u + 2, p->width - 1); ++a) {
-          const float c = p->pixel_correction_mm[static_cast<size_t>(b) * p->width + a];
+      for (int b = std::max(v - 2, 0); b <= std::min(v + 2, height - 1); ++b) {
+        for (int a = std::max(u - 2, 0); a <= std::min(u + 2, width - 1); ++a) {
+          const float c = map[static_cast<size_t>(b) * width + a];
           if (c != 0.0f) window.push_back(c);
         }
       }
       if (static_cast<int>(window.size()) < kFixedPatternMinNeighbours) continue;
       const auto middle = window.begin() + static_cast<std::ptrdiff_t>(window.size() / 2);
       std::nth_element(window.begin(), middle, window.end());
-      p->fixed_pattern_mm[i] = p->pixel_correction_mm[i] - *middle;
+      pattern[i] = map[i] - *middle;
     }
   }
+  return pattern;
+}
+
+}  // namespace
+
+void derive_fixed_pattern(CameraProfile* p) {
+  p->fixed_pattern_mm = fixed_pattern_of(p->pixel_correction_mm, p->width, p->height);
 }
 
 void apply_camera_profile(const CameraProfile& p, depth_image_t* frame, const link_labels_t* labels) {
   const size_t pixels = static_cast<size_t>(p.width) * static_cast<size_t>(p.height);
   if (frame->depth_mm.size() != pixels || p.pixel_correction_mm.size() != pixels) return;
   const bool by_label = labels != nullptr && labels->label.size() == pixels;
-  CameraProfile derived;
-  const std::vector<float>* fixed_pattern = &p.fixed_pattern_mm;
-  if (by_label && fixed_pattern->size() != pixels) {
-    derived.width = p.width;
-    derived.height = p.height;
-    derived.pixel_correction_mm = p.pixel_correction_mm;
-    derive_fixed_pattern(&derived);
-    fixed_pattern = &derived.fixed_pattern_mm;
-  }
+  const bool derive_here = by_label && p.fixed_pattern_mm.size() != pixels;
+  const std::vector<float> derived =
+      derive_here ? fixed_pattern_of(p.pixel_correction_mm, p.width, p.height) : std::vector<float>();
+  const std::vector<float>& fixed_pattern = derive_here ? derived : p.fixed_pattern_mm;
   for (int v = 0; v < p.height; ++v) {
     for (int u = 0; u < p.width; ++u) {
       const size_t i = static_cast<size_t>(v) * p.width + u;
@@ -100,7 +104,7 @@ void apply_camera_profile(const CameraProfile& p, depth_image_t* frame, const li
       const double f = z_per_radial(p.fx, p.fy, p.cx, p.cy, u, v);
       const double r_m = z_mm * 1e-3 / f;
       const bool moving = by_label && on_moving_link(*labels, labels->label[i]);
-      const double pixel_mm = moving ? (*fixed_pattern)[i] : p.pixel_correction_mm[i];
+      const double pixel_mm = moving ? fixed_pattern[i] : p.pixel_correction_mm[i];
       const double corrected = z_mm + f * p.distance_correction_at(r_m) + pixel_mm;
       frame->depth_mm[i] =
           corrected >= 1 && corrected <= 32767 ? static_cast<int16_t>(std::lround(corrected)) : 0;

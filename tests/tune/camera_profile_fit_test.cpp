@@ -59,12 +59,25 @@ std::vector<RenderedPair> crowded_frames(int count) {
   return frames;
 }
 
-TEST(CameraProfileFit, SmoothCorrectionHoldsWhereTheSamplesCrowdAtOneEndOfEachBin) {
+// The profile fit of `frames` with 3 mm of noise and bins of 1000 samples.
+ProfileFit fit_of(const std::vector<RenderedPair>& frames) {
   discrepancy::Tolerance tolerance;
   tolerance.noise = DepthNoise{3.0, 0.0};
   ProfileFitOptions options;
   options.min_bin_samples = 1000;
-  const ProfileFit fit = fit_camera_profile(crowded_frames(24), tolerance, 0.0, options);
+  return fit_camera_profile(frames, tolerance, 0.0, options);
+}
+
+// `pair`'s labels with one robot link, "forearm" (moved by a joint: no
+// link_axis given), before the wall; no pixel labelled with it yet.
+void add_forearm(RenderedPair* pair) {
+  pair->labels.num_robot_links = 1;
+  pair->labels.num_links = 2;
+  pair->labels.link_name = {"forearm", "wall"};
+}
+
+TEST(CameraProfileFit, SmoothCorrectionHoldsWhereTheSamplesCrowdAtOneEndOfEachBin) {
+  const ProfileFit fit = fit_of(crowded_frames(24));
   ASSERT_TRUE(fit.ok) << fit.error;
   // Between the surfaces' distances, the correction (I_dis / f: true minus
   // measured), applied at the distance the camera measures, is the
@@ -88,21 +101,15 @@ TEST(CameraProfileFit, SmoothCorrectionHoldsWhereTheSamplesCrowdAtOneEndOfEachBi
 // error (here 8 mm of multipath on rows 0-5) moves with it and would be
 // wrong for the scene behind when the link has gone.
 TEST(CameraProfileFit, LearnsNoPixelOffsetFromAMovingLink) {
-  discrepancy::Tolerance tolerance;
-  tolerance.noise = DepthNoise{3.0, 0.0};
-  ProfileFitOptions options;
-  options.min_bin_samples = 1000;
   std::vector<RenderedPair> frames = crowded_frames(24);
   for (RenderedPair& pair : frames) {
-    pair.labels.num_robot_links = 1;
-    pair.labels.num_links = 2;
-    pair.labels.link_name = {"forearm", "wall"};
+    add_forearm(&pair);
     for (size_t i = 0; i < static_cast<size_t>(kRowsPerSurface * kImageWidth); ++i) {
       pair.labels.label[i] = kLabelRobotFirst;
       pair.camera.depth_mm[i] = static_cast<int16_t>(pair.camera.depth_mm[i] + 8);
     }
   }
-  const ProfileFit fit = fit_camera_profile(frames, tolerance, 0.0, options);
+  const ProfileFit fit = fit_of(frames);
   ASSERT_TRUE(fit.ok) << fit.error;
   for (size_t i = 0; i < static_cast<size_t>(kRowsPerSurface * kImageWidth); ++i)
     ASSERT_EQ(fit.profile.pixel_correction_mm[i], 0.0f) << "pixel " << i;
@@ -113,20 +120,13 @@ TEST(CameraProfileFit, LearnsNoPixelOffsetFromAMovingLink) {
 // A checking recording whose arm comes nearer the camera than the learning
 // one went: its pixels there get the correction's end value, a guess.
 TEST(CameraProfileFit, CoverageCountsTheArmsPixelsOutsideTheProfilesRange) {
-  discrepancy::Tolerance tolerance;
-  tolerance.noise = DepthNoise{3.0, 0.0};
-  ProfileFitOptions options;
-  options.min_bin_samples = 1000;
-  const ProfileFit fit = fit_camera_profile(crowded_frames(24), tolerance, 0.0, options);
+  const ProfileFit fit = fit_of(crowded_frames(24));
   ASSERT_TRUE(fit.ok) << fit.error;
-  // An arm link (moved by a joint: no link_axis given) on the first 12
-  // rows: at 0.90 m on rows 0-5, outside the profile's 1.0-1.95 m; at
+  // The forearm on the first 12 rows: at 0.90 m on rows 0-5, outside the profile's 1.0-1.95 m; at
   // 1.30 m on rows 6-11, inside.
   std::vector<RenderedPair> checking = crowded_frames(2);
   for (RenderedPair& pair : checking) {
-    pair.labels.num_robot_links = 1;
-    pair.labels.num_links = 2;
-    pair.labels.link_name = {"forearm", "wall"};
+    add_forearm(&pair);
     const depth_image_t& in = pair.rendered;
     for (int v = 0; v < 2 * kRowsPerSurface; ++v) {
       const double r_m = v < kRowsPerSurface ? 0.90 : 1.30;
