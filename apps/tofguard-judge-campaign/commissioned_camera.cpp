@@ -128,11 +128,11 @@ CommissionedCamera commission_imperfect_camera(const CampaignArm& arm, uint64_t 
           << fixed(checked.tuned.fixed_pattern_sigma_mm, 1) << " mm, near steps "
           << fixed(checked.tuned.silhouette_bias_mm, 1) << " mm within " << checked.tuned.silhouette_band_px
           << " px";
-  if (!checked.static_error.silhouette_link.empty()) {
+  if (!checked.static_error.near_steps.link.empty()) {
     double least_mm = checked.tuned.silhouette_bias_mm;
     for (const auto& link : checked.tuned.silhouette_bias_by_link_mm)
       least_mm = std::min(least_mm, link.second);
-    summary << " (" << checked.static_error.silhouette_link << "; its links " << fixed(least_mm, 1) << ".."
+    summary << " (" << checked.static_error.near_steps.link << "; its links " << fixed(least_mm, 1) << ".."
             << fixed(checked.tuned.silhouette_bias_mm, 1) << " mm)";
   }
   summary << ", arm pixels outside the profile's range "

@@ -389,70 +389,6 @@ NoiseFit measure_smooth_error(const std::vector<RenderedPair>& frames, const Tun
 // A measured allowance as the config carries it: rounded up to 0.1 mm.
 double rounded_up_mm(double value_mm) { return std::max(0.0, std::ceil(value_mm * 10 - 1e-9) / 10); }
 
-// The near side of rendered steps (StaticError::step_ring_*): on each of
-// the arm's links, I_dis less the smooth part at the pixel's rendered
-// depth (within the evidence's naming gate of the smooth fit's sigma), by
-// the pixel's distance from the nearest farther surface; then the band and
-// the allowance beyond the smooth one (`smooth_allowance_mm`): the rings
-// whose |mean| + 2 standard errors exceeds it on some link.
-void measure_near_step_error(const std::vector<RenderedPair>& frames, const TuneSettings& settings,
-                             const NoiseFit& smooth, double smooth_allowance_mm, StaticError* error) {
-  const int rings = kStepRingsPx;
-  const double gate = settings.discrepancy.evidence_naming_gate_sigmas;
-  // Per (link, ring): count, sum and sum of squares.
-  std::map<std::string, std::vector<std::array<double, 3>>> sums;
-  for (const RenderedPair& frame : frames) {
-    const std::vector<uint8_t> used = noise_pixels(frame, settings.discrepancy.silhouette_jump_mm);
-    const std::vector<uint8_t> distance =
-        discrepancy::step_distance_px(frame.rendered, rings, settings.discrepancy.silhouette_jump_mm);
-    for (size_t i = 0; i < used.size() && i < distance.size(); ++i) {
-      if (!used[i] || distance[i] == 0) continue;
-      const int link =
-          link_of_label(frame.labels.label[i], frame.labels.num_robot_links, frame.labels.num_links);
-      if (link < 0 || link >= frame.labels.num_robot_links) continue;  // the arm's pixels only
-      const int gen = frame.rendered.depth_mm[i];
-      const double d_m = gen / 1000.0;
-      const double e = gen - frame.camera.depth_mm[i] - smooth.median_mm_at(gen);
-      if (std::abs(e) > gate * (smooth.sigma_at_0m_mm + smooth.sigma_per_m2_mm * d_m * d_m)) continue;
-      std::vector<std::array<double, 3>>& by_ring = sums[frame.labels.link_name[static_cast<size_t>(link)]];
-      by_ring.resize(static_cast<size_t>(rings), {0.0, 0.0, 0.0});
-      std::array<double, 3>& ring = by_ring[static_cast<size_t>(distance[i] - 1)];
-      ring[0] += 1;
-      ring[1] += e;
-      ring[2] += e * e;
-    }
-  }
-  error->step_ring_mean_mm.assign(rings, 0.0);
-  error->step_ring_samples.assign(rings, 0);
-  double largest_mm = 0;
-  for (const auto& [link, by_ring] : sums) {
-    bool measured = false;
-    double link_largest_mm = smooth_allowance_mm;
-    for (int k = 0; k < rings; ++k) {
-      const auto& [n, sum, sum_squares] = by_ring[static_cast<size_t>(k)];
-      if (n < kMinStepRingSamples) continue;
-      measured = true;
-      const double mean = sum / n;
-      const double variance = std::max(0.0, (sum_squares - n * mean * mean) / (n - 1));
-      if (std::abs(mean) > std::abs(error->step_ring_mean_mm[k])) {
-        error->step_ring_mean_mm[k] = mean;
-        error->step_ring_samples[k] = static_cast<int64_t>(n);
-      }
-      const double bound = std::abs(mean) + 2 * std::sqrt(variance / n);
-      if (bound <= smooth_allowance_mm) continue;
-      error->silhouette_band_px = std::max(error->silhouette_band_px, k + 1);
-      link_largest_mm = std::max(link_largest_mm, bound);
-      if (bound > largest_mm) {
-        largest_mm = bound;
-        error->silhouette_link = link;
-      }
-    }
-    if (measured) error->silhouette_bias_by_link_mm[link] = link_largest_mm - smooth_allowance_mm;
-  }
-  if (error->silhouette_band_px == 0) error->silhouette_bias_by_link_mm.clear();
-  error->silhouette_bias_mm = error->silhouette_band_px > 0 ? largest_mm - smooth_allowance_mm : 0.0;
-}
-
 // Pass 2b: the static error (StaticError): the smooth part by rendered
 // depth, the fixed pattern from the environment pixels' means over the
 // frames less the smooth part, the near side of steps on the arm's pixels.
@@ -494,7 +430,9 @@ StaticError measure_static_error(const std::vector<RenderedPair>& frames, const 
     error.fixed_pattern_sigma_mm =
         std::sqrt(std::max(0.0, pattern_variance / static_cast<double>(error.pattern_pixels)));
   }
-  measure_near_step_error(frames, settings, smooth, rounded_up_mm(error.smooth_bound_mm), &error);
+  error.near_steps = measure_near_step_error(frames, settings.discrepancy.silhouette_jump_mm,
+                                             settings.discrepancy.evidence_naming_gate_sigmas, smooth,
+                                             rounded_up_mm(error.smooth_bound_mm));
   return error;
 }
 
@@ -563,9 +501,10 @@ void run_sequential_tests(const std::vector<RenderedPair>& frames, const TuneSet
   tuned.pixels_per_sample = result->pixels_per_sample;
   tuned.static_bias_mm = rounded_up_mm(result->static_error.smooth_bound_mm);
   tuned.fixed_pattern_sigma_mm = rounded_up_mm(result->static_error.fixed_pattern_sigma_mm);
-  tuned.silhouette_band_px = result->static_error.silhouette_band_px;
-  tuned.silhouette_bias_mm = rounded_up_mm(result->static_error.silhouette_bias_mm);
-  for (const auto& [link, bias_mm] : result->static_error.silhouette_bias_by_link_mm)
+  const NearStepError& near_steps = result->static_error.near_steps;
+  tuned.silhouette_band_px = near_steps.band_px;
+  tuned.silhouette_bias_mm = rounded_up_mm(near_steps.bias_mm);
+  for (const auto& [link, bias_mm] : near_steps.bias_by_link_mm)
     tuned.silhouette_bias_by_link_mm[link] = rounded_up_mm(bias_mm);
   result->tuned = run_evidence(frames, settings, tree, tuned);
   result->measured_static_bias_mm = tuned.static_bias_mm;
@@ -742,12 +681,18 @@ std::string tune_report(const TuneResult& r, const TuneSettings& settings) {
       << ", fixed_pattern_sigma_mm " << settings.discrepancy.evidence_fixed_pattern_sigma_mm << ")\n";
   out << "near rendered steps, the arm's pixels' mean I_dis less the smooth part by distance, the largest "
          "of a link (px: mm, samples):";
-  for (size_t k = 0; k < e.step_ring_samples.size(); ++k) {
-    out << " " << k + 1 << ": " << fixed(e.step_ring_mean_mm[k], 1) << " (" << e.step_ring_samples[k] << ")";
+  const NearStepError& steps = e.near_steps;
+  for (size_t k = 0; k < steps.ring_samples.size(); ++k)
+    out << " " << k + 1 << ": " << fixed(steps.ring_mean_mm[k], 1) << " (" << steps.ring_samples[k] << ")";
+  out << "; allowance beyond the smooth one (a link's larger of its rings' bounds and its largest "
+         "one-second mean) "
+      << fixed(steps.bias_mm, 1) << " mm within " << steps.band_px << " px"
+      << (steps.link.empty() ? "" : " (set by " + steps.link + ")");
+  if (!steps.bias_by_link_mm.empty()) {
+    out << "; by link:";
+    for (const auto& [link, bias_mm] : steps.bias_by_link_mm) out << " " << link << " " << fixed(bias_mm, 1);
   }
-  out << "; allowance beyond the smooth one " << fixed(e.silhouette_bias_mm, 1) << " mm within "
-      << e.silhouette_band_px << " px"
-      << (e.silhouette_link.empty() ? "" : " (set by " + e.silhouette_link + ")") << "\n";
+  out << "\n";
   if (!r.allowance_raised.empty()) {
     out << "static allowance raised from " << fixed(r.measured_static_bias_mm, 1) << " mm to "
         << fixed(r.tuned.static_bias_mm, 1) << " mm: " << r.allowance_raised << "\n";

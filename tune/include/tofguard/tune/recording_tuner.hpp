@@ -20,6 +20,7 @@
 #include "tofguard/settings/renderer_settings.hpp"
 #include "tofguard/settings/risk_settings.hpp"
 #include "tofguard/tune/camera_profile_fit.hpp"
+#include "tofguard/tune/near_step_error.hpp"
 #include "tofguard/tune/noise_fit.hpp"
 #include "tofguard/tune/rendered_pair.hpp"
 
@@ -100,28 +101,10 @@ struct StaticError {
   // n), kept >= 0.
   double fixed_pattern_sigma_mm = 0;
   int64_t pattern_pixels = 0;
-  // The near side of rendered steps (evidence.silhouette_allowance): on
-  // each of the arm's links, its pixels used as the noise fit's and within
-  // the naming gate, the mean of I_dis less the smooth part per ring of
-  // distance 1..kStepRingsPx pixels from the nearest rendered surface
-  // farther by more than the silhouette jump (a camera's multipath there
-  // moves with the arm). A link's ring with at least kMinStepRingSamples
-  // samples whose |mean| + 2 standard errors exceeds the smooth allowance
-  // joins the band (band_px: the farthest such ring); bias_mm: the largest
-  // such bound less the smooth allowance (silhouette_link: whose);
-  // silhouette_bias_by_link_mm: each measured link's own (0 for a link
-  // none of whose rings exceeds it). Per ring: the largest |mean| of a
-  // link and its samples.
-  std::vector<double> step_ring_mean_mm;
-  std::vector<int64_t> step_ring_samples;
-  int silhouette_band_px = 0;
-  double silhouette_bias_mm = 0;
-  std::string silhouette_link;
-  std::map<std::string, double> silhouette_bias_by_link_mm;
+  // The near side of rendered steps on the arm's links
+  // (evidence.silhouette_allowance).
+  NearStepError near_steps;
 };
-
-constexpr int kStepRingsPx = 12;
-constexpr int64_t kMinStepRingSamples = 200;
 
 // The sequential tests over the recording with one noise model.
 struct EvidenceRun {

@@ -1,0 +1,55 @@
+#pragma once
+// The error of the arm's pixels on the near side of a rendered step, beyond
+// the smooth part (the evidence's silhouette allowance, docs/safety-chain.md
+// "Static error: the composite null"): a ToF camera's multipath, a link
+// read farther before the surface behind it. It moves with the arm, so no
+// per-pixel profile learns it, and it changes with the pose (what lies
+// behind the link, how near).
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "tofguard/tune/noise_fit.hpp"
+#include "tofguard/tune/rendered_pair.hpp"
+
+namespace tofguard::tune {
+
+// Rings of distance 1..kStepRingsPx pixels (Chebyshev) from the nearest
+// rendered surface farther by more than the silhouette jump; a ring of a
+// link, or a second of a link's band, counts with at least
+// kMinStepRingSamples pixels.
+constexpr int kStepRingsPx = 12;
+constexpr int64_t kMinStepRingSamples = 200;
+
+// Measured on each of the arm's links, its pixels used as the noise fit's
+// (noise_pixels) and within the naming gate of the smooth fit's sigma: e =
+// I_dis less the smooth part at the pixel's rendered depth, mm.
+struct NearStepError {
+  // Per ring: the largest |mean e| of a link and its samples.
+  std::vector<double> ring_mean_mm;
+  std::vector<int64_t> ring_samples;
+  // The band: the farthest ring whose |mean| + 2 standard errors exceeds
+  // the smooth allowance on some link; 0: none (and no allowance).
+  int band_px = 0;
+  // Each measured link's allowance beyond the smooth one: the larger of its
+  // rings' bounds (|mean| + 2 standard errors) and its largest |mean e|
+  // within the band over any one second of the recording, less the smooth
+  // allowance, >= 0. A link without a ring of kMinStepRingSamples is not
+  // measured (it takes bias_mm). The whole recording's mean averages poses
+  // whose multipath differs in size and sign; a CUSUM needs a bias held for
+  // only a few seconds to reach h.
+  std::map<std::string, double> bias_by_link_mm;
+  // The largest of them and its link.
+  double bias_mm = 0;
+  std::string link;
+};
+
+// `frames` in recording order (each frame's second: its camera utime less
+// the first's); `smooth`: the fit whose median by depth is the smooth part;
+// `smooth_allowance_mm`: the evidence's static_bias_mm.
+NearStepError measure_near_step_error(const std::vector<RenderedPair>& frames, double silhouette_jump_mm,
+                                      double naming_gate_sigmas, const NoiseFit& smooth,
+                                      double smooth_allowance_mm);
+
+}  // namespace tofguard::tune
