@@ -112,6 +112,32 @@ void apply_camera_profile(const CameraProfile& p, depth_image_t* frame, const li
   }
 }
 
+void add_profile_coverage(const CameraProfile& p, const depth_image_t& rendered, const link_labels_t& labels,
+                          const std::vector<uint8_t>& used, ProfileCoverage* coverage) {
+  coverage->first_m = p.distance_first_m;
+  coverage->last_m =
+      p.distance_first_m +
+      p.distance_bin_m * static_cast<double>(std::max<size_t>(p.distance_correction_mm.size(), 1) - 1);
+  const size_t pixels = static_cast<size_t>(p.width) * static_cast<size_t>(p.height);
+  if (rendered.depth_mm.size() != pixels || labels.label.size() != pixels) return;
+  if (!used.empty() && used.size() != pixels) return;
+  const double lowest_m = coverage->first_m - p.distance_bin_m;
+  const double highest_m = coverage->last_m + p.distance_bin_m;
+  for (int v = 0; v < p.height; ++v) {
+    for (int u = 0; u < p.width; ++u) {
+      const size_t i = static_cast<size_t>(v) * p.width + u;
+      const int z_mm = rendered.depth_mm[i];
+      if (z_mm <= 0 || (!used.empty() && !used[i]) || !on_moving_link(labels, labels.label[i])) continue;
+      const double r_m = z_mm * 1e-3 / z_per_radial(p.fx, p.fy, p.cx, p.cy, u, v);
+      ++coverage->pixels;
+      if (r_m >= lowest_m && r_m <= highest_m) continue;
+      ++coverage->outside;
+      if (coverage->nearest_m == 0 || r_m < coverage->nearest_m) coverage->nearest_m = r_m;
+      coverage->farthest_m = std::max(coverage->farthest_m, r_m);
+    }
+  }
+}
+
 CameraProfile read_camera_profile(const std::string& path) {
   YamlMap map = load_yaml_file(path);
   CameraProfile p;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iomanip>
 #include <limits>
 #include <sstream>
 
@@ -706,6 +707,29 @@ DiscrepancyFrame compare_frames(const depth_image_t& camera, const depth_image_t
 
 }  // namespace
 
+namespace {
+
+// Why the arm of `rendered` is where `profile` was not measured
+// (ProfileCoverage beyond kMaxShareOutsideProfile), one line; empty when it
+// is not, or when the labels cannot say (compare_frames refuses them).
+std::string outside_profile(const CameraProfile& profile, const depth_image_t& rendered,
+                            const link_labels_t& labels) {
+  if (!labels.usable) return "";
+  ProfileCoverage c;
+  add_profile_coverage(profile, rendered, labels, {}, &c);
+  if (c.outside_share() <= kMaxShareOutsideProfile) return "";
+  std::ostringstream why;
+  why << std::fixed << std::setprecision(2) << "camera needs recommissioning: the arm is " << c.nearest_m
+      << "-" << c.farthest_m << " m from it (radial, the model's), beyond the " << c.first_m << "-"
+      << c.last_m << " m its profile " << (profile.file.empty() ? std::string("(in memory)") : profile.file)
+      << " was measured over (" << std::setprecision(1) << 100 * c.outside_share()
+      << " % of the arm's pixels; at most " << 100 * kMaxShareOutsideProfile
+      << " %): commission it on a recording through the arm's whole workspace";
+  return why.str();
+}
+
+}  // namespace
+
 DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_image_t& rendered,
                                      const link_labels_t& labels, const DiscrepancyOptions& options,
                                      WorkerPool* workers) {
@@ -715,6 +739,11 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
   if (const std::string why = profile_mismatch(*options.camera_profile, camera); !why.empty()) {
     DiscrepancyFrame frame;
     frame.summary = unusable_summary(camera, discrepancy_t::UNUSABLE_MISMATCHED, why);
+    return frame;
+  }
+  if (const std::string why = outside_profile(*options.camera_profile, rendered, labels); !why.empty()) {
+    DiscrepancyFrame frame;
+    frame.summary = unusable_summary(camera, discrepancy_t::UNUSABLE_OUTSIDE_PROFILE, why);
     return frame;
   }
   depth_image_t corrected = camera;

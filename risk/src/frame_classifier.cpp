@@ -91,6 +91,10 @@ FrameFinding unusable_frame(const FrameEvidence& e) {
     return finding(risk_t::CAUSE_COMPONENT_FAULT, "tofguard-renderer", 1, 0,
                    "frame not rendered in time: " + f.unusable_reason);
   }
+  if (f.unusable_kind == discrepancy_t::UNUSABLE_OUTSIDE_PROFILE) {
+    // The camera's commissioning does not cover where the arm is.
+    return finding(risk_t::CAUSE_SENSOR_FAULT, e.context.depth_channel, 1, 0, f.unusable_reason);
+  }
   return finding(risk_t::CAUSE_SENSOR_FAULT, e.context.labels_channel, 1, 0,
                  "frame unusable: " + f.unusable_reason);
 }

@@ -112,6 +112,54 @@ TEST(CameraProfile, AMovingLinksPixelGetsTheFixedPatternAndTheSceneTheWholeMap) 
   EXPECT_EQ(derived_here.depth_mm, by_label.depth_mm);
 }
 
+// The profile's range: bin centres 1.0-2.0 m, a bin (0.5 m) of margin
+// either side. Counted by the rendered (model's) distance, on the moving
+// links' pixels only.
+TEST(CameraProfile, CoverageCountsTheMovingLinksRenderedPixelsBeyondTheRange) {
+  const Intrinsics in = small_camera();
+  const CameraProfile p = profile_of(in);
+  link_labels_t labels;
+  labels.num_robot_links = 2;
+  labels.num_links = 3;
+  labels.num_pixels = 48;
+  labels.label.assign(48, kLabelEnvironmentFirst);
+  labels.link_axis = {-1, 0};  // link 0 a base no joint moves, link 1 moved by axis 0
+  labels.num_link_axes = 2;
+  std::vector<float> rendered_m(48, 3.0f);  // the scene beyond the range: not the arm
+  // Pixels 0..3: the moving link at Z 0.30 m, radial 0.30-0.40 m (f >=
+  // 0.75 on row 0): below 1.0 - 0.5 m, outside.
+  for (int i = 0; i < 4; ++i) {
+    labels.label[static_cast<size_t>(i)] = kLabelRobotFirst + 1;
+    rendered_m[static_cast<size_t>(i)] = 0.30f;
+  }
+  // Pixels 4..7: the moving link at Z 1.2 m, inside; 8..11: the base at
+  // 0.3 m, not counted (no joint moves it).
+  for (int i = 4; i < 8; ++i) {
+    labels.label[static_cast<size_t>(i)] = kLabelRobotFirst + 1;
+    rendered_m[static_cast<size_t>(i)] = 1.2f;
+  }
+  for (int i = 8; i < 12; ++i) {
+    labels.label[static_cast<size_t>(i)] = kLabelRobotFirst + 0;
+    rendered_m[static_cast<size_t>(i)] = 0.3f;
+  }
+  const depth_image_t rendered = make_depth_image("cam", in, 1, 1, true, rendered_m);
+  ProfileCoverage coverage;
+  add_profile_coverage(p, rendered, labels, {}, &coverage);
+  EXPECT_EQ(coverage.pixels, 8);
+  EXPECT_EQ(coverage.outside, 4);
+  EXPECT_DOUBLE_EQ(coverage.first_m, 1.0);
+  EXPECT_DOUBLE_EQ(coverage.last_m, 2.0);
+  EXPECT_GE(coverage.nearest_m, 0.30);
+  EXPECT_LT(coverage.farthest_m, 0.41);
+  // Only the pixels `used` marks.
+  std::vector<uint8_t> used(48, 1);
+  used[0] = used[4] = 0;
+  ProfileCoverage of_used;
+  add_profile_coverage(p, rendered, labels, used, &of_used);
+  EXPECT_EQ(of_used.pixels, 6);
+  EXPECT_EQ(of_used.outside, 3);
+}
+
 TEST(CameraProfile, NamesWhatDiffersFromTheFramesCamera) {
   const Intrinsics in = small_camera();
   const CameraProfile p = profile_of(in);

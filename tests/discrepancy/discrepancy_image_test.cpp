@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -403,6 +404,54 @@ TEST(Discrepancy, FramesThatDoNotFitAreUnusableAndSayWhy) {
   s = compute_discrepancy(camera, depth_frame(model.depth_mm, 4), bad_cover, sim_options()).summary;
   EXPECT_FALSE(s.usable);
   EXPECT_NE(s.unusable_reason.find("num_arm_spheres"), std::string::npos) << s.unusable_reason;
+}
+
+// A zero profile of the synthetic camera whose smooth correction was
+// measured over `first_m`..`first_m` + 0.2 m (radial).
+std::shared_ptr<const CameraProfile> zero_profile_from(double first_m) {
+  CameraProfile p;
+  p.file = "tof-mast-profile.yaml";
+  p.camera_id = "tof-mast";
+  p.width = kWidth;
+  p.height = kHeight;
+  p.fx = p.fy = kFocalPx;
+  p.cx = kWidth / 2.0;
+  p.cy = kHeight / 2.0;
+  p.distance_first_m = first_m;
+  p.distance_bin_m = 0.1;
+  p.distance_correction_mm = {0, 0, 0};
+  p.pixel_correction_mm.assign(static_cast<size_t>(kPixels), 0.0f);
+  derive_fixed_pattern(&p);
+  return std::make_shared<const CameraProfile>(p);
+}
+
+// The arm (1.5 m) where the camera's profile was not measured (1.8-2.0 m,
+// a bin of margin): the frame is refused, the camera needs
+// recommissioning. An object before the arm is no such thing: the range is
+// the model's.
+TEST(Discrepancy, TheArmBeyondTheProfilesRangeMakesTheFrameUnusable) {
+  const SyntheticImage model = draw(default_arm());
+  DiscrepancyOptions options = sim_options();
+  options.camera_profile = zero_profile_from(1.8);
+  discrepancy_t s = compare(model, model.depth_mm, options).summary;
+  EXPECT_FALSE(s.usable);
+  EXPECT_EQ(s.unusable_kind, discrepancy_t::UNUSABLE_OUTSIDE_PROFILE);
+  EXPECT_EQ(s.unusable_reason.rfind("camera needs recommissioning: the arm is 1.50-", 0), 0u)
+      << s.unusable_reason;
+  EXPECT_NE(
+      s.unusable_reason.find("beyond the 1.80-2.00 m its profile tof-mast-profile.yaml was measured over"),
+      std::string::npos)
+      << s.unusable_reason;
+
+  options.camera_profile = zero_profile_from(1.4);
+  EXPECT_TRUE(compare(model, model.depth_mm, options).summary.usable);
+  std::vector<int16_t> object_before_arm = model.depth_mm;
+  for (size_t i = 0; i < object_before_arm.size(); ++i) {
+    if (model.label[i] == 3) object_before_arm[i] = 1000;
+  }
+  s = compare(model, object_before_arm, options).summary;
+  EXPECT_TRUE(s.usable) << s.unusable_reason;
+  EXPECT_GT(s.num_occluded + s.num_unexpected_surface, 500);
 }
 
 TEST(Discrepancy, ColourImageIsRedForNearerBlueForFartherBlackForMatch) {

@@ -455,6 +455,14 @@ TEST(FrameClassifier, SensorFaultsComeFirst) {
   f = classify(d);
   EXPECT_EQ(f.cause, risk_t::CAUSE_COMPONENT_FAULT);
   EXPECT_EQ(f.suspect, "tofguard-renderer");
+
+  // The arm where the camera's profile was not measured: the camera's.
+  d.unusable_kind = discrepancy_t::UNUSABLE_OUTSIDE_PROFILE;
+  d.unusable_reason = "camera needs recommissioning: the arm is 0.93-0.97 m from it";
+  f = classify(d);
+  EXPECT_EQ(f.cause, risk_t::CAUSE_SENSOR_FAULT);
+  EXPECT_EQ(f.suspect, "TOF_DEPTH");
+  EXPECT_EQ(f.detail, d.unusable_reason);
 }
 
 TEST(FrameClassifier, LinkUnknownToTheUrdfIsNeverJudgedSafe) {

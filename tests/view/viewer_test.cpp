@@ -20,7 +20,8 @@ namespace {
 constexpr int kW = 176;
 constexpr int kH = 144;
 
-depth_image_t frame(int64_t seq, bool camera) {
+// The arm at `arm_mm`, 1 m unless said.
+depth_image_t frame(int64_t seq, bool camera, int16_t arm_mm = 1000) {
   depth_image_t m;
   m.utime = 1700000000000000 + seq * 33333;
   m.seq = seq;
@@ -35,14 +36,14 @@ depth_image_t frame(int64_t seq, bool camera) {
   m.num_pixels = kW * kH;
   m.depth_mm.assign(m.num_pixels, 2000);  // the floor
   for (int v = 40; v < 100; ++v) {
-    for (int u = 40; u < 70; ++u) m.depth_mm[v * kW + u] = 1000;  // the arm
+    for (int u = 40; u < 70; ++u) m.depth_mm[v * kW + u] = arm_mm;  // the arm
   }
   if (camera) {
     // Something nearer than the modelled floor: I_dis = 2000 - 1200 > 0.
     for (int v = 50; v < 90; ++v) {
       for (int u = 110; u < 140; ++u) m.depth_mm[v * kW + u] = 1200;
     }
-    // The arm's top missing, the camera sees the floor: I_dis = 1000 - 2000 < 0.
+    // The arm's top missing, the camera sees the floor: I_dis = arm_mm - 2000 < 0.
     for (int v = 40; v < 60; ++v) {
       for (int u = 40; u < 70; ++u) m.depth_mm[v * kW + u] = 2000;
     }
@@ -82,9 +83,11 @@ TEST(Viewer, ExportsOnePngPerCameraFrameWithNearerRedAndFartherBlue) {
     lcm::LogFile log(log_path, "w");
     for (int64_t seq = 10; seq < 13; ++seq) {
       const int64_t t = 1700000000000000 + seq * 33333;
-      write_log_event(&log, t, "TOF_DEPTH", frame(seq, true));
+      // The arm 1.5 m away: within the distances config/sim.yaml's camera
+      // profile was measured over (nearer, the frame is unusable).
+      write_log_event(&log, t, "TOF_DEPTH", frame(seq, true, 1500));
       if (seq == 12) continue;  // the last frame never got its rendering
-      write_log_event(&log, t + 5000, "TOF_RENDERED", frame(seq, false));
+      write_log_event(&log, t + 5000, "TOF_RENDERED", frame(seq, false, 1500));
       write_log_event(&log, t + 5000, "TOF_LABELS", labels(seq));
       risk_t risk;
       risk.utime = t;

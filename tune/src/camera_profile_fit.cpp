@@ -316,24 +316,10 @@ void fit_pixel_part(const std::vector<RenderedPair>& frames, const std::vector<d
 ProfileCoverage profile_coverage(const CameraProfile& profile, const std::vector<RenderedPair>& frames,
                                  double silhouette_jump_mm) {
   ProfileCoverage coverage;
-  coverage.first_m = profile.distance_first_m;
-  coverage.last_m = profile.distance_first_m +
-                    profile.distance_bin_m * static_cast<double>(profile.distance_correction_mm.size() - 1);
-  const double margin_m = profile.distance_bin_m;
-  std::vector<double> f;
   for (const RenderedPair& frame : frames) {
     if (!profile_mismatch(profile, frame.camera).empty()) continue;
-    if (f.empty()) f = z_per_radial_image(frame.camera);
-    const std::vector<uint8_t> used = noise_pixels(frame, silhouette_jump_mm);
-    for (size_t i = 0; i < used.size(); ++i) {
-      if (!used[i] || !on_moving_link(frame.labels, frame.labels.label[i])) continue;
-      const double r_m = frame.camera.depth_mm[i] * 1e-3 / f[i];
-      ++coverage.pixels;
-      if (r_m >= coverage.first_m - margin_m && r_m <= coverage.last_m + margin_m) continue;
-      ++coverage.outside;
-      if (coverage.nearest_m == 0 || r_m < coverage.nearest_m) coverage.nearest_m = r_m;
-      coverage.farthest_m = std::max(coverage.farthest_m, r_m);
-    }
+    add_profile_coverage(profile, frame.rendered, frame.labels, noise_pixels(frame, silhouette_jump_mm),
+                         &coverage);
   }
   return coverage;
 }

@@ -106,35 +106,10 @@ ProfileFit fit_camera_profile(const std::vector<RenderedPair>& frames,
                               const ProfileFitOptions& options = {});
 
 // How `frames` (a recording the profile was not learned on) stay within the
-// distances `profile`'s smooth correction was measured over: of the
-// compared pixels (noise_pixels) of links a joint moves, how many the
-// camera measured at a radial distance more than one bin beyond the
-// profile's end bins' centres (which lie within a bin of its outermost
-// measured points), where the correction holds its end value: a guess
-// that the allowances measured on a recording inside the range do not
-// cover. A
-// profile learned on a recording that kept the arm farther from the camera
-// than it goes misleads the evidence there (on the Kinova Gen3's camera 5,
-// a 12 s recording: joint 5 read 1.2 deg off 0.86-0.96 m from the camera).
-struct ProfileCoverage {
-  int64_t pixels = 0;                    // compared pixels of moving links
-  int64_t outside = 0;                   // of them, outside [first_m - bin, last_m + bin]
-  double first_m = 0, last_m = 0;        // the profile's range (radial, m)
-  double nearest_m = 0, farthest_m = 0;  // of the pixels outside (radial, m; 0: none)
-  double outside_share() const { return pixels > 0 ? static_cast<double>(outside) / pixels : 0.0; }
-};
+// distances `profile`'s smooth correction was measured over
+// (ProfileCoverage, camera_profile.hpp): their compared pixels
+// (noise_pixels) of links a joint moves.
 ProfileCoverage profile_coverage(const CameraProfile& profile, const std::vector<RenderedPair>& frames,
                                  double silhouette_jump_mm);
-
-// The largest share of a checking recording's moving-link pixels that may
-// lie outside the profile's range (ProfileCoverage::outside_share): more
-// refuses the profile (tofguard-tune on a checking recording): the
-// allowances measured on the rest would not hold there.
-// A bin (5 cm) is 7 sigma of the noise at 2 m and more than multipath
-// adds, so the arm's pixels that far out show the arm going there: the
-// limit only forgives a stray few. At 0.5 % the Kinova Gen3's camera 5,
-// learned on 12 s, passed with 0.39 % and stopped on joint 5 when its arm
-// went there again (docs/camera.md).
-constexpr double kMaxShareOutsideProfile = 0.001;
 
 }  // namespace tofguard::tune
