@@ -89,8 +89,13 @@ struct Options {
   double commission_s = 40;
 };
 
+// A value that is a number but not one the option takes: its own message.
+struct OptionError : std::invalid_argument {
+  using std::invalid_argument::invalid_argument;
+};
+
 // Option `option`'s value into *o; false for an unknown option. Throws
-// for a value that is not a number (list).
+// for a value that is not a number (list), OptionError for one out of range.
 bool set_option(const std::string& option, const std::string& value, Options* o) {
   using namespace tofguard::test;
   if (option == "--arms") {
@@ -125,7 +130,7 @@ bool set_option(const std::string& option, const std::string& value, Options* o)
     o->camera_seeds.clear();
     for (double seed : number_list(value)) {
       if (!(seed >= 1) || seed != static_cast<int>(seed))
-        throw std::invalid_argument("--camera-seeds: expected whole numbers >= 1, got '" + value + "'");
+        throw OptionError("--camera-seeds: expected whole numbers >= 1, got '" + value + "'");
       o->camera_seeds.push_back(static_cast<int>(seed));
     }
   } else if (option == "--commission-s") {
@@ -154,6 +159,8 @@ std::optional<int> parse_options(int argc, char** argv, Options* o) {
     const std::string value = argv[++i];
     try {
       if (!set_option(option, value, o)) return usage("unknown option " + option);
+    } catch (const OptionError& e) {
+      return usage(e.what());
     } catch (const std::exception&) {
       return usage(option + ": expected a number list or a number, got '" + value + "'");
     }
