@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <sstream>
 #include <vector>
@@ -56,6 +57,46 @@ std::vector<tune::RenderedPair> nominal_frames(const deployment::Config& config,
   return pairs;
 }
 
+// The motion time in [from_s, to_s), on a grid of kApproachStepS, at which
+// the arm comes nearest the camera: the least radial distance of a rendered
+// pixel of a link a joint moves. A user commissions on recordings that take
+// the arm through its whole workspace (docs/camera.md); the nominal
+// motion's sinusoids reach their nearest combination only now and then, so
+// the recordings are centred there (the scene behind the arm, the far end
+// of the range, is in every frame).
+constexpr double kApproachStepS = 0.2;
+
+double nearest_approach_s(const deployment::Config& config, double from_s, double to_s) {
+  const robot_model::SceneModel model_scene =
+      robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths,
+                              renderer::scene_options(config.renderer, config.robot));
+  renderer::DepthRenderer model(model_scene, config.renderer.near_m, config.renderer.far_m);
+  const Eigen::Isometry3d pose = config.camera.pose.frame_from_optical();
+  const Intrinsics& in = config.camera.intrinsics;
+  double nearest_m = std::numeric_limits<double>::infinity(), nearest_at_s = from_s;
+  for (double t_s = from_s; t_s < to_s; t_s += kApproachStepS) {
+    robot_model::JointPositions q;
+    for (const sim::JointMotion& m : config.joints_sim.motion) q[m.joint] = joint_position(m, t_s);
+    const renderer::RenderResult rendered =
+        model.render_at(robot_model::forward_kinematics(model_scene, q), pose, in);
+    if (!rendered.usable) throw std::runtime_error(rendered.unusable_reason);
+    for (int v = 0; v < in.height; ++v) {
+      for (int u = 0; u < in.width; ++u) {
+        const size_t i = static_cast<size_t>(v) * in.width + u;
+        const int link =
+            link_of_label(rendered.labels[i], rendered.num_robot_links, rendered.num_robot_links);
+        if (link < 0 || rendered.depth_m[i] <= 0) continue;
+        const double r_m = rendered.depth_m[i] / z_per_radial(in.fx, in.fy, in.cx, in.cy, u, v);
+        if (r_m < nearest_m) {
+          nearest_m = r_m;
+          nearest_at_s = t_s;
+        }
+      }
+    }
+  }
+  return nearest_at_s;
+}
+
 tune::TuneSettings tune_settings(const deployment::Config& config) {
   tune::TuneSettings settings;
   settings.renderer = deployment::renderer_process_settings(config);
@@ -80,20 +121,25 @@ CommissionedCamera commission_imperfect_camera(const CampaignArm& arm, uint64_t 
   deployment::Config& config = out.arm.config;
   const sim::SimResidualSettings truth = sim::draw_imperfect_camera(seed, config.camera.sim.amplitude_at_1m);
   config.camera.sim.residual = truth;
-  // Learn the profile on one recording (motion from 50 s on)...
+  // Learn the profile on one recording and check it on a second, each
+  // centred where the arm comes nearest the camera within its own stretch
+  // of the motion (600-1800 s, 1800-3000 s: beyond the 0-600 s the nominal
+  // runs take).
+  const double learn_from_s = std::max(0.0, nearest_approach_s(config, 600, 1800) - seconds / 2);
+  const double check_from_s = std::max(0.0, nearest_approach_s(config, 1800, 3000) - seconds / 2);
   tune::TuneOptions learn;
   learn.learn_profile = true;
-  const tune::TuneResult learned =
-      tune::tune_rendered_frames(tune_settings(config), nominal_frames(config, seconds, 50, 1000 + seed),
-                                 out.arm.name + " learning", learn);
+  const tune::TuneResult learned = tune::tune_rendered_frames(
+      tune_settings(config), nominal_frames(config, seconds, learn_from_s, 1000 + seed),
+      out.arm.name + " learning", learn);
   if (!learned.usable) {
     out.error = learned.error;
     return out;
   }
   config.discrepancy.camera_profile = std::make_shared<const CameraProfile>(learned.profile_fit.profile);
-  // ...and measure what is left with it on a second (from 90 s on).
+  // ...and measure what is left with it on the second.
   const tune::TuneResult checked = tune::tune_rendered_frames(
-      tune_settings(config), nominal_frames(config, seconds, 50 + seconds + 28, 2000 + seed),
+      tune_settings(config), nominal_frames(config, seconds, check_from_s, 2000 + seed),
       out.arm.name + " checking");
   if (!checked.usable) {
     out.error = checked.error;

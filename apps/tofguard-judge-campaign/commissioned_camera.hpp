@@ -4,8 +4,10 @@
 // simulated camera gets the static errors of draw_imperfect_camera(seed)
 // (camera.sim.residual: nothing downstream of the camera knows them); the
 // arm moves through its nominal motion for `seconds` (the frames rendered
-// as tofguard-renderer renders them; the learning one from motion time
-// 50 s, the checking one 28 s after it ends); tofguard-tune's passes learn the
+// as tofguard-renderer renders them; each recording centred where the arm
+// comes nearest the camera, the learning one within motion time 600-1800 s,
+// the checking one within 1800-3000 s, as a user's recordings take the arm
+// through its workspace); tofguard-tune's passes learn the
 // camera's profile on one such recording and measure, with the profile
 // applied, the noise, its correlation and the static error left on a
 // second; the arm's config then carries what a user would deploy:
