@@ -44,6 +44,19 @@ CameraProfile profile_of(const Intrinsics& in) {
   return p;
 }
 
+// Labels of small_camera()'s 48 pixels, all the scene's: robot link 0 a
+// base no joint moves, link 1 moved by axis 0, then one environment link.
+link_labels_t base_and_moving_link_labels() {
+  link_labels_t labels;
+  labels.num_robot_links = 2;
+  labels.num_links = 3;
+  labels.num_pixels = 48;
+  labels.label.assign(48, kLabelEnvironmentFirst);
+  labels.link_axis = {-1, 0};
+  labels.num_link_axes = 2;
+  return labels;
+}
+
 TEST(CameraProfile, InterpolatesByRadialDistanceAndHoldsTheEnds) {
   const CameraProfile p = profile_of(small_camera());
   EXPECT_DOUBLE_EQ(p.distance_correction_at(0.2), 10);
@@ -90,13 +103,7 @@ TEST(CameraProfile, AMovingLinksPixelGetsTheFixedPatternAndTheSceneTheWholeMap) 
   EXPECT_NEAR(p.fixed_pattern_mm[beside], 2.0 - 2.1, 1e-4);
   EXPECT_EQ(p.fixed_pattern_mm[0], 0.0f) << "pixel 0 is unmapped (0)";
 
-  link_labels_t labels;
-  labels.num_robot_links = 2;
-  labels.num_links = 3;
-  labels.num_pixels = 48;
-  labels.label.assign(48, kLabelEnvironmentFirst);
-  labels.link_axis = {-1, 0};  // link 0 a base no joint moves, link 1 moved by axis 0
-  labels.num_link_axes = 2;
+  link_labels_t labels = base_and_moving_link_labels();
   labels.label[spike] = kLabelRobotFirst + 1;
   labels.label[beside] = kLabelRobotFirst + 0;
   const depth_image_t measured = make_depth_image("cam", in, 1, 1, true, std::vector<float>(48, 1.5f));
@@ -118,13 +125,7 @@ TEST(CameraProfile, AMovingLinksPixelGetsTheFixedPatternAndTheSceneTheWholeMap) 
 TEST(CameraProfile, CoverageCountsTheMovingLinksRenderedPixelsBeyondTheRange) {
   const Intrinsics in = small_camera();
   const CameraProfile p = profile_of(in);
-  link_labels_t labels;
-  labels.num_robot_links = 2;
-  labels.num_links = 3;
-  labels.num_pixels = 48;
-  labels.label.assign(48, kLabelEnvironmentFirst);
-  labels.link_axis = {-1, 0};  // link 0 a base no joint moves, link 1 moved by axis 0
-  labels.num_link_axes = 2;
+  link_labels_t labels = base_and_moving_link_labels();
   std::vector<float> rendered_m(48, 3.0f);  // the scene beyond the range: not the arm
   // Pixels 0..3: the moving link at Z 0.30 m, radial 0.30-0.40 m (f >=
   // 0.75 on row 0): below 1.0 - 0.5 m, outside.
