@@ -153,6 +153,7 @@ CommissionedCamera commission_imperfect_camera(const CampaignArm& arm, uint64_t 
   config.discrepancy.evidence_silhouette_band_px = checked.tuned.silhouette_band_px;
   config.discrepancy.evidence_silhouette_bias_mm = checked.tuned.silhouette_bias_mm;
   config.discrepancy.evidence_silhouette_bias_by_link_mm = checked.tuned.silhouette_bias_by_link_mm;
+  config.discrepancy.evidence_silhouette_band_step_mm = checked.tuned.silhouette_band_step_mm;
   std::ostringstream summary;
   summary << out.arm.name << ": wiggle " << fixed(truth.wiggle_amplitude_mm, 1) << " mm / "
           << fixed(truth.wiggle_period_m, 2) << " m, slope " << fixed(truth.slope_mm_per_m, 1)

@@ -601,6 +601,7 @@ DiscrepancyOptions discrepancy_options(const DiscrepancySettings& config) {
   p.evidence.silhouette_band_px = config.evidence_silhouette_band_px;
   p.evidence.silhouette_bias_mm = config.evidence_silhouette_bias_mm;
   p.evidence.silhouette_bias_by_link_mm = config.evidence_silhouette_bias_by_link_mm;
+  p.evidence.silhouette_band_step_mm = config.evidence_silhouette_band_step_mm;
   return p;
 }
 

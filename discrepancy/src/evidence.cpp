@@ -734,8 +734,9 @@ std::vector<float> near_step_allowance_mm(const depth_image_t& rendered, const l
     const auto own = options.silhouette_bias_by_link_mm.find(labels.link_name[k]);
     if (own != options.silhouette_bias_by_link_mm.end()) by_link[k] = static_cast<float>(own->second);
   }
-  const std::vector<uint8_t> near =
-      near_side_of_steps(rendered, options.silhouette_band_px, silhouette_jump_mm);
+  const double band_step_mm =
+      options.silhouette_band_step_mm > 0 ? options.silhouette_band_step_mm : silhouette_jump_mm;
+  const std::vector<uint8_t> near = near_side_of_steps(rendered, options.silhouette_band_px, band_step_mm);
   std::vector<float> allowance(near.size(), 0.0f);
   const bool labelled = labels.label.size() == near.size();
   for (size_t i = 0; i < near.size(); ++i) {

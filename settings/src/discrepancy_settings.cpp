@@ -54,6 +54,8 @@ DiscrepancySettings read_discrepancy_settings(YamlMap map) {
       YamlMap allowance = evidence.map("silhouette_allowance");
       d.evidence_silhouette_band_px = static_cast<int>(allowance.integer("band_px", 1, 64));
       d.evidence_silhouette_bias_mm = allowance.number("bias_mm", 0, 1000);
+      if (allowance.optional("step_mm"))
+        d.evidence_silhouette_band_step_mm = allowance.number("step_mm", 1, 1000);
       if (allowance.optional("by_link")) {
         YamlMap by_link = allowance.map("by_link");
         for (const std::string& link : by_link.keys())

@@ -259,6 +259,16 @@ TEST(Config, TheSilhouetteAllowanceTakesEachLinksOwnBound) {
   EXPECT_EQ(config.discrepancy.evidence_silhouette_bias_mm, 2.3);
   const std::map<std::string, double> expected = {{"link1", 2.3}, {"link7", 0.4}};
   EXPECT_EQ(config.discrepancy.evidence_silhouette_bias_by_link_mm, expected);
+  // Without step_mm the band opens at the silhouette jump; with it, at its step.
+  EXPECT_EQ(config.discrepancy.evidence_silhouette_band_step_mm, 0.0);
+  const std::string stepped =
+      sim_variant("silhouette-step", "    silhouette_allowance: {band_px: 11, bias_mm: 2.3}\n",
+                  "    silhouette_allowance: {band_px: 11, step_mm: 10, bias_mm: 2.3}\n");
+  EXPECT_EQ(deployment::load_config(stepped, nullptr).discrepancy.evidence_silhouette_band_step_mm, 10.0);
+  const std::string no_step =
+      sim_variant("silhouette-step-zero", "    silhouette_allowance: {band_px: 11, bias_mm: 2.3}\n",
+                  "    silhouette_allowance: {band_px: 11, step_mm: 0, bias_mm: 2.3}\n");
+  EXPECT_NE(config_error(no_step).find("step_mm"), std::string::npos) << config_error(no_step);
 }
 
 TEST(Config, AKeyFileOpenToOthersIsAConfigError) {

@@ -856,6 +856,42 @@ TEST(StepDistance, CountsPixelsToTheNearestFartherSurface) {
   EXPECT_EQ(std::count(no_band.begin(), no_band.end(), 1), 0);
 }
 
+TEST(StepDistance, TheAllowanceBandOpensAtItsOwnStep) {
+  // A link (label 1) 2 cm before another (label 2): a concave corner under
+  // the 50 mm silhouette jump.
+  depth_image_t rendered{};
+  rendered.width = 20;
+  rendered.height = 4;
+  rendered.depth_mm.assign(80, 1000);
+  link_labels_t labels{};
+  labels.num_robot_links = 2;
+  labels.num_links = 2;
+  labels.link_name = {"near", "far"};
+  labels.label.assign(80, 1);
+  for (int v = 0; v < 4; ++v) {
+    for (int u = 10; u < 20; ++u) {
+      rendered.depth_mm[static_cast<size_t>(v * 20 + u)] = 1020;
+      labels.label[static_cast<size_t>(v * 20 + u)] = 2;
+    }
+  }
+  EvidenceOptions options;
+  options.silhouette_band_px = 2;
+  options.silhouette_bias_mm = 3.0;
+  const std::vector<float> from_jump = near_step_allowance_mm(rendered, labels, options, 50);
+  EXPECT_EQ(std::count(from_jump.begin(), from_jump.end(), 0.0f), 80) << "no step over 50 mm";
+  options.silhouette_band_step_mm = 10;
+  const std::vector<float> from_step = near_step_allowance_mm(rendered, labels, options, 50);
+  for (int v = 0; v < 4; ++v) {
+    EXPECT_EQ(from_step[static_cast<size_t>(v * 20 + 9)], 3.0f);
+    EXPECT_EQ(from_step[static_cast<size_t>(v * 20 + 8)], 3.0f);
+    EXPECT_EQ(from_step[static_cast<size_t>(v * 20 + 7)], 0.0f) << "beyond band_px";
+    EXPECT_EQ(from_step[static_cast<size_t>(v * 20 + 10)], 0.0f) << "the far side";
+  }
+  options.silhouette_band_step_mm = 30;
+  const std::vector<float> above = near_step_allowance_mm(rendered, labels, options, 50);
+  EXPECT_EQ(std::count(above.begin(), above.end(), 0.0f), 80) << "a 20 mm step under a 30 mm band step";
+}
+
 TEST_F(EvidenceTest, AStillArmShowsNoJointOffsetFromOneMixedPixel) {
   // The default arm halted where safety_chain_e2e_test's arm once stopped
   // (JOINT_STATE of the run): a pixel of link7 lies beside a scene step of

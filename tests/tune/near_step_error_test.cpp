@@ -17,14 +17,17 @@ constexpr double kSilhouetteJumpMm = 50;
 constexpr double kNamingGateSigmas = 4;
 constexpr double kSmoothAllowanceMm = 0.5;
 
-// `seconds` of 30 Hz frames of the still default arm before the floor:
-// link2 reads `link2_farther_mm(second)` farther, every pixel N(0, 3 mm)
-// of noise.
+constexpr double kBandStepMm = 10;
+
+// `seconds` of 30 Hz frames of the still `arm` (the default arm's boxes
+// unless given) before the floor: link2 (label 3) reads
+// `link2_farther_mm(second)` farther, every pixel N(0, 3 mm) of noise.
 template <typename Farther>
-std::vector<RenderedPair> frames_with_link2_farther(int seconds, Farther link2_farther_mm) {
+std::vector<RenderedPair> frames_with_link2_farther(int seconds, Farther link2_farther_mm,
+                                                    const std::vector<test::Box>& arm = test::default_arm()) {
   std::mt19937_64 random(11);
   std::normal_distribution<double> noise(0, kNoiseMm);
-  const test::SyntheticImage model = test::draw(test::default_arm());
+  const test::SyntheticImage model = test::draw(arm);
   std::vector<RenderedPair> frames;
   for (int k = 0; k < 30 * seconds; ++k) {
     RenderedPair pair;
@@ -41,10 +44,11 @@ std::vector<RenderedPair> frames_with_link2_farther(int seconds, Farther link2_f
   return frames;
 }
 
-NearStepError measure(const std::vector<RenderedPair>& frames) {
+NearStepError measure(const std::vector<RenderedPair>& frames, double band_step_mm = kBandStepMm) {
   NoiseFit smooth;  // no smooth part (no bins), sigma 3 mm
   smooth.sigma_at_0m_mm = kNoiseMm;
-  return measure_near_step_error(frames, kSilhouetteJumpMm, kNamingGateSigmas, smooth, kSmoothAllowanceMm);
+  return measure_near_step_error(frames, kSilhouetteJumpMm, band_step_mm, kNamingGateSigmas, smooth,
+                                 kSmoothAllowanceMm);
 }
 
 TEST(NearStepError, ALinksAllowanceIsItsLargestOneSecondMeanNotTheRecordingsMean) {
@@ -67,6 +71,26 @@ TEST(NearStepError, ALinksAllowanceIsItsLargestOneSecondMeanNotTheRecordingsMean
   // link2's.
   ASSERT_EQ(error.bias_by_link_mm.count("link1"), 1u);
   EXPECT_LT(error.bias_by_link_mm.at("link1"), 0.2);
+}
+
+TEST(NearStepError, AConcaveCornerUnderTheSilhouetteJumpIsMeasuredFromTheBandsStep) {
+  // link2 2 cm before link1, whose face surrounds it by 40 px or more: no
+  // silhouette (a step over 5 cm) lies within the rings of link2's pixels,
+  // only the 2 cm corner. link2 reads 4 mm farther throughout.
+  const std::vector<test::Box> corner = {{20, 20, 156, 130, test::kArmMm, 2},
+                                         {70, 60, 110, 80, test::kArmMm - 20, 3}};
+  const auto frames = frames_with_link2_farther(
+      3, [](int) { return 4.0; }, corner);
+  const NearStepError from_band_step = measure(frames);
+  EXPECT_EQ(from_band_step.band_step_mm, kBandStepMm);
+  EXPECT_GT(from_band_step.band_px, 0);
+  ASSERT_EQ(from_band_step.bias_by_link_mm.count("link2"), 1u);
+  EXPECT_NEAR(from_band_step.bias_by_link_mm.at("link2"), 4.0 - kSmoothAllowanceMm, 0.3);
+  EXPECT_EQ(from_band_step.link, "link2");
+  // Measured from the silhouette jump, the corner is no step: no band, and
+  // link2's 4 mm would accumulate in its joint's test.
+  const NearStepError from_silhouettes = measure(frames, kSilhouetteJumpMm);
+  EXPECT_EQ(from_silhouettes.bias_by_link_mm.count("link2"), 0u);
 }
 
 TEST(NearStepError, ACameraWithoutNearStepErrorGetsNoBand) {

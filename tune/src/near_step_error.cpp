@@ -27,8 +27,8 @@ void add(double e, Sums* s) {
 }
 
 std::map<std::string, LinkStepSums> sum_near_step_error(const std::vector<RenderedPair>& frames,
-                                                        double silhouette_jump_mm, double naming_gate_sigmas,
-                                                        const NoiseFit& smooth) {
+                                                        double silhouette_jump_mm, double band_step_mm,
+                                                        double naming_gate_sigmas, const NoiseFit& smooth) {
   constexpr size_t rings = kStepRingsPx;
   std::map<std::string, LinkStepSums> sums;
   const int64_t first_utime = frames.empty() ? 0 : frames.front().camera.utime;
@@ -37,7 +37,7 @@ std::map<std::string, LinkStepSums> sum_near_step_error(const std::vector<Render
         static_cast<size_t>(std::max<int64_t>(0, frame.camera.utime - first_utime) / 1'000'000);
     const std::vector<uint8_t> used = noise_pixels(frame, silhouette_jump_mm);
     const std::vector<uint8_t> distance =
-        discrepancy::step_distance_px(frame.rendered, kStepRingsPx, silhouette_jump_mm);
+        discrepancy::step_distance_px(frame.rendered, kStepRingsPx, band_step_mm);
     for (size_t i = 0; i < used.size() && i < distance.size(); ++i) {
       if (!used[i] || distance[i] == 0) continue;
       const int link =
@@ -76,11 +76,12 @@ double largest_second_mean_mm(const LinkStepSums& link, int band_px) {
 }  // namespace
 
 NearStepError measure_near_step_error(const std::vector<RenderedPair>& frames, double silhouette_jump_mm,
-                                      double naming_gate_sigmas, const NoiseFit& smooth,
+                                      double band_step_mm, double naming_gate_sigmas, const NoiseFit& smooth,
                                       double smooth_allowance_mm) {
   const std::map<std::string, LinkStepSums> sums =
-      sum_near_step_error(frames, silhouette_jump_mm, naming_gate_sigmas, smooth);
+      sum_near_step_error(frames, silhouette_jump_mm, band_step_mm, naming_gate_sigmas, smooth);
   NearStepError error;
+  error.band_step_mm = band_step_mm;
   error.ring_mean_mm.assign(kStepRingsPx, 0.0);
   error.ring_samples.assign(kStepRingsPx, 0);
   // Each measured link's largest ring bound (|mean| + 2 standard errors).

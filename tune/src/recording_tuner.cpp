@@ -44,6 +44,7 @@ EvidenceRun run_evidence(const std::vector<RenderedPair>& frames, const TuneSett
   options.evidence.silhouette_band_px = model.silhouette_band_px;
   options.evidence.silhouette_bias_mm = model.silhouette_bias_mm;
   options.evidence.silhouette_bias_by_link_mm = model.silhouette_bias_by_link_mm;
+  options.evidence.silhouette_band_step_mm = model.silhouette_band_step_mm;
   // The frames are corrected already (correct_frames).
   options.camera_profile = nullptr;
   risk::SequentialEvidence evidence(settings.risk, tree, settings.renderer.camera.rate_hz);
@@ -430,7 +431,7 @@ StaticError measure_static_error(const std::vector<RenderedPair>& frames, const 
     error.fixed_pattern_sigma_mm =
         std::sqrt(std::max(0.0, pattern_variance / static_cast<double>(error.pattern_pixels)));
   }
-  error.near_steps = measure_near_step_error(frames, settings.discrepancy.silhouette_jump_mm,
+  error.near_steps = measure_near_step_error(frames, settings.discrepancy.silhouette_jump_mm, kBandStepMm,
                                              settings.discrepancy.evidence_naming_gate_sigmas, smooth,
                                              rounded_up_mm(error.smooth_bound_mm));
   return error;
@@ -503,6 +504,7 @@ void run_sequential_tests(const std::vector<RenderedPair>& frames, const TuneSet
   tuned.fixed_pattern_sigma_mm = rounded_up_mm(result->static_error.fixed_pattern_sigma_mm);
   const NearStepError& near_steps = result->static_error.near_steps;
   tuned.silhouette_band_px = near_steps.band_px;
+  tuned.silhouette_band_step_mm = near_steps.band_step_mm;
   tuned.silhouette_bias_mm = rounded_up_mm(near_steps.bias_mm);
   for (const auto& [link, bias_mm] : near_steps.bias_by_link_mm)
     tuned.silhouette_bias_by_link_mm[link] = rounded_up_mm(bias_mm);
@@ -520,6 +522,7 @@ void run_sequential_tests(const std::vector<RenderedPair>& frames, const TuneSet
     configured.silhouette_band_px = settings.discrepancy.evidence_silhouette_band_px;
     configured.silhouette_bias_mm = settings.discrepancy.evidence_silhouette_bias_mm;
     configured.silhouette_bias_by_link_mm = settings.discrepancy.evidence_silhouette_bias_by_link_mm;
+    configured.silhouette_band_step_mm = settings.discrepancy.evidence_silhouette_band_step_mm;
     result->configured = run_evidence(frames, settings, tree, configured);
   }
 }
@@ -679,9 +682,10 @@ std::string tune_report(const TuneResult& r, const TuneSettings& settings) {
       << "fixed pattern sigma " << fixed(e.fixed_pattern_sigma_mm, 1) << " mm over " << e.pattern_pixels
       << " environment pixels (config: static_bias_mm " << settings.discrepancy.evidence_static_bias_mm
       << ", fixed_pattern_sigma_mm " << settings.discrepancy.evidence_fixed_pattern_sigma_mm << ")\n";
-  out << "near rendered steps, the arm's pixels' mean I_dis less the smooth part by distance, the largest "
-         "of a link (px: mm, samples):";
   const NearStepError& steps = e.near_steps;
+  out << "near rendered steps over " << fixed(steps.band_step_mm, 0)
+      << " mm, the arm's pixels' mean I_dis less the smooth part by distance, the largest of a link (px: mm, "
+         "samples):";
   for (size_t k = 0; k < steps.ring_samples.size(); ++k)
     out << " " << k + 1 << ": " << fixed(steps.ring_mean_mm[k], 1) << " (" << steps.ring_samples[k] << ")";
   out << "; allowance beyond the smooth one (a link's larger of its rings' bounds and its largest "
@@ -702,7 +706,11 @@ std::string tune_report(const TuneResult& r, const TuneSettings& settings) {
         << " d^2, pixels_per_sample " << run.pixels_per_sample << ", static error allowed "
         << fixed(run.static_bias_mm, 1) << " mm + fixed pattern " << fixed(run.fixed_pattern_sigma_mm, 1)
         << " mm + " << fixed(run.silhouette_bias_mm, 1) << " mm within " << run.silhouette_band_px
-        << " px of a step\n"
+        << " px of a step over "
+        << fixed(run.silhouette_band_step_mm > 0 ? run.silhouette_band_step_mm
+                                                 : settings.discrepancy.silhouette_jump_mm,
+                 0)
+        << " mm\n"
         << "  false-mismatch rate per pixel at |I_dis| > " << settings.discrepancy.tolerance_sigmas
         << " sigma + " << settings.discrepancy.model_tolerance_mm << " mm: " << run.mismatches << " of "
         << run.pixels << " (" << std::setprecision(3) << run.mismatch_fraction() << ")\n"
@@ -769,10 +777,12 @@ std::string tuned_config_lines(const TuneResult& r, const std::string& date) {
   out << "    static_bias_mm: " << fixed(r.tuned.static_bias_mm, 1) << "\n"
       << "    fixed_pattern_sigma_mm: " << fixed(r.tuned.fixed_pattern_sigma_mm, 1) << "\n";
   if (r.tuned.silhouette_band_px > 0) {
-    out << "    # The arm's pixels within band_px of a farther surface read this much more\n"
-        << "    # (multipath), their rings' largest |mean| + 2 standard errors beyond static_bias_mm;\n"
+    out << "    # The arm's pixels within band_px of a surface farther by step_mm read this much\n"
+        << "    # more (multipath), beyond static_bias_mm: each measured link's rings' largest\n"
+        << "    # |mean| + 2 standard errors or its largest one-second mean, whichever is larger;\n"
         << "    # by_link: each measured link's own, bias_mm the largest (other links, the scene).\n"
         << "    silhouette_allowance: {band_px: " << r.tuned.silhouette_band_px
+        << ", step_mm: " << fixed(r.tuned.silhouette_band_step_mm, 0)
         << ", bias_mm: " << fixed(r.tuned.silhouette_bias_mm, 1);
     if (!r.tuned.silhouette_bias_by_link_mm.empty()) {
       out << ", by_link: {";

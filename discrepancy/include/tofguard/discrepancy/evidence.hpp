@@ -100,6 +100,12 @@ struct EvidenceOptions {
   double silhouette_bias_mm = 0.0;
   int silhouette_band_px = 0;
   std::map<std::string, double> silhouette_bias_by_link_mm;
+  //  - silhouette_band_step_mm: the rendered step that opens the band (a
+  //    surface farther by more than this within silhouette_band_px), mm;
+  //    <= 0: the silhouette jump. Multipath needs only a surface behind
+  //    the pixel, not a silhouette: a wrist before its own forearm is a
+  //    concave corner of a few cm.
+  double silhouette_band_step_mm = 0.0;
 };
 
 // The pixels on the near side of a rendered step (row-major, 1 = within
@@ -109,7 +115,9 @@ struct EvidenceOptions {
 std::vector<uint8_t> near_side_of_steps(const depth_image_t& rendered, int band_px,
                                         double silhouette_jump_mm);
 // Per pixel (row-major), the silhouette allowance of `rendered`'s pixels on
-// the near side of a step (near_side_of_steps within silhouette_band_px):
+// the near side of a step (near_side_of_steps within silhouette_band_px, of
+// a step larger than silhouette_band_step_mm, or silhouette_jump_mm when
+// that is <= 0):
 // silhouette_bias_by_link_mm of its link where given, silhouette_bias_mm
 // otherwise; 0 elsewhere. Empty when silhouette_band_px <= 0.
 std::vector<float> near_step_allowance_mm(const depth_image_t& rendered, const link_labels_t& labels,

@@ -80,9 +80,12 @@ struct DiscrepancySettings {
   // a farther surface: it moves with the arm, no profile learns it), mm.
   // by_link (optional): a link's own bound, by link name, where
   // commissioning measured it; other links and the scene take bias_mm.
+  // step_mm (optional; absent: 0, silhouette_jump_mm): the rendered step
+  // that opens the band, mm.
   int evidence_silhouette_band_px = 0;
   double evidence_silhouette_bias_mm = 0;
   std::map<std::string, double> evidence_silhouette_bias_by_link_mm;
+  double evidence_silhouette_band_step_mm = 0;
   // camera_profile (optional; absent: none): the camera's commissioned
   // profile file (tofguard-tune --profile-out; docs/camera.md,
   // "Commissioning a camera"), read with the config: every frame is

@@ -16,11 +16,24 @@
 namespace tofguard::tune {
 
 // Rings of distance 1..kStepRingsPx pixels (Chebyshev) from the nearest
-// rendered surface farther by more than the silhouette jump; a ring of a
+// rendered surface farther by more than the band's step; a ring of a
 // link, or a second of a link's band, counts with at least
 // kMinStepRingSamples pixels.
 constexpr int kStepRingsPx = 12;
 constexpr int64_t kMinStepRingSamples = 200;
+// The rendered step that opens the band (EvidenceOptions::
+// silhouette_band_step_mm), mm. Multipath needs a surface behind the
+// pixel, not a silhouette: the arm's own concave corners (a wrist before
+// its forearm, a gripper before its wrist) are steps of 1-5 cm, under the
+// 5 cm silhouette jump, and a simulated camera's multipath there stopped
+// the Kinova Gen3 on joint_6 (docs/safety-chain.md, "Static error: the
+// composite null"). 1 cm: about twice a ToF camera's depth sigma at 1 m
+// (4-6 mm), a step a frame's pixels show as a surface behind rather than
+// noise on a slope. A smaller step widens the band over the arm's slopes
+// and costs detection. The simulated camera's multipath starts at 1 cm
+// steps too (sim/tof_error_model.cpp); a real camera's behind smaller
+// steps is left to static_bias_mm.
+constexpr double kBandStepMm = 10;
 
 // Measured on each of the arm's links, its pixels used as the noise fit's
 // (noise_pixels) and within the naming gate of the smooth fit's sigma: e =
@@ -32,6 +45,8 @@ struct NearStepError {
   // The band: the farthest ring whose |mean| + 2 standard errors exceeds
   // the smooth allowance on some link; 0: none (and no allowance).
   int band_px = 0;
+  // The rendered step the rings are measured from (mm).
+  double band_step_mm = 0;
   // Each measured link's allowance beyond the smooth one: the larger of its
   // rings' bounds (|mean| + 2 standard errors) and its largest |mean e|
   // within the band over any one second of the recording, less the smooth
@@ -46,10 +61,12 @@ struct NearStepError {
 };
 
 // `frames` in recording order (each frame's second: its camera utime less
-// the first's); `smooth`: the fit whose median by depth is the smooth part;
+// the first's); `silhouette_jump_mm`: the silhouettes left out of the
+// noise pixels; `band_step_mm`: the rendered step the rings are measured
+// from; `smooth`: the fit whose median by depth is the smooth part;
 // `smooth_allowance_mm`: the evidence's static_bias_mm.
 NearStepError measure_near_step_error(const std::vector<RenderedPair>& frames, double silhouette_jump_mm,
-                                      double naming_gate_sigmas, const NoiseFit& smooth,
+                                      double band_step_mm, double naming_gate_sigmas, const NoiseFit& smooth,
                                       double smooth_allowance_mm);
 
 }  // namespace tofguard::tune

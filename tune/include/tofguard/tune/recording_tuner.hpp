@@ -117,6 +117,7 @@ struct EvidenceRun {
   int silhouette_band_px = 0;
   double silhouette_bias_mm = 0;
   std::map<std::string, double> silhouette_bias_by_link_mm;
+  double silhouette_band_step_mm = 0;  // <= 0: the silhouette jump
   std::vector<ParameterScores> parameters;
   double max_cusum = 0;
   std::string max_cusum_hypothesis;
