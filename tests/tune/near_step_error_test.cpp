@@ -93,6 +93,38 @@ TEST(NearStepError, AConcaveCornerUnderTheSilhouetteJumpIsMeasuredFromTheBandsSt
   EXPECT_EQ(from_silhouettes.bias_by_link_mm.count("link2"), 0u);
 }
 
+TEST(NearStepError, ALinksCornersDoNotDiluteItsSilhouettesAllowance) {
+  // link2 2 cm before link1 on its left, over the floor on its right: its
+  // pixels within 12 px of the floor (columns 128 on) read 4 mm farther
+  // (multipath beside a silhouette), its many pixels by link1's corner
+  // read as far as they are. Measured as one class, the corner's pixels
+  // would lower the mean.
+  const std::vector<test::Box> arm = {{20, 20, 140, 130, test::kArmMm, 2},
+                                      {60, 60, 160, 100, test::kArmMm - 20, 3}};
+  const test::SyntheticImage model = test::draw(arm);
+  std::mt19937_64 random(12);
+  std::normal_distribution<double> noise(0, kNoiseMm);
+  std::vector<RenderedPair> frames;
+  for (int k = 0; k < 90; ++k) {
+    RenderedPair pair;
+    pair.rendered = test::depth_frame(model.depth_mm, k);
+    pair.labels = test::labels_frame(model.label, k);
+    pair.camera = pair.rendered;
+    for (size_t i = 0; i < model.depth_mm.size(); ++i) {
+      const int u = static_cast<int>(i) % test::kWidth;
+      const double farther_mm = model.label[i] == 3 && u >= 128 ? 4.0 : 0.0;
+      pair.camera.depth_mm[i] =
+          static_cast<int16_t>(std::lround(model.depth_mm[i] + farther_mm + noise(random)));
+    }
+    frames.push_back(std::move(pair));
+  }
+  const NearStepError error = measure(frames);
+  EXPECT_GT(error.silhouette_band_px, 0);
+  ASSERT_EQ(error.bias_by_link_mm.count("link2"), 1u);
+  EXPECT_NEAR(error.bias_by_link_mm.at("link2"), 4.0 - kSmoothAllowanceMm, 0.4);
+  EXPECT_LT(error.corner_bias_mm, 0.5) << "the corner reads as far as it is";
+}
+
 TEST(NearStepError, ACameraWithoutNearStepErrorGetsNoBand) {
   const NearStepError error = measure(frames_with_link2_farther(6, [](int) { return 0.0; }));
   EXPECT_EQ(error.band_px, 0);

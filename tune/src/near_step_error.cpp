@@ -26,33 +26,49 @@ void add(double e, Sums* s) {
   (*s)[2] += e * e;
 }
 
-std::map<std::string, LinkStepSums> sum_near_step_error(const std::vector<RenderedPair>& frames,
-                                                        double silhouette_jump_mm, double band_step_mm,
-                                                        double naming_gate_sigmas, const NoiseFit& smooth) {
+// Per link, the sums of the near side of silhouettes (rings by the
+// distance to a rendered step over the silhouette jump) and of the arm's
+// concave corners (pixels with no silhouette within kStepRingsPx, rings by
+// the distance to a step over band_step_mm).
+struct ClassSums {
+  std::map<std::string, LinkStepSums> silhouettes;
+  std::map<std::string, LinkStepSums> corners;
+};
+
+void add_pixel(double e, size_t second, size_t ring, LinkStepSums* link_sums) {
   constexpr size_t rings = kStepRingsPx;
-  std::map<std::string, LinkStepSums> sums;
+  link_sums->by_ring.resize(rings, {0.0, 0.0, 0.0});
+  if (link_sums->by_second.size() <= second) link_sums->by_second.resize(second + 1);
+  link_sums->by_second[second].resize(rings, {0.0, 0.0, 0.0});
+  add(e, &link_sums->by_ring[ring]);
+  add(e, &link_sums->by_second[second][ring]);
+}
+
+ClassSums sum_near_step_error(const std::vector<RenderedPair>& frames, double silhouette_jump_mm,
+                              double band_step_mm, double naming_gate_sigmas, const NoiseFit& smooth) {
+  ClassSums sums;
   const int64_t first_utime = frames.empty() ? 0 : frames.front().camera.utime;
   for (const RenderedPair& frame : frames) {
     const auto second =
         static_cast<size_t>(std::max<int64_t>(0, frame.camera.utime - first_utime) / 1'000'000);
     const std::vector<uint8_t> used = noise_pixels(frame, silhouette_jump_mm);
-    const std::vector<uint8_t> distance =
+    const std::vector<uint8_t> to_silhouette =
+        discrepancy::step_distance_px(frame.rendered, kStepRingsPx, silhouette_jump_mm);
+    const std::vector<uint8_t> to_corner =
         discrepancy::step_distance_px(frame.rendered, kStepRingsPx, band_step_mm);
-    for (size_t i = 0; i < used.size() && i < distance.size(); ++i) {
-      if (!used[i] || distance[i] == 0) continue;
+    for (size_t i = 0; i < used.size() && i < to_silhouette.size() && i < to_corner.size(); ++i) {
+      if (!used[i] || to_corner[i] == 0) continue;
       const int link =
           link_of_label(frame.labels.label[i], frame.labels.num_robot_links, frame.labels.num_links);
       if (link < 0 || link >= frame.labels.num_robot_links) continue;  // the arm's pixels only
       const int gen = frame.rendered.depth_mm[i];
       const double e = gen - frame.camera.depth_mm[i] - smooth.median_mm_at(gen);
       if (std::abs(e) > naming_gate_sigmas * smooth.sigma_mm(gen / 1000.0)) continue;
-      LinkStepSums& link_sums = sums[frame.labels.link_name[static_cast<size_t>(link)]];
-      link_sums.by_ring.resize(rings, {0.0, 0.0, 0.0});
-      if (link_sums.by_second.size() <= second) link_sums.by_second.resize(second + 1);
-      link_sums.by_second[second].resize(rings, {0.0, 0.0, 0.0});
-      const size_t ring = distance[i] - 1u;
-      add(e, &link_sums.by_ring[ring]);
-      add(e, &link_sums.by_second[second][ring]);
+      const std::string& name = frame.labels.link_name[static_cast<size_t>(link)];
+      if (to_silhouette[i] > 0)
+        add_pixel(e, second, to_silhouette[i] - 1u, &sums.silhouettes[name]);
+      else
+        add_pixel(e, second, to_corner[i] - 1u, &sums.corners[name]);
     }
   }
   return sums;
@@ -73,15 +89,9 @@ double largest_second_mean_mm(const LinkStepSums& link, int band_px) {
   return largest;
 }
 
-}  // namespace
-
-NearStepError measure_near_step_error(const std::vector<RenderedPair>& frames, double silhouette_jump_mm,
-                                      double band_step_mm, double naming_gate_sigmas, const NoiseFit& smooth,
-                                      double smooth_allowance_mm) {
-  const std::map<std::string, LinkStepSums> sums =
-      sum_near_step_error(frames, silhouette_jump_mm, band_step_mm, naming_gate_sigmas, smooth);
+// One class's measure (NearStepError's fields but band_step_mm).
+NearStepError measure_class(const std::map<std::string, LinkStepSums>& sums, double smooth_allowance_mm) {
   NearStepError error;
-  error.band_step_mm = band_step_mm;
   error.ring_mean_mm.assign(kStepRingsPx, 0.0);
   error.ring_samples.assign(kStepRingsPx, 0);
   // Each measured link's largest ring bound (|mean| + 2 standard errors).
@@ -117,6 +127,33 @@ NearStepError measure_near_step_error(const std::vector<RenderedPair>& frames, d
     }
   }
   error.bias_mm = std::max(0.0, largest_mm - smooth_allowance_mm);
+  return error;
+}
+
+}  // namespace
+
+NearStepError measure_near_step_error(const std::vector<RenderedPair>& frames, double silhouette_jump_mm,
+                                      double band_step_mm, double naming_gate_sigmas, const NoiseFit& smooth,
+                                      double smooth_allowance_mm) {
+  const ClassSums sums =
+      sum_near_step_error(frames, silhouette_jump_mm, band_step_mm, naming_gate_sigmas, smooth);
+  NearStepError error = measure_class(sums.silhouettes, smooth_allowance_mm);
+  const NearStepError corners = measure_class(sums.corners, smooth_allowance_mm);
+  error.band_step_mm = band_step_mm;
+  error.silhouette_band_px = error.band_px;
+  error.corner_band_px = corners.band_px;
+  error.corner_bias_mm = corners.bias_mm;
+  // One band over both: each link takes the larger of its two classes'
+  // allowances, so that neither class's pixels dilute the other's.
+  error.band_px = std::max(error.band_px, corners.band_px);
+  for (const auto& [link, bias_mm] : corners.bias_by_link_mm) {
+    double& own = error.bias_by_link_mm[link];
+    own = std::max(own, bias_mm);
+    if (own > error.bias_mm) {
+      error.bias_mm = own;
+      error.link = link;
+    }
+  }
   return error;
 }
 

@@ -609,6 +609,35 @@ TuneResult tune_rendered_frames(const TuneSettings& settings, std::vector<Render
   return result;
 }
 
+// The report's lines on the static error: the smooth part, the fixed
+// pattern and the near side of steps.
+void describe_static_error(const TuneResult& r, const TuneSettings& settings, std::ostringstream& out) {
+  const StaticError& e = r.static_error;
+  out << "static error (the same in every frame): smooth part within " << fixed(e.smooth_bound_mm, 1)
+      << " mm (largest at " << fixed(e.smooth_depth_m, 2)
+      << " m rendered depth: the bin's median I_dis + 2 standard errors), "
+      << "fixed pattern sigma " << fixed(e.fixed_pattern_sigma_mm, 1) << " mm over " << e.pattern_pixels
+      << " environment pixels (config: static_bias_mm " << settings.discrepancy.evidence_static_bias_mm
+      << ", fixed_pattern_sigma_mm " << settings.discrepancy.evidence_fixed_pattern_sigma_mm << ")\n";
+  const NearStepError& steps = e.near_steps;
+  out << "near rendered steps over " << fixed(steps.band_step_mm, 0)
+      << " mm, the arm's pixels' mean I_dis less the smooth part by distance, the largest of a link (px: mm, "
+         "samples):";
+  for (size_t k = 0; k < steps.ring_samples.size(); ++k)
+    out << " " << k + 1 << ": " << fixed(steps.ring_mean_mm[k], 1) << " (" << steps.ring_samples[k] << ")";
+  out << "; allowance beyond the smooth one (a link's larger of its rings' bounds and its largest "
+         "one-second mean, of silhouettes and of its concave corners each) "
+      << fixed(steps.bias_mm, 1) << " mm within " << steps.band_px << " px"
+      << (steps.link.empty() ? "" : " (set by " + steps.link + ")") << " (silhouettes "
+      << steps.silhouette_band_px << " px; corners " << steps.corner_band_px << " px, up to "
+      << fixed(steps.corner_bias_mm, 1) << " mm)";
+  if (!steps.bias_by_link_mm.empty()) {
+    out << "; by link:";
+    for (const auto& [link, bias_mm] : steps.bias_by_link_mm) out << " " << link << " " << fixed(bias_mm, 1);
+  }
+  out << "\n";
+}
+
 std::string tune_report(const TuneResult& r, const TuneSettings& settings) {
   std::ostringstream out;
   out << "recording: " << r.log_path << "\n"
@@ -675,28 +704,7 @@ std::string tune_report(const TuneResult& r, const TuneSettings& settings) {
         << " % of the arm's compared pixels more than a bin outside it (at most "
         << fixed(100 * kMaxShareOutsideProfile, 1) << " %)\n";
   }
-  const StaticError& e = r.static_error;
-  out << "static error (the same in every frame): smooth part within " << fixed(e.smooth_bound_mm, 1)
-      << " mm (largest at " << fixed(e.smooth_depth_m, 2)
-      << " m rendered depth: the bin's median I_dis + 2 standard errors), "
-      << "fixed pattern sigma " << fixed(e.fixed_pattern_sigma_mm, 1) << " mm over " << e.pattern_pixels
-      << " environment pixels (config: static_bias_mm " << settings.discrepancy.evidence_static_bias_mm
-      << ", fixed_pattern_sigma_mm " << settings.discrepancy.evidence_fixed_pattern_sigma_mm << ")\n";
-  const NearStepError& steps = e.near_steps;
-  out << "near rendered steps over " << fixed(steps.band_step_mm, 0)
-      << " mm, the arm's pixels' mean I_dis less the smooth part by distance, the largest of a link (px: mm, "
-         "samples):";
-  for (size_t k = 0; k < steps.ring_samples.size(); ++k)
-    out << " " << k + 1 << ": " << fixed(steps.ring_mean_mm[k], 1) << " (" << steps.ring_samples[k] << ")";
-  out << "; allowance beyond the smooth one (a link's larger of its rings' bounds and its largest "
-         "one-second mean) "
-      << fixed(steps.bias_mm, 1) << " mm within " << steps.band_px << " px"
-      << (steps.link.empty() ? "" : " (set by " + steps.link + ")");
-  if (!steps.bias_by_link_mm.empty()) {
-    out << "; by link:";
-    for (const auto& [link, bias_mm] : steps.bias_by_link_mm) out << " " << link << " " << fixed(bias_mm, 1);
-  }
-  out << "\n";
+  describe_static_error(r, settings, out);
   if (!r.allowance_raised.empty()) {
     out << "static allowance raised from " << fixed(r.measured_static_bias_mm, 1) << " mm to "
         << fixed(r.tuned.static_bias_mm, 1) << " mm: " << r.allowance_raised << "\n";
@@ -779,7 +787,8 @@ std::string tuned_config_lines(const TuneResult& r, const std::string& date) {
   if (r.tuned.silhouette_band_px > 0) {
     out << "    # The arm's pixels within band_px of a surface farther by step_mm read this much\n"
         << "    # more (multipath), beyond static_bias_mm: each measured link's rings' largest\n"
-        << "    # |mean| + 2 standard errors or its largest one-second mean, whichever is larger;\n"
+        << "    # |mean| + 2 standard errors or its largest one-second mean, whichever is larger,\n"
+        << "    # beside its silhouettes and its concave corners each, the larger of the two;\n"
         << "    # by_link: each measured link's own, bias_mm the largest (other links, the scene).\n"
         << "    silhouette_allowance: {band_px: " << r.tuned.silhouette_band_px
         << ", step_mm: " << fixed(r.tuned.silhouette_band_step_mm, 0)

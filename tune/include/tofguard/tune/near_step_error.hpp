@@ -16,7 +16,7 @@
 namespace tofguard::tune {
 
 // Rings of distance 1..kStepRingsPx pixels (Chebyshev) from the nearest
-// rendered surface farther by more than the band's step; a ring of a
+// rendered surface farther by more than a class's step; a ring of a
 // link, or a second of a link's band, counts with at least
 // kMinStepRingSamples pixels.
 constexpr int kStepRingsPx = 12;
@@ -32,21 +32,36 @@ constexpr int64_t kMinStepRingSamples = 200;
 // noise on a slope. A smaller step widens the band over the arm's slopes
 // and costs detection. The simulated camera's multipath starts at 1 cm
 // steps too (sim/tof_error_model.cpp); a real camera's behind smaller
-// steps is left to static_bias_mm.
+// steps is left to static_bias_mm. Measured as one class with the
+// silhouettes, the corners' many pixels lowered a link's mean beside its
+// silhouette, and the iiwa14 stopped on joint 6 (its links' allowances
+// 0.2-2.2 mm within 7 px, from the silhouettes alone 1.0-2.0 mm within
+// 12 px): each class is measured on its own, and a link takes the larger.
 constexpr double kBandStepMm = 10;
 
 // Measured on each of the arm's links, its pixels used as the noise fit's
 // (noise_pixels) and within the naming gate of the smooth fit's sigma: e =
 // I_dis less the smooth part at the pixel's rendered depth, mm.
 struct NearStepError {
-  // Per ring: the largest |mean e| of a link and its samples.
+  // Per ring of the silhouettes: the largest |mean e| of a link and its
+  // samples.
   std::vector<double> ring_mean_mm;
   std::vector<int64_t> ring_samples;
-  // The band: the farthest ring whose |mean| + 2 standard errors exceeds
-  // the smooth allowance on some link; 0: none (and no allowance).
+  // The band: the farthest ring of either class whose |mean| + 2 standard
+  // errors exceeds the smooth allowance on some link; 0: none (and no
+  // allowance).
   int band_px = 0;
-  // The rendered step the rings are measured from (mm).
+  // The rendered step the band opens at (mm), and the two classes of its
+  // pixels, each measured on its own (a class's rings and one-second means
+  // would be diluted by the other's pixels): the near side of silhouettes
+  // (a step over the silhouette jump within kStepRingsPx; ring_* are
+  // theirs) and the arm's concave corners (a step over band_step_mm, no
+  // silhouette within kStepRingsPx). band_px and bias_by_link_mm are the
+  // larger of the two.
   double band_step_mm = 0;
+  int silhouette_band_px = 0;
+  int corner_band_px = 0;
+  double corner_bias_mm = 0;
   // Each measured link's allowance beyond the smooth one: the larger of its
   // rings' bounds (|mean| + 2 standard errors) and its largest |mean e|
   // within the band over any one second of the recording, less the smooth
