@@ -180,7 +180,9 @@ CommissionedCamera commission_imperfect_camera(const CampaignArm& arm, uint64_t 
     for (const auto& link : checked.tuned.silhouette_bias_by_link_mm)
       least_mm = std::min(least_mm, link.second);
     summary << " (" << checked.static_error.near_steps.link << "; its links " << fixed(least_mm, 1) << ".."
-            << fixed(checked.tuned.silhouette_bias_mm, 1) << " mm)";
+            << fixed(checked.tuned.silhouette_bias_mm, 1) << " mm; concave corners "
+            << checked.static_error.near_steps.corner_band_px << " px, up to "
+            << fixed(checked.static_error.near_steps.corner_bias_mm, 1) << " mm)";
   }
   summary << ", arm pixels outside the profile's range "
           << fixed(100 * checked.profile_coverage.outside_share(), 2) << " %";
