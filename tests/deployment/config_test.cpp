@@ -196,16 +196,16 @@ INSTANTIATE_TEST_SUITE_P(
                   "  worker_threads: many\n",
                   {"discrepancy.worker_threads", "expected an integer in [1, 64] or auto", "'many'"}},
         BadConfig{"silhouette-allowance-without-band",
-                  "    silhouette_allowance: {band_px: 12, step_mm: 10, ",
-                  "    silhouette_allowance: {step_mm: 10, ",
+                  "    silhouette_allowance: {band_px: 11, bias_mm: 2.3}\n",
+                  "    silhouette_allowance: {bias_mm: 2.3}\n",
                   {"discrepancy.evidence.silhouette_allowance.band_px", "missing key"}},
         BadConfig{"silhouette-allowance-by-link-not-a-number",
-                  "by_link: {base_link: 0.7, ",
-                  "by_link: {base_link: wide, ",
-                  {"discrepancy.evidence.silhouette_allowance.by_link.base_link", "'wide'"}},
+                  "    silhouette_allowance: {band_px: 11, bias_mm: 2.3}\n",
+                  "    silhouette_allowance: {band_px: 11, bias_mm: 2.3, by_link: {link7: wide}}\n",
+                  {"discrepancy.evidence.silhouette_allowance.by_link.link7", "'wide'"}},
         BadConfig{"silhouette-allowance-step-zero",
-                  "    silhouette_allowance: {band_px: 12, step_mm: 10, ",
-                  "    silhouette_allowance: {band_px: 12, step_mm: 0, ",
+                  "    silhouette_allowance: {band_px: 11, bias_mm: 2.3}\n",
+                  "    silhouette_allowance: {band_px: 11, step_mm: 0, bias_mm: 2.3}\n",
                   {"discrepancy.evidence.silhouette_allowance.step_mm", "'0'"}},
         BadConfig{"worker-threads-zero",
                   "  worker_threads: auto\n",
@@ -255,17 +255,19 @@ INSTANTIATE_TEST_SUITE_P(
     });
 
 TEST(Config, TheSilhouetteAllowanceTakesEachLinksOwnBoundAndItsStep) {
-  const deployment::Config config = deployment::load_config(sim_yaml_path(), nullptr);
-  EXPECT_EQ(config.discrepancy.evidence_silhouette_band_px, 12);
+  const std::string path =
+      sim_variant("silhouette-by-link", "    silhouette_allowance: {band_px: 11, bias_mm: 2.3}\n",
+                  "    silhouette_allowance: {band_px: 11, step_mm: 10, bias_mm: 2.3, by_link: "
+                  "{link1: 2.3, link7: 0.4}}\n");
+  const deployment::Config config = deployment::load_config(path, nullptr);
+  EXPECT_EQ(config.discrepancy.evidence_silhouette_bias_mm, 2.3);
   EXPECT_EQ(config.discrepancy.evidence_silhouette_band_step_mm, 10.0);
-  EXPECT_EQ(config.discrepancy.evidence_silhouette_bias_mm, 2.8);
-  EXPECT_EQ(config.discrepancy.evidence_silhouette_bias_by_link_mm.size(), 9u);
-  EXPECT_EQ(config.discrepancy.evidence_silhouette_bias_by_link_mm.at("link4"), 1.8);
-  EXPECT_EQ(config.discrepancy.evidence_silhouette_bias_by_link_mm.at("link7"), 2.8);
-  // Without step_mm the band opens at the silhouette jump (0 here).
-  const std::string from_jump =
-      sim_variant("silhouette-from-jump", "{band_px: 12, step_mm: 10, ", "{band_px: 12, ");
-  EXPECT_EQ(deployment::load_config(from_jump, nullptr).discrepancy.evidence_silhouette_band_step_mm, 0.0);
+  const std::map<std::string, double> expected = {{"link1", 2.3}, {"link7", 0.4}};
+  EXPECT_EQ(config.discrepancy.evidence_silhouette_bias_by_link_mm, expected);
+  // Without step_mm (config/sim.yaml's) the band opens at the silhouette
+  // jump (0 here).
+  EXPECT_EQ(deployment::load_config(sim_yaml_path(), nullptr).discrepancy.evidence_silhouette_band_step_mm,
+            0.0);
 }
 
 TEST(Config, AKeyFileOpenToOthersIsAConfigError) {
