@@ -735,7 +735,7 @@ std::vector<float> near_step_allowance_mm(const depth_image_t& rendered, const l
     if (own != options.silhouette_bias_by_link_mm.end()) by_link[k] = static_cast<float>(own->second);
   }
   const double band_step_mm =
-      options.silhouette_band_step_mm > 0 ? options.silhouette_band_step_mm : silhouette_jump_mm;
+      silhouette_band_step_or_jump_mm(options.silhouette_band_step_mm, silhouette_jump_mm);
   const std::vector<uint8_t> near = near_side_of_steps(rendered, options.silhouette_band_px, band_step_mm);
   std::vector<float> allowance(near.size(), 0.0f);
   const bool labelled = labels.label.size() == near.size();

@@ -715,8 +715,8 @@ std::string tune_report(const TuneResult& r, const TuneSettings& settings) {
         << fixed(run.static_bias_mm, 1) << " mm + fixed pattern " << fixed(run.fixed_pattern_sigma_mm, 1)
         << " mm + " << fixed(run.silhouette_bias_mm, 1) << " mm within " << run.silhouette_band_px
         << " px of a step over "
-        << fixed(run.silhouette_band_step_mm > 0 ? run.silhouette_band_step_mm
-                                                 : settings.discrepancy.silhouette_jump_mm,
+        << fixed(discrepancy::silhouette_band_step_or_jump_mm(run.silhouette_band_step_mm,
+                                                              settings.discrepancy.silhouette_jump_mm),
                  0)
         << " mm\n"
         << "  false-mismatch rate per pixel at |I_dis| > " << settings.discrepancy.tolerance_sigmas

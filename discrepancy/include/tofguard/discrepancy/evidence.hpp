@@ -208,6 +208,13 @@ inline int silhouette_step_limit_mm(double silhouette_jump_mm) {
   return x > -1.0 ? static_cast<int>(std::floor(x)) : -1;
 }
 
+// The rendered step that opens the silhouette allowance's band (mm):
+// EvidenceOptions::silhouette_band_step_mm where set (> 0), the silhouette
+// jump otherwise.
+inline double silhouette_band_step_or_jump_mm(double silhouette_band_step_mm, double silhouette_jump_mm) {
+  return silhouette_band_step_mm > 0 ? silhouette_band_step_mm : silhouette_jump_mm;
+}
+
 // Per-pixel Jacobians of a rendered frame and its labels' kinematics.
 // Keeps pointers into `rendered` and `labels`: they must outlive it.
 class EvidenceJacobian {
