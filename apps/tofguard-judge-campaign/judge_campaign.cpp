@@ -25,6 +25,7 @@
 #include "tofguard/renderer/renderer_service.hpp"
 #include "tofguard/risk/protective_field.hpp"
 #include "tofguard/risk/risk_monitor.hpp"
+#include "tofguard/risk/sequential_evidence.hpp"
 #include "tofguard/risk_t.hpp"
 #include "tofguard/robot_model/arm_spheres.hpp"
 #include "tofguard/robot_model/kinematic_tree.hpp"
@@ -505,7 +506,9 @@ struct CampaignWorld {
         intrinsics(config.camera.intrinsics),
         period_s(1.0 / config.camera.rate_hz),
         period_us(static_cast<int64_t>(std::llround(period_s * 1e6))),
-        reported_pose(config.camera.pose.frame_from_optical()) {}
+        reported_pose(config.camera.pose.frame_from_optical()),
+        memory_decay(
+            risk::SequentialEvidence(config.risk, robot_tree, config.camera.rate_hz).memory_decay()) {}
 
   const deployment::Config& config;
   SimulatedFrames truth;
@@ -521,6 +524,8 @@ struct CampaignWorld {
   const double period_s;
   const int64_t period_us;
   const Eigen::Isometry3d reported_pose;
+  // What every stop test's per-frame ratio is lowered by (nats).
+  const double memory_decay;
 };
 
 // One run of the campaign: its frames through the discrepancy and the risk
@@ -706,9 +711,27 @@ class CampaignRunJudge {
       }
       previous_t_[d.joint_name[j]] = t;
     }
+    if (kind_ == Kind::kNone) add_smallest_offsets(d);
     if (std::getenv("TOFGUARD_CAMPAIGN_CAMERA_SCORES") != nullptr)
       for (int a = 0; a < 6 && d.evidence_available; ++a)
         add_score(d.camera_score[a], d.camera_information[7 * a]);
+  }
+
+  // Per joint, the smallest offset this nominal frame can show, as the
+  // risk monitor's stop test takes its evidence (degrees; mm when
+  // prismatic).
+  void add_smallest_offsets(const discrepancy_t& d) {
+    for (int j = 0; j < d.num_joints; ++j) {
+      const bool prismatic = w_.model_scene.is_prismatic_joint(d.joint_name[j]);
+      const double delta =
+          prismatic ? config_.risk.evidence_joint_offset_m : config_.risk.evidence_joint_offset_rad;
+      const double bound =
+          static_cast<size_t>(j) < d.joint_static_bound.size() ? d.joint_static_bound[j] : 0.0;
+      const double offset =
+          risk::smallest_growing_offset(delta, d.joint_information[j], bound, w_.memory_decay);
+      result_.nominal_smallest_offset[d.joint_name[j]].push_back(
+          static_cast<float>(prismatic ? 1000 * offset : offset * 180 / M_PI));
+    }
   }
 
   void judge_verdict(const risk_t& verdict) {
@@ -804,6 +827,38 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
   for (const CampaignRun& run : runs) results.push_back(CampaignRunJudge(&world, run).judge());
   return results;
 }
+
+namespace {
+
+// One line: per joint over the nominal runs' frames, the median of the
+// smallest offset a frame can show, and the share of frames that can show
+// none (docs/safety-chain.md, "The smallest fault a frame can show"); ""
+// without nominal frames.
+std::string smallest_offsets_text(const std::vector<CampaignResult>& results) {
+  std::map<std::string, std::vector<float>> by_joint;
+  for (const CampaignResult& r : results) {
+    for (const auto& [joint, offsets] : r.nominal_smallest_offset)
+      by_joint[joint].insert(by_joint[joint].end(), offsets.begin(), offsets.end());
+  }
+  if (by_joint.empty()) return "";
+  std::ostringstream out;
+  out << "\nSmallest joint offset a nominal frame can show (B/I + d'/2 + decay/(d' I); deg, mm if "
+         "prismatic), "
+         "median over the frames (none: not seen, or the allowance covers the whole alternative):";
+  const char* separator = " ";
+  for (auto& [joint, offsets] : by_joint) {
+    const auto none = std::count_if(offsets.begin(), offsets.end(), [](float v) { return std::isinf(v); });
+    std::nth_element(offsets.begin(), offsets.begin() + offsets.size() / 2, offsets.end());
+    const float median = offsets[offsets.size() / 2];
+    out << separator << joint << " " << (std::isinf(median) ? std::string("none") : fixed_text(median, 1));
+    if (none > 0) out << " (none on " << fixed_text(100.0 * none / offsets.size(), 0) << " %)";
+    separator = ", ";
+  }
+  out << "\n";
+  return out.str();
+}
+
+}  // namespace
 
 std::string campaign_report(const std::string& arm, const std::vector<CampaignResult>& results,
                             double frame_period_s) {
@@ -902,6 +957,7 @@ std::string campaign_report(const std::string& arm, const std::vector<CampaignRe
         << "; from frame to frame (noise alone): variance "
         << fixed_text(differences > 0 ? difference_sum_sq / static_cast<double>(differences) : 0, 2) << "\n";
   }
+  out << smallest_offsets_text(results);
   const std::string m = misses.str();
   if (!m.empty()) out << "\n" << m;
   return out.str();

@@ -19,6 +19,7 @@
 // pose. Frames: camera optical (x right, y down, z forward); world = the
 // robot's root link.
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -167,6 +168,11 @@ struct CampaignResult {
   // pose cancels in the difference).
   int64_t nominal_differences = 0;
   double nominal_difference_sum_sq = 0;
+  // On the nominal frames of a run without a fault: per joint, the
+  // smallest offset each frame can show (risk::smallest_growing_offset;
+  // degrees, or mm for a prismatic joint; infinity where the allowance
+  // covers the whole alternative).
+  std::map<std::string, std::vector<float>> nominal_smallest_offset;
 };
 
 // Runs `runs` on `arm`, each from a fresh chain (new CUSUMs, new latch).

@@ -26,6 +26,13 @@ double effective_delta(double delta, double information, double static_bound) {
   return std::max(0.0, delta - static_bound / information);
 }
 
+double smallest_growing_offset(double delta, double information, double static_bound, double memory_decay) {
+  const double tested = effective_delta(delta, information, static_bound);
+  if (!(information > 0) || !(tested > 0)) return std::numeric_limits<double>::infinity();
+  return std::max(0.0, static_bound) / information + tested / 2 +
+         std::max(0.0, memory_decay) / (tested * information);
+}
+
 namespace {
 
 // The diagonal of a row-major 6x6 information matrix.

@@ -501,6 +501,50 @@ TEST(EvidenceTests, AHardlyInformedTestForgetsWithinItsMemory) {
             << expected_frames << " frames later (derived), at 0 after " << frames << " frames\n";
 }
 
+// The smallest offset a frame can show (smallest_growing_offset): on
+// shrunk scores of a joint off by theta, s ~ N(theta I, I) less the static
+// bound B, the stop test's mean ratio less the memory decay is below 0 at
+// 0.8 of it and above 0 at 1.5 of it, for a hardly seen joint with a wide
+// allowance (the default arm's a7 on a commissioned camera: 1.4 deg per
+// frame, B / I = 2.3 deg), a well seen one with a narrow allowance, and
+// one without an allowance (where it is delta / 2 plus the decay's share).
+TEST(EvidenceTests, TheSmallestOffsetAFrameCanShowIsWhereTheRatioTurns) {
+  const double delta = 3 * kDeg;
+  const double decay = 20.6 / (kRateHz * risk::kEvidenceMemoryS);
+  struct Case {
+    double sigma_deg, bound_deg, expected_deg;
+  };
+  // Expected: B/I + d'/2 + decay / (d' I), d' = 3 deg - B/I.
+  for (const Case& c : {Case{1.4, 2.3, 2.68}, Case{0.3, 1.0, 2.00}, Case{1.0, 0.0, 1.50}}) {
+    const double information = 1 / std::pow(c.sigma_deg * kDeg, 2);
+    const double bound = c.bound_deg * kDeg * information;
+    const double smallest = risk::smallest_growing_offset(delta, information, bound, decay);
+    EXPECT_NEAR(smallest / kDeg, c.expected_deg, 0.01) << c.sigma_deg << " deg per frame";
+    const double tested = risk::effective_delta(delta, information, bound);
+    std::mt19937 rng(7);
+    std::normal_distribution<double> noise(0, std::sqrt(information));
+    for (const double fraction : {0.8, 1.5}) {
+      double sum = 0;
+      constexpr int kFrames = 50000;
+      for (int k = 0; k < kFrames; ++k) {
+        const double s = fraction * smallest * information + noise(rng);
+        const double shrunk = std::copysign(std::max(0.0, std::abs(s) - bound), s);
+        sum += risk::joint_llr(shrunk, information, tested) - decay;
+      }
+      const double mean = sum / kFrames;
+      if (fraction < 1) {
+        EXPECT_LT(mean, 0) << fraction << " of " << smallest / kDeg << " deg";
+      } else {
+        EXPECT_GT(mean, 0) << fraction << " of " << smallest / kDeg << " deg";
+      }
+    }
+  }
+  // The allowance covers the whole alternative: no offset shows.
+  const double information = 1 / std::pow(1.4 * kDeg, 2);
+  EXPECT_TRUE(std::isinf(risk::smallest_growing_offset(delta, information, 3.1 * kDeg * information, decay)));
+  EXPECT_TRUE(std::isinf(risk::smallest_growing_offset(delta, 0, 0, decay)));
+}
+
 // A fault that the fit reads smaller than half the test's delta (a large
 // offset outside the fit's linear range, as the arm moves) turns the stop
 // test against it, so its CUSUM falls below the warning level; the

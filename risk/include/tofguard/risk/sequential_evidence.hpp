@@ -51,6 +51,17 @@ double joint_llr(double score, double information, double delta);
 // bound, i.e. as a fault of delta - bound / information (>= 0; 0: the fault
 // cannot show beyond the allowance, the ratio is 1). With no bound: delta.
 double effective_delta(double delta, double information, double static_bound);
+// The smallest offset (radians, or metres for a prismatic joint) whose
+// stop test gains evidence on one frame, on average (docs/safety-chain.md,
+// "The smallest fault a frame can show"): a fault of theta moves the
+// shrunk score by theta * I - B, and the simple alternative's expected
+// ratio d' (theta I - B) - d'^2 I / 2, d' = effective_delta, beats the
+// memory decay when
+//   theta > B / I + d' / 2 + decay / (d' I).
+// Infinity when d' is 0 (the allowance covers the whole alternative) or
+// the frame has no information. The mixture's log 2 per frame is left out,
+// so this is the offset's lower bound: a smaller fault's test only falls.
+double smallest_growing_offset(double delta, double information, double static_bound, double memory_decay);
 
 // The camera's: the mixture over the 12 alternatives "+-delta_a along
 // parameter a" (tx, ty, tz, rx, ry, rz), with the diagonal of the 6x6
