@@ -10,6 +10,7 @@
 
 #include "double2.hpp"
 #include "tofguard/common/camera_profile.hpp"
+#include "tofguard/common/demand.hpp"
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/discrepancy/joint_search.hpp"
 
@@ -680,12 +681,16 @@ void store_link_bias(const EvidenceSums& total, int num_links, discrepancy_t* s)
 
 }  // namespace
 
-std::vector<uint8_t> step_distance_px(const depth_image_t& rendered, int max_px, double silhouette_jump_mm) {
+std::vector<uint8_t> step_distance_px(const depth_image_t& rendered, int max_px, double silhouette_jump_mm,
+                                      const std::vector<uint8_t>* farther_from) {
   const int width = rendered.width;
   const int height = rendered.height;
   const size_t pixels = static_cast<size_t>(std::max(width, 0)) * static_cast<size_t>(std::max(height, 0));
   std::vector<uint8_t> distance(pixels, 0);
   if (max_px <= 0 || pixels == 0 || rendered.depth_mm.size() != pixels) return distance;
+  TOFGUARD_DEMAND(farther_from == nullptr || farther_from->size() == pixels,
+                  "step_distance_px: farther_from has " + std::to_string(farther_from->size()) +
+                      " entries for " + std::to_string(pixels) + " pixels");
   max_px = std::min(max_px, 255);
   const int limit = silhouette_step_limit_mm(silhouette_jump_mm);
   // farthest: the farthest rendered depth within k pixels (Chebyshev), one
@@ -699,7 +704,9 @@ std::vector<uint8_t> step_distance_px(const depth_image_t& rendered, int max_px,
   size_t open = 0;  // pixels with a surface and no step found yet
   for (size_t i = 0; i < pixels; ++i) {
     const int gen = rendered.depth_mm[i];
-    far[i] = static_cast<float>(gen);
+    // A pixel that may not be the farther surface takes part as none (0:
+    // the dilation keeps the farthest).
+    far[i] = farther_from == nullptr || (*farther_from)[i] ? static_cast<float>(gen) : 0.0f;
     beyond[i] = gen > 0 ? static_cast<float>(gen + limit) : std::numeric_limits<float>::infinity();
     if (gen > 0) ++open;
   }
@@ -739,11 +746,27 @@ std::vector<float> near_step_allowance_mm(const depth_image_t& rendered, const l
   const std::vector<uint8_t> near = near_side_of_steps(rendered, options.silhouette_band_px, band_step_mm);
   std::vector<float> allowance(near.size(), 0.0f);
   const bool labelled = labels.label.size() == near.size();
+  if (!labelled) {
+    for (size_t i = 0; i < near.size(); ++i)
+      if (near[i]) allowance[i] = static_cast<float>(options.silhouette_bias_mm);
+    return allowance;
+  }
+  // The arm's pixels, and the pixels within the band of a farther one.
+  std::vector<uint8_t> arm(near.size(), 0);
+  for (size_t i = 0; i < near.size(); ++i) {
+    const int link = link_of_label(labels.label[i], labels.num_robot_links, labels.num_links);
+    arm[i] = link >= 0 && link < labels.num_robot_links ? 1 : 0;
+  }
+  const std::vector<uint8_t> before_arm =
+      step_distance_px(rendered, options.silhouette_band_px, band_step_mm, &arm);
   for (size_t i = 0; i < near.size(); ++i) {
     if (!near[i]) continue;
-    const int link = labelled ? link_of_label(labels.label[i], labels.num_robot_links, labels.num_links) : -1;
-    allowance[i] =
-        link >= 0 ? by_link[static_cast<size_t>(link)] : static_cast<float>(options.silhouette_bias_mm);
+    if (arm[i]) {
+      allowance[i] = by_link[static_cast<size_t>(
+          link_of_label(labels.label[i], labels.num_robot_links, labels.num_links))];
+    } else if (before_arm[i] > 0) {
+      allowance[i] = static_cast<float>(options.silhouette_bias_mm);
+    }
   }
   return allowance;
 }

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -890,6 +891,51 @@ TEST(StepDistance, TheAllowanceBandOpensAtItsOwnStep) {
   options.silhouette_band_step_mm = 30;
   const std::vector<float> above = near_step_allowance_mm(rendered, labels, options, 50);
   EXPECT_EQ(std::count(above.begin(), above.end(), 0.0f), 80) << "a 20 mm step under a 30 mm band step";
+}
+
+// One row of four surfaces, 10 columns each: the scene at 1000 mm, the
+// scene at 1100 mm, an arm link at 1200 mm, the scene at 2000 mm. The
+// scene before the farther scene takes no allowance (the profile's
+// per-pixel map holds that multipath), the scene before the arm takes
+// silhouette_bias_mm, the arm before the scene its link's own.
+TEST(StepDistance, TheSceneTakesTheAllowanceOnlyBeforeTheArm) {
+  depth_image_t rendered{};
+  rendered.width = 40;
+  rendered.height = 3;
+  link_labels_t labels{};
+  labels.num_robot_links = 1;
+  labels.num_links = 2;
+  labels.link_name = {"link7", "wall"};
+  const int16_t scene = link_labels_t::ENVIRONMENT_FIRST;
+  const int16_t arm = link_labels_t::ROBOT_FIRST;
+  for (int v = 0; v < 3; ++v) {
+    for (int u = 0; u < 40; ++u) {
+      const int surface = u / 10;
+      rendered.depth_mm.push_back(std::array<int, 4>{1000, 1100, 1200, 2000}[static_cast<size_t>(surface)]);
+      labels.label.push_back(surface == 2 ? arm : scene);
+    }
+  }
+  EvidenceOptions options;
+  options.silhouette_band_px = 2;
+  options.silhouette_band_step_mm = 10;
+  options.silhouette_bias_mm = 3.0;
+  options.silhouette_bias_by_link_mm["link7"] = 1.5;
+  const std::vector<float> allowance = near_step_allowance_mm(rendered, labels, options, 50);
+  for (int v = 0; v < 3; ++v) {
+    const auto at = [&](int u) { return allowance[static_cast<size_t>(v * 40 + u)]; };
+    EXPECT_EQ(at(8), 0.0f) << "the scene before the farther scene";
+    EXPECT_EQ(at(9), 0.0f) << "the scene before the farther scene";
+    EXPECT_EQ(at(18), 3.0f) << "the scene before the arm";
+    EXPECT_EQ(at(19), 3.0f) << "the scene before the arm";
+    EXPECT_EQ(at(17), 0.0f) << "beyond band_px";
+    EXPECT_EQ(at(28), 1.5f) << "the arm before the scene: its own";
+    EXPECT_EQ(at(29), 1.5f) << "the arm before the scene: its own";
+    EXPECT_EQ(at(30), 0.0f) << "the far side";
+  }
+  // Without labels every pixel of the band takes silhouette_bias_mm.
+  const std::vector<float> unlabelled = near_step_allowance_mm(rendered, link_labels_t{}, options, 50);
+  EXPECT_EQ(unlabelled[9], 3.0f);
+  EXPECT_EQ(unlabelled[29], 3.0f);
 }
 
 TEST_F(EvidenceTest, AStillArmShowsNoJointOffsetFromOneMixedPixel) {

@@ -119,13 +119,24 @@ std::vector<uint8_t> near_side_of_steps(const depth_image_t& rendered, int band_
 // a step larger than silhouette_band_step_mm, or silhouette_jump_mm when
 // that is <= 0):
 // silhouette_bias_by_link_mm of its link where given, silhouette_bias_mm
-// otherwise; 0 elsewhere. Empty when silhouette_band_px <= 0.
+// otherwise; 0 elsewhere. A pixel of the static scene takes
+// silhouette_bias_mm only where the farther surface within the band is the
+// arm's: before a farther static surface its multipath is as static as
+// the surfaces, and the camera's profile learned it per pixel
+// (docs/camera.md); only the arm moving behind it changes it. (Given the
+// scene's pixels before every step, the largest link's allowance blinded
+// the camera's own test: at 1 cm steps most of the scene is in the band.)
+// Without labels every pixel in the band takes silhouette_bias_mm. Empty
+// when silhouette_band_px <= 0.
 std::vector<float> near_step_allowance_mm(const depth_image_t& rendered, const link_labels_t& labels,
                                           const EvidenceOptions& options, double silhouette_jump_mm);
 // Per pixel, how far (pixels, Chebyshev, 1..max_px) the nearest rendered
 // surface farther than it by more than silhouette_step's jump is; 0: none
-// within max_px (or no rendered surface). max_px at most 255.
-std::vector<uint8_t> step_distance_px(const depth_image_t& rendered, int max_px, double silhouette_jump_mm);
+// within max_px (or no rendered surface). max_px at most 255. With
+// `farther_from` (one per pixel), only its pixels set to 1 count as the
+// farther surface.
+std::vector<uint8_t> step_distance_px(const depth_image_t& rendered, int max_px, double silhouette_jump_mm,
+                                      const std::vector<uint8_t>* farther_from = nullptr);
 
 // How many sigmas of a fixed pattern's score offset the shrinking allows
 // (EvidenceOptions::fixed_pattern_sigma_mm): the offset is one draw per
