@@ -16,6 +16,12 @@
 namespace tofguard::test {
 namespace {
 
+// config/sim.yaml's silhouette allowance, as the variants below replace it.
+const char* const kSimSilhouetteAllowance =
+    "    silhouette_allowance: {band_px: 12, step_mm: 10, bias_mm: 5.0, by_link: {base_link: 0.6, gripper: "
+    "2.0,\n"
+    "      link1: 2.0, link2: 0.3, link3: 0.7, link4: 1.5, link5: 1.5, link6: 2.9, link7: 5.0}}\n";
+
 std::string sim_yaml_path() { return source_dir() + "/config/sim.yaml"; }
 
 // sim.yaml with `from` replaced by `to` (which must occur), in the test
@@ -196,15 +202,15 @@ INSTANTIATE_TEST_SUITE_P(
                   "  worker_threads: many\n",
                   {"discrepancy.worker_threads", "expected an integer in [1, 64] or auto", "'many'"}},
         BadConfig{"silhouette-allowance-without-band",
-                  "    silhouette_allowance: {band_px: 11, bias_mm: 2.3}\n",
+                  kSimSilhouetteAllowance,
                   "    silhouette_allowance: {bias_mm: 2.3}\n",
                   {"discrepancy.evidence.silhouette_allowance.band_px", "missing key"}},
         BadConfig{"silhouette-allowance-by-link-not-a-number",
-                  "    silhouette_allowance: {band_px: 11, bias_mm: 2.3}\n",
+                  kSimSilhouetteAllowance,
                   "    silhouette_allowance: {band_px: 11, bias_mm: 2.3, by_link: {link7: wide}}\n",
                   {"discrepancy.evidence.silhouette_allowance.by_link.link7", "'wide'"}},
         BadConfig{"silhouette-allowance-step-zero",
-                  "    silhouette_allowance: {band_px: 11, bias_mm: 2.3}\n",
+                  kSimSilhouetteAllowance,
                   "    silhouette_allowance: {band_px: 11, step_mm: 0, bias_mm: 2.3}\n",
                   {"discrepancy.evidence.silhouette_allowance.step_mm", "'0'"}},
         BadConfig{"worker-threads-zero",
@@ -255,19 +261,24 @@ INSTANTIATE_TEST_SUITE_P(
     });
 
 TEST(Config, TheSilhouetteAllowanceTakesEachLinksOwnBoundAndItsStep) {
-  const std::string path =
-      sim_variant("silhouette-by-link", "    silhouette_allowance: {band_px: 11, bias_mm: 2.3}\n",
-                  "    silhouette_allowance: {band_px: 11, step_mm: 10, bias_mm: 2.3, by_link: "
-                  "{link1: 2.3, link7: 0.4}}\n");
+  // config/sim.yaml's, over two lines as tofguard-tune's can be pasted.
+  const deployment::Config sim = deployment::load_config(sim_yaml_path(), nullptr);
+  EXPECT_EQ(sim.discrepancy.evidence_silhouette_bias_mm, 5.0);
+  EXPECT_EQ(sim.discrepancy.evidence_silhouette_band_px, 12);
+  EXPECT_EQ(sim.discrepancy.evidence_silhouette_band_step_mm, 10.0);
+  EXPECT_EQ(sim.discrepancy.evidence_silhouette_bias_by_link_mm.size(), 9u);
+  EXPECT_EQ(sim.discrepancy.evidence_silhouette_bias_by_link_mm.at("link7"), 5.0);
+  EXPECT_EQ(sim.discrepancy.evidence_silhouette_bias_by_link_mm.at("link2"), 0.3);
+  const std::string path = sim_variant("silhouette-by-link", kSimSilhouetteAllowance,
+                                       "    silhouette_allowance: {band_px: 11, bias_mm: 2.3, by_link: "
+                                       "{link1: 2.3, link7: 0.4}}\n");
   const deployment::Config config = deployment::load_config(path, nullptr);
   EXPECT_EQ(config.discrepancy.evidence_silhouette_bias_mm, 2.3);
-  EXPECT_EQ(config.discrepancy.evidence_silhouette_band_step_mm, 10.0);
   const std::map<std::string, double> expected = {{"link1", 2.3}, {"link7", 0.4}};
   EXPECT_EQ(config.discrepancy.evidence_silhouette_bias_by_link_mm, expected);
-  // Without step_mm (config/sim.yaml's) the band opens at the silhouette
-  // jump (0 here).
-  EXPECT_EQ(deployment::load_config(sim_yaml_path(), nullptr).discrepancy.evidence_silhouette_band_step_mm,
-            0.0);
+  // Without step_mm the band opens at the silhouette jump (0 here), as in
+  // configs measured before tofguard-tune measured from 1 cm steps.
+  EXPECT_EQ(config.discrepancy.evidence_silhouette_band_step_mm, 0.0);
 }
 
 TEST(Config, AKeyFileOpenToOthersIsAConfigError) {
