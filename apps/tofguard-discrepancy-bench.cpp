@@ -32,6 +32,7 @@
 #include "tofguard/common/worker_pool.hpp"
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/discrepancy/discrepancy_image.hpp"
+#include "tofguard/discrepancy/evidence.hpp"
 #include "tofguard/discrepancy/joint_search.hpp"
 #include "tofguard/renderer/depth_renderer.hpp"
 #include "tofguard/renderer/rendered_kinematics.hpp"
@@ -201,14 +202,19 @@ SimulatedArmFrames make_simulated_arm_frames(int width, int height) {
 // caches idle between frames; -33: the same pause with the caller spinning
 // through it, so that its core never idles: the pair showed the worker put
 // on the caller's core, WorkerPool), not timed; wall time then.
-void BM_ComputeDiscrepancySimulatedArm(benchmark::State& state) {
-  // Made once per size (Google Benchmark calls this several times).
+// The default arm's frames at width x height, made once per size (Google
+// Benchmark calls a benchmark several times).
+const SimulatedArmFrames& simulated_arm_frames(int64_t width, int64_t height) {
   static std::map<std::pair<int64_t, int64_t>, SimulatedArmFrames> made;
-  const auto size = std::make_pair(state.range(0), state.range(1));
+  const auto size = std::make_pair(width, height);
   if (made.count(size) == 0) {
     made[size] = make_simulated_arm_frames(static_cast<int>(size.first), static_cast<int>(size.second));
   }
-  const SimulatedArmFrames& sim = made[size];
+  return made[size];
+}
+
+void BM_ComputeDiscrepancySimulatedArm(benchmark::State& state) {
+  const SimulatedArmFrames& sim = simulated_arm_frames(state.range(0), state.range(1));
   const tofguard::discrepancy::DiscrepancyOptions options =
       tofguard::discrepancy::discrepancy_options(sim.config.discrepancy);
   std::unique_ptr<tofguard::WorkerPool> workers;
@@ -266,6 +272,26 @@ BENCHMARK(BM_ComputeDiscrepancySimulatedArm)
     ->Args({176, 144, 2, -33})
     ->Args({640, 480, 0, 0})
     ->UseRealTime()
+    ->Unit(benchmark::kMicrosecond);
+
+// near_step_allowance_mm alone on the default arm's frames with
+// config/sim.yaml's allowance (12 px from 1 cm steps, by link): the band,
+// and the band before the arm's pixels that the scene's pixels take it in.
+void BM_NearStepAllowanceSimulatedArm(benchmark::State& state) {
+  const SimulatedArmFrames& sim = simulated_arm_frames(state.range(0), state.range(1));
+  const tofguard::discrepancy::DiscrepancyOptions options =
+      tofguard::discrepancy::discrepancy_options(sim.config.discrepancy);
+  size_t k = 0;
+  for (auto _ : state) {
+    const Frames& f = sim.frames[k++ % sim.frames.size()];
+    const std::vector<float> allowance = tofguard::discrepancy::near_step_allowance_mm(
+        f.rendered, f.labels, options.evidence, sim.config.discrepancy.silhouette_jump_mm);
+    benchmark::DoNotOptimize(allowance.data());
+  }
+}
+BENCHMARK(BM_NearStepAllowanceSimulatedArm)
+    ->ArgNames({"width", "height"})
+    ->Args({176, 144})
     ->Unit(benchmark::kMicrosecond);
 
 void BM_DepthHash(benchmark::State& state) {

@@ -681,16 +681,12 @@ void store_link_bias(const EvidenceSums& total, int num_links, discrepancy_t* s)
 
 }  // namespace
 
-std::vector<uint8_t> step_distance_px(const depth_image_t& rendered, int max_px, double silhouette_jump_mm,
-                                      const std::vector<uint8_t>* farther_from) {
+std::vector<uint8_t> step_distance_px(const depth_image_t& rendered, int max_px, double silhouette_jump_mm) {
   const int width = rendered.width;
   const int height = rendered.height;
   const size_t pixels = static_cast<size_t>(std::max(width, 0)) * static_cast<size_t>(std::max(height, 0));
   std::vector<uint8_t> distance(pixels, 0);
   if (max_px <= 0 || pixels == 0 || rendered.depth_mm.size() != pixels) return distance;
-  TOFGUARD_DEMAND(farther_from == nullptr || farther_from->size() == pixels,
-                  "step_distance_px: farther_from has " + std::to_string(farther_from->size()) +
-                      " entries for " + std::to_string(pixels) + " pixels");
   max_px = std::min(max_px, 255);
   const int limit = silhouette_step_limit_mm(silhouette_jump_mm);
   // farthest: the farthest rendered depth within k pixels (Chebyshev), one
@@ -704,9 +700,7 @@ std::vector<uint8_t> step_distance_px(const depth_image_t& rendered, int max_px,
   size_t open = 0;  // pixels with a surface and no step found yet
   for (size_t i = 0; i < pixels; ++i) {
     const int gen = rendered.depth_mm[i];
-    // A pixel that may not be the farther surface takes part as none (0:
-    // the dilation keeps the farthest).
-    far[i] = farther_from == nullptr || (*farther_from)[i] ? static_cast<float>(gen) : 0.0f;
+    far[i] = static_cast<float>(gen);
     beyond[i] = gen > 0 ? static_cast<float>(gen + limit) : std::numeric_limits<float>::infinity();
     if (gen > 0) ++open;
   }
@@ -723,10 +717,35 @@ std::vector<uint8_t> step_distance_px(const depth_image_t& rendered, int max_px,
   return distance;
 }
 
-std::vector<uint8_t> near_side_of_steps(const depth_image_t& rendered, int band_px,
-                                        double silhouette_jump_mm) {
-  std::vector<uint8_t> near = step_distance_px(rendered, band_px, silhouette_jump_mm);
-  for (uint8_t& n : near) n = n > 0 ? 1 : 0;
+std::vector<uint8_t> near_side_of_steps(const depth_image_t& rendered, int band_px, double silhouette_jump_mm,
+                                        const std::vector<uint8_t>* farther_from) {
+  const int width = rendered.width;
+  const int height = rendered.height;
+  const size_t pixels = static_cast<size_t>(std::max(width, 0)) * static_cast<size_t>(std::max(height, 0));
+  std::vector<uint8_t> near(pixels, 0);
+  if (band_px <= 0 || pixels == 0 || rendered.depth_mm.size() != pixels) return near;
+  TOFGUARD_DEMAND(farther_from == nullptr || farther_from->size() == pixels,
+                  "near_side_of_steps: farther_from has " + std::to_string(farther_from->size()) +
+                      " entries for " + std::to_string(pixels) + " pixels");
+  band_px = std::min(band_px, 255);
+  const int limit = silhouette_step_limit_mm(silhouette_jump_mm);
+  // The farthest rendered depth within band_px (Chebyshev): one dilation
+  // by the (2 band_px + 1)-square, which equals band_px 3x3 dilations
+  // (step_distance_px's) at a fraction of their cost. Pixels outside the
+  // image take no part; one that may not be the farther surface takes
+  // part as none (0). In float: depths in mm are exact.
+  cv::Mat1f farthest(height, width);
+  float* far = farthest.ptr<float>(0);
+  for (size_t i = 0; i < pixels; ++i) {
+    far[i] = farther_from == nullptr || (*farther_from)[i] ? static_cast<float>(rendered.depth_mm[i]) : 0.0f;
+  }
+  const cv::Mat square =
+      cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * band_px + 1, 2 * band_px + 1));
+  cv::dilate(farthest, farthest, square);
+  for (size_t i = 0; i < pixels; ++i) {
+    const int gen = rendered.depth_mm[i];
+    near[i] = gen > 0 && far[i] > static_cast<float>(gen + limit) ? 1 : 0;
+  }
   return near;
 }
 
@@ -758,7 +777,7 @@ std::vector<float> near_step_allowance_mm(const depth_image_t& rendered, const l
     arm[i] = link >= 0 && link < labels.num_robot_links ? 1 : 0;
   }
   const std::vector<uint8_t> before_arm =
-      step_distance_px(rendered, options.silhouette_band_px, band_step_mm, &arm);
+      near_side_of_steps(rendered, options.silhouette_band_px, band_step_mm, &arm);
   for (size_t i = 0; i < near.size(); ++i) {
     if (!near[i]) continue;
     if (arm[i]) {

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <random>
 #include <string>
 #include <utility>
 #include <vector>
@@ -855,6 +856,27 @@ TEST(StepDistance, CountsPixelsToTheNearestFartherSurface) {
   EXPECT_EQ(std::count(band.begin(), band.end(), 1), 8);
   const std::vector<uint8_t> no_band = near_side_of_steps(rendered, 0, 50);
   EXPECT_EQ(std::count(no_band.begin(), no_band.end(), 1), 0);
+}
+
+// near_side_of_steps' one large dilation is step_distance_px's band, on
+// random depths with holes, for every band width.
+TEST(StepDistance, TheBandIsTheDistanceWithinIt) {
+  depth_image_t rendered{};
+  rendered.width = 31;
+  rendered.height = 23;
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<int> depth(0, 3000);
+  for (int i = 0; i < 31 * 23; ++i) {
+    const int d = depth(rng);
+    rendered.depth_mm.push_back(static_cast<int16_t>(d < 300 ? 0 : d));
+  }
+  for (int band = 1; band <= 12; ++band) {
+    const std::vector<uint8_t> distance = step_distance_px(rendered, band, 500);
+    const std::vector<uint8_t> near = near_side_of_steps(rendered, band, 500);
+    ASSERT_EQ(near.size(), distance.size());
+    for (size_t i = 0; i < near.size(); ++i)
+      ASSERT_EQ(near[i], distance[i] > 0 ? 1 : 0) << band << " px, pixel " << i;
+  }
 }
 
 TEST(StepDistance, TheAllowanceBandOpensAtItsOwnStep) {

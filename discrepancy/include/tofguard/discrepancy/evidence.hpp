@@ -112,8 +112,10 @@ struct EvidenceOptions {
 // `band_px` pixels, Chebyshev, of a rendered surface farther by more than
 // silhouette_step's jump): EvidenceOptions::silhouette_band_px. All 0 for
 // band_px <= 0. A pixel without a rendered surface is no step.
-std::vector<uint8_t> near_side_of_steps(const depth_image_t& rendered, int band_px,
-                                        double silhouette_jump_mm);
+// With `farther_from` (one per pixel), only its pixels set to 1 count as
+// the farther surface.
+std::vector<uint8_t> near_side_of_steps(const depth_image_t& rendered, int band_px, double silhouette_jump_mm,
+                                        const std::vector<uint8_t>* farther_from = nullptr);
 // Per pixel (row-major), the silhouette allowance of `rendered`'s pixels on
 // the near side of a step (near_side_of_steps within silhouette_band_px, of
 // a step larger than silhouette_band_step_mm, or silhouette_jump_mm when
@@ -132,11 +134,8 @@ std::vector<float> near_step_allowance_mm(const depth_image_t& rendered, const l
                                           const EvidenceOptions& options, double silhouette_jump_mm);
 // Per pixel, how far (pixels, Chebyshev, 1..max_px) the nearest rendered
 // surface farther than it by more than silhouette_step's jump is; 0: none
-// within max_px (or no rendered surface). max_px at most 255. With
-// `farther_from` (one per pixel), only its pixels set to 1 count as the
-// farther surface.
-std::vector<uint8_t> step_distance_px(const depth_image_t& rendered, int max_px, double silhouette_jump_mm,
-                                      const std::vector<uint8_t>* farther_from = nullptr);
+// within max_px (or no rendered surface). max_px at most 255.
+std::vector<uint8_t> step_distance_px(const depth_image_t& rendered, int max_px, double silhouette_jump_mm);
 
 // How many sigmas of a fixed pattern's score offset the shrinking allows
 // (EvidenceOptions::fixed_pattern_sigma_mm): the offset is one draw per
