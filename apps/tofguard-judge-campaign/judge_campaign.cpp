@@ -507,8 +507,7 @@ struct CampaignWorld {
         period_s(1.0 / config.camera.rate_hz),
         period_us(static_cast<int64_t>(std::llround(period_s * 1e6))),
         reported_pose(config.camera.pose.frame_from_optical()),
-        memory_decay(
-            risk::SequentialEvidence(config.risk, robot_tree, config.camera.rate_hz).memory_decay()) {}
+        evidence(config.risk, robot_tree, config.camera.rate_hz) {}
 
   const deployment::Config& config;
   SimulatedFrames truth;
@@ -524,8 +523,9 @@ struct CampaignWorld {
   const double period_s;
   const int64_t period_us;
   const Eigen::Isometry3d reported_pose;
-  // What every stop test's per-frame ratio is lowered by (nats).
-  const double memory_decay;
+  // The risk monitor's stop tests as configured: what a frame can show
+  // (SequentialEvidence::smallest_offset).
+  const risk::SequentialEvidence evidence;
 };
 
 // One run of the campaign: its frames through the discrepancy and the risk
@@ -718,17 +718,12 @@ class CampaignRunJudge {
   }
 
   // Per joint, the smallest offset this nominal frame can show, as the
-  // risk monitor's stop test takes its evidence (degrees; mm when
+  // risk monitor's stop tests take their evidence (degrees; mm when
   // prismatic).
   void add_smallest_offsets(const discrepancy_t& d) {
     for (int j = 0; j < d.num_joints; ++j) {
+      const double offset = w_.evidence.smallest_offset(d, j);
       const bool prismatic = w_.model_scene.is_prismatic_joint(d.joint_name[j]);
-      const double delta =
-          prismatic ? config_.risk.evidence_joint_offset_m : config_.risk.evidence_joint_offset_rad;
-      const double bound =
-          static_cast<size_t>(j) < d.joint_static_bound.size() ? d.joint_static_bound[j] : 0.0;
-      const double offset =
-          risk::smallest_growing_offset(delta, d.joint_information[j], bound, w_.memory_decay);
       result_.nominal_smallest_offset[d.joint_name[j]].push_back(
           static_cast<float>(prismatic ? 1000 * offset : offset * 180 / M_PI));
     }

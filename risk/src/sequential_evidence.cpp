@@ -139,13 +139,15 @@ SequentialEvidence::SequentialEvidence(const RiskSettings& risk, const robot_mod
     : prismatic_(robot.prismatic_joint_names),
       joint_delta_rad_(risk.evidence_joint_offset_rad),
       joint_delta_m_(risk.evidence_joint_offset_m),
+      joint_large_rad_(risk.evidence_large_joint_offset_rad),
+      joint_large_m_(risk.evidence_large_joint_offset_m),
       camera_delta_{risk.evidence_camera_translation_m, risk.evidence_camera_translation_m,
                     risk.evidence_camera_translation_m, risk.evidence_camera_rotation_rad,
                     risk.evidence_camera_rotation_rad,  risk.evidence_camera_rotation_rad},
       warning_fraction_(risk.evidence_warning_fraction) {
   clearing_cusum_["camera"] = 0;
   for (const std::string& joint : robot.movable_joint_names) {
-    joint_cusum_[joint] = 0;
+    joint_tests_[joint] = JointTests{};
     clearing_cusum_[joint] = 0;
   }
   h_ = cusum_threshold(hypotheses(), camera_rate_hz, risk.evidence_false_stop_period_h);
@@ -153,14 +155,19 @@ SequentialEvidence::SequentialEvidence(const RiskSettings& risk, const robot_mod
 }
 
 double SequentialEvidence::joint_cusum(const std::string& joint) const {
-  const auto it = joint_cusum_.find(joint);
-  return it == joint_cusum_.end() ? 0 : it->second;
+  const auto it = joint_tests_.find(joint);
+  return it == joint_tests_.end() ? 0 : it->second.largest();
+}
+
+double SequentialEvidence::joint_large_cusum(const std::string& joint) const {
+  const auto it = joint_tests_.find(joint);
+  return it == joint_tests_.end() ? 0 : it->second.at_large;
 }
 
 bool SequentialEvidence::quiet() const {
   if (camera_cusum_ >= warning_level()) return false;
-  for (const auto& [joint, s] : joint_cusum_) {
-    if (s >= warning_level()) return false;
+  for (const auto& [joint, tests] : joint_tests_) {
+    if (tests.largest() >= warning_level()) return false;
   }
   return true;
 }
@@ -176,7 +183,7 @@ double SequentialEvidence::clearing_cusum(const std::string& hypothesis) const {
 
 void SequentialEvidence::reset() {
   camera_cusum_ = 0;
-  for (auto& [joint, s] : joint_cusum_) s = 0;
+  for (auto& [joint, tests] : joint_tests_) tests = JointTests{};
   for (auto& [hypothesis, g] : clearing_cusum_) g = 0;
 }
 
@@ -198,6 +205,12 @@ double step(double cusum, double llr, double h) {
 double clearing_step(double clearing, double llr, double level) {
   if (!std::isfinite(llr)) return 0;
   return std::min(level, std::max(0.0, clearing - llr));
+}
+
+// Joint i's static bound on frame f (discrepancy_t.joint_static_bound;
+// 0 from a tofguard-discrepancy without an allowance).
+double joint_static_bound(const discrepancy_t& f, int i) {
+  return static_cast<size_t>(i) < f.joint_static_bound.size() ? f.joint_static_bound[i] : 0.0;
 }
 
 }  // namespace
@@ -318,6 +331,11 @@ FrameFinding SequentialEvidence::joint_finding(const discrepancy_t& f, int i) co
       "joint " + joint +
       " reads other than seen (sequential evidence, CUSUM log-likelihood ratio): " + fixed(finding.score, 1) +
       " of h " + fixed(h_, 1);
+  const auto tests = joint_tests_.find(joint);
+  if (tests != joint_tests_.end() && tests->second.at_large > tests->second.at_delta) {
+    finding.detail += " (its test at the large offset " +
+                      fixed(unit * (prismatic ? joint_large_m_ : joint_large_rad_), 0) + unit_name + ")";
+  }
   if (information > 0) {
     finding.detail += "; fitted offset (seen - reported) " + fixed(unit * f.joint_score[i] / information, 1) +
                       unit_name + " ± " + fixed(unit / std::sqrt(information), 1) + unit_name;
@@ -398,19 +416,44 @@ void SequentialEvidence::add_frame(const discrepancy_t& f) {
                     clearing_level());
   if (camera_cusum_ >= h_) camera_clearing = 0;
   for (int i = 0; i < f.num_joints; ++i) {
-    const auto it = joint_cusum_.find(f.joint_name[i]);
-    if (it == joint_cusum_.end()) continue;  // not a moving joint of the robot: not a hypothesis
-    const double delta = prismatic_.count(it->first) > 0 ? joint_delta_m_ : joint_delta_rad_;
-    const double bound = static_cast<size_t>(i) < f.joint_static_bound.size() ? f.joint_static_bound[i] : 0.0;
-    const double information = f.joint_information[i];
-    const double tested = effective_delta(delta, information, bound);
-    it->second = step(it->second, joint_llr(f.joint_score[i], information, tested) - memory_decay_, h_);
-    double& clearing = clearing_cusum_[it->first];
-    clearing = clearing_step(clearing,
-                             joint_llr(f.joint_score[i], information, kClearingAlternativeFraction * tested),
-                             clearing_level());
-    if (it->second >= h_) clearing = 0;
+    const auto it = joint_tests_.find(f.joint_name[i]);
+    if (it == joint_tests_.end()) continue;  // not a moving joint of the robot: not a hypothesis
+    add_joint(f, i, &it->second);
   }
+}
+
+double SequentialEvidence::smallest_offset(const discrepancy_t& f, int i) const {
+  const bool prismatic = prismatic_.count(f.joint_name[i]) > 0;
+  const double bound = joint_static_bound(f, i);
+  const double information = f.joint_information[i];
+  return std::min(smallest_growing_offset(prismatic ? joint_delta_m_ : joint_delta_rad_, information, bound,
+                                          memory_decay_),
+                  smallest_growing_offset(prismatic ? joint_large_m_ : joint_large_rad_, information, bound,
+                                          memory_decay_));
+}
+
+void SequentialEvidence::add_joint(const discrepancy_t& f, int i, JointTests* tests) {
+  const bool prismatic = prismatic_.count(f.joint_name[i]) > 0;
+  const double bound = joint_static_bound(f, i);
+  const double information = f.joint_information[i];
+  const double tested = effective_delta(prismatic ? joint_delta_m_ : joint_delta_rad_, information, bound);
+  const double large = effective_delta(prismatic ? joint_large_m_ : joint_large_rad_, information, bound);
+  tests->at_delta =
+      step(tests->at_delta, joint_llr(f.joint_score[i], information, tested) - memory_decay_, h_);
+  tests->at_large =
+      step(tests->at_large, joint_llr(f.joint_score[i], information, large) - memory_decay_, h_);
+  // Each crossing restarts the clearing test, at half of the alternative
+  // of the test that crossed (the first test's when both did).
+  if (tests->at_delta >= h_) {
+    tests->clearing_at_large = false;
+  } else if (tests->at_large >= h_) {
+    tests->clearing_at_large = true;
+  }
+  const double clearing_delta = kClearingAlternativeFraction * (tests->clearing_at_large ? large : tested);
+  double& clearing = clearing_cusum_[f.joint_name[i]];
+  clearing =
+      clearing_step(clearing, joint_llr(f.joint_score[i], information, clearing_delta), clearing_level());
+  if (tests->largest() >= h_) clearing = 0;
 }
 
 std::string SequentialEvidence::clearing_summary(const std::string& hypothesis) const {
@@ -421,15 +464,16 @@ std::string SequentialEvidence::clearing_summary(const std::string& hypothesis) 
 
 SequentialEvidence::NamedCusum SequentialEvidence::largest_cusum() const {
   NamedCusum largest{"camera", camera_cusum_};
-  for (const auto& [joint, s] : joint_cusum_) {
-    if (s > largest.value) largest = NamedCusum{joint, s};
+  for (const auto& [joint, tests] : joint_tests_) {
+    if (tests.largest() > largest.value) largest = NamedCusum{joint, tests.largest()};
   }
   return largest;
 }
 
 SequentialEvidence::NamedCusum SequentialEvidence::crossed_joint() const {
   NamedCusum crossed{"", 0};
-  for (const auto& [joint, s] : joint_cusum_) {
+  for (const auto& [joint, tests] : joint_tests_) {
+    const double s = tests.largest();
     if (s >= h_ && s > crossed.value) crossed = NamedCusum{joint, s};
   }
   return crossed;
@@ -441,7 +485,7 @@ int SequentialEvidence::suspect_joint(const discrepancy_t& f) const {
   double best_explained = -1;
   double best_crossed_explained = -1;
   for (int i = 0; i < f.num_joints; ++i) {
-    if (joint_cusum_.count(f.joint_name[i]) == 0) continue;
+    if (joint_tests_.count(f.joint_name[i]) == 0) continue;
     const double explained = naming_chi2(f, i);
     if (!(explained > 0)) continue;
     if (explained > best_explained) {

@@ -88,11 +88,27 @@ void read_estimate(YamlMap estimate, RiskSettings* r) {
   estimate.finish();
 }
 
+// risk.evidence.large_joint_offset_{deg,m} (optional): the large-offset test's
+// alternatives, each above the first test's (at or below it, the second
+// test would repeat the first).
+void read_large_joint_offset(YamlMap* evidence, RiskSettings* r) {
+  const double deg =
+      evidence->optional_number("large_joint_offset_deg", kDefaultLargeJointOffsetDeg, 0.01, 90);
+  const double m = evidence->optional_number("large_joint_offset_m", kDefaultLargeJointOffsetM, 1e-5, 1);
+  r->evidence_large_joint_offset_rad = deg * M_PI / 180.0;
+  r->evidence_large_joint_offset_m = m;
+  if (r->evidence_large_joint_offset_rad <= r->evidence_joint_offset_rad)
+    evidence->fail("large_joint_offset_deg", "a number above joint_offset_deg", std::to_string(deg));
+  if (m <= r->evidence_joint_offset_m)
+    evidence->fail("large_joint_offset_m", "a number above joint_offset_m", std::to_string(m));
+}
+
 // risk.evidence: the sequential evidence tests.
 void read_evidence(YamlMap evidence, RiskSettings* r) {
   r->evidence_false_stop_period_h = evidence.number("false_stop_period_h", 1e-3, 1e9);
   r->evidence_joint_offset_rad = evidence.number("joint_offset_deg", 0.01, 90) * M_PI / 180.0;
   r->evidence_joint_offset_m = evidence.number("joint_offset_m", 1e-5, 1);
+  read_large_joint_offset(&evidence, r);
   r->evidence_camera_translation_m = evidence.number("camera_translation_m", 1e-4, 1);
   r->evidence_camera_rotation_rad = evidence.number("camera_rotation_deg", 0.01, 90) * M_PI / 180.0;
   r->evidence_warning_fraction = evidence.number("warning_fraction", 0.01, 1);

@@ -249,6 +249,14 @@ INSTANTIATE_TEST_SUITE_P(
                   "  max_age_ms: 250\n  insecure: true\n",
                   {"auth.key_file", "one or the other"}},
         BadConfig{"auth-zero-replay-window", "max_age_ms: 250", "max_age_ms: 0", {"auth.max_age_ms"}},
+        BadConfig{"large-joint-offset-not-above-the-first",
+                  "large_joint_offset_deg: 10.0",
+                  "large_joint_offset_deg: 3.0",
+                  {"risk.evidence.large_joint_offset_deg", "a number above joint_offset_deg"}},
+        BadConfig{"large-joint-offset-m-not-above-the-first",
+                  "large_joint_offset_m: 0.01",
+                  "large_joint_offset_m: 0.002",
+                  {"risk.evidence.large_joint_offset_m", "a number above joint_offset_m"}},
         BadConfig{"plan-step-longer-than-horizon",
                   "step_ms: 20}",
                   "step_ms: 600}",
@@ -279,6 +287,19 @@ TEST(Config, TheSilhouetteAllowanceTakesEachLinksOwnBoundAndItsStep) {
   // Without step_mm the band opens at the silhouette jump (0 here), as in
   // configs measured before tofguard-tune measured from 1 cm steps.
   EXPECT_EQ(config.discrepancy.evidence_silhouette_band_step_mm, 0.0);
+}
+
+TEST(Config, TheLargeOffsetTestIsConfiguredOrTenDegrees) {
+  const deployment::Config sim = deployment::load_config(sim_yaml_path(), nullptr);
+  EXPECT_NEAR(sim.risk.evidence_large_joint_offset_rad * 180 / M_PI, 10.0, 1e-12);
+  EXPECT_EQ(sim.risk.evidence_large_joint_offset_m, 0.01);
+  // A config written before the large-offset test: its defaults.
+  const std::string path = sim_variant(
+      "large-offset-absent", "    large_joint_offset_deg: 10.0\n    large_joint_offset_m: 0.01\n", "");
+  const deployment::Config config = deployment::load_config(path, nullptr);
+  EXPECT_NEAR(config.risk.evidence_large_joint_offset_rad * 180 / M_PI, settings::kDefaultLargeJointOffsetDeg,
+              1e-12);
+  EXPECT_EQ(config.risk.evidence_large_joint_offset_m, settings::kDefaultLargeJointOffsetM);
 }
 
 TEST(Config, AKeyFileOpenToOthersIsAConfigError) {

@@ -149,9 +149,11 @@ TEST(EvidenceTests, TheThresholdFollowsFromTheFalseStopRate) {
   EXPECT_NEAR(risk::cusum_threshold(8, 30, 1000), std::log(8 * 30 * 3600.0 * 1000), 1e-12);
   EXPECT_NEAR(risk::cusum_threshold(8, 30, 1000), 20.577, 1e-3);
   const SequentialEvidence evidence(sim_config().risk, friend_arm(), sim_config().camera.rate_hz);
-  EXPECT_EQ(evidence.hypotheses(), 8);  // the camera and a1..a7
-  EXPECT_NEAR(evidence.threshold(), 20.577, 1e-3);
-  EXPECT_NEAR(evidence.warning_level(), 0.5 * 20.577, 1e-3);
+  // The camera's test and two for each of a1..a7 (at joint_offset and at
+  // large_joint_offset).
+  EXPECT_EQ(evidence.hypotheses(), 15);
+  EXPECT_NEAR(evidence.threshold(), 21.206, 1e-3);
+  EXPECT_NEAR(evidence.warning_level(), 0.5 * 21.206, 1e-3);
 }
 
 // 200 000 nominal frames (1.85 hours at 30 Hz): no test crosses h, and
@@ -467,8 +469,8 @@ TEST(EvidenceTests, GrowingEvidenceWarnsBeforeItCrosses) {
   EXPECT_DOUBLE_EQ(evidence.joint_cusum("a5"), 0);
 }
 
-// A hardly informed test (a7: I = 1 / rad^2, delta^2 I = 0.003 per frame)
-// raised by one outlying frame keeps it without the memory decay: the
+// A hardly informed test (a7: I = 1 / rad^2, delta^2 I = 0.003 per frame;
+// the large-offset test's 0.03) raised by one outlying frame keeps it without the memory decay: the
 // mixture's drift without a fault is -(delta^2 I)^2 / 4 = -2e-6 per frame,
 // 20 000 hours from the warning level back to 0. With it the CUSUM falls by
 // h / (rate * kEvidenceMemoryS) = 0.011 per frame: below the warning level
@@ -478,8 +480,9 @@ TEST(EvidenceTests, AHardlyInformedTestForgetsWithinItsMemory) {
   EXPECT_NEAR(evidence.memory_decay(), evidence.threshold() / (kRateHz * risk::kEvidenceMemoryS), 1e-12);
   ScoreSource source(8);
   discrepancy_t outlier = source.frame(1);
-  // 300 sigma in one frame: LLR = log cosh(0.0524 * 300) - ... = 15.0.
-  outlier.joint_score[joint_index("a7")] = 300;
+  // 100 sigma in one frame: the large-offset test's LLR = log cosh(0.1745 * 100)
+  // - ... = 16.8 (the first test's 4.5).
+  outlier.joint_score[joint_index("a7")] = 100;
   evidence.update(outlier);
   const double raised = evidence.joint_cusum("a7");
   ASSERT_GT(raised, evidence.warning_level());
@@ -545,6 +548,62 @@ TEST(EvidenceTests, TheSmallestOffsetAFrameCanShowIsWhereTheRatioTurns) {
   EXPECT_TRUE(std::isinf(risk::smallest_growing_offset(delta, 0, 0, decay)));
 }
 
+// A joint whose static allowance covers the first test's whole alternative
+// (B / I = 4 deg > delta = 3 deg: that test gains nothing) is still
+// guarded by its large-offset test (10 deg, tested at 10 - 4 = 6 deg): the
+// default arm's wrist on a commissioned camera. Nominal frames with a bias
+// at the bound never cross; a 20 deg offset that the linear fit reads as
+// 16 deg crosses on its first frame, named as the large-offset test's; with the
+// offset gone, the clearing test at half the large-offset test's alternative
+// clears within a few frames.
+TEST(EvidenceTests, ALargeOffsetShowsWhereTheAllowanceCoversTheFirstTest) {
+  SequentialEvidence evidence(sim_config().risk, friend_arm(), kRateHz);
+  const int a6 = joint_index("a6");
+  const double information = 1 / std::pow(0.8 * kDeg, 2);
+  const double bound = 4 * kDeg * information;
+  std::mt19937 rng(11);
+  std::normal_distribution<double> noise(0, std::sqrt(information));
+  int64_t seq = 1;
+  // The frame's shrunk score of a6 off by read_deg (as the fit reads it)
+  // with a static bias of `bias` (score units) and noise.
+  const auto frame = [&](double read_deg, double bias) {
+    discrepancy_t d = evidence_frame(seq++);
+    d.joint_information[a6] = information;
+    d.joint_static_bound.assign(d.num_joints, 0.0);
+    d.joint_static_bound[a6] = bound;
+    const double s = read_deg * kDeg * information + bias + noise(rng);
+    d.joint_score[a6] = std::copysign(std::max(0.0, std::abs(s) - bound), s);
+    d.joint_naming_score = d.joint_score;
+    return d;
+  };
+  ASSERT_TRUE(
+      std::isinf(risk::smallest_growing_offset(3 * kDeg, information, bound, evidence.memory_decay())));
+  double smallest = evidence.smallest_offset(frame(0, 0), a6) / kDeg;
+  EXPECT_GT(smallest, 7.0);  // B/I + 6/2 + decay's share
+  EXPECT_LT(smallest, 7.1);
+  double largest = 0;
+  for (int k = 0; k < 3000; ++k) {
+    const EvidenceStep step = evidence.update(frame(0, (k % 2 == 0 ? 1 : -1) * bound));
+    ASSERT_FALSE(step.crossed) << "frame " << k << ": " << step.finding.detail;
+    largest = std::max(largest, evidence.joint_cusum("a6"));
+  }
+  EXPECT_LT(largest, evidence.warning_level());
+  const EvidenceStep step = evidence.update(frame(-16, 0));
+  ASSERT_TRUE(step.crossed);
+  EXPECT_EQ(step.finding.suspect, "a6");
+  EXPECT_GE(evidence.joint_large_cusum("a6"), evidence.threshold());
+  EXPECT_NE(step.finding.detail.find("its test at the large offset 10°"), std::string::npos)
+      << step.finding.detail;
+  EXPECT_FALSE(evidence.cleared("a6"));
+  int frames_to_clear = 0;
+  while (!evidence.cleared("a6")) {
+    ASSERT_LT(frames_to_clear, 20) << evidence.clearing_summary("a6");
+    evidence.update(frame(0, 0));
+    ++frames_to_clear;
+  }
+  EXPECT_GE(frames_to_clear, 2);
+}
+
 // A fault that the fit reads smaller than half the test's delta (a large
 // offset outside the fit's linear range, as the arm moves) turns the stop
 // test against it, so its CUSUM falls below the warning level; the
@@ -574,7 +633,7 @@ TEST(EvidenceTests, OnlyEvidenceThatTheFaultIsGoneClearsACrossedTest) {
       0u)
       << evidence.clearing_summary("a3");
   // The fault gone: the clearing test gains (delta/2)^2 I / 2 = 3.4 per
-  // frame and reaches its level (h = 20.6) within about 6 frames.
+  // frame and reaches its level (h = 21.2) within about 6 frames.
   int frames_to_clear = 0;
   while (!evidence.cleared("a3")) {
     ASSERT_LT(frames_to_clear, 20) << evidence.clearing_summary("a3");

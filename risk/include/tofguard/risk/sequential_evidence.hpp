@@ -179,15 +179,26 @@ class SequentialEvidence {
   // The level a clearing test must reach: h, as a stop test's
   // (docs/safety-chain.md, "How long a diagnosis stays open").
   double clearing_level() const { return h_; }
-  int hypotheses() const { return static_cast<int>(joint_cusum_.size()) + 1; }
+  // The stop tests the threshold's union bound counts: the camera's and
+  // each joint's two (at joint_offset and at large_joint_offset).
+  int hypotheses() const { return 2 * static_cast<int>(joint_tests_.size()) + 1; }
   // What every stop test's per-frame ratio is lowered by, nats:
   // h / (camera rate * kEvidenceMemoryS).
   double memory_decay() const { return memory_decay_; }
   double camera_cusum() const { return camera_cusum_; }
-  // 0 for a joint that is not a moving joint of the robot.
+  // A joint's stop tests: the larger of its two CUSUMs; 0 for a joint that
+  // is not a moving joint of the robot.
   double joint_cusum(const std::string& joint) const;
+  // Its large-offset test's CUSUM alone (0 for one that is not a moving joint).
+  double joint_large_cusum(const std::string& joint) const;
   // Every CUSUM below warning_level().
   bool quiet() const;
+  // The smallest offset of joint `index` of `frame` that its stop tests gain
+  // evidence of on that frame, on average: smallest_growing_offset of the
+  // frame's information and static bound at each test's alternative, the
+  // smaller (radians, metres for a prismatic joint; infinity when neither
+  // can show one).
+  double smallest_offset(const discrepancy_t& frame, int index) const;
   // Hypothesis `hypothesis` ("camera" or a joint) shows evidence that its
   // fault is gone: its clearing test, a CUSUM on the negated log-likelihood
   // ratio at kClearingAlternativeFraction of the stop test's (effective)
@@ -201,6 +212,20 @@ class SequentialEvidence {
   std::string clearing_summary(const std::string& hypothesis) const;
 
  private:
+  // A joint's two stop tests (docs/safety-chain.md, "A large offset"): at
+  // the smallest fault to detect (evidence.joint_offset), and at a large
+  // offset (evidence.large_joint_offset), which still shows where the static
+  // allowance covers the first test's whole alternative.
+  struct JointTests {
+    double at_delta = 0;
+    double at_large = 0;
+    // The last crossing was the large-offset test's alone: the clearing test runs
+    // at half of the large alternative (at half of the first test's, where
+    // the allowance covers it, it could never clear).
+    bool clearing_at_large = false;
+    double largest() const { return at_delta > at_large ? at_delta : at_large; }
+  };
+
   // A hypothesis's name ("camera" or a joint's) and its CUSUM.
   struct NamedCusum {
     std::string name;
@@ -209,6 +234,8 @@ class SequentialEvidence {
 
   // A frame's log-likelihood ratios into the CUSUMs and the clearing tests.
   void add_frame(const discrepancy_t& frame);
+  // Joint `index` of the frame into its tests and its clearing test.
+  void add_joint(const discrepancy_t& frame, int index, JointTests* tests);
   // The largest CUSUM (the camera's among equals).
   NamedCusum largest_cusum() const;
   // The joint test that crossed with the largest CUSUM (name empty: none).
@@ -245,12 +272,14 @@ class SequentialEvidence {
   std::set<std::string> prismatic_;
   double joint_delta_rad_;
   double joint_delta_m_;
+  double joint_large_rad_;
+  double joint_large_m_;
   std::array<double, 6> camera_delta_;
   double warning_fraction_;
   double h_;
   double memory_decay_;
   double camera_cusum_ = 0;
-  std::map<std::string, double> joint_cusum_;  // every moving joint of the robot
+  std::map<std::string, JointTests> joint_tests_;  // every moving joint of the robot
   // The clearing tests: "camera" and every moving joint.
   std::map<std::string, double> clearing_cusum_;
 };

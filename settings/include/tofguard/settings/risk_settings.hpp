@@ -13,6 +13,13 @@
 
 namespace tofguard::settings {
 
+// The large-offset test's alternatives where risk.evidence leaves them out: about
+// where a joint's linear fit stops following its offset (a 20 deg offset
+// reads 16-20 deg on the default arm's wrist), so a large offset's reading
+// is still near the alternative (docs/safety-chain.md, "A large offset").
+constexpr double kDefaultLargeJointOffsetDeg = 10.0;
+constexpr double kDefaultLargeJointOffsetM = 0.01;
+
 struct RiskSettings {
   // check_period_ms: how often deadlines are checked (and timeouts
   // re-published); microseconds.
@@ -117,6 +124,13 @@ struct RiskSettings {
   // radians).
   double evidence_joint_offset_rad = 0;
   double evidence_joint_offset_m = 0;
+  // A joint's second test, at a large offset (large_joint_offset_deg, held
+  // in radians, and large_joint_offset_m; optional, absent: 10 deg and
+  // 10 mm; each above its joint_offset): where the static allowance covers
+  // the first test's alternative, a large offset still shows beyond it
+  // (docs/safety-chain.md, "A large offset").
+  double evidence_large_joint_offset_rad = 0;
+  double evidence_large_joint_offset_m = 0;
   double evidence_camera_translation_m = 0;
   double evidence_camera_rotation_rad = 0;
   // WARNING while some CUSUM is at or above this fraction of h.
