@@ -444,8 +444,8 @@ StaticError measure_static_error(const std::vector<RenderedPair>& frames, const 
 // its silhouettes, its surfaces' reflectivity), which no bin's median shows.
 // With an allowance that covers the static error, a test's CUSUM reaches
 // the warning level w h within n frames with probability at most
-// n e^(-w h) (Ville's inequality from each start: 1.2 % for 360 frames at
-// h 20.6, w 0.5): a test that reaches it on a nominal recording shows an
+// n e^(-w h) (Ville's inequality from each start: 0.9 % for 360 frames at
+// h 21.2, w 0.5): a test that reaches it on a nominal recording shows an
 // error the allowance does not cover. The allowance is then raised, by
 // bisection to 0.1 mm, to the smallest that keeps every test below the
 // warning level, up to half the camera test's translation (beyond it a
