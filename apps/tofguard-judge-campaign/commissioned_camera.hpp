@@ -3,7 +3,8 @@
 // as docs/camera.md says ("Commissioning a camera"), in-process: the
 // simulated camera gets the static errors of draw_imperfect_camera(seed)
 // (camera.sim.residual: nothing downstream of the camera knows them); the
-// arm moves through its nominal motion for `seconds` (the frames rendered
+// arm moves through its nominal motion for `seconds` to learn and
+// kCheckRecordingLengths times that to check (the frames rendered
 // as tofguard-renderer renders them; each recording centred where the arm
 // comes nearest the camera, the learning one within motion time 600-1800 s,
 // the checking one within 1800-3000 s, as a user's recordings take the arm
@@ -30,6 +31,10 @@ struct CommissionedCamera {
   // One line: the camera's truth and what commissioning deployed.
   std::string summary;
 };
+
+// The check recording is this many times as long as the learning one
+// (docs/camera.md: 40 s and 120 s).
+constexpr double kCheckRecordingLengths = 3;
 
 CommissionedCamera commission_imperfect_camera(const CampaignArm& arm, uint64_t seed, double seconds = 12);
 

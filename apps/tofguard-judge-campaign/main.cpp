@@ -30,7 +30,8 @@
 // imperfect as real ones (draw_imperfect_camera(1..N)), each commissioned
 // first (commissioned_camera.hpp), instead of the config's ideal camera;
 // --camera-seeds: those of the draws only (a camera of a campaign again);
-// --commission-s: how long each of its two recordings is (default 40 s: a
+// --commission-s: how long its learning recording is, the check recording
+// three times that (default 40 s and 120 s: a
 // 12 s recording kept the Kinova Gen3 farther from camera 5 than its motion
 // later goes, and commissioning refuses such a profile).
 // --tsv: every run, a line each (campaign_tsv); --plots: detection rate and

@@ -18,9 +18,9 @@ namespace {
 
 // config/sim.yaml's silhouette allowance, as the variants below replace it.
 const char* const kSimSilhouetteAllowance =
-    "    silhouette_allowance: {band_px: 12, step_mm: 10, bias_mm: 5.0, by_link: {base_link: 0.6, gripper: "
-    "2.0,\n"
-    "      link1: 2.0, link2: 0.3, link3: 0.7, link4: 1.5, link5: 1.5, link6: 2.9, link7: 5.0}}\n";
+    "    silhouette_allowance: {band_px: 12, step_mm: 10, bias_mm: 6.0, by_link: {base_link: 0.2, gripper: "
+    "6.0,\n"
+    "      link1: 1.8, link2: 0.2, link3: 0.9, link4: 1.0, link5: 1.6, link6: 3.4, link7: 4.4}}\n";
 
 std::string sim_yaml_path() { return source_dir() + "/config/sim.yaml"; }
 
@@ -271,12 +271,12 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(Config, TheSilhouetteAllowanceTakesEachLinksOwnBoundAndItsStep) {
   // config/sim.yaml's, over two lines as tofguard-tune's can be pasted.
   const deployment::Config sim = deployment::load_config(sim_yaml_path(), nullptr);
-  EXPECT_EQ(sim.discrepancy.evidence_silhouette_bias_mm, 5.0);
+  EXPECT_EQ(sim.discrepancy.evidence_silhouette_bias_mm, 6.0);
   EXPECT_EQ(sim.discrepancy.evidence_silhouette_band_px, 12);
   EXPECT_EQ(sim.discrepancy.evidence_silhouette_band_step_mm, 10.0);
   EXPECT_EQ(sim.discrepancy.evidence_silhouette_bias_by_link_mm.size(), 9u);
-  EXPECT_EQ(sim.discrepancy.evidence_silhouette_bias_by_link_mm.at("link7"), 5.0);
-  EXPECT_EQ(sim.discrepancy.evidence_silhouette_bias_by_link_mm.at("link2"), 0.3);
+  EXPECT_EQ(sim.discrepancy.evidence_silhouette_bias_by_link_mm.at("link7"), 4.4);
+  EXPECT_EQ(sim.discrepancy.evidence_silhouette_bias_by_link_mm.at("link2"), 0.2);
   const std::string path = sim_variant("silhouette-by-link", kSimSilhouetteAllowance,
                                        "    silhouette_allowance: {band_px: 11, bias_mm: 2.3, by_link: "
                                        "{link1: 2.3, link7: 0.4}}\n");

@@ -129,8 +129,12 @@ class RecordingRenderer {
       } else if (event->channel == channels_.camera_pose) {
         const auto pose = decode_message<camera_pose_t>(event->data, event->datalen);
         if (pose && check_camera_pose(*pose).empty()) service_.on_camera_pose(*pose);
-      } else if (event->channel == channels_.depth && result_.depth_frames < options_.max_frames) {
-        on_depth(*event);
+      } else if (event->channel == channels_.depth) {
+        if (result_.depth_frames < options_.max_frames) {
+          on_depth(*event);
+        } else {
+          ++result_.frames_left_out;
+        }
       }
     }
     render_waiting(INT64_MAX);
@@ -647,6 +651,10 @@ std::string tune_report(const TuneResult& r, const TuneSettings& settings) {
       << " unusable" << (r.unusable_frames > 0 ? " (" + r.first_unusable_reason + ")" : "") << "; "
       << r.joint_states << " joint states, most moving joint " << r.most_moving_joint << " over "
       << fixed(r.largest_motion, 3) << " rad (m)\n";
+  if (r.frames_left_out > 0) {
+    out << "  note: " << r.frames_left_out << " later frames of the recording were left out (at most "
+        << TuneOptions{}.max_frames << " are used)\n";
+  }
   if (r.measured_rate_hz > 0 && settings.renderer.camera.rate_hz > 0 &&
       std::abs(r.measured_rate_hz / settings.renderer.camera.rate_hz - 1) > 0.1) {
     out << "  note: the frames came at " << fixed(r.measured_rate_hz, 1)
