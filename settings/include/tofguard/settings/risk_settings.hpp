@@ -13,10 +13,12 @@
 
 namespace tofguard::settings {
 
-// The large-offset test's alternatives where risk.evidence leaves them out: about
-// where a joint's linear fit stops following its offset (a 20 deg offset
-// reads 16-20 deg on the default arm's wrist), so a large offset's reading
-// is still near the alternative (docs/safety-chain.md, "A large offset").
+// The large-offset test's alternatives where risk.evidence leaves them out:
+// well above the share of the alternative a commissioned camera's allowance
+// takes where it covers the first test's (B / I of 3-5 deg on the default
+// arm's wrist), and half the naming search's range, within which the linear
+// fit's reading still grows with the offset (docs/safety-chain.md, "A large
+// offset").
 constexpr double kDefaultLargeJointOffsetDeg = 10.0;
 constexpr double kDefaultLargeJointOffsetM = 0.01;
 
