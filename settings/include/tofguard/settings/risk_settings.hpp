@@ -15,8 +15,8 @@ namespace tofguard::settings {
 
 // The large-offset test's alternatives where risk.evidence leaves them out:
 // well above the share of the alternative a commissioned camera's allowance
-// takes where it covers the first test's (B / I of 3-5 deg on the default
-// arm's wrist), and half the naming search's range, within which the linear
+// takes where it covers the first test's (B / I above 3 deg on a quarter of
+// the default arm's wrist frames), and half the naming search's range, within which the linear
 // fit's reading still grows with the offset (docs/safety-chain.md, "A large
 // offset").
 constexpr double kDefaultLargeJointOffsetDeg = 10.0;
