@@ -333,8 +333,8 @@ FrameFinding SequentialEvidence::joint_finding(const discrepancy_t& f, int i) co
       " of h " + fixed(h_, 1);
   const auto tests = joint_tests_.find(joint);
   if (tests != joint_tests_.end() && tests->second.at_large > tests->second.at_delta) {
-    finding.detail += " (its test at the large offset " +
-                      fixed(unit * (prismatic ? joint_large_m_ : joint_large_rad_), 0) + unit_name + ")";
+    finding.detail += " (its test at the large offset " + fixed(unit * joint_alternatives(joint).large, 0) +
+                      unit_name + ")";
   }
   if (information > 0) {
     finding.detail += "; fitted offset (seen - reported) " + fixed(unit * f.joint_score[i] / information, 1) +
@@ -422,22 +422,25 @@ void SequentialEvidence::add_frame(const discrepancy_t& f) {
   }
 }
 
+SequentialEvidence::JointAlternatives SequentialEvidence::joint_alternatives(const std::string& joint) const {
+  if (prismatic_.count(joint) > 0) return {joint_delta_m_, joint_large_m_};
+  return {joint_delta_rad_, joint_large_rad_};
+}
+
 double SequentialEvidence::smallest_offset(const discrepancy_t& f, int i) const {
-  const bool prismatic = prismatic_.count(f.joint_name[i]) > 0;
+  const JointAlternatives alternatives = joint_alternatives(f.joint_name[i]);
   const double bound = joint_static_bound(f, i);
   const double information = f.joint_information[i];
-  return std::min(smallest_growing_offset(prismatic ? joint_delta_m_ : joint_delta_rad_, information, bound,
-                                          memory_decay_),
-                  smallest_growing_offset(prismatic ? joint_large_m_ : joint_large_rad_, information, bound,
-                                          memory_decay_));
+  return std::min(smallest_growing_offset(alternatives.first, information, bound, memory_decay_),
+                  smallest_growing_offset(alternatives.large, information, bound, memory_decay_));
 }
 
 void SequentialEvidence::add_joint(const discrepancy_t& f, int i, JointTests* tests) {
-  const bool prismatic = prismatic_.count(f.joint_name[i]) > 0;
+  const JointAlternatives alternatives = joint_alternatives(f.joint_name[i]);
   const double bound = joint_static_bound(f, i);
   const double information = f.joint_information[i];
-  const double tested = effective_delta(prismatic ? joint_delta_m_ : joint_delta_rad_, information, bound);
-  const double large = effective_delta(prismatic ? joint_large_m_ : joint_large_rad_, information, bound);
+  const double tested = effective_delta(alternatives.first, information, bound);
+  const double large = effective_delta(alternatives.large, information, bound);
   tests->at_delta =
       step(tests->at_delta, joint_llr(f.joint_score[i], information, tested) - memory_decay_, h_);
   tests->at_large =

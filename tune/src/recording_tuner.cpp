@@ -652,8 +652,8 @@ std::string tune_report(const TuneResult& r, const TuneSettings& settings) {
       << r.joint_states << " joint states, most moving joint " << r.most_moving_joint << " over "
       << fixed(r.largest_motion, 3) << " rad (m)\n";
   if (r.frames_left_out > 0) {
-    out << "  note: " << r.frames_left_out << " later frames of the recording were left out (at most "
-        << TuneOptions{}.max_frames << " are used)\n";
+    out << "  note: " << r.frames_left_out << " later frames of the recording were left out (after the first "
+        << r.depth_frames << ")\n";
   }
   if (r.measured_rate_hz > 0 && settings.renderer.camera.rate_hz > 0 &&
       std::abs(r.measured_rate_hz / settings.renderer.camera.rate_hz - 1) > 0.1) {

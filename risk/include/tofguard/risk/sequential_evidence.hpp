@@ -226,6 +226,14 @@ class SequentialEvidence {
     double largest() const { return at_delta > at_large ? at_delta : at_large; }
   };
 
+  // A joint's two alternatives as configured (radians; metres for a
+  // prismatic joint), before the allowance takes its share.
+  struct JointAlternatives {
+    double first;
+    double large;
+  };
+  JointAlternatives joint_alternatives(const std::string& joint) const;
+
   // A hypothesis's name ("camera" or a joint's) and its CUSUM.
   struct NamedCusum {
     std::string name;
