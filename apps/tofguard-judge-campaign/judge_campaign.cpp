@@ -573,6 +573,7 @@ class CampaignRunJudge {
     const depth_image_t camera = capture(k, faulty, state, true_joints, true_pose);
     discrepancy::DiscrepancyFrame frame = discrepancy_of(k, camera, state, true_joints, true_pose);
     if (k < run_.onset_frame || kind_ == Kind::kNone) add_nominal_scores(frame.summary);
+    if (faulty && kind_ == Kind::kJointOffset) add_fault_search_gain(frame.summary);
     monitor_.on_depth(now_us);
     if (!(kind_ == Kind::kJointStall && faulty)) monitor_.on_joint_state(state, now_us);
     for (const risk_t& verdict : monitor_.on_frame(frame.summary, now_us)) judge_verdict(verdict);
@@ -711,7 +712,10 @@ class CampaignRunJudge {
       }
       previous_t_[d.joint_name[j]] = t;
     }
-    if (kind_ == Kind::kNone) add_smallest_offsets(d);
+    if (kind_ == Kind::kNone) {
+      add_smallest_offsets(d);
+      add_search_gains(d);
+    }
     if (std::getenv("TOFGUARD_CAMPAIGN_CAMERA_SCORES") != nullptr)
       for (int a = 0; a < 6 && d.evidence_available; ++a)
         add_score(d.camera_score[a], d.camera_information[7 * a]);
@@ -727,6 +731,29 @@ class CampaignRunJudge {
       result_.nominal_smallest_offset[d.joint_name[j]].push_back(
           static_cast<float>(prismatic ? 1000 * offset : offset * 180 / M_PI));
     }
+  }
+
+  // Per joint, the naming search's gain on this nominal frame (none when
+  // the frame carries no search).
+  void add_search_gains(const discrepancy_t& d) {
+    if (!risk::searched(d)) return;
+    const risk::RiskSettings& r = config_.risk;
+    for (int j = 0; j < d.num_joints; ++j) {
+      const bool prismatic = w_.model_scene.is_prismatic_joint(d.joint_name[j]);
+      const double large = prismatic ? r.evidence_large_joint_offset_m : r.evidence_large_joint_offset_rad;
+      const float gain = static_cast<float>(d.joint_search_gain[j]);
+      result_.nominal_search_gain[d.joint_name[j]].push_back(gain);
+      if (std::abs(d.joint_search_offset[j]) >= large)
+        result_.nominal_search_gain_large[d.joint_name[j]].push_back(gain);
+    }
+  }
+
+  // The faulty joint's naming search gain on this frame of the fault.
+  void add_fault_search_gain(const discrepancy_t& d) {
+    if (!risk::searched(d)) return;
+    const auto at = std::find(d.joint_name.begin(), d.joint_name.end(), run_.fault.joint);
+    if (at != d.joint_name.end())
+      result_.fault_search_gain.push_back(static_cast<float>(d.joint_search_gain[at - d.joint_name.begin()]));
   }
 
   void judge_verdict(const risk_t& verdict) {
@@ -853,6 +880,53 @@ std::string smallest_offsets_text(const std::vector<CampaignResult>& results) {
   return out.str();
 }
 
+// The q-th quantile of `values` (0 <= q <= 1; 1: the largest), which it sorts.
+float quantile(std::vector<float>* values, double q) {
+  std::sort(values->begin(), values->end());
+  const size_t at =
+      std::min(values->size() - 1, static_cast<size_t>(q * static_cast<double>(values->size())));
+  return (*values)[at];
+}
+
+// One line: per joint over the nominal runs' frames, the naming search's
+// gain (its 99th percentile and the largest, chi^2), and the largest where
+// the searched offset is the large-offset test's alternative or more: what
+// nominal frames give a test on the search's gain (docs/safety-chain.md,
+// "A large offset"); "" without such frames.
+std::string search_gains_text(const std::vector<CampaignResult>& results) {
+  std::map<std::string, std::vector<float>> all, large;
+  for (const CampaignResult& r : results) {
+    for (const auto& [joint, gains] : r.nominal_search_gain)
+      all[joint].insert(all[joint].end(), gains.begin(), gains.end());
+    for (const auto& [joint, gains] : r.nominal_search_gain_large)
+      large[joint].insert(large[joint].end(), gains.begin(), gains.end());
+  }
+  if (all.empty()) return "";
+  std::ostringstream out;
+  out << "\nThe naming search's gain on the nominal frames (chi^2), per joint: 99th percentile / largest; "
+         "at a searched offset of the large-offset test's or more: the largest (frames):";
+  const char* separator = " ";
+  for (auto& [joint, gains] : all) {
+    out << separator << joint << " " << fixed_text(quantile(&gains, 0.99), 0) << " / "
+        << fixed_text(gains.back(), 0);
+    std::vector<float>& at_large = large[joint];
+    out << " (" << (at_large.empty() ? std::string("-") : fixed_text(quantile(&at_large, 1.0), 0)) << ", "
+        << at_large.size() << ")";
+    separator = ", ";
+  }
+  out << "\n";
+  return out.str();
+}
+
+// "; the naming search's gain of the joint ..." for a missed joint offset
+// (its median and largest over the frames from the onset); "" without.
+std::string fault_search_gain_text(std::vector<float> gains) {
+  if (gains.empty()) return "";
+  const float median = quantile(&gains, 0.5);
+  return "; the naming search's gain of the joint from the onset: median " + fixed_text(median, 0) +
+         ", largest " + fixed_text(gains.back(), 0) + " chi^2";
+}
+
 }  // namespace
 
 std::string campaign_report(const std::string& arm, const std::vector<CampaignResult>& results,
@@ -904,7 +978,7 @@ std::string campaign_report(const std::string& arm, const std::vector<CampaignRe
     }
     if (!r.stopped) {
       misses << "- " << arm << ", " << r.label << ": not detected (the fault changes " << r.changed_pixels
-             << " pixels by more than 3 sigma)\n";
+             << " pixels by more than 3 sigma" << fault_search_gain_text(r.fault_search_gain) << ")\n";
     } else if (!r.right_suspect) {
       misses << "- " << arm << ", " << r.label << ": stopped as " << risk_cause_name(r.cause)
              << (r.suspect.empty() ? "" : " " + r.suspect) << " (" << r.detail << ")\n";
@@ -953,6 +1027,7 @@ std::string campaign_report(const std::string& arm, const std::vector<CampaignRe
         << fixed_text(differences > 0 ? difference_sum_sq / static_cast<double>(differences) : 0, 2) << "\n";
   }
   out << smallest_offsets_text(results);
+  out << search_gains_text(results);
   const std::string m = misses.str();
   if (!m.empty()) out << "\n" << m;
   return out.str();

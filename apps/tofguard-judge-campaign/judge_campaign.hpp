@@ -135,6 +135,9 @@ struct CampaignResult {
   // at the true and at the reported joints and pose). A fault that changes
   // no pixel cannot be seen by any camera rule.
   int changed_pixels = 0;
+  // A joint offset fault: the naming search's gain of the faulty joint
+  // (discrepancy_t.joint_search_gain, chi^2) on each frame from the onset.
+  std::vector<float> fault_search_gain;
   // kObject: pixels where the camera sees the object at the onset; its true
   // distance to the arm (the 1 cm cover) at the onset, the least over the
   // run, and at the stop's frame; the stop's score and threshold (for an
@@ -173,6 +176,11 @@ struct CampaignResult {
   // degrees, or mm for a prismatic joint; infinity where the allowance
   // covers the whole alternative).
   std::map<std::string, std::vector<float>> nominal_smallest_offset;
+  // On the same frames, per joint: the naming search's gain (chi^2), and
+  // the gains of the frames whose searched offset is at least the
+  // large-offset test's alternative (evidence.large_joint_offset).
+  std::map<std::string, std::vector<float>> nominal_search_gain;
+  std::map<std::string, std::vector<float>> nominal_search_gain_large;
 };
 
 // Runs `runs` on `arm`, each from a fresh chain (new CUSUMs, new latch).

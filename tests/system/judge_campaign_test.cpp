@@ -100,6 +100,11 @@ void expect_targets(const CampaignArm& arm) {
       EXPECT_TRUE(r.stopped) << r.changed_pixels << " pixels changed";
       EXPECT_EQ(r.cause, risk_t::CAUSE_JOINT_ERROR) << r.detail;
       right_suspects += r.right_suspect ? 1 : 0;
+      // The naming search's gain of the faulty joint, every frame from the
+      // onset: on some frame at least the camera candidate's 25 (5 sigma of
+      // one parameter), as it names the joint.
+      ASSERT_EQ(r.fault_search_gain.size(), 15u);
+      EXPECT_GE(*std::max_element(r.fault_search_gain.begin(), r.fault_search_gain.end()), 25.0f);
     }
     if (r.stopped) stop_frames.push_back(r.stop_frames);
     // The diagnosis persists: no SAFE verdict, no other suspect while the
