@@ -737,11 +737,9 @@ class CampaignRunJudge {
   // the frame carries no search).
   void add_search_gains(const discrepancy_t& d) {
     if (!risk::searched(d)) return;
-    const risk::RiskSettings& r = config_.risk;
     for (int j = 0; j < d.num_joints; ++j) {
-      const bool prismatic = w_.model_scene.is_prismatic_joint(d.joint_name[j]);
-      const double large = prismatic ? r.evidence_large_joint_offset_m : r.evidence_large_joint_offset_rad;
-      const float gain = static_cast<float>(d.joint_search_gain[j]);
+      const double large = w_.evidence.joint_alternatives(d.joint_name[j]).large;
+      const double gain = d.joint_search_gain[j];
       result_.nominal_search_gain[d.joint_name[j]].push_back(gain);
       if (std::abs(d.joint_search_offset[j]) >= large)
         result_.nominal_search_gain_large[d.joint_name[j]].push_back(gain);
@@ -753,7 +751,7 @@ class CampaignRunJudge {
     if (!risk::searched(d)) return;
     const auto at = std::find(d.joint_name.begin(), d.joint_name.end(), run_.fault.joint);
     if (at != d.joint_name.end())
-      result_.fault_search_gain.push_back(static_cast<float>(d.joint_search_gain[at - d.joint_name.begin()]));
+      result_.fault_search_gain.push_back(d.joint_search_gain[at - d.joint_name.begin()]);
   }
 
   void judge_verdict(const risk_t& verdict) {
@@ -852,16 +850,26 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
 
 namespace {
 
+// A per-joint figure of every run (`member` of CampaignResult), all runs'
+// values together.
+template <typename T>
+std::map<std::string, std::vector<T>> by_joint_over_runs(
+    const std::vector<CampaignResult>& results,
+    std::map<std::string, std::vector<T>> CampaignResult::*member) {
+  std::map<std::string, std::vector<T>> by_joint;
+  for (const CampaignResult& r : results) {
+    for (const auto& [joint, values] : r.*member)
+      by_joint[joint].insert(by_joint[joint].end(), values.begin(), values.end());
+  }
+  return by_joint;
+}
+
 // One line: per joint over the nominal runs' frames, the median of the
 // smallest offset a frame can show, and the share of frames that can show
 // none (docs/safety-chain.md, "The smallest fault a frame can show"); ""
 // without nominal frames.
 std::string smallest_offsets_text(const std::vector<CampaignResult>& results) {
-  std::map<std::string, std::vector<float>> by_joint;
-  for (const CampaignResult& r : results) {
-    for (const auto& [joint, offsets] : r.nominal_smallest_offset)
-      by_joint[joint].insert(by_joint[joint].end(), offsets.begin(), offsets.end());
-  }
+  auto by_joint = by_joint_over_runs(results, &CampaignResult::nominal_smallest_offset);
   if (by_joint.empty()) return "";
   std::ostringstream out;
   out << "\nSmallest joint offset a nominal frame can show (B/I + d'/2 + decay/(d' I); deg, mm if "
@@ -880,37 +888,26 @@ std::string smallest_offsets_text(const std::vector<CampaignResult>& results) {
   return out.str();
 }
 
-// The q-th quantile of `values` (0 <= q <= 1; 1: the largest), which it sorts.
-float quantile(std::vector<float>* values, double q) {
-  std::sort(values->begin(), values->end());
-  const size_t at =
-      std::min(values->size() - 1, static_cast<size_t>(q * static_cast<double>(values->size())));
-  return (*values)[at];
-}
-
 // One line: per joint over the nominal runs' frames, the naming search's
 // gain (its 99th percentile and the largest, chi^2), and the largest where
 // the searched offset is the large-offset test's alternative or more: what
 // nominal frames give a test on the search's gain (docs/safety-chain.md,
 // "A large offset"); "" without such frames.
 std::string search_gains_text(const std::vector<CampaignResult>& results) {
-  std::map<std::string, std::vector<float>> all, large;
-  for (const CampaignResult& r : results) {
-    for (const auto& [joint, gains] : r.nominal_search_gain)
-      all[joint].insert(all[joint].end(), gains.begin(), gains.end());
-    for (const auto& [joint, gains] : r.nominal_search_gain_large)
-      large[joint].insert(large[joint].end(), gains.begin(), gains.end());
-  }
+  auto all = by_joint_over_runs(results, &CampaignResult::nominal_search_gain);
+  auto large = by_joint_over_runs(results, &CampaignResult::nominal_search_gain_large);
   if (all.empty()) return "";
   std::ostringstream out;
   out << "\nThe naming search's gain on the nominal frames (chi^2), per joint: 99th percentile / largest; "
          "at a searched offset of the large-offset test's or more: the largest (frames):";
   const char* separator = " ";
   for (auto& [joint, gains] : all) {
-    out << separator << joint << " " << fixed_text(quantile(&gains, 0.99), 0) << " / "
+    std::sort(gains.begin(), gains.end());
+    out << separator << joint << " " << fixed_text(quantile(gains, 0.99), 0) << " / "
         << fixed_text(gains.back(), 0);
-    std::vector<float>& at_large = large[joint];
-    out << " (" << (at_large.empty() ? std::string("-") : fixed_text(quantile(&at_large, 1.0), 0)) << ", "
+    const std::vector<double>& at_large = large[joint];
+    const auto largest = std::max_element(at_large.begin(), at_large.end());
+    out << " (" << (largest == at_large.end() ? std::string("-") : fixed_text(*largest, 0)) << ", "
         << at_large.size() << ")";
     separator = ", ";
   }
@@ -920,11 +917,11 @@ std::string search_gains_text(const std::vector<CampaignResult>& results) {
 
 // "; the naming search's gain of the joint ..." for a missed joint offset
 // (its median and largest over the frames from the onset); "" without.
-std::string fault_search_gain_text(std::vector<float> gains) {
+std::string fault_search_gain_text(std::vector<double> gains) {
   if (gains.empty()) return "";
-  const float median = quantile(&gains, 0.5);
-  return "; the naming search's gain of the joint from the onset: median " + fixed_text(median, 0) +
-         ", largest " + fixed_text(gains.back(), 0) + " chi^2";
+  std::sort(gains.begin(), gains.end());
+  return "; the naming search's gain of the joint from the onset: median " +
+         fixed_text(quantile(gains, 0.5), 0) + ", largest " + fixed_text(gains.back(), 0) + " chi^2";
 }
 
 }  // namespace

@@ -137,7 +137,7 @@ struct CampaignResult {
   int changed_pixels = 0;
   // A joint offset fault: the naming search's gain of the faulty joint
   // (discrepancy_t.joint_search_gain, chi^2) on each frame from the onset.
-  std::vector<float> fault_search_gain;
+  std::vector<double> fault_search_gain;
   // kObject: pixels where the camera sees the object at the onset; its true
   // distance to the arm (the 1 cm cover) at the onset, the least over the
   // run, and at the stop's frame; the stop's score and threshold (for an
@@ -179,8 +179,8 @@ struct CampaignResult {
   // On the same frames, per joint: the naming search's gain (chi^2), and
   // the gains of the frames whose searched offset is at least the
   // large-offset test's alternative (evidence.large_joint_offset).
-  std::map<std::string, std::vector<float>> nominal_search_gain;
-  std::map<std::string, std::vector<float>> nominal_search_gain_large;
+  std::map<std::string, std::vector<double>> nominal_search_gain;
+  std::map<std::string, std::vector<double>> nominal_search_gain_large;
 };
 
 // Runs `runs` on `arm`, each from a fresh chain (new CUSUMs, new latch).

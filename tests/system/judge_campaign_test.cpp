@@ -104,7 +104,7 @@ void expect_targets(const CampaignArm& arm) {
       // onset: on some frame at least the camera candidate's 25 (5 sigma of
       // one parameter), as it names the joint.
       ASSERT_EQ(r.fault_search_gain.size(), 15u);
-      EXPECT_GE(*std::max_element(r.fault_search_gain.begin(), r.fault_search_gain.end()), 25.0f);
+      EXPECT_GE(*std::max_element(r.fault_search_gain.begin(), r.fault_search_gain.end()), 25.0);
     }
     if (r.stopped) stop_frames.push_back(r.stop_frames);
     // The diagnosis persists: no SAFE verdict, no other suspect while the

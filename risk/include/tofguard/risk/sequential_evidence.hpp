@@ -199,6 +199,14 @@ class SequentialEvidence {
   // smaller (radians, metres for a prismatic joint; infinity when neither
   // can show one).
   double smallest_offset(const discrepancy_t& frame, int index) const;
+  // A joint's two alternatives as configured (radians; metres for a
+  // prismatic joint), before the allowance takes its share: the first
+  // test's (evidence.joint_offset) and the large-offset test's.
+  struct JointAlternatives {
+    double first;
+    double large;
+  };
+  JointAlternatives joint_alternatives(const std::string& joint) const;
   // Hypothesis `hypothesis` ("camera" or a joint) shows evidence that its
   // fault is gone: its clearing test, a CUSUM on the negated log-likelihood
   // ratio at kClearingAlternativeFraction of the stop test's (effective)
@@ -225,14 +233,6 @@ class SequentialEvidence {
     bool clearing_at_large = false;
     double largest() const { return at_delta > at_large ? at_delta : at_large; }
   };
-
-  // A joint's two alternatives as configured (radians; metres for a
-  // prismatic joint), before the allowance takes its share.
-  struct JointAlternatives {
-    double first;
-    double large;
-  };
-  JointAlternatives joint_alternatives(const std::string& joint) const;
 
   // A hypothesis's name ("camera" or a joint's) and its CUSUM.
   struct NamedCusum {
