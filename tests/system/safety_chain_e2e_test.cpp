@@ -16,10 +16,12 @@
 #include <cstdlib>
 #include <deque>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <thread>
 
+#include "quiet_subscriptions.hpp"
 #include "recovery_deadline.hpp"
 #include "tofguard/authenticated_message_t.hpp"
 #include "tofguard/camera_pose_t.hpp"
@@ -50,12 +52,14 @@ class Chain {
         config_(deployment::load_config(config_path_, nullptr)),
         safety_(config_.lcm.url),
         images_(config_.lcm.image_url) {
-    safety_.subscribe(config_.channels.status, &Chain::on_status, this);
-    safety_.subscribe(config_.channels.risk, &Chain::on_risk, this);
-    images_.subscribe(config_.channels.depth, &Chain::on_depth, this);
-    safety_.subscribe(config_.channels.joint_state, &Chain::on_joints, this);
-    safety_.subscribe(config_.channels.heartbeat, &Chain::on_heartbeat, this);
-    safety_.subscribe(config_.channels.motion_estimate, &Chain::on_estimate, this);
+    // Quiet: the nominal part sends malformed messages on these channels.
+    listening_.add<safety_status_t>(safety_, config_.channels.status, [this](auto& m) { on_status(m); });
+    listening_.add<risk_t>(safety_, config_.channels.risk, [this](auto& m) { on_risk(m); });
+    listening_.add<depth_image_t>(images_, config_.channels.depth, [this](auto& m) { on_depth(m); });
+    listening_.add<joint_state_t>(safety_, config_.channels.joint_state, [this](auto& m) { on_joints(m); });
+    listening_.add<heartbeat_t>(safety_, config_.channels.heartbeat, [this](auto& m) { on_heartbeat(m); });
+    listening_.add<motion_estimate_t>(safety_, config_.channels.motion_estimate,
+                                      [this](auto& m) { on_estimate(m); });
     safety_.getFileno();
     images_.getFileno();
     for (const char* name :
@@ -187,7 +191,9 @@ class Chain {
 
   // Runs `inject` and returns how long after the first affected camera
   // frame (the first captured after it) the permission was withdrawn;
-  // fills the stop's status.
+  // fills the stop's status. 0 when the stop came before that frame
+  // arrived: a fault that reaches the chain beside the camera (a camera pose
+  // on CAMERA_POSE) already affects the frames in flight.
   int64_t stop_latency_after_frame(const std::function<void()>& inject, safety_status_t* stop) {
     const int64_t injected_utime = wall_utime();
     risk_log_.clear();
@@ -200,7 +206,11 @@ class Chain {
         << "no stop; last risk " << describe_last_risk();
     *stop = stop_status_;
     std::cout << "risk verdicts after the fault:\n" << risk_log_ << std::flush;
-    if (first_affected_arrival_us_ < 0) return stopped_at_us_ - injected_utime;  // should not happen
+    if (stopped_at_us_ < 0) return std::numeric_limits<int64_t>::max();  // no stop (failed above)
+    if (first_affected_arrival_us_ < 0 || first_affected_arrival_us_ > stopped_at_us_) {
+      std::cout << "the stop came on a frame captured before the fault" << std::endl;
+      return 0;
+    }
     return stopped_at_us_ - first_affected_arrival_us_;
   }
 
@@ -278,48 +288,48 @@ class Chain {
   }
 
  private:
-  void on_status(const lcm::ReceiveBuffer*, const std::string&, const safety_status_t* s) {
-    if (motion_allowed_ && !s->motion_allowed) {
+  void on_status(const safety_status_t& s) {
+    if (motion_allowed_ && !s.motion_allowed) {
       ++stops_seen_;
       if (stopped_at_us_ < 0) {
         stopped_at_us_ = monotonic_us();
-        stop_status_ = *s;
+        stop_status_ = s;
       }
     }
-    motion_allowed_ = s->motion_allowed;
+    motion_allowed_ = s.motion_allowed;
   }
-  void on_risk(const lcm::ReceiveBuffer*, const std::string&, const risk_t* r) {
-    last_risk_ = *r;
-    if (r->seq >= 0) risk_details_.push_back(r->detail);
-    if (r->seq >= 0 && std::count(risk_log_.begin(), risk_log_.end(), '\n') < 12) {
-      risk_log_ += "  seq " + std::to_string(r->seq) + " " + risk_level_name(r->level) + " " +
-                   risk_cause_name(r->cause) + " '" + r->suspect + "': " + r->detail + "\n";
+  void on_risk(const risk_t& r) {
+    last_risk_ = r;
+    if (r.seq >= 0) risk_details_.push_back(r.detail);
+    if (r.seq >= 0 && std::count(risk_log_.begin(), risk_log_.end(), '\n') < 12) {
+      risk_log_ += "  seq " + std::to_string(r.seq) + " " + risk_level_name(r.level) + " " +
+                   risk_cause_name(r.cause) + " '" + r.suspect + "': " + r.detail + "\n";
     }
-    if (r->seq < 0) return;
-    safe_streak_ = r->level == risk_t::SAFE ? safe_streak_ + 1 : 0;
+    if (r.seq < 0) return;
+    safe_streak_ = r.level == risk_t::SAFE ? safe_streak_ + 1 : 0;
   }
-  void on_estimate(const lcm::ReceiveBuffer*, const std::string&, const motion_estimate_t* e) {
-    std::string line = "  estimate seq " + std::to_string(e->seq) + " trigger " + std::to_string(e->trigger) +
-                       (e->usable ? "" : " unusable: " + e->unusable_reason) +
-                       (e->converged ? " converged" : " not converged") + " it " +
-                       std::to_string(e->iterations) + " res " + std::to_string(e->residual_before_mm) +
-                       "->" + std::to_string(e->residual_after_mm) + " mm, offsets deg:";
-    for (int i = 0; i < e->num_joints; ++i) {
-      line += " " + e->joint_name[i] + "=" +
-              std::to_string((e->estimated_position[i] - e->reported_position[i]) * 180 / M_PI) + "+-" +
-              std::to_string(e->position_sigma[i] * 180 / M_PI);
+  void on_estimate(const motion_estimate_t& e) {
+    std::string line = "  estimate seq " + std::to_string(e.seq) + " trigger " + std::to_string(e.trigger) +
+                       (e.usable ? "" : " unusable: " + e.unusable_reason) +
+                       (e.converged ? " converged" : " not converged") + " it " +
+                       std::to_string(e.iterations) + " res " + std::to_string(e.residual_before_mm) + "->" +
+                       std::to_string(e.residual_after_mm) + " mm, offsets deg:";
+    for (int i = 0; i < e.num_joints; ++i) {
+      line += " " + e.joint_name[i] + "=" +
+              std::to_string((e.estimated_position[i] - e.reported_position[i]) * 180 / M_PI) + "+-" +
+              std::to_string(e.position_sigma[i] * 180 / M_PI);
     }
-    line += " cam " + std::to_string(e->correction_translation[0]) + "," +
-            std::to_string(e->correction_translation[1]) + "," +
-            std::to_string(e->correction_translation[2]) + " us " + std::to_string(e->compute_us);
+    line += " cam " + std::to_string(e.correction_translation[0]) + "," +
+            std::to_string(e.correction_translation[1]) + "," + std::to_string(e.correction_translation[2]) +
+            " us " + std::to_string(e.compute_us);
     estimate_log_.push_back(line);
   }
-  void on_joints(const lcm::ReceiveBuffer*, const std::string&, const joint_state_t* j) {
-    for (int i = 0; i < j->num_joints; ++i) latest_joints_[j->name[i]] = j->position[i];
+  void on_joints(const joint_state_t& j) {
+    for (int i = 0; i < j.num_joints; ++i) latest_joints_[j.name[i]] = j.position[i];
   }
-  void on_depth(const lcm::ReceiveBuffer*, const std::string&, const depth_image_t* d) {
+  void on_depth(const depth_image_t& d) {
     last_depth_arrival_us_ = monotonic_us();
-    if (first_affected_arrival_us_ < 0 && affected_after_utime_ > 0 && d->utime >= affected_after_utime_) {
+    if (first_affected_arrival_us_ < 0 && affected_after_utime_ > 0 && d.utime >= affected_after_utime_) {
       first_affected_arrival_us_ = last_depth_arrival_us_;
     }
   }
@@ -328,6 +338,7 @@ class Chain {
   deployment::Config config_;
   lcm::LCM safety_;
   lcm::LCM images_;
+  QuietSubscriptions listening_;
   std::map<std::string, std::unique_ptr<Subprocess>> processes_;
   int starts_ = 0;
   bool motion_allowed_ = false;
@@ -345,9 +356,7 @@ class Chain {
 
  public:
   const std::map<std::string, heartbeat_t>& heartbeats() const { return heartbeats_; }
-  void on_heartbeat(const lcm::ReceiveBuffer*, const std::string&, const heartbeat_t* hb) {
-    heartbeats_[hb->process] = *hb;
-  }
+  void on_heartbeat(const heartbeat_t& hb) { heartbeats_[hb.process] = hb; }
 
  private:
   int64_t last_pose_us_ = 0;
