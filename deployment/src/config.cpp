@@ -30,6 +30,7 @@ Config load_config(const std::string& path, const char* lcm_default_url_env) {
   config.auth = auth::read_auth_settings(root);
   config.robot = read_robot_settings(root.map("robot"));
   config.environment = read_environment_settings(root.optional_map("environment"));
+  config.occupant = settings::read_occupant_settings(root.optional_map("occupant"));
 
   {
     YamlMap camera = root.map("camera");

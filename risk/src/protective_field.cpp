@@ -46,6 +46,12 @@ FieldSize field_size(const RiskSettings& risk, double response_time_s, double ar
   return f;
 }
 
+double highest_arm_speed_for_separation_m_s(const RiskSettings& risk, double response_time_s,
+                                            double separation_m) {
+  const double at_rest_m = field_size(risk, response_time_s, 0).protective_m;
+  return std::max(0.0, (separation_m - at_rest_m) / response_time_s);
+}
+
 std::optional<double> object_distance_m(const discrepancy_t& frame, double min_area_m2) {
   for (int k = 0; k < frame.num_field_bins; ++k) {
     if (frame.unexplained_area_within_m2[k] >= min_area_m2)

@@ -116,4 +116,13 @@ double distance_to_arm_m(const PlacedArmSpheres& placed, const Eigen::Vector3d& 
   return nearest;
 }
 
+double separation_from_arm_m(const PlacedArmSpheres& placed, const OccupantPart& part) {
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const PlacedSphere& sphere : placed) {
+    nearest =
+        std::min(nearest, std::max(0.0, distance_to_part_m(part, sphere.center_world_m) - sphere.radius_m));
+  }
+  return nearest;
+}
+
 }  // namespace tofguard::robot_model

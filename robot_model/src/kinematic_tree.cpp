@@ -130,6 +130,7 @@ class TreeBuilder {
       if (link->collision_array.empty() && link->collision) {
         entry.collisions.push_back(to_geometry(link->collision->geometry, link->collision->origin));
       }
+      if (link->inertial) entry.mass_kg = link->inertial->mass;
       tree_.links.push_back(std::move(entry));
       // Siblings in the order of their names (urdfdom keeps no document
       // order), pushed in reverse so that the first is visited first.
@@ -320,6 +321,23 @@ std::string KinematicTree::child_link(const std::string& joint) const {
     if (j.name == joint) return links[j.child_link].name;
   }
   return "";
+}
+
+double moving_mass_kg(const KinematicTree& tree) {
+  double mass_kg = 0;
+  for (int i = 0; i < tree.num_robot_links; ++i) {
+    const Link& link = tree.links[i];
+    if (tree.nearest_movable_joint_above(link.name).empty()) continue;  // fixed to the root
+    // A link with no geometry and no <inertial> is a frame (a tool point).
+    if (!link.mass_kg && link.visuals.empty() && link.collisions.empty()) continue;
+    if (!link.mass_kg) {
+      throw ModelError(link.file + ": link '" + link.name +
+                       "' moves and has no <inertial><mass> (the arm's moving mass sizes the contact "
+                       "speeds the user's body regions allow; expected a mass in kg)");
+    }
+    mass_kg += *link.mass_kg;
+  }
+  return mass_kg;
 }
 
 }  // namespace tofguard::robot_model

@@ -9,6 +9,7 @@
 #include <map>
 #include <string>
 
+#include "occupant_test_config.hpp"
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/deployment/process_settings.hpp"
 #include "tool_support.hpp"
@@ -376,6 +377,62 @@ TEST(Config, MissingFileIsNamed) {
   const std::string message = config_error("/nonexistent/tofguard.yaml");
   EXPECT_NE(message.find("/nonexistent/tofguard.yaml"), std::string::npos) << message;
   EXPECT_NE(message.find("no such file"), std::string::npos) << message;
+}
+
+// The occupant: absent in the embedded default (nobody modelled); given, it
+// is read whole, and every mistake in it is one line naming the key.
+TEST(Config, TheOccupantSectionIsOptionalAndReadWhole) {
+  EXPECT_FALSE(deployment::load_config(sim_yaml_path(), nullptr).occupant.has_value());
+  const deployment::Config config =
+      deployment::load_config(sim_config_variant("config-occupant", {}, occupant_section()), nullptr);
+  ASSERT_TRUE(config.occupant.has_value());
+  const OccupantSettings& o = *config.occupant;
+  EXPECT_EQ(o.seated_on, "wheelchair");
+  EXPECT_DOUBLE_EQ(o.payload_kg, 0.5);
+  EXPECT_DOUBLE_EQ(o.contact_force_factor, 1.0);
+  ASSERT_EQ(o.regions.size(), static_cast<size_t>(kNumBodyRegions));
+  EXPECT_DOUBLE_EQ(o.regions.at(BodyRegion::kFace).envelope_m, 0.05);
+  EXPECT_DOUBLE_EQ(o.regions.at(BodyRegion::kFace).clearance_m.value_or(-1), 0.03);
+  EXPECT_FALSE(o.regions.at(BodyRegion::kHand).clearance_m.has_value());
+}
+
+TEST(Config, OccupantMistakesNameTheKey) {
+  struct Mistake {
+    std::string name, from, to;
+    std::vector<std::string> expected;
+  };
+  const std::vector<Mistake> mistakes = {
+      {"face-without-clearance",
+       "face: {envelope_m: 0.05, clearance_m: 0.03}",
+       "face: {envelope_m: 0.05}",
+       {"occupant.regions.face.clearance_m", "the head and the neck get a clearance, never a contact"}},
+      {"unknown-region",
+       "    thigh: {envelope_m: 0.03}\n",
+       "    thigh: {envelope_m: 0.03}\n    tail: {envelope_m: 0.03}\n",
+       {"occupant.regions.tail", "a body region (one of skull_and_forehead"}},
+      {"missing-region",
+       "    hand: {envelope_m: 0.10}\n",
+       "",
+       {"occupant.regions.hand", "every body region with its envelope_m"}},
+      {"force-factor",
+       "contact_force_factor: 1.0",
+       "contact_force_factor: 3",
+       {"occupant.contact_force_factor"}},
+  };
+  for (const Mistake& m : mistakes) {
+    std::string section = occupant_section();
+    const auto at = section.find(m.from);
+    ASSERT_NE(at, std::string::npos) << m.name;
+    section.replace(at, m.from.size(), m.to);
+    const std::string path = sim_config_variant("config-occupant-" + m.name, {}, section);
+    const std::string message = config_error(path);
+    EXPECT_EQ(message.find('\n'), std::string::npos) << "not one line: " << message;
+    EXPECT_NE(message.find(path), std::string::npos) << message;
+    for (const std::string& part : m.expected) {
+      EXPECT_NE(message.find(part), std::string::npos)
+          << m.name << ": '" << part << "' missing from: " << message;
+    }
+  }
 }
 
 }  // namespace

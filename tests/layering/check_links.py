@@ -31,7 +31,8 @@ import check_includes  # noqa: E402  (the layer table and its rules)
 # component and what that component itself needs.
 DEPLOYMENT = ["tofguard_deployment", "tofguard_common", "tofguard_lcmtypes", "tofguard_auth",
               "tofguard_camera_settings", "tofguard_discrepancy_settings", "tofguard_estimator_settings",
-              "tofguard_intervene_settings", "tofguard_launch_settings", "tofguard_renderer_settings",
+              "tofguard_intervene_settings", "tofguard_launch_settings", "tofguard_occupant_settings",
+              "tofguard_renderer_settings",
               "tofguard_risk_settings", "tofguard_sim_settings", "tofguard_view_settings"]
 RENDERER = ["tofguard_renderer", "tofguard_scene_model", "tofguard_robot_model", "tofguard_robot_state"]
 PROGRAM_CLOSURES = {

@@ -29,6 +29,7 @@
 #include "tofguard/settings/estimator_settings.hpp"
 #include "tofguard/settings/intervene_settings.hpp"
 #include "tofguard/settings/launch_settings.hpp"
+#include "tofguard/settings/occupant_settings.hpp"
 #include "tofguard/settings/renderer_settings.hpp"
 #include "tofguard/settings/risk_settings.hpp"
 #include "tofguard/settings/sim_settings.hpp"
@@ -57,6 +58,8 @@ struct Config {
   auth::AuthSettings auth;
   RobotSettings robot;
   EnvironmentSettings environment;
+  // Optional: the wheelchair's occupant (absent: nobody is modelled).
+  std::optional<OccupantSettings> occupant;
   CameraSection camera;
   renderer::RendererSettings renderer;
   discrepancy::DiscrepancySettings discrepancy;

@@ -47,6 +47,13 @@ struct FieldSize {
 };
 FieldSize field_size(const RiskSettings& risk, double response_time_s, double arm_speed_m_s);
 
+// Speed and separation monitoring with speed scaling (ISO/TS 15066 5.5.4):
+// the highest arm speed v_arm (m/s) whose S still fits `separation_m`, S
+// solved for v_arm: (separation - K (T_r + T_s) - S_s - C) / T_r; 0 when
+// even the arm at rest needs more than `separation_m`.
+double highest_arm_speed_for_separation_m_s(const RiskSettings& risk, double response_time_s,
+                                            double separation_m);
+
 // The distance (m) of the nearest unexplained surface that counts as an
 // object: the first field bin's outer edge at which the cumulative area
 // (discrepancy_t.unexplained_area_within_m2) reaches `min_area_m2`;

@@ -23,6 +23,7 @@
 #include <Eigen/Geometry>
 
 #include "tofguard/robot_model/kinematics.hpp"
+#include "tofguard/robot_model/occupant_model.hpp"
 #include "tofguard/robot_model/scene_model.hpp"
 
 namespace tofguard::robot_model {
@@ -65,5 +66,12 @@ PlacedArmSpheres place_arm_spheres(const ArmSpheres& cover, const LinkPoses& pos
 // Distance (m) from `point_world` (world frame) to the placed cover, 0
 // inside a sphere. +infinity when the cover is empty.
 double distance_to_arm_m(const PlacedArmSpheres& placed, const Eigen::Vector3d& point_world);
+
+// The separation (m) between the placed cover and a part of the occupant
+// (occupant_model.hpp): the smallest over the spheres of the exact distance
+// from the sphere's centre to the part's shapes less the sphere's radius, 0
+// where they overlap. Like distance_to_arm_m it is never more than the true
+// separation from the arm's surface. +infinity when the cover is empty.
+double separation_from_arm_m(const PlacedArmSpheres& placed, const OccupantPart& part);
 
 }  // namespace tofguard::robot_model

@@ -15,6 +15,7 @@
 // Loading happens once, at start; everything that can be wrong with the
 // tree (malformed XML, a joint type tofguard does not model, a moving joint
 // in an environment, a broken mimic) is a ModelError there.
+#include <optional>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -90,6 +91,8 @@ struct Link {
   std::string file;
   std::vector<GeometryElement> visuals;
   std::vector<GeometryElement> collisions;
+  // <inertial><mass>, kg; nullopt when the link has no <inertial>.
+  std::optional<double> mass_kg;
 };
 
 struct KinematicTree {
@@ -138,6 +141,14 @@ struct KinematicTree {
   // Link indices from `link` up to its root, link first.
   std::vector<int> chain_to_root(const std::string& link) const;
 };
+
+// The mass of the robot's moving parts, kg: the sum of <inertial><mass>
+// over the robot links that some movable joint moves (ISO/TS 15066 Annex A's
+// M, from which the robot's effective mass in a contact is M/2 + payload).
+// A moving link with neither geometry nor <inertial> is a frame (0 kg).
+// Throws ModelError naming the first moving link with geometry but no
+// <inertial>: a missing mass is not a light arm.
+double moving_mass_kg(const KinematicTree& tree);
 
 // Parses the robot's URDF and the environments' (fixed joints only).
 // Throws ModelError.
