@@ -80,6 +80,8 @@ ChannelNames read_channel_names(YamlMap map) {
   name("status_auth", &c.status_auth);
   name("power_auth", &c.power_auth);
   name("reset_auth", &c.reset_auth);
+  name("speed_limit", &c.speed_limit);
+  name("speed_limit_auth", &c.speed_limit_auth);
   name("motion_estimate", &c.motion_estimate);
   name("planned_trajectory", &c.planned_trajectory);
   name("sim_true_joint_state", &c.sim_true_joint_state);

@@ -53,6 +53,11 @@ std::string RiskMonitor::check_joint_names(const std::vector<std::string>& names
   return "";
 }
 
+speed_limit_t RiskMonitor::speed_limit(const discrepancy_t& frame) const {
+  return frame_speed_limit(settings_, response_time_s_, frame,
+                           arm_speed_bound_m_s(frame, joint_states_.at(frame.utime)));
+}
+
 ClassifiedFrame RiskMonitor::classify(const discrepancy_t& frame) const {
   const joint_state_t* at_capture = joint_states_.at(frame.utime);
   ClassifierContext context = classifier_context_;

@@ -18,7 +18,9 @@ ProcessInfo process_info() {
   return {
       "tofguard-risk",
       "Classifies the risk of every frame and fires deadlines: SAFETY_DISCREPANCY, TOF_DEPTH, JOINT_STATE, "
-      "CAMERA_POSE, SAFETY_HEARTBEAT, MOTION_ESTIMATE, PLANNED_TRAJECTORY -> SAFETY_RISK (risk_t)."};
+      "CAMERA_POSE, SAFETY_HEARTBEAT, MOTION_ESTIMATE, PLANNED_TRAJECTORY -> SAFETY_RISK (risk_t) and the "
+      "arm's "
+      "speed limit, SAFETY_SPEED_LIMIT (speed_limit_t)."};
 }
 
 int run_risk(const RiskProcessSettings& settings) {
@@ -51,6 +53,11 @@ int run_risk(const RiskProcessSettings& settings) {
   auto publish_all = [&](const std::vector<risk_t>& verdicts) {
     for (const risk_t& r : verdicts) publish(r);
   };
+  // The controller's speed limit, signed first as the verdicts are.
+  auto publish_limit = [&](const speed_limit_t& limit) {
+    auth::publish_signed(node.safety(), signer ? &*signer : nullptr, settings.channels.speed_limit,
+                         settings.channels.speed_limit_auth, limit, wall_utime());
+  };
   node.subscribe<discrepancy_t>(
       node.safety(), settings.channels.discrepancy,
       [&](const discrepancy_t& d) {
@@ -61,6 +68,8 @@ int run_risk(const RiskProcessSettings& settings) {
           node.counters().frames_dropped++;
           node.errors().report(settings.channels.discrepancy + " order",
                                settings.channels.discrepancy + ": refused: " + monitor.last_refusal());
+        } else {
+          publish_limit(monitor.speed_limit(d));
         }
       },
       check_discrepancy);
@@ -109,7 +118,10 @@ int run_risk(const RiskProcessSettings& settings) {
       [&](const heartbeat_t& hb) { monitor.on_heartbeat(hb, monotonic_us()); }, check_heartbeat);
   node.add_timer(settings.risk.check_period_us, [&] {
     publish_all(monitor.release_due(monotonic_us()));
-    if (const auto timeout = monitor.check_deadlines(monotonic_us())) publish(*timeout);
+    if (const auto timeout = monitor.check_deadlines(monotonic_us())) {
+      publish(*timeout);
+      publish_limit(stand_still_limit(settings.risk, timeout->utime, camera_id, timeout->detail));
+    }
   });
   node.heartbeat().set_status("ok: waiting for frames");
   node.run();

@@ -4,12 +4,15 @@
 // dropped and counted while good frames are still judged.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 
 #include "chain_bus.hpp"
 #include "synthetic_estimates.hpp"
 #include "synthetic_frames.hpp"
+#include "tofguard/auth/message_verifier.hpp"
+#include "tofguard/authenticated_message_t.hpp"
 #include "tofguard/camera_pose_t.hpp"
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/deployment/process_settings.hpp"
@@ -17,6 +20,7 @@
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/motion_estimate_t.hpp"
 #include "tofguard/planned_trajectory_t.hpp"
+#include "tofguard/speed_limit_t.hpp"
 
 namespace tofguard::test {
 namespace {
@@ -264,6 +268,63 @@ TEST_F(RiskProcess, CameraStallTimesOutByItselfWithinTheDeadline) {
   // risk.deadlines_ms.depth = 150: not before it, and well within 200 ms of it.
   EXPECT_GE(after_us, 150'000);
   EXPECT_LE(after_us, 300'000);
+}
+
+// The controller's speed limit (speed_limit_t): one per frame taken, with
+// its seq, and 0 m/s with every timeout; each also signed on
+// SAFETY_SPEED_LIMIT_AUTH with the deployment's key.
+TEST_F(RiskProcess, EveryFrameAndEveryTimeoutGivesTheControllerASignedSpeedLimit) {
+  Inbox<speed_limit_t> limits;
+  Inbox<authenticated_message_t> signed_limits;
+  bus_.safety.subscribe("SAFETY_SPEED_LIMIT", &Inbox<speed_limit_t>::on_message, &limits);
+  bus_.safety.subscribe("SAFETY_SPEED_LIMIT_AUTH", &Inbox<authenticated_message_t>::on_message,
+                        &signed_limits);
+  // Before any frame: the deadlines' timeouts, each with a limit of 0.
+  ASSERT_TRUE(wait_until([&] { return !limits.messages.empty(); }, kDeadline, [&] { bus_.poll(); }));
+  EXPECT_EQ(limits.messages.front().seq, -1);
+  EXPECT_EQ(limits.messages.front().set_by, speed_limit_t::SET_BY_NO_JUDGEMENT);
+  EXPECT_DOUBLE_EQ(limits.messages.front().max_arm_speed_m_s, 0);
+  EXPECT_EQ(limits.messages.front().reason.rfind("stand: ", 0), 0u) << limits.messages.front().reason;
+
+  // Frames with the arm's cover and nothing unexplained: the range (2 m)
+  // sets the limit, (2 - S at rest 0.779 m) / T_r 0.193 s = 6.31 m/s.
+  discrepancy_t frame = good_;
+  frame.field_available = true;
+  frame.field_bin_m = 0.01f;
+  frame.num_field_bins = 200;
+  frame.unexplained_area_within_m2.assign(200, 0.0f);
+  ASSERT_TRUE(feed_until_judged(frame, 5));
+  ASSERT_TRUE(wait_until(
+      [&] {
+        return std::any_of(limits.messages.begin(), limits.messages.end(),
+                           [](const speed_limit_t& l) { return l.seq == 5; });
+      },
+      kDeadline, [&] { bus_.poll(); }));
+  for (int64_t seq = 1; seq <= 5; ++seq) {
+    const auto it = std::find_if(limits.messages.begin(), limits.messages.end(),
+                                 [&](const speed_limit_t& l) { return l.seq == seq; });
+    ASSERT_NE(it, limits.messages.end()) << "no limit for frame " << seq;
+    EXPECT_EQ(it->set_by, speed_limit_t::SET_BY_RANGE) << it->reason;
+    EXPECT_NEAR(it->max_arm_speed_m_s, 6.31, 0.01) << it->reason;
+    EXPECT_EQ(it->valid_for_ms, 150);
+    EXPECT_EQ(it->camera_id, "tof-mast");
+  }
+  // The signed copies open with the deployment's key, each a limit sent.
+  const deployment::Config config = deployment::load_config(chain_config("risk-key"), nullptr);
+  auth::MessageVerifier verifier(config.auth.key, config.auth.max_age_us);
+  ASSERT_FALSE(signed_limits.messages.empty());
+  int opened = 0;
+  for (size_t i = 0; i < signed_limits.messages.size(); ++i) {
+    std::string refusal;
+    const std::optional<speed_limit_t> limit = verifier.open<speed_limit_t>(
+        signed_limits.messages[i], "SAFETY_SPEED_LIMIT", signed_limits.messages[i].utime, &refusal);
+    ASSERT_TRUE(limit.has_value()) << refusal;
+    ++opened;
+    if (limit->seq == 5) {
+      EXPECT_NEAR(limit->max_arm_speed_m_s, 6.31, 0.01);
+    }
+  }
+  EXPECT_EQ(opened, static_cast<int>(signed_limits.messages.size()));
 }
 
 TEST_F(RiskProcess, MissingHeartbeatIsAComponentFault) {

@@ -43,6 +43,11 @@ struct ChannelNames {
   std::string status_auth = "SAFETY_STATUS_AUTH";
   std::string power_auth = "SAFETY_POWER_AUTH";
   std::string reset_auth = "SAFETY_RESET_AUTH";
+  // tofguard-risk's speed limit for the arm's controller (speed_limit_t)
+  // and its signed copy: the controller may follow it (speed scaling); it
+  // never allows motion that SAFETY_STATUS withdraws.
+  std::string speed_limit = "SAFETY_SPEED_LIMIT";
+  std::string speed_limit_auth = "SAFETY_SPEED_LIMIT_AUTH";
   // tofguard-estimator's joint offsets and camera correction
   // (motion_estimate_t) and the arm controller's plan (planned_trajectory_t).
   std::string motion_estimate = "MOTION_ESTIMATE";

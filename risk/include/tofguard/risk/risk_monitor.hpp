@@ -44,6 +44,7 @@
 #include "tofguard/risk/joint_states_by_utime.hpp"
 #include "tofguard/risk/plan_monitor.hpp"
 #include "tofguard/risk/sequential_evidence.hpp"
+#include "tofguard/risk/speed_limit.hpp"
 #include "tofguard/risk_t.hpp"
 #include "tofguard/robot_model/kinematic_tree.hpp"
 #include "tofguard/settings/risk_settings.hpp"
@@ -90,6 +91,9 @@ class RiskMonitor {
   // a clock set back).
   std::vector<risk_t> on_frame(const discrepancy_t& frame, int64_t now_us);
   int64_t refused_frames() const { return refused_frames_; }
+  // The speed limit for the arm's controller at `frame` (speed_limit.hpp),
+  // with the arm's speed bound from the joint state at its capture.
+  speed_limit_t speed_limit(const discrepancy_t& frame) const;
   const std::string& last_refusal() const { return last_refusal_; }
   // A valid estimate (check_motion_estimate, this camera, the robot's
   // joints): the verdicts it releases.

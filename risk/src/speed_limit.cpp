@@ -1,0 +1,69 @@
+#include "tofguard/risk/speed_limit.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <optional>
+
+#include "tofguard/risk/protective_field.hpp"
+
+namespace tofguard::risk {
+namespace {
+
+speed_limit_t limit_base(const RiskSettings& risk, int64_t utime, int64_t seq, const std::string& camera_id) {
+  speed_limit_t limit{};
+  limit.utime = utime;
+  limit.seq = seq;
+  limit.camera_id = camera_id;
+  limit.max_arm_speed_m_s = 0;
+  limit.set_by = speed_limit_t::SET_BY_NO_JUDGEMENT;
+  limit.separation_m = -1;
+  limit.arm_speed_m_s = -1;
+  limit.valid_for_ms = static_cast<int32_t>(risk.discrepancy_deadline_us / 1000);
+  return limit;
+}
+
+std::string format(const char* pattern, double a, double b) {
+  char text[160];
+  std::snprintf(text, sizeof text, pattern, a, b);
+  return text;
+}
+
+}  // namespace
+
+speed_limit_t frame_speed_limit(const RiskSettings& risk, double response_time_s, const discrepancy_t& frame,
+                                double arm_speed_m_s) {
+  speed_limit_t limit = limit_base(risk, frame.utime, frame.seq, frame.camera_id);
+  limit.arm_speed_m_s = std::isfinite(arm_speed_m_s) ? arm_speed_m_s : -1;
+  if (!frame.usable) {
+    limit.reason = "stand: the frame could not be compared (" + frame.unusable_reason + ")";
+    return limit;
+  }
+  if (!frame.field_available) {
+    limit.reason = "stand: the frame carries no distances to the arm (no cover in the labels)";
+    return limit;
+  }
+  const std::optional<double> object_m = object_distance_m(frame, risk.unknown_object_min_area_m2);
+  if (object_m) {
+    limit.set_by = speed_limit_t::SET_BY_UNKNOWN_OBJECT;
+    limit.separation_m = *object_m;
+    limit.max_arm_speed_m_s = highest_arm_speed_for_separation_m_s(risk, response_time_s, *object_m);
+    limit.reason = format("unknown object %.2f m from the arm: S fits up to %.2f m/s", *object_m,
+                          limit.max_arm_speed_m_s);
+  } else {
+    const double range_m = field_range_m(frame);
+    limit.set_by = speed_limit_t::SET_BY_RANGE;
+    limit.max_arm_speed_m_s = highest_arm_speed_for_separation_m_s(risk, response_time_s, range_m);
+    limit.reason = format("nothing unexplained within the %.2f m monitored: S fits up to %.2f m/s", range_m,
+                          limit.max_arm_speed_m_s);
+  }
+  return limit;
+}
+
+speed_limit_t stand_still_limit(const RiskSettings& risk, int64_t utime, const std::string& camera_id,
+                                const std::string& reason) {
+  speed_limit_t limit = limit_base(risk, utime, -1, camera_id);
+  limit.reason = "stand: " + reason;
+  return limit;
+}
+
+}  // namespace tofguard::risk
