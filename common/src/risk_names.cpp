@@ -2,6 +2,7 @@
 
 #include "tofguard/risk_t.hpp"
 #include "tofguard/safety_status_t.hpp"
+#include "tofguard/speed_limit_t.hpp"
 
 namespace tofguard {
 
@@ -58,6 +59,21 @@ std::string stop_name(int8_t stop) {
       return "power cut";
     default:
       return "stop " + std::to_string(stop);
+  }
+}
+
+std::string speed_limit_setter_name(int8_t set_by) {
+  switch (set_by) {
+    case speed_limit_t::SET_BY_RANGE:
+      return "range";
+    case speed_limit_t::SET_BY_UNKNOWN_OBJECT:
+      return "unknown object";
+    case speed_limit_t::SET_BY_BODY_REGION:
+      return "body region";
+    case speed_limit_t::SET_BY_NO_JUDGEMENT:
+      return "no judgement";
+    default:
+      return "set_by " + std::to_string(set_by);
   }
 }
 

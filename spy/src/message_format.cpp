@@ -26,6 +26,7 @@
 #include "tofguard/safety_status_t.hpp"
 #include "tofguard/sim_camera_fault_t.hpp"
 #include "tofguard/sim_joint_fault_t.hpp"
+#include "tofguard/speed_limit_t.hpp"
 
 namespace tofguard::spy {
 namespace {
@@ -72,6 +73,16 @@ std::string format(const safety_status_t& m) {
   std::ostringstream s;
   s << "seq=" << m.seq << " motion_allowed=" << yes_no(m.motion_allowed) << " stop=" << stop_name(m.stop)
     << " latched=" << yes_no(m.latched) << " cause=" << risk_cause_name(m.cause) << " | " << m.reason;
+  return s.str();
+}
+
+std::string format(const speed_limit_t& m) {
+  std::ostringstream s;
+  s << "utime=" << m.utime << " seq=" << m.seq << std::fixed << std::setprecision(2)
+    << " max_arm_speed=" << m.max_arm_speed_m_s << " m/s set_by=" << speed_limit_setter_name(m.set_by);
+  if (!m.body_region.empty()) s << " region=" << m.body_region;
+  if (m.separation_m >= 0) s << " separation=" << m.separation_m << " m";
+  s << " arm_speed=" << m.arm_speed_m_s << " m/s valid_for=" << m.valid_for_ms << " ms | " << m.reason;
   return s.str();
 }
 
@@ -201,6 +212,7 @@ const std::map<int64_t, std::pair<std::string, Formatter>>& formatters() {
       entry<sim_joint_fault_t>(),  entry<discrepancy_t>(),
       entry<motion_estimate_t>(),  entry<planned_trajectory_t>(),
       entry<sim_camera_fault_t>(), entry<authenticated_message_t>(),
+      entry<speed_limit_t>(),
   };
   return table;
 }

@@ -7,6 +7,7 @@
 #include "tofguard/common/risk_names.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/link_labels_t.hpp"
+#include "tofguard/speed_limit_t.hpp"
 #include "tofguard/spy/message_format.hpp"
 
 namespace tofguard::spy {
@@ -42,6 +43,11 @@ void StatusBoard::on_message(const std::string& channel, const void* data, int s
       risk_arrival_us_ = now_us;
       if (m->seq >= 0) camera_utime = m->utime;
     }
+  } else if (type == "speed_limit_t") {
+    if (auto m = decode_message<speed_limit_t>(data, size)) {
+      limit_ = m;
+      limit_arrival_us_ = now_us;
+    }
   } else if (type == "heartbeat_t") {
     if (auto m = decode_message<heartbeat_t>(data, size)) heartbeats_[m->process] = {*m, now_us};
   } else if (type == "depth_image_t") {
@@ -76,6 +82,19 @@ std::string StatusBoard::render(int64_t now_us, int64_t) const {
     s << "  (frame seq " << risk_->seq << ", score " << risk_->score << " / threshold " << risk_->threshold
       << ", age " << age(now_us - risk_arrival_us_) << ")\n";
     if (!risk_->detail.empty()) s << "  " << risk_->detail << "\n";
+  }
+  s << "SPEED LIMIT: ";
+  if (!limit_) {
+    s << "none received\n";
+  } else {
+    const int64_t limit_age_us = now_us - limit_arrival_us_;
+    s << std::fixed << std::setprecision(2) << limit_->max_arm_speed_m_s << " m/s, set by "
+      << speed_limit_setter_name(limit_->set_by);
+    if (!limit_->body_region.empty()) s << " (" << limit_->body_region << ")";
+    if (limit_->separation_m >= 0) s << " at " << limit_->separation_m << " m";
+    s << "  (arm at " << limit_->arm_speed_m_s << " m/s, age " << age(limit_age_us)
+      << (limit_age_us > limit_->valid_for_ms * 1000LL ? ", EXPIRED: 0 m/s" : "") << ")\n  " << limit_->reason
+      << "\n";
   }
   s << "PROCESSES (heartbeats):\n";
   if (heartbeats_.empty()) s << "  none received\n";

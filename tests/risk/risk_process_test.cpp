@@ -9,6 +9,7 @@
 #include <iostream>
 
 #include "chain_bus.hpp"
+#include "signed_publisher.hpp"
 #include "synthetic_estimates.hpp"
 #include "synthetic_frames.hpp"
 #include "tofguard/auth/message_verifier.hpp"
@@ -20,6 +21,7 @@
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/motion_estimate_t.hpp"
 #include "tofguard/planned_trajectory_t.hpp"
+#include "tofguard/safety_status_t.hpp"
 #include "tofguard/speed_limit_t.hpp"
 
 namespace tofguard::test {
@@ -325,6 +327,44 @@ TEST_F(RiskProcess, EveryFrameAndEveryTimeoutGivesTheControllerASignedSpeedLimit
     }
   }
   EXPECT_EQ(opened, static_cast<int>(signed_limits.messages.size()));
+}
+
+// The speed-scaling controller's example (auth/examples/follow_speed_limit
+// .cpp) on the live stream: it caps its speed at the verified limit while a
+// verified status allows motion, and at 0 before.
+TEST_F(RiskProcess, TheControllerExampleFollowsTheVerifiedLimit) {
+  // A person 0.9 m from the arm: 0.62 m/s, below the example's 0.7.
+  discrepancy_t frame = good_;
+  frame.field_available = true;
+  frame.field_bin_m = 0.01f;
+  frame.num_field_bins = 200;
+  frame.unexplained_area_within_m2.assign(200, 0.0f);
+  for (int k = 89; k < 200; ++k) frame.unexplained_area_within_m2[k] = 0.01f;
+  Subprocess controller("follow-speed-limit", {bin_dir() + "/tofguard-follow-speed-limit-example", "--key",
+                                               default_key_file(), "--url", kSafetyUrl, "--desired-m-s",
+                                               "0.7", "--count", "20", "--timeout-ms", "3000"});
+  SignedPublisher intervene(bus_.safety);
+  safety_status_t allowed{};
+  allowed.motion_allowed = true;
+  allowed.reason = "test: motion allowed";
+  int steps = 0;
+  ASSERT_TRUE(run_until(
+      bus_, [&] { return !controller.running(); }, kDeadline, kFramePeriodMs,
+      [&] {
+        step(frame);
+        // The permission starts after the fifth frame.
+        if (++steps > 5) {
+          allowed.utime = wall_utime();
+          ++allowed.seq;
+          intervene.publish("SAFETY_STATUS", allowed);
+        }
+      }))
+      << controller.stdout_text();
+  EXPECT_EQ(controller.wait(std::chrono::seconds(1)), 0) << controller.stderr_text();
+  const std::string seen = controller.stdout_text();
+  EXPECT_NE(seen.find("max=0.62 set_by=1 -> cap 0.62 (the limit)"), std::string::npos) << seen;
+  EXPECT_NE(seen.find("-> cap 0.00 (no fresh status allowing motion)"), std::string::npos) << seen;
+  EXPECT_EQ(seen.find("refused"), std::string::npos) << seen;
 }
 
 TEST_F(RiskProcess, MissingHeartbeatIsAComponentFault) {

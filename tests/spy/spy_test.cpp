@@ -13,6 +13,7 @@
 #include "tofguard/authenticated_message_t.hpp"
 #include "tofguard/motion_estimate_t.hpp"
 #include "tofguard/safety_status_t.hpp"
+#include "tofguard/speed_limit_t.hpp"
 #include "tofguard/spy/message_format.hpp"
 #include "tofguard/spy/status_board.hpp"
 #include "tool_support.hpp"
@@ -206,6 +207,38 @@ TEST(MessageFormat, ASignedEnvelopeShowsItsChannelSeqKeyAndPayloadType) {
             "SAFETY_STATUS_AUTH authenticated_message_t for=SAFETY_STATUS seq=1700000000000005 "
             "key=0123456789abcdef payload=safety_status_t (" +
                 std::to_string(m.payload.size()) + " bytes, tag not checked)");
+}
+
+// The speed limit (speed_limit_t): one decoded line, and on the board what
+// set it, how far, and when it no longer holds.
+TEST(MessageFormat, TheSpeedLimitShowsWhatSetItAndTheBoardWhenItExpires) {
+  speed_limit_t limit{};
+  limit.utime = 1700000000123456;
+  limit.seq = 42;
+  limit.camera_id = "tof-mast";
+  limit.max_arm_speed_m_s = 0.62;
+  limit.set_by = speed_limit_t::SET_BY_UNKNOWN_OBJECT;
+  limit.separation_m = 0.9;
+  limit.arm_speed_m_s = 0.25;
+  limit.valid_for_ms = 150;
+  limit.reason = "unknown object 0.90 m from the arm: S fits up to 0.62 m/s";
+  std::vector<uint8_t> bytes(static_cast<size_t>(limit.getEncodedSize()));
+  limit.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  EXPECT_EQ(
+      spy::format_message("SAFETY_SPEED_LIMIT", bytes.data(), static_cast<int>(bytes.size())),
+      "SAFETY_SPEED_LIMIT speed_limit_t utime=1700000000123456 seq=42 max_arm_speed=0.62 m/s "
+      "set_by=unknown object separation=0.90 m arm_speed=0.25 m/s valid_for=150 ms | unknown object 0.90 "
+      "m from the arm: S fits up to 0.62 m/s");
+  spy::StatusBoard board;
+  board.on_message("SAFETY_SPEED_LIMIT", bytes.data(), static_cast<int>(bytes.size()), 1'000'000,
+                   limit.utime);
+  const std::string fresh = board.render(1'100'000, limit.utime);
+  EXPECT_NE(
+      fresh.find("SPEED LIMIT: 0.62 m/s, set by unknown object at 0.90 m  (arm at 0.25 m/s, age 0.10 s)"),
+      std::string::npos)
+      << fresh;
+  const std::string later = board.render(1'200'000, limit.utime);
+  EXPECT_NE(later.find("EXPIRED: 0 m/s"), std::string::npos) << later;
 }
 
 }  // namespace

@@ -15,6 +15,9 @@ std::string risk_level_name(int8_t level);
 std::string risk_cause_name(int8_t cause);
 // "none", "software stop", "power cut", else "stop <n>".
 std::string stop_name(int8_t stop);
+// speed_limit_t.set_by as a word ("range", "unknown object", "body region",
+// "no judgement").
+std::string speed_limit_setter_name(int8_t set_by);
 
 // True for the causes that count as sensor/component faults (SENSOR_FAULT,
 // COMPONENT_FAULT; tofguard-risk debounces them with

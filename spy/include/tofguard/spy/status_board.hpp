@@ -1,6 +1,6 @@
 #pragma once
 // The spy's refreshing status board: the permission to move and why, the
-// latest risk with cause and suspect, each process's heartbeat age and
+// latest risk with cause and suspect, the arm's speed limit, each process's heartbeat age and
 // counters, each channel's rate, and the end-to-end latency from the camera
 // frame's capture utime. Pure: every call gets the clocks.
 //
@@ -16,6 +16,7 @@
 #include "tofguard/heartbeat_t.hpp"
 #include "tofguard/risk_t.hpp"
 #include "tofguard/safety_status_t.hpp"
+#include "tofguard/speed_limit_t.hpp"
 
 namespace tofguard::spy {
 
@@ -33,6 +34,8 @@ class StatusBoard {
   int64_t status_arrival_us_ = 0;
   std::optional<risk_t> risk_;
   int64_t risk_arrival_us_ = 0;
+  std::optional<speed_limit_t> limit_;
+  int64_t limit_arrival_us_ = 0;
   std::map<std::string, std::pair<heartbeat_t, int64_t>> heartbeats_;  // by process: message, arrival
   std::map<std::string, ChannelStats> channels_;
 };
