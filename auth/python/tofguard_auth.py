@@ -241,6 +241,49 @@ def decode_safety_status(payload):
     return status
 
 
+# speed_limit_t's fields, as in lcmtypes/speed_limit_t.lcm.
+SPEED_LIMIT_FINGERPRINT = _lcm_fingerprint(
+    _lcm_base_hash([
+        ("int64_t", "utime", []),
+        ("int64_t", "seq", []),
+        ("string", "camera_id", []),
+        ("double", "max_arm_speed_m_s", []),
+        ("int8_t", "set_by", []),
+        ("string", "body_region", []),
+        ("double", "separation_m", []),
+        ("double", "arm_speed_m_s", []),
+        ("int32_t", "valid_for_ms", []),
+        ("string", "reason", []),
+    ]))
+
+
+def decode_speed_limit(payload):
+    """speed_limit_t (lcmtypes/speed_limit_t.lcm) as a dict. A controller
+    keeps the arm's fastest surface point at or below max_arm_speed_m_s of the
+    newest verified limit, for valid_for_ms after its arrival on its own
+    clock, and at 0 without one (docs/security.md, "The speed limit")."""
+    r = _Reader(payload)
+    if r.unpack(">Q") != SPEED_LIMIT_FINGERPRINT:
+        raise Refused("payload is not a speed_limit_t (wrong fingerprint)")
+    limit = {
+        "utime": r.unpack(">q"),
+        "seq": r.unpack(">q"),
+        "camera_id": r.string(),
+        "max_arm_speed_m_s": r.unpack(">d"),
+        "set_by": r.unpack(">b"),
+        "body_region": r.string(),
+        "separation_m": r.unpack(">d"),
+        "arm_speed_m_s": r.unpack(">d"),
+        "valid_for_ms": r.unpack(">i"),
+        "reason": r.string(),
+    }
+    if r.at != len(payload):
+        raise Refused("payload is not one speed_limit_t (trailing bytes)")
+    if not (limit["max_arm_speed_m_s"] >= 0) or limit["valid_for_ms"] <= 0:
+        raise Refused("speed_limit_t: max_arm_speed_m_s must be >= 0 and valid_for_ms > 0")
+    return limit
+
+
 def main(argv):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     sub = parser.add_subparsers(dest="command", required=True)

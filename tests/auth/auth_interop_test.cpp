@@ -11,6 +11,7 @@
 #include "tofguard/auth/message_signer.hpp"
 #include "tofguard/auth/message_verifier.hpp"
 #include "tofguard/safety_status_t.hpp"
+#include "tofguard/speed_limit_t.hpp"
 #include "tool_support.hpp"
 
 namespace tofguard::auth {
@@ -91,6 +92,40 @@ TEST_F(AuthInteropTest, PythonSignsTheSameBytesAsCpp) {
   const auto status = verifier.open<safety_status_t>(from_python, "SAFETY_STATUS", kNow, &why);
   ASSERT_TRUE(status) << why;
   EXPECT_EQ(status->reason, status_.reason);
+}
+
+// The speed limit (speed_limit_t) as the Python module decodes it: its
+// fingerprint from the .lcm's fields, every field in order.
+TEST_F(AuthInteropTest, PythonDecodesTheSpeedLimitAsCppEncodesIt) {
+  speed_limit_t limit{};
+  limit.utime = kNow;
+  limit.seq = 42;
+  limit.camera_id = "tof-mast";
+  limit.max_arm_speed_m_s = 0.625;
+  limit.set_by = speed_limit_t::SET_BY_UNKNOWN_OBJECT;
+  limit.separation_m = 0.9;
+  limit.arm_speed_m_s = 0.25;
+  limit.valid_for_ms = 150;
+  limit.reason = "unknown object 0.90 m from the arm";
+  const std::string payload_file = output_dir() + "/interop-speed-limit.bin";
+  write_bytes(payload_file, encoded(limit));
+  std::string out;
+  ASSERT_EQ(
+      run_command("interop-speed-limit",
+                  {kPython, "-c",
+                   "import sys; sys.path.insert(0, '" + source_dir() +
+                       "/auth/python'); import tofguard_auth as t; "
+                       "l = t.decode_speed_limit(open(sys.argv[1], 'rb').read()); "
+                       "print(l['seq'], l['camera_id'], l['max_arm_speed_m_s'], l['set_by'], "
+                       "repr(l['body_region']), l['separation_m'], l['arm_speed_m_s'], l['valid_for_ms'], "
+                       "l['reason'])",
+                   payload_file},
+                  &out),
+      0)
+      << out;
+  EXPECT_NE(out.find("42 tof-mast 0.625 1 '' 0.9 0.25 150 unknown object 0.90 m from the arm"),
+            std::string::npos)
+      << out;
 }
 
 TEST_F(AuthInteropTest, BothSidesGiveTheSameVerdictsInTheSameWords) {
