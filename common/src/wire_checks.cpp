@@ -1,5 +1,8 @@
 #include "tofguard/common/wire_checks.hpp"
 
+#include "tofguard/common/body_region.hpp"
+
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <sstream>
@@ -273,6 +276,27 @@ std::string check_evidence(const discrepancy_t& d) {
   return "";
 }
 
+// num_body_regions .. body_region_separation_m (link_labels_t and
+// discrepancy_t alike): counts, a known body region each, once, and a
+// finite separation >= 0.
+std::string check_body_regions(int32_t n, const std::vector<std::string>& names,
+                               const std::vector<float>& separations_m) {
+  if (auto p = check_count(n, names, "body_region", "num_body_regions"); !p.empty()) return p;
+  if (auto p = check_count(n, separations_m, "body_region_separation_m", "num_body_regions"); !p.empty())
+    return p;
+  for (int k = 0; k < n; ++k) {
+    const std::string at = "[" + std::to_string(k) + "]";
+    if (!body_region_named(names[k]) || std::count(names.begin(), names.begin() + k, names[k]) > 0) {
+      return "body_region" + at + ": expected a body region named once (one of " + body_region_names() +
+             "), got '" + names[k] + "'";
+    }
+    if (!(std::isfinite(separations_m[k]) && separations_m[k] >= 0)) {
+      return expected("body_region_separation_m" + at, "a finite separation >= 0 (m)", separations_m[k]);
+    }
+  }
+  return "";
+}
+
 }  // namespace
 
 std::string check_arm_cover(const link_labels_t& l) {
@@ -378,7 +402,8 @@ std::string check_link_labels(const link_labels_t& labels) {
     return expected("num_pixels", "width*height = " + std::to_string(pixels), labels.num_pixels);
   }
   if (auto problem = check_kinematics(labels); !problem.empty()) return problem;
-  return check_arm_cover(labels);
+  if (auto problem = check_arm_cover(labels); !problem.empty()) return problem;
+  return check_body_regions(labels.num_body_regions, labels.body_region, labels.body_region_separation_m);
 }
 
 std::string check_risk(const risk_t& risk) {
@@ -519,6 +544,10 @@ std::string check_discrepancy(const discrepancy_t& d) {
     return "near_arm_area_m2 / largest_blob_area_m2: expected finite areas";
   }
   if (auto p = check_field(d); !p.empty()) return p;
+  if (auto p = check_body_regions(d.num_body_regions, d.body_region, d.body_region_separation_m);
+      !p.empty()) {
+    return p;
+  }
   return check_evidence(d);
 }
 

@@ -7,6 +7,7 @@ renderer::RendererProcessSettings renderer_process_settings(const Config& config
   s.lcm = config.lcm;
   s.channels = config.channels;
   s.robot = config.robot;
+  s.occupant = config.occupant;
   s.environment = config.environment;
   s.camera = config.camera;
   s.renderer = config.renderer;
@@ -26,6 +27,7 @@ risk::RiskProcessSettings risk_process_settings(const Config& config) {
   risk::RiskProcessSettings s;
   s.lcm = config.lcm;
   s.channels = config.channels;
+  s.occupant = config.occupant;
   s.robot_urdf_path = config.robot.urdf_path;
   s.camera_id = config.camera.id;
   s.camera_rate_hz = config.camera.rate_hz;

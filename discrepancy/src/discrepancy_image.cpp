@@ -542,6 +542,14 @@ void joint_reach(const std::vector<double>& reach, discrepancy_t* s) {
   if (reach.size() == static_cast<size_t>(s->num_joints)) s->joint_reach_m = reach;
 }
 
+// The labels' body regions and their separations from the arm, as they
+// came (checked with the labels, check_link_labels).
+void body_regions(const link_labels_t& labels, discrepancy_t* s) {
+  s->num_body_regions = labels.num_body_regions;
+  s->body_region = labels.body_region;
+  s->body_region_separation_m = labels.body_region_separation_m;
+}
+
 }  // namespace
 
 // Stage 2 (the header says why).
@@ -703,6 +711,7 @@ DiscrepancyFrame compare_frames(const depth_image_t& camera, const depth_image_t
                    options.evidence, &s, workers, &pixel_stages);
   pixel_stages.run_once();
   joint_reach(reach, &s);
+  body_regions(labels, &s);
   return frame;
 }
 

@@ -1,5 +1,7 @@
 #include "tofguard/renderer/rendered_kinematics.hpp"
 
+#include <cmath>
+
 #include <map>
 
 #include "tofguard/common/demand.hpp"
@@ -171,6 +173,16 @@ void set_rendered_arm_cover(const RenderedArmCover& cover, link_labels_t* labels
     labels->arm_sphere_link[k] = static_cast<int16_t>(sphere.link);
     for (int c = 0; c < 3; ++c) labels->arm_sphere_center_m[k][c] = static_cast<float>(sphere.center_m[c]);
     labels->arm_sphere_radius_m[k] = static_cast<float>(sphere.radius_m + kFloatMarginM);
+  }
+  labels->num_body_regions = static_cast<int32_t>(cover.body_region_separations_m.size());
+  labels->body_region.clear();
+  labels->body_region_separation_m.clear();
+  for (const auto& [region, separation_m] : cover.body_region_separations_m) {
+    labels->body_region.push_back(body_region_name(region));
+    // Rounded down to a float: never more than the separation computed.
+    float on_wire = static_cast<float>(separation_m);
+    if (on_wire > separation_m) on_wire = std::nextafter(on_wire, 0.0f);
+    labels->body_region_separation_m.push_back(on_wire);
   }
 }
 

@@ -32,6 +32,19 @@ std::unique_ptr<DepthRenderer> make_renderer(const robot_model::SceneModel& scen
   return std::make_unique<DepthRenderer>(scene, config.near_m, config.far_m);
 }
 
+std::optional<robot_model::OccupantModel> load_occupant(const std::optional<OccupantSettings>& occupant,
+                                                        const robot_model::SceneModel& scene) {
+  if (!occupant) return std::nullopt;
+  Eigen::Isometry3d world_from_seat;
+  try {
+    world_from_seat = robot_model::fixed_link_pose(scene, occupant->seated_on);
+  } catch (const robot_model::ModelError& e) {
+    throw robot_model::ModelError("occupant.seated_on '" + occupant->seated_on + "': " + e.what() +
+                                  " (expected a link of the environment)");
+  }
+  return robot_model::load_occupant(occupant->urdf_path, world_from_seat);
+}
+
 }  // namespace
 
 RendererService::RendererService(const RendererProcessSettings& settings)
@@ -39,6 +52,7 @@ RendererService::RendererService(const RendererProcessSettings& settings)
       scene_(robot_model::load_scene(settings.robot.urdf_path, settings.environment.urdf_paths,
                                      scene_options(settings.renderer, settings.robot))),
       arm_cover_(robot_model::cover_arm_with_spheres(scene_, settings.renderer.arm_cover_cell_m)),
+      occupant_(load_occupant(settings.occupant, scene_)),
       renderer_(make_renderer(scene_, settings.renderer)),
       state_(state_history_settings(settings.renderer, settings.robot.id, settings.camera)) {}
 
@@ -234,6 +248,10 @@ RenderedFrame RendererService::render(const depth_image_t& frame) {
     if (optical) {
       kinematics = rendered_kinematics(scene_, poses, *optical);
       arm_cover = rendered_arm_cover(arm_cover_, poses, *optical);
+      if (occupant_) {
+        arm_cover->body_region_separations_m = robot_model::body_region_separations_m(
+            robot_model::place_arm_spheres(arm_cover_, poses), *occupant_);
+      }
     }
   }
   RenderedFrame out = make_output(frame, std::move(result), kinematics, arm_cover);

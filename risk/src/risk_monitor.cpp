@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace tofguard::risk {
 namespace {
@@ -55,8 +56,34 @@ std::string RiskMonitor::check_joint_names(const std::vector<std::string>& names
 
 speed_limit_t RiskMonitor::speed_limit(const discrepancy_t& frame) const {
   return frame_speed_limit(settings_, response_time_s_, frame,
-                           arm_speed_bound_m_s(frame, joint_states_.at(frame.utime)));
+                           arm_speed_bound_m_s(frame, joint_states_.at(frame.utime)), body_region_rules_);
 }
+
+void RiskMonitor::set_occupant(const OccupantSettings& occupant) {
+  body_region_rules_ = body_region_rules(occupant, robot_model::moving_mass_kg(robot_));
+}
+
+namespace {
+
+// The arm faster than a body region's limit (a finite speed bound above
+// it): the finding, as the protective field's, UNKNOWN_OBJECT.
+std::optional<FrameFinding> faster_than_the_user_allows(const speed_limit_t& limit) {
+  if (limit.set_by != speed_limit_t::SET_BY_BODY_REGION || !(limit.arm_speed_m_s > limit.max_arm_speed_m_s)) {
+    return std::nullopt;
+  }
+  FrameFinding f;
+  f.cause = risk_t::CAUSE_UNKNOWN_OBJECT;
+  f.score = limit.arm_speed_m_s;
+  f.threshold = limit.max_arm_speed_m_s;
+  char text[200];
+  std::snprintf(text, sizeof text, "arm at %.2f m/s, %.0f cm from the user's %s, limit %.2f m/s (m/s)",
+                limit.arm_speed_m_s, limit.separation_m * 100, limit.body_region.c_str(),
+                limit.max_arm_speed_m_s);
+  f.detail = text;
+  return f;
+}
+
+}  // namespace
 
 ClassifiedFrame RiskMonitor::classify(const discrepancy_t& frame) const {
   const joint_state_t* at_capture = joint_states_.at(frame.utime);
@@ -72,6 +99,14 @@ ClassifiedFrame RiskMonitor::classify(const discrepancy_t& frame) const {
   c.frame = frame;
   c.finding = classify_frame(frame, robot_, settings_, context);
   c.model_mismatch = is_model_mismatch(c.finding.cause);
+  // The arm faster than the user's body regions allow: only when the
+  // camera shows nothing wrong (the protective field's own finding comes
+  // from the rules above).
+  if (c.finding.cause == risk_t::CAUSE_NONE && !body_region_rules_.empty()) {
+    if (std::optional<FrameFinding> faster = faster_than_the_user_allows(speed_limit(frame))) {
+      c.finding = std::move(*faster);
+    }
+  }
   // The arm left its plan: only when the camera shows nothing wrong (a
   // camera finding says more).
   if (c.finding.cause == risk_t::CAUSE_NONE && at_capture != nullptr) {

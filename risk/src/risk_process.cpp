@@ -27,6 +27,7 @@ int run_risk(const RiskProcessSettings& settings) {
   RiskMonitor monitor(settings.risk, settings.channels,
                       robot_model::load_kinematic_tree(settings.robot_urdf_path), settings.camera_rate_hz,
                       monotonic_us());
+  if (settings.occupant) monitor.set_occupant(*settings.occupant);
   const std::string camera_id = settings.camera_id;
   LcmNode node(settings.lcm, settings.channels, process_info().name);
   int64_t dangerous = 0;

@@ -1,5 +1,6 @@
 #include "tofguard/risk/speed_limit.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <optional>
@@ -28,10 +29,41 @@ std::string format(const char* pattern, double a, double b) {
   return text;
 }
 
+// The rules' limit at the frame's regions, when lower than `limit`'s.
+void limit_by_body_regions(const RiskSettings& risk, double response_time_s, const discrepancy_t& frame,
+                           const std::vector<BodyRegionRule>& rules, speed_limit_t* limit) {
+  double reach_m = 0;
+  for (const double r : frame.joint_reach_m) reach_m = std::max(reach_m, r);
+  const double uncertainty_m = std::sin(risk.evidence_joint_offset_rad) * reach_m;
+  const double stopping_time_s = risk.field_stopping_time_us * 1e-6;
+  for (const BodyRegionRule& rule : rules) {
+    const std::string name = body_region_name(rule.region);
+    const auto at = std::find(frame.body_region.begin(), frame.body_region.end(), name);
+    if (at == frame.body_region.end()) {
+      *limit = limit_base(risk, frame.utime, frame.seq, frame.camera_id);
+      limit->reason = "stand: the frame has no separation from the user's " + name +
+                      " (is the occupant configured where the arm is rendered?)";
+      return;
+    }
+    const double separation_m =
+        std::max(0.0, frame.body_region_separation_m[at - frame.body_region.begin()] - rule.envelope_m);
+    const double permitted =
+        permitted_arm_speed_m_s(rule, separation_m, uncertainty_m, response_time_s, stopping_time_s);
+    if (permitted < limit->max_arm_speed_m_s) {
+      limit->max_arm_speed_m_s = permitted;
+      limit->set_by = speed_limit_t::SET_BY_BODY_REGION;
+      limit->body_region = name;
+      limit->separation_m = separation_m;
+      limit->reason =
+          "the user's " + name + format(" %.2f m from the arm: up to %.2f m/s", separation_m, permitted);
+    }
+  }
+}
+
 }  // namespace
 
 speed_limit_t frame_speed_limit(const RiskSettings& risk, double response_time_s, const discrepancy_t& frame,
-                                double arm_speed_m_s) {
+                                double arm_speed_m_s, const std::vector<BodyRegionRule>& rules) {
   speed_limit_t limit = limit_base(risk, frame.utime, frame.seq, frame.camera_id);
   limit.arm_speed_m_s = std::isfinite(arm_speed_m_s) ? arm_speed_m_s : -1;
   if (!frame.usable) {
@@ -56,6 +88,7 @@ speed_limit_t frame_speed_limit(const RiskSettings& risk, double response_time_s
     limit.reason = format("nothing unexplained within the %.2f m monitored: S fits up to %.2f m/s", range_m,
                           limit.max_arm_speed_m_s);
   }
+  limit_by_body_regions(risk, response_time_s, frame, rules, &limit);
   return limit;
 }
 

@@ -125,4 +125,17 @@ double separation_from_arm_m(const PlacedArmSpheres& placed, const OccupantPart&
   return nearest;
 }
 
+std::vector<std::pair<BodyRegion, double>> body_region_separations_m(const PlacedArmSpheres& placed,
+                                                                     const OccupantModel& occupant) {
+  std::vector<std::pair<BodyRegion, double>> out;
+  for (const BodyRegion region : occupant.regions()) {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const OccupantPart& part : occupant.parts) {
+      if (part.region == region) nearest = std::min(nearest, separation_from_arm_m(placed, part));
+    }
+    out.emplace_back(region, nearest);
+  }
+  return out;
+}
+
 }  // namespace tofguard::robot_model

@@ -312,6 +312,29 @@ TEST(WireChecks, LinkLabelsArmCover) {
   EXPECT_EQ(field_of(bad), "arm_sphere_radius_m");
 }
 
+TEST(WireChecks, LinkLabelsBodyRegions) {
+  link_labels_t l = labels_with_kinematics();
+  l.num_body_regions = 2;
+  l.body_region = {"face", "hand"};
+  l.body_region_separation_m = {0.3f, 0.0f};
+  EXPECT_EQ(check_link_labels(l), "");
+  link_labels_t bad = l;
+  bad.body_region[1] = "hands";  // no such region
+  EXPECT_EQ(field_of(bad), "body_region[1]");
+  bad = l;
+  bad.body_region[1] = "face";  // twice
+  EXPECT_EQ(field_of(bad), "body_region[1]");
+  bad = l;
+  bad.body_region_separation_m[0] = -0.01f;
+  EXPECT_EQ(field_of(bad), "body_region_separation_m[0]");
+  bad = l;
+  bad.body_region_separation_m[0] = std::numeric_limits<float>::infinity();
+  EXPECT_EQ(field_of(bad), "body_region_separation_m[0]");
+  bad = l;
+  bad.body_region_separation_m.pop_back();
+  EXPECT_EQ(field_of(bad), "body_region_separation_m");
+}
+
 TEST(WireChecks, Heartbeat) {
   heartbeat_t hb{};
   EXPECT_EQ(check_heartbeat(hb), "process: expected a process name, got an empty string");

@@ -4,10 +4,12 @@
 
 #include <cmath>
 
+#include "occupant_test_config.hpp"
 #include "tofguard/common/wire_checks.hpp"
 #include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/renderer/prediction_schedule.hpp"
 #include "tofguard/renderer/renderer_service.hpp"
+#include "tofguard/robot_model/arm_spheres.hpp"
 #include "tool_support.hpp"
 
 namespace tofguard::renderer {
@@ -96,6 +98,46 @@ TEST(RendererService, PublishesTheModelAtTheInterpolatedJointsInMillimetres) {
   EXPECT_GT(robot_pixels, 1000);
   // And different from the arm at either bracketing message.
   EXPECT_NE(renderer.render(arm(1.0), config.camera.pose, k).depth_m, expected.depth_m);
+}
+
+// With an occupant the labels carry each body region's separation from the
+// arm's cover at the frame's joints: robot_model's, rounded down to a
+// float; without one, none.
+TEST(RendererService, TheLabelsCarryTheUsersBodyRegionsSeparations) {
+  RendererService without(deployment::renderer_process_settings(sim_config()));
+  ASSERT_TRUE(without.on_joint_state(joint_state(1'000'000, arm(1.0))));
+  ASSERT_TRUE(without.on_joint_state(joint_state(1'010'000, arm(1.0))));
+  const RenderedFrame plain = without.render(frame(1'002'500, 42, sim_config().camera.intrinsics));
+  ASSERT_TRUE(plain.labels.usable) << plain.labels.unusable_reason;
+  EXPECT_EQ(plain.labels.num_body_regions, 0);
+  const deployment::Config config = deployment::load_config(
+      tofguard::test::sim_config_variant("renderer-occupant", {}, tofguard::test::occupant_section()),
+      nullptr);
+  RendererService service(deployment::renderer_process_settings(config));
+  ASSERT_TRUE(service.on_joint_state(joint_state(1'000'000, arm(1.0))));
+  ASSERT_TRUE(service.on_joint_state(joint_state(1'010'000, arm(1.0))));
+  const RenderedFrame out = service.render(frame(1'002'500, 42, config.camera.intrinsics));
+  ASSERT_TRUE(out.labels.usable) << out.labels.unusable_reason;
+  EXPECT_EQ(check_link_labels(out.labels), "");
+  ASSERT_EQ(out.labels.num_body_regions, kNumBodyRegions);
+
+  const robot_model::SceneModel scene = robot_model::load_scene(
+      config.robot.urdf_path, config.environment.urdf_paths, scene_options(config.renderer, config.robot));
+  const robot_model::OccupantModel occupant = robot_model::load_occupant(
+      config.occupant->urdf_path, robot_model::fixed_link_pose(scene, config.occupant->seated_on));
+  const auto expected = robot_model::body_region_separations_m(
+      robot_model::place_arm_spheres(
+          robot_model::cover_arm_with_spheres(scene, config.renderer.arm_cover_cell_m),
+          robot_model::forward_kinematics(scene, arm(1.0))),
+      occupant);
+  ASSERT_EQ(expected.size(), static_cast<size_t>(kNumBodyRegions));
+  for (int k = 0; k < kNumBodyRegions; ++k) {
+    EXPECT_EQ(out.labels.body_region[k], body_region_name(expected[k].first));
+    EXPECT_LE(out.labels.body_region_separation_m[k], expected[k].second) << out.labels.body_region[k];
+    EXPECT_NEAR(out.labels.body_region_separation_m[k], expected[k].second, 1e-6)
+        << out.labels.body_region[k];
+    EXPECT_GT(out.labels.body_region_separation_m[k], 0) << out.labels.body_region[k];
+  }
 }
 
 TEST(RendererService, UnusableFramesPublishOnlyLabelsWithTheReason) {

@@ -7,6 +7,7 @@
 #include <limits>
 #include <sstream>
 
+#include "occupant_test_config.hpp"
 #include "synthetic_frames.hpp"
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/deployment/process_settings.hpp"
@@ -15,6 +16,7 @@
 #include "tofguard/risk/protective_field.hpp"
 #include "tofguard/risk/risk_monitor.hpp"
 #include "tofguard/robot_model/kinematic_tree.hpp"
+#include "tofguard/speed_limit_t.hpp"
 #include "tool_support.hpp"
 
 namespace tofguard::test {
@@ -529,6 +531,97 @@ risk_t judged_at_once(RiskMonitor* m, discrepancy_t frame, int64_t now) {
   const std::vector<risk_t> verdicts = m->on_frame(frame, now);
   EXPECT_EQ(verdicts.size(), 1u) << "frame " << frame.seq << " should be judged on arrival";
   return verdicts.empty() ? risk_t{} : verdicts.front();
+}
+
+// The user's body regions (docs/safety-chain.md, "The user"): a frame
+// whose arm is faster than the face's limit is an unknown-object finding
+// naming the face, stopped after the debounce; slower, the limit is the
+// face's and the frame is safe.
+TEST(RiskMonitor, TheArmFasterThanTheUsersFaceAllowsIsStoppedAfterTheDebounce) {
+  const deployment::Config with_user =
+      deployment::load_config(sim_config_variant("risk-logic-occupant", {}, occupant_section()), nullptr);
+  ASSERT_TRUE(with_user.occupant.has_value());
+  discrepancy_t d = summary_of(default_arm(), 40);
+  ASSERT_TRUE(d.usable);
+  ASSERT_TRUE(d.field_available);
+  // One joint, a1, reaching 0.35 m (the synthetic frame carries no
+  // kinematics of its own).
+  ASSERT_EQ(d.num_joints, 0);
+  d.num_joints = 1;
+  d.joint_name = {"a1"};
+  for (auto* per_joint :
+       {&d.joint_score, &d.joint_information, &d.joint_naming_score, &d.joint_naming_information,
+        &d.joint_static_bound, &d.joint_search_offset, &d.joint_search_gain}) {
+    per_joint->assign(1, 0.0);
+  }
+  d.joint_fit_pixels.assign(1, 0);
+  d.joint_reach_m.assign(1, 0.35);
+  d.num_body_regions = kNumBodyRegions;
+  d.body_region.clear();
+  d.body_region_separation_m.clear();
+  for (const BodyRegion region : all_body_regions()) {
+    d.body_region.push_back(body_region_name(region));
+    // The face 20 cm away (15 cm beyond its 5 cm envelope); the rest 1 m.
+    d.body_region_separation_m.push_back(region == BodyRegion::kFace ? 0.20f : 1.0f);
+  }
+  // a1 at `speed` rad/s: the arm's bound is 0.35 m * speed.
+  auto state_at = [&](double speed, int64_t utime) {
+    joint_state_t s{};
+    s.utime = utime;
+    s.num_joints = d.num_joints;
+    s.name = d.joint_name;
+    s.position.assign(d.num_joints, 0.0);
+    s.velocity.assign(d.num_joints, speed);
+    return s;
+  };
+  const double response_s = risk::chain_response_time_s(with_user.risk, kRateHz);
+  // (0.20 - 0.05 envelope - 0.03 clearance - sin 3 deg * 0.35 m) / (T_r + 0.15 s) = 0.296 m/s.
+  const double face_limit = (0.15 - 0.03 - std::sin(3 * M_PI / 180) * 0.35) / (response_s + 0.15);
+  EXPECT_NEAR(face_limit, 0.296, 0.001);
+
+  for (const double speed : {0.9 * face_limit, 1.1 * face_limit}) {
+    const double per_joint = speed / 0.35;
+    RiskMonitor m(with_user.risk, with_user.channels, friend_arm(), kRateHz, kStart);
+    m.set_occupant(*with_user.occupant);
+    std::vector<risk_t> verdicts;
+    for (int i = 0; i < 3; ++i) {
+      const int64_t now = kStart + i * 33 * kMs;
+      feed_all(&m, now);
+      discrepancy_t frame = d;
+      frame.seq = 40 + i;
+      frame.utime = d.utime + i * 33'000;
+      m.on_joint_state(state_at(per_joint, frame.utime), now);
+      const speed_limit_t limit = m.speed_limit(frame);
+      EXPECT_EQ(limit.set_by, speed_limit_t::SET_BY_BODY_REGION) << limit.reason;
+      EXPECT_EQ(limit.body_region, "face");
+      EXPECT_NEAR(limit.max_arm_speed_m_s, face_limit, 1e-3) << limit.reason;
+      EXPECT_NEAR(limit.separation_m, 0.15, 1e-6);
+      verdicts.push_back(judged_at_once(&m, frame, now));
+    }
+    if (speed < face_limit) {
+      for (const risk_t& r : verdicts) EXPECT_EQ(r.level, risk_t::SAFE) << r.detail;
+    } else {
+      EXPECT_EQ(verdicts[0].level, risk_t::WARNING) << verdicts[0].detail;
+      EXPECT_EQ(verdicts[2].level, risk_t::DANGEROUS) << verdicts[2].detail;
+      EXPECT_EQ(verdicts[2].cause, risk_t::CAUSE_UNKNOWN_OBJECT);
+      EXPECT_NE(verdicts[2].detail.find("arm at 0.33 m/s, 15 cm from the user's face, limit 0.30 m/s"),
+                std::string::npos)
+          << verdicts[2].detail;
+    }
+  }
+}
+
+// Rules for a region the frame does not carry (a renderer without the
+// occupant): nothing to size the limit on, 0 m/s.
+TEST(RiskMonitor, AFrameWithoutTheUsersRegionsLimitsTheArmToStand) {
+  const deployment::Config with_user = deployment::load_config(
+      sim_config_variant("risk-logic-occupant-missing", {}, occupant_section()), nullptr);
+  RiskMonitor m(with_user.risk, with_user.channels, friend_arm(), kRateHz, kStart);
+  m.set_occupant(*with_user.occupant);
+  const speed_limit_t limit = m.speed_limit(summary_of(default_arm(), 40));
+  EXPECT_EQ(limit.set_by, speed_limit_t::SET_BY_NO_JUDGEMENT);
+  EXPECT_DOUBLE_EQ(limit.max_arm_speed_m_s, 0);
+  EXPECT_NE(limit.reason.find("no separation from the user's"), std::string::npos) << limit.reason;
 }
 
 TEST(RiskMonitor, NothingArrivedIsStaleAfterTheFirstDeadline) {

@@ -95,13 +95,18 @@ struct RenderedArmCover {
   };
   std::vector<Sphere> spheres;
   double max_radius_m = 0;
+  // The occupant's body regions and their separations from the cover
+  // (robot_model::body_region_separations_m, metres); empty without an
+  // occupant.
+  std::vector<std::pair<BodyRegion, double>> body_region_separations_m;
 };
 RenderedArmCover rendered_arm_cover(const robot_model::ArmSpheres& cover,
                                     const robot_model::LinkPoses& link_poses,
                                     const Eigen::Isometry3d& world_from_optical);
 
 // Writes the cover into link_labels_t's arm_cover_max_radius_m ..
-// arm_sphere_radius_m (replacing what was there).
+// arm_sphere_radius_m and the body regions' separations into
+// num_body_regions .. body_region_separation_m (replacing what was there).
 void set_rendered_arm_cover(const RenderedArmCover& cover, link_labels_t* labels);
 
 // The complete TOF_LABELS message of `frame` for a render (labels,

@@ -153,6 +153,8 @@ class RendererService {
   // The robot's cover of spheres (renderer.arm_cover_cell_m), placed with
   // every frame's labels.
   robot_model::ArmSpheres arm_cover_;
+  // The occupant (settings.occupant), seated where the config says.
+  std::optional<robot_model::OccupantModel> occupant_;
   std::unique_ptr<DepthRenderer> renderer_;
   robot_state::StateHistory state_;
   std::optional<depth_image_t> pending_;

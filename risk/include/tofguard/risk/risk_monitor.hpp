@@ -94,6 +94,12 @@ class RiskMonitor {
   // The speed limit for the arm's controller at `frame` (speed_limit.hpp),
   // with the arm's speed bound from the joint state at its capture.
   speed_limit_t speed_limit(const discrepancy_t& frame) const;
+  // The wheelchair's occupant: its body regions' rules (body_region_rules
+  // .hpp, with the arm's moving mass from its URDF) set the speed limit
+  // too, and a frame whose arm is faster than a region's limit is an
+  // UNKNOWN_OBJECT finding naming the region (debounced as the others).
+  // Throws robot_model::ModelError for an arm without masses.
+  void set_occupant(const OccupantSettings& occupant);
   const std::string& last_refusal() const { return last_refusal_; }
   // A valid estimate (check_motion_estimate, this camera, the robot's
   // joints): the verdicts it releases.
@@ -134,6 +140,8 @@ class RiskMonitor {
   DecisionRule decision_;
   // T_r of the protective fields, s (chain_response_time_s).
   double response_time_s_ = 0;
+  // The occupant's rules (set_occupant); empty without one.
+  std::vector<BodyRegionRule> body_region_rules_;
   int64_t last_frame_utime_ = 0;
   // The newest frame taken in order (seq, utime) and the seqs judged lately.
   bool any_frame_ = false;

@@ -18,6 +18,7 @@
 //
 // Frames and units as in kinematic_tree.hpp: centres in their link's frame,
 // metres; distances in metres.
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -73,5 +74,10 @@ double distance_to_arm_m(const PlacedArmSpheres& placed, const Eigen::Vector3d& 
 // where they overlap. Like distance_to_arm_m it is never more than the true
 // separation from the arm's surface. +infinity when the cover is empty.
 double separation_from_arm_m(const PlacedArmSpheres& placed, const OccupantPart& part);
+
+// The smallest separation_from_arm_m over each region's parts, for every
+// region the occupant has (OccupantModel::regions order, head to feet).
+std::vector<std::pair<BodyRegion, double>> body_region_separations_m(const PlacedArmSpheres& placed,
+                                                                     const OccupantModel& occupant);
 
 }  // namespace tofguard::robot_model

@@ -3,12 +3,14 @@
 // and what the process needs besides them. Durations are integer
 // microseconds, converted once when the file is read (YamlMap::milliseconds_as_us).
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "tofguard/common/camera_settings.hpp"
 #include "tofguard/common/lcm_settings.hpp"
 #include "tofguard/common/robot_settings.hpp"
 #include "tofguard/common/yaml_reader.hpp"
+#include "tofguard/settings/occupant_settings.hpp"
 
 namespace tofguard::settings {
 
@@ -75,6 +77,9 @@ struct RendererProcessSettings {
   ChannelNames channels;
   RobotSettings robot;
   EnvironmentSettings environment;
+  // The wheelchair's occupant (absent: none): the renderer places it and
+  // sends each body region's separation from the arm with the labels.
+  std::optional<OccupantSettings> occupant;
   CameraSettings camera;
   RendererSettings renderer;
 };

@@ -4,12 +4,14 @@
 // converted once when the file is read (YamlMap::milliseconds_as_us), so
 // that every deadline check compares integers on the monotonic clock.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "tofguard/auth/auth_settings.hpp"
 #include "tofguard/common/lcm_settings.hpp"
 #include "tofguard/common/yaml_reader.hpp"
+#include "tofguard/settings/occupant_settings.hpp"
 
 namespace tofguard::settings {
 
@@ -167,6 +169,10 @@ struct RiskProcessSettings {
   // (the only risk stream a keyed tofguard-intervene trusts).
   auth::AuthSettings auth;
   RiskSettings risk;
+  // The wheelchair's occupant (absent: none): its body regions' rules set
+  // the speed limit beside the protective field's (docs/safety-chain.md,
+  // "The user").
+  std::optional<OccupantSettings> occupant;
 };
 
 // The intrusion distance C that ISO 13855 requires for a detection
