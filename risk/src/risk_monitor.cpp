@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 namespace tofguard::risk {
 namespace {
@@ -65,20 +66,30 @@ void RiskMonitor::set_occupant(const OccupantSettings& occupant) {
 
 namespace {
 
-// The arm faster than a body region's limit (a finite speed bound above
-// it): the finding, as the protective field's, UNKNOWN_OBJECT.
+// The arm faster than a body region's limit, or of a speed that cannot be
+// bounded (arm_speed_m_s -1: no joint state at the capture, a joint
+// without its speed) where a region sets the limit: the finding, as the
+// protective field's, UNKNOWN_OBJECT.
 std::optional<FrameFinding> faster_than_the_user_allows(const speed_limit_t& limit) {
-  if (limit.set_by != speed_limit_t::SET_BY_BODY_REGION || !(limit.arm_speed_m_s > limit.max_arm_speed_m_s)) {
+  const bool unbounded = limit.arm_speed_m_s < 0;
+  if (limit.set_by != speed_limit_t::SET_BY_BODY_REGION ||
+      !(unbounded || limit.arm_speed_m_s > limit.max_arm_speed_m_s)) {
     return std::nullopt;
   }
   FrameFinding f;
   f.cause = risk_t::CAUSE_UNKNOWN_OBJECT;
-  f.score = limit.arm_speed_m_s;
+  f.score = unbounded ? std::numeric_limits<double>::infinity() : limit.arm_speed_m_s;
   f.threshold = limit.max_arm_speed_m_s;
   char text[200];
-  std::snprintf(text, sizeof text, "arm at %.2f m/s, %.0f cm from the user's %s, limit %.2f m/s (m/s)",
-                limit.arm_speed_m_s, limit.separation_m * 100, limit.body_region.c_str(),
-                limit.max_arm_speed_m_s);
+  if (unbounded) {
+    std::snprintf(text, sizeof text,
+                  "arm speed not bounded, %.0f cm from the user's %s, limit %.2f m/s (m/s)",
+                  limit.separation_m * 100, limit.body_region.c_str(), limit.max_arm_speed_m_s);
+  } else {
+    std::snprintf(text, sizeof text, "arm at %.2f m/s, %.0f cm from the user's %s, limit %.2f m/s (m/s)",
+                  limit.arm_speed_m_s, limit.separation_m * 100, limit.body_region.c_str(),
+                  limit.max_arm_speed_m_s);
+  }
   f.detail = text;
   return f;
 }

@@ -579,7 +579,9 @@ TEST(RiskMonitor, TheArmFasterThanTheUsersFaceAllowsIsStoppedAfterTheDebounce) {
   const double face_limit = (0.15 - 0.03 - std::sin(3 * M_PI / 180) * 0.35) / (response_s + 0.15);
   EXPECT_NEAR(face_limit, 0.296, 0.001);
 
-  for (const double speed : {0.9 * face_limit, 1.1 * face_limit}) {
+  // Below the limit, above it, and of no known speed (a1's speed not a
+  // number: the arm's speed cannot be bounded).
+  for (const double speed : {0.9 * face_limit, 1.1 * face_limit, std::nan("")}) {
     const double per_joint = speed / 0.35;
     RiskMonitor m(with_user.risk, with_user.channels, friend_arm(), kRateHz, kStart);
     m.set_occupant(*with_user.occupant);
@@ -598,7 +600,13 @@ TEST(RiskMonitor, TheArmFasterThanTheUsersFaceAllowsIsStoppedAfterTheDebounce) {
       EXPECT_NEAR(limit.separation_m, 0.15, 1e-6);
       verdicts.push_back(judged_at_once(&m, frame, now));
     }
-    if (speed < face_limit) {
+    if (std::isnan(speed)) {
+      EXPECT_EQ(verdicts[2].level, risk_t::DANGEROUS) << verdicts[2].detail;
+      EXPECT_EQ(verdicts[2].cause, risk_t::CAUSE_UNKNOWN_OBJECT);
+      EXPECT_NE(verdicts[2].detail.find("arm speed not bounded, 15 cm from the user's face, limit 0.30 m/s"),
+                std::string::npos)
+          << verdicts[2].detail;
+    } else if (speed < face_limit) {
       for (const risk_t& r : verdicts) EXPECT_EQ(r.level, risk_t::SAFE) << r.detail;
     } else {
       EXPECT_EQ(verdicts[0].level, risk_t::WARNING) << verdicts[0].detail;
