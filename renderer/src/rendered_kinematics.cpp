@@ -141,7 +141,8 @@ void set_rendered_kinematics(const RenderedKinematics& k, link_labels_t* labels)
 
 RenderedArmCover rendered_arm_cover(const robot_model::ArmSpheres& cover,
                                     const robot_model::LinkPoses& link_poses,
-                                    const Eigen::Isometry3d& world_from_optical) {
+                                    const Eigen::Isometry3d& world_from_optical,
+                                    const robot_model::OccupantModel* occupant) {
   const robot_model::PlacedArmSpheres placed = robot_model::place_arm_spheres(cover, link_poses);
   const Eigen::Isometry3d optical_from_world = world_from_optical.inverse();
   RenderedArmCover out;
@@ -152,6 +153,8 @@ RenderedArmCover rendered_arm_cover(const robot_model::ArmSpheres& cover,
     out.spheres[k].center_m = optical_from_world * placed[k].center_world_m;
     out.spheres[k].radius_m = placed[k].radius_m;
   }
+  if (occupant != nullptr)
+    out.body_region_separations_m = robot_model::body_region_separations_m(placed, *occupant);
   return out;
 }
 

@@ -247,11 +247,7 @@ RenderedFrame RendererService::render(const depth_image_t& frame) {
     }
     if (optical) {
       kinematics = rendered_kinematics(scene_, poses, *optical);
-      arm_cover = rendered_arm_cover(arm_cover_, poses, *optical);
-      if (occupant_) {
-        arm_cover->body_region_separations_m = robot_model::body_region_separations_m(
-            robot_model::place_arm_spheres(arm_cover_, poses), *occupant_);
-      }
+      arm_cover = rendered_arm_cover(arm_cover_, poses, *optical, occupant_ ? &*occupant_ : nullptr);
     }
   }
   RenderedFrame out = make_output(frame, std::move(result), kinematics, arm_cover);

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 
 namespace tofguard::risk {
@@ -80,17 +79,10 @@ std::optional<FrameFinding> faster_than_the_user_allows(const speed_limit_t& lim
   f.cause = risk_t::CAUSE_UNKNOWN_OBJECT;
   f.score = unbounded ? std::numeric_limits<double>::infinity() : limit.arm_speed_m_s;
   f.threshold = limit.max_arm_speed_m_s;
-  char text[200];
-  if (unbounded) {
-    std::snprintf(text, sizeof text,
-                  "arm speed not bounded, %.0f cm from the user's %s, limit %.2f m/s (m/s)",
-                  limit.separation_m * 100, limit.body_region.c_str(), limit.max_arm_speed_m_s);
-  } else {
-    std::snprintf(text, sizeof text, "arm at %.2f m/s, %.0f cm from the user's %s, limit %.2f m/s (m/s)",
-                  limit.arm_speed_m_s, limit.separation_m * 100, limit.body_region.c_str(),
-                  limit.max_arm_speed_m_s);
-  }
-  f.detail = text;
+  const std::string where = fixed(limit.separation_m * 100, 0) + " cm from the user's " + limit.body_region +
+                            ", limit " + fixed(limit.max_arm_speed_m_s, 2) + " m/s (m/s)";
+  f.detail = unbounded ? "arm speed not bounded, " + where
+                       : "arm at " + fixed(limit.arm_speed_m_s, 2) + " m/s, " + where;
   return f;
 }
 

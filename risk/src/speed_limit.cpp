@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <optional>
 
+#include "tofguard/risk/frame_classifier.hpp"
 #include "tofguard/risk/protective_field.hpp"
 
 namespace tofguard::risk {
@@ -21,12 +21,6 @@ speed_limit_t limit_base(const RiskSettings& risk, int64_t utime, int64_t seq, c
   limit.arm_speed_m_s = -1;
   limit.valid_for_ms = static_cast<int32_t>(risk.discrepancy_deadline_us / 1000);
   return limit;
-}
-
-std::string format(const char* pattern, double a, double b) {
-  char text[160];
-  std::snprintf(text, sizeof text, pattern, a, b);
-  return text;
 }
 
 // The rules' limit at the frame's regions, when lower than `limit`'s.
@@ -54,8 +48,8 @@ void limit_by_body_regions(const RiskSettings& risk, double response_time_s, con
       limit->set_by = speed_limit_t::SET_BY_BODY_REGION;
       limit->body_region = name;
       limit->separation_m = separation_m;
-      limit->reason =
-          "the user's " + name + format(" %.2f m from the arm: up to %.2f m/s", separation_m, permitted);
+      limit->reason = "the user's " + name + " " + fixed(separation_m, 2) + " m from the arm: up to " +
+                      fixed(permitted, 2) + " m/s";
     }
   }
 }
@@ -79,14 +73,14 @@ speed_limit_t frame_speed_limit(const RiskSettings& risk, double response_time_s
     limit.set_by = speed_limit_t::SET_BY_UNKNOWN_OBJECT;
     limit.separation_m = *object_m;
     limit.max_arm_speed_m_s = highest_arm_speed_for_separation_m_s(risk, response_time_s, *object_m);
-    limit.reason = format("unknown object %.2f m from the arm: S fits up to %.2f m/s", *object_m,
-                          limit.max_arm_speed_m_s);
+    limit.reason = "unknown object " + fixed(*object_m, 2) + " m from the arm: S fits up to " +
+                   fixed(limit.max_arm_speed_m_s, 2) + " m/s";
   } else {
     const double range_m = field_range_m(frame);
     limit.set_by = speed_limit_t::SET_BY_RANGE;
     limit.max_arm_speed_m_s = highest_arm_speed_for_separation_m_s(risk, response_time_s, range_m);
-    limit.reason = format("nothing unexplained within the %.2f m monitored: S fits up to %.2f m/s", range_m,
-                          limit.max_arm_speed_m_s);
+    limit.reason = "nothing unexplained within the " + fixed(range_m, 2) + " m monitored: S fits up to " +
+                   fixed(limit.max_arm_speed_m_s, 2) + " m/s";
   }
   limit_by_body_regions(risk, response_time_s, frame, rules, &limit);
   return limit;

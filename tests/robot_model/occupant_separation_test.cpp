@@ -66,13 +66,7 @@ TEST(OccupantSeparation, TheDefaultArmsNominalMotionNeverNeedsToStandForTheHeadO
       arm_speed_m_s =
           std::max(arm_speed_m_s, (placed[s].center_world_m - before[s].center_world_m).norm() / kDtS);
     }
-    std::map<BodyRegion, double> separation_m;
-    for (const OccupantPart& part : occupant.parts) {
-      const double d = separation_from_arm_m(placed, part);
-      separation_m[part.region] =
-          separation_m.count(part.region) ? std::min(separation_m[part.region], d) : d;
-    }
-    for (const auto& [region, d] : separation_m) {
+    for (const auto& [region, d] : body_region_separations_m(placed, occupant)) {
       const risk::BodyRegionRule& rule = rules.at(region);
       const double permitted =
           risk::permitted_arm_speed_m_s(rule, std::max(0.0, d - rule.envelope_m), z_m, t_r, t_s);

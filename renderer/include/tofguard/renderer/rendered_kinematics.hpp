@@ -100,9 +100,12 @@ struct RenderedArmCover {
   // occupant.
   std::vector<std::pair<BodyRegion, double>> body_region_separations_m;
 };
+// With `occupant`, also each of its body regions' separation from the
+// placed cover (body_region_separations_m), from the same placement.
 RenderedArmCover rendered_arm_cover(const robot_model::ArmSpheres& cover,
                                     const robot_model::LinkPoses& link_poses,
-                                    const Eigen::Isometry3d& world_from_optical);
+                                    const Eigen::Isometry3d& world_from_optical,
+                                    const robot_model::OccupantModel* occupant = nullptr);
 
 // Writes the cover into link_labels_t's arm_cover_max_radius_m ..
 // arm_sphere_radius_m and the body regions' separations into
