@@ -1075,7 +1075,9 @@ std::string write_bench_config(const CampaignArm& arm, const Intrinsics& intrins
       {"estimate:\n    enabled: true", "estimate:\n    enabled: false"},
       {"from_joint_states: true", joint_prediction ? "from_joint_states: true" : "from_joint_states: false"}};
   replacements.insert(replacements.end(), bench.begin(), bench.end());
-  return sim_config_variant(name, replacements);
+  // The bench's frames (SimulatedFrames) show no wheelchair user: the
+  // chain models none.
+  return sim_config_variant(name, replacements, "occupant: ~\n");
 }
 
 BenchReport run_bench(const BenchOptions& options, std::ostream& log) {

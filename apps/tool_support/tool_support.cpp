@@ -110,6 +110,17 @@ int run_command(const std::string& name, const std::vector<std::string>& argv, s
   return code;
 }
 
+void erase_config_section(std::string* text, const std::string& key) {
+  const auto start = text->find("\n" + key + ":");
+  if (start == std::string::npos) return;
+  size_t end = start + 1;
+  while ((end = text->find('\n', end)) != std::string::npos && end + 1 < text->size() &&
+         ((*text)[end + 1] == ' ' || (*text)[end + 1] == '\n' || (*text)[end + 1] == '#')) {
+    ++end;
+  }
+  text->erase(start, end == std::string::npos ? std::string::npos : end - start);
+}
+
 std::string sim_config_variant(const std::string& name,
                                const std::vector<std::pair<std::string, std::string>>& replacements,
                                const std::string& appended) {
@@ -136,21 +147,17 @@ std::string sim_config_variant(const std::string& name,
   if (const auto at = text.find(key_line); at != std::string::npos) {
     text.replace(at, key_line.size(), "key_file: " + source_dir() + "/config/auth.key");
   }
-  // A top-level section in `appended` replaces sim.yaml's own.
+  // A top-level section in `appended` replaces sim.yaml's own; "key: ~"
+  // removes it.
   std::stringstream added(appended);
+  std::string kept;
   for (std::string line; std::getline(added, line);) {
+    const bool removes = line.size() > 3 && line[0] != ' ' && line.compare(line.size() - 3, 3, ": ~") == 0;
+    if (!removes) kept += line + "\n";
     if (line.empty() || line[0] == ' ' || line[0] == '#' || line.find(':') == std::string::npos) continue;
-    const std::string key = "\n" + line.substr(0, line.find(':') + 1);
-    const auto start = text.find(key);
-    if (start == std::string::npos) continue;
-    size_t end = start + 1;
-    while ((end = text.find('\n', end)) != std::string::npos && end + 1 < text.size() &&
-           (text[end + 1] == ' ' || text[end + 1] == '\n' || text[end + 1] == '#')) {
-      ++end;
-    }
-    text.erase(start, end == std::string::npos ? std::string::npos : end - start);
+    erase_config_section(&text, line.substr(0, line.find(':')));
   }
-  text += appended;
+  text += appended.empty() ? appended : kept;
   const std::string path = output_dir() + "/" + name + ".yaml";
   write_file(path, text);
   return path;

@@ -60,7 +60,14 @@ int run_command(const std::string& name, const std::vector<std::string>& argv,
 // config/sim.yaml copied to output_dir()/<name>.yaml with `replacements`
 // (each `from` must occur) applied and `appended` added at the end; the
 // model, key and camera profile paths are made absolute so the copy works
-// from anywhere. Returns the copy's path.
+// from anywhere. A top-level section in `appended` replaces sim.yaml's
+// own; a line "<key>: ~" there removes sim.yaml's section `key` (an
+// optional section absent, e.g. "occupant: ~"). Returns the copy's path.
+// Erases the top-level section `key` of a config's `text` (its line, its
+// indented lines and the blank and comment lines after them); nothing when
+// there is none.
+void erase_config_section(std::string* text, const std::string& key);
+
 std::string sim_config_variant(const std::string& name,
                                const std::vector<std::pair<std::string, std::string>>& replacements = {},
                                const std::string& appended = "");

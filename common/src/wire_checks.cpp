@@ -10,6 +10,8 @@
 #include <utility>
 #include <vector>
 
+#include <Eigen/Core>
+
 namespace tofguard {
 namespace {
 
@@ -297,6 +299,107 @@ std::string check_body_regions(int32_t n, const std::vector<std::string>& names,
   return "";
 }
 
+// A vector of `n` entries of `width` finite floats each.
+std::string check_rows(const std::vector<std::vector<float>>& rows, int32_t n, size_t width,
+                       const std::string& field, const std::string& count) {
+  if (auto p = check_count(n, rows, field, count); !p.empty()) return p;
+  for (int32_t k = 0; k < n; ++k) {
+    if (rows[k].size() != width) {
+      return field + "[" + std::to_string(k) + "]: expected " + std::to_string(width) + " entries, got " +
+             std::to_string(rows[k].size());
+    }
+    for (float x : rows[k]) {
+      if (!std::isfinite(x)) return expected(field + "[" + std::to_string(k) + "]", "finite numbers", x);
+    }
+  }
+  return "";
+}
+
+// link_labels_t's body_region_envelope_m and occupant_shape_*: an
+// envelope >= 0 per region; per shape a known kind, a region index, a
+// finite centre, sizes >= 0 and a rotation (orthonormal, det +1, to 1e-3).
+std::string check_occupant_shapes(const link_labels_t& labels) {
+  const int32_t regions = labels.num_body_regions;
+  if (auto p =
+          check_count(regions, labels.body_region_envelope_m, "body_region_envelope_m", "num_body_regions");
+      !p.empty())
+    return p;
+  for (int32_t k = 0; k < regions; ++k) {
+    const float e = labels.body_region_envelope_m[k];
+    if (!(std::isfinite(e) && e >= 0)) {
+      return expected("body_region_envelope_m[" + std::to_string(k) + "]", "a finite envelope >= 0 (m)", e);
+    }
+  }
+  const int32_t n = labels.num_occupant_shapes;
+  const std::string count = "num_occupant_shapes";
+  if (auto p = check_count(n, labels.occupant_shape_kind, "occupant_shape_kind", count); !p.empty()) return p;
+  if (auto p = check_count(n, labels.occupant_shape_region, "occupant_shape_region", count); !p.empty())
+    return p;
+  if (auto p = check_rows(labels.occupant_shape_center_m, n, 3, "occupant_shape_center_m", count); !p.empty())
+    return p;
+  if (auto p = check_rows(labels.occupant_shape_rotation, n, 9, "occupant_shape_rotation", count); !p.empty())
+    return p;
+  if (auto p = check_rows(labels.occupant_shape_size_m, n, 3, "occupant_shape_size_m", count); !p.empty())
+    return p;
+  for (int32_t k = 0; k < n; ++k) {
+    const std::string at = "[" + std::to_string(k) + "]";
+    const int kind = labels.occupant_shape_kind[k];
+    if (kind < link_labels_t::SHAPE_BOX || kind > link_labels_t::SHAPE_CYLINDER) {
+      return expected("occupant_shape_kind" + at, "SHAPE_BOX, SHAPE_SPHERE or SHAPE_CYLINDER", kind);
+    }
+    const int region = labels.occupant_shape_region[k];
+    if (region < 0 || region >= regions) {
+      return expected("occupant_shape_region" + at, "a body_region index 0.." + std::to_string(regions - 1),
+                      region);
+    }
+    for (float x : labels.occupant_shape_size_m[k]) {
+      if (x < 0) return expected("occupant_shape_size_m" + at, "sizes >= 0 (m)", x);
+    }
+    Eigen::Matrix3d r;
+    for (int i = 0; i < 9; ++i) r(i / 3, i % 3) = labels.occupant_shape_rotation[k][i];
+    const double off = (r * r.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+    if (!(off <= 1e-3 && r.determinant() > 0)) {
+      return expected("occupant_shape_rotation" + at, "a rotation (R R^T = I to 1e-3, det +1): largest error",
+                      off);
+    }
+  }
+  return "";
+}
+
+// discrepancy_t's per-region sightings: counts per region, 0 <= missing <=
+// modelled, seen >= 0, and a seen separation that is -1 or finite >= 0.
+std::string check_region_sightings(const discrepancy_t& d) {
+  const int32_t n = d.num_body_regions;
+  const std::string count = "num_body_regions";
+  if (auto p = check_count(n, d.body_region_modelled_pixels, "body_region_modelled_pixels", count);
+      !p.empty())
+    return p;
+  if (auto p = check_count(n, d.body_region_missing_pixels, "body_region_missing_pixels", count); !p.empty())
+    return p;
+  if (auto p = check_count(n, d.body_region_seen_pixels, "body_region_seen_pixels", count); !p.empty())
+    return p;
+  if (auto p = check_count(n, d.body_region_seen_separation_m, "body_region_seen_separation_m", count);
+      !p.empty())
+    return p;
+  for (int32_t k = 0; k < n; ++k) {
+    const std::string at = "[" + std::to_string(k) + "]";
+    if (!(d.body_region_missing_pixels[k] >= 0 &&
+          d.body_region_missing_pixels[k] <= d.body_region_modelled_pixels[k])) {
+      return expected("body_region_missing_pixels" + at, "0..body_region_modelled_pixels",
+                      d.body_region_missing_pixels[k]);
+    }
+    if (d.body_region_seen_pixels[k] < 0) {
+      return expected("body_region_seen_pixels" + at, "a count >= 0", d.body_region_seen_pixels[k]);
+    }
+    const float sep = d.body_region_seen_separation_m[k];
+    if (!(sep == -1.0f || (std::isfinite(sep) && sep >= 0))) {
+      return expected("body_region_seen_separation_m" + at, "-1 (none seen) or a finite separation >= 0 (m)",
+                      sep);
+    }
+  }
+  return "";
+}
+
 }  // namespace
 
 std::string check_arm_cover(const link_labels_t& l) {
@@ -403,7 +506,11 @@ std::string check_link_labels(const link_labels_t& labels) {
   }
   if (auto problem = check_kinematics(labels); !problem.empty()) return problem;
   if (auto problem = check_arm_cover(labels); !problem.empty()) return problem;
-  return check_body_regions(labels.num_body_regions, labels.body_region, labels.body_region_separation_m);
+  if (auto problem =
+          check_body_regions(labels.num_body_regions, labels.body_region, labels.body_region_separation_m);
+      !problem.empty())
+    return problem;
+  return check_occupant_shapes(labels);
 }
 
 std::string check_risk(const risk_t& risk) {
@@ -415,6 +522,20 @@ std::string check_risk(const risk_t& risk) {
   }
   if (!std::isfinite(risk.score)) return expected("score", "a finite number", risk.score);
   if (!std::isfinite(risk.threshold)) return expected("threshold", "a finite number", risk.threshold);
+  return "";
+}
+
+std::string check_speed_limit(const speed_limit_t& limit) {
+  if (!(std::isfinite(limit.max_arm_speed_m_s) && limit.max_arm_speed_m_s >= 0)) {
+    return expected("max_arm_speed_m_s", "a finite speed >= 0 (m/s)", limit.max_arm_speed_m_s);
+  }
+  if (limit.set_by < speed_limit_t::SET_BY_RANGE || limit.set_by > speed_limit_t::SET_BY_NO_JUDGEMENT) {
+    return expected("set_by", "one of speed_limit_t's SET_BY_ constants (0..3)", limit.set_by);
+  }
+  if (!(limit.arm_speed_m_s == -1 || (std::isfinite(limit.arm_speed_m_s) && limit.arm_speed_m_s >= 0))) {
+    return expected("arm_speed_m_s", "a finite speed >= 0 (m/s) or -1 (not bounded)", limit.arm_speed_m_s);
+  }
+  if (limit.valid_for_ms <= 0) return expected("valid_for_ms", "a validity > 0 (ms)", limit.valid_for_ms);
   return "";
 }
 
@@ -548,6 +669,7 @@ std::string check_discrepancy(const discrepancy_t& d) {
       !p.empty()) {
     return p;
   }
+  if (auto p = check_region_sightings(d); !p.empty()) return p;
   return check_evidence(d);
 }
 

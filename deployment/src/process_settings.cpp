@@ -48,6 +48,7 @@ estimator::EstimatorProcessSettings estimator_process_settings(const Config& con
   s.noise_sigma_per_m2_mm = config.discrepancy.noise_sigma_per_m2_mm;
   s.camera_profile = config.discrepancy.camera_profile;
   s.estimator = config.estimator;
+  s.occupant = config.occupant;
   return s;
 }
 

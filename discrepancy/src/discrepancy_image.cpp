@@ -12,6 +12,7 @@
 #include "tofguard/common/demand.hpp"
 #include "tofguard/common/wire_checks.hpp"
 #include "tofguard/discrepancy/arm_distance.hpp"
+#include "tofguard/discrepancy/occupant_shapes.hpp"
 
 namespace tofguard::discrepancy {
 namespace {
@@ -200,11 +201,22 @@ std::string check_labels(const link_labels_t& labels) {
   const int num_pixels = labels.width * labels.height;
   for (int i = 0; i < num_pixels; ++i) {
     const int l = labels.label[i];
-    if (l == kLabelNothing || link_of_label(l, num_robot_links, num_links) >= 0) continue;
+    if (l == kLabelNothing || link_of_label(l, num_robot_links, num_links) >= 0 ||
+        occupant_shape_of_label(l, labels.num_occupant_shapes) >= 0) {
+      continue;
+    }
     std::ostringstream why;
     why << "label[" << i << "]: expected " << kLabelNothing << ", " << kLabelRobotFirst << ".."
-        << kLabelRobotFirst + num_robot_links - 1 << " or " << kLabelEnvironmentFirst << ".."
-        << kLabelEnvironmentFirst + (num_links - num_robot_links) - 1 << ", got " << l;
+        << kLabelRobotFirst + num_robot_links - 1;
+    if (labels.num_occupant_shapes > 0) {
+      why << ", " << kLabelEnvironmentFirst << ".."
+          << kLabelEnvironmentFirst + (num_links - num_robot_links) - 1 << " or " << kLabelOccupantFirst
+          << ".." << kLabelOccupantFirst + labels.num_occupant_shapes - 1;
+    } else {
+      why << " or " << kLabelEnvironmentFirst << ".."
+          << kLabelEnvironmentFirst + (num_links - num_robot_links) - 1;
+    }
+    why << ", got " << l;
     return why.str();
   }
   // The arm cover indexes links and spheres by what it carries
@@ -230,16 +242,53 @@ struct PixelClasses {
   // 0 where the model has a robot link, 255 elsewhere (distance transform).
   cv::Mat1b not_robot;
   bool any_robot = false;
+  // Per body region (link_labels_t.body_region order): the occupant's
+  // modelled pixels with a camera depth, those the camera sees farther than
+  // the envelope, and those it sees within it.
+  std::vector<int32_t> region_modelled;
+  std::vector<int32_t> region_missing;
+  std::vector<int32_t> region_seen;
 };
 
 // Stage 3, pixel classes: I_dis = I_gen - I_ToF (mm) and the class of every
 // pixel (docs/safety-chain.md, "Pixel classes") into frame->pixel_class and
 // frame->dis_mm (allocated by the caller), with the masks and totals the
 // later stages need into `p` (fresh).
+// A pixel where the model shows the occupant (shape `shape`) and the
+// camera a surface, I_dis = `dis_mm`: within the tolerance and the region's
+// envelope it is the user as modelled (a match); nearer, something is in
+// front of the user (an unexplained nearer surface, judged in 3-D by
+// unexplained_surfaces); farther, the user is not there: counted per
+// region, not a mismatch blob (the risk judges an absent user).
+int classify_occupant_pixel(int dis_mm, double tolerance_mm, int i, const OccupantShapes& occupant, int shape,
+                            const std::vector<uint8_t>& silhouette, PixelClasses* p) {
+  const int region = occupant.region_of_shape(shape);
+  // Silhouette pixels mix the user with what is behind: not counted for
+  // the region (their class is still the comparison's).
+  const bool counted = silhouette[i] == 0;
+  if (counted) p->region_modelled[region]++;
+  ++p->num_compared;
+  p->sum_abs_dis_mm += std::abs(dis_mm);
+  if (std::abs(dis_mm) <= tolerance_mm + 1000.0 * occupant.envelope_m(region)) {
+    if (counted) p->region_seen[region]++;
+    return discrepancy_t::PIXEL_MATCH;
+  }
+  if (dis_mm > 0) {
+    p->nearer_mask.ptr<uint8_t>()[i] = counted ? 255 : 0;
+    return discrepancy_t::PIXEL_UNEXPECTED_SURFACE;
+  }
+  if (counted) p->region_missing[region]++;
+  return discrepancy_t::PIXEL_ENVIRONMENT_MISSING;
+}
+
 void classify_pixels(const depth_image_t& camera, const depth_image_t& rendered, const link_labels_t& labels,
                      const std::vector<uint8_t>& silhouette, const Tolerance& tolerance,
-                     DiscrepancyFrame* frame, PixelClasses* classes) {
+                     const OccupantShapes& occupant, DiscrepancyFrame* frame, PixelClasses* classes) {
   PixelClasses& p = *classes;
+  const int num_shapes = occupant.num_shapes();
+  p.region_modelled.assign(labels.num_body_regions, 0);
+  p.region_missing.assign(labels.num_body_regions, 0);
+  p.region_seen.assign(labels.num_body_regions, 0);
   const int num_links = labels.num_links;
   const int num_robot_links = labels.num_robot_links;
   const int16_t* label = labels.label.data();
@@ -259,6 +308,13 @@ void classify_pixels(const depth_image_t& camera, const depth_image_t& rendered,
     const int t = tof[i];
     const int g = gen[i];
     const bool modelled = g > 0;
+    if (const int shape = occupant_shape_of_label(label[i], num_shapes); shape >= 0 && modelled && t > 0) {
+      const int c = classify_occupant_pixel(g - t, tolerance.at(t), i, occupant, shape, silhouette, &p);
+      dis[i] = g - t;
+      pixel_class[i] = static_cast<uint8_t>(c);
+      p.count[c]++;
+      continue;
+    }
     const bool robot = modelled && link >= 0 && link < num_robot_links;
     if (robot) {
       robot_free[i] = 0;
@@ -334,6 +390,9 @@ void per_link_statistics(const DiscrepancyFrame& frame, const depth_image_t& cam
   h.reset(num_links);
   std::vector<Histogram>& link_dis = h.per_link;
   for (int i = 0; i < num_pixels; ++i) {
+    // The occupant's pixels are judged by their envelopes, not by the
+    // model's tolerance: no link's, and not in the frame's scores.
+    if (label[i] >= kLabelOccupantFirst) continue;
     const int link = link_of_label(label[i], labels.num_robot_links, num_links);
     const bool modelled = gen[i] > 0;
     if (tof[i] <= 0) {
@@ -451,6 +510,39 @@ int surface_depth_mm(const int16_t* tof, const uint8_t* unexplained, int i, int 
   return placed == std::numeric_limits<int>::max() ? d : placed;
 }
 
+// The user's seen surfaces per body region: the pixel classes' counts,
+// the unexplained surfaces found within an envelope, and each region's
+// smallest seen distance to the arm's cover (-1: none seen, or no cover).
+class UserSightings {
+ public:
+  explicit UserSightings(const PixelClasses& classes)
+      : modelled_(classes.region_modelled),
+        missing_(classes.region_missing),
+        seen_(classes.region_seen),
+        separation_m_(classes.region_seen.size(), -1.0f) {}
+  void saw(int region, double distance_to_arm_m) {
+    seen_[region]++;
+    if (distance_to_arm_m < 0) return;
+    float& best = separation_m_[region];
+    // Rounded down to a float: never more than the distance computed.
+    float d = static_cast<float>(distance_to_arm_m);
+    if (d > distance_to_arm_m) d = std::nextafter(d, 0.0f);
+    if (best < 0 || d < best) best = d;
+  }
+  void write(discrepancy_t* s) const {
+    s->body_region_modelled_pixels = modelled_;
+    s->body_region_missing_pixels = missing_;
+    s->body_region_seen_pixels = seen_;
+    s->body_region_seen_separation_m = separation_m_;
+  }
+
+ private:
+  std::vector<int32_t> modelled_;
+  std::vector<int32_t> missing_;
+  std::vector<int32_t> seen_;
+  std::vector<float> separation_m_;
+};
+
 // Stage 6, unexplained nearer surfaces and the protective fields: every
 // occluded or unexpected-surface pixel (after the opening, on surfaces:
 // opened_on_surfaces)
@@ -463,8 +555,9 @@ int surface_depth_mm(const int16_t* tof, const uint8_t* unexplained, int i, int 
 // (field_*).
 void unexplained_surfaces(const depth_image_t& camera, const link_labels_t& labels,
                           const DiscrepancyFrame& frame, const PixelClasses& classes,
-                          const DiscrepancyOptions& options, const PixelFootprint& footprint,
-                          discrepancy_t* s) {
+                          const OccupantShapes& occupant, const DiscrepancyOptions& options,
+                          const PixelFootprint& footprint, discrepancy_t* s) {
+  UserSightings user(classes);
   s->near_arm_min_distance_m = -1;
   s->field_available = labels.num_arm_spheres > 0;
   const int num_bins = static_cast<int>(std::ceil(options.field_range_m / options.field_bin_m - 1e-9));
@@ -484,14 +577,28 @@ void unexplained_surfaces(const depth_image_t& camera, const link_labels_t& labe
   double near_area = 0;
   for (int i = 0; i < num_pixels; ++i) {
     if (candidate[i] == 0) continue;
-    double distance_m = 0;
-    if (s->field_available && pixel_class[i] != discrepancy_t::PIXEL_OCCLUDED) {
-      // The camera-frame point (optical frame, m) of pixel i at its depth.
+    // The camera-frame point (optical frame, m) of pixel i at its depth.
+    const auto point = [&] {
       const double z = metres_from_mm(
           surface_depth_mm(tof, candidate, i, width, camera.height, options.silhouette_jump_mm));
-      const Eigen::Vector3d point((i % width - camera.cx) * z / camera.fx,
-                                  (i / width - camera.cy) * z / camera.fy, z);
-      distance_m = arm.distance_m(point, up_to_m);
+      return Eigen::Vector3d((i % width - camera.cx) * z / camera.fx, (i / width - camera.cy) * z / camera.fy,
+                             z);
+    };
+    if (!occupant.empty()) {
+      // A surface within a region's envelope is the user (hiding the arm
+      // or not): not an unknown object, but how near the user's seen body
+      // is to the arm.
+      const Eigen::Vector3d p = point();
+      if (const int region = occupant.region_holding(p); region >= 0) {
+        // Beyond up_to_m the search gives some value >= it: up_to_m, never
+        // more than the truth.
+        user.saw(region, s->field_available ? std::min(arm.distance_m(p, up_to_m), up_to_m) : -1.0);
+        continue;
+      }
+    }
+    double distance_m = 0;
+    if (s->field_available && pixel_class[i] != discrepancy_t::PIXEL_OCCLUDED) {
+      distance_m = arm.distance_m(point(), up_to_m);
     }
     const double area = footprint.m2(i);
     if (distance_m <= options.near_arm_m) {
@@ -505,6 +612,7 @@ void unexplained_surfaces(const depth_image_t& camera, const link_labels_t& labe
   }
   s->near_arm_area_m2 = static_cast<float>(near_area);
   if (s->near_arm_pixels > 0) s->near_arm_min_distance_m = static_cast<float>(min_distance);
+  user.write(s);
   s->unexplained_area_within_m2.resize(num_bins);
   double cumulative = 0;
   for (int k = 0; k < num_bins; ++k) {
@@ -683,7 +791,8 @@ DiscrepancyFrame compare_frames(const depth_image_t& camera, const depth_image_t
     frame.pixel_class.create(camera.height, camera.width);
     frame.dis_mm.create(camera.height, camera.width);
     PixelClasses classes(camera.height, camera.width);
-    classify_pixels(camera, rendered, labels, silhouette, options.tolerance, &frame, &classes);
+    const OccupantShapes occupant(labels);
+    classify_pixels(camera, rendered, labels, silhouette, options.tolerance, occupant, &frame, &classes);
 
     // The seed's score and the class counts.
     s.num_match = classes.count[discrepancy_t::PIXEL_MATCH];
@@ -703,7 +812,7 @@ DiscrepancyFrame compare_frames(const depth_image_t& camera, const depth_image_t
     per_link_statistics(frame, camera, rendered, labels, silhouette, &s);
     const PixelFootprint footprint(camera, rendered);
     largest_blob(classes.mismatch_mask, options.opening_radius_px, footprint, &s);
-    unexplained_surfaces(camera, labels, frame, classes, options, footprint, &s);
+    unexplained_surfaces(camera, labels, frame, classes, occupant, options, footprint, &s);
     if (s.field_available) reach = joint_reach_m(labels);
   });
   // Stage 7, evidence (evidence.hpp).

@@ -2,9 +2,12 @@
 
 #include <chrono>
 #include <memory>
+#include <utility>
 
 #include "tofguard/estimator/estimator_process.hpp"
 #include "tofguard/renderer/depth_renderer.hpp"
+#include "tofguard/renderer/rendered_occupant.hpp"
+#include "tofguard/robot_model/occupant_model.hpp"
 
 namespace tofguard::estimator {
 
@@ -59,7 +62,14 @@ void EstimatorWorker::run() {
     // The renderer's GL context belongs to this thread.
     renderer = std::make_unique<renderer::DepthRenderer>(scene_, settings_.renderer.near_m,
                                                          settings_.renderer.far_m);
-    estimator = std::make_unique<MotionEstimator>(scene_, renderer.get(), options_from_settings(settings_));
+    std::vector<renderer::ExtraObject> occupant;
+    if (settings_.occupant) {
+      occupant = renderer::occupant_render_objects(
+          robot_model::load_occupant(settings_.occupant->urdf_path,
+                                     robot_model::fixed_link_pose(scene_, settings_.occupant->seated_on)));
+    }
+    estimator = std::make_unique<MotionEstimator>(scene_, renderer.get(), options_from_settings(settings_),
+                                                  std::move(occupant));
   } catch (const std::exception& e) {
     std::lock_guard<std::mutex> lock(mutex_);
     start_error_ = e.what();

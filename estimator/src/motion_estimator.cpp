@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <utility>
 
 #include <Eigen/Cholesky>
 #include <opencv2/imgproc.hpp>
@@ -168,8 +169,8 @@ double correction_angle_rad(const EstimateResult& result) {
 }
 
 MotionEstimator::MotionEstimator(const robot_model::SceneModel& scene, renderer::DepthRenderer* renderer,
-                                 const EstimatorOptions& options)
-    : scene_(scene), renderer_(renderer), options_(options) {
+                                 const EstimatorOptions& options, std::vector<renderer::ExtraObject> occupant)
+    : scene_(scene), renderer_(renderer), occupant_(std::move(occupant)), options_(options) {
   if (renderer_ == nullptr) throw std::invalid_argument("MotionEstimator: renderer is null");
   const EstimatorOptions& o = options_;
   if (o.pixel_stride < 1 || !(o.final_robust_scale_m > 0) ||
@@ -455,7 +456,8 @@ std::string MotionEstimator::linearize(const EstimatorFrame& frame, const State&
       robot_model::forward_kinematics(scene_, joints_at(scene_, frame, state.joint_offsets));
   if (!poses.usable) return poses.unusable_reason;
   const Eigen::Isometry3d world_from_optical = frame.world_from_optical * state.correction;
-  const renderer::RenderResult rendered = renderer_->render_at(poses, world_from_optical, frame.intrinsics);
+  const renderer::RenderResult rendered =
+      renderer_->render_at(poses, world_from_optical, frame.intrinsics, occupant_);
   if (!rendered.usable) return "render: " + rendered.unusable_reason;
   const double sigma_1m = options_.noise.sigma_m(1.0);
   const RenderedView view{

@@ -8,6 +8,7 @@
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/common/wire_checks.hpp"
 #include "tofguard/renderer/rendered_kinematics.hpp"
+#include "tofguard/renderer/rendered_occupant.hpp"
 #include "tofguard/renderer/state_history_settings.hpp"
 
 namespace tofguard::renderer {
@@ -53,6 +54,7 @@ RendererService::RendererService(const RendererProcessSettings& settings)
                                      scene_options(settings.renderer, settings.robot))),
       arm_cover_(robot_model::cover_arm_with_spheres(scene_, settings.renderer.arm_cover_cell_m)),
       occupant_(load_occupant(settings.occupant, scene_)),
+      occupant_objects_(occupant_ ? occupant_render_objects(*occupant_) : std::vector<ExtraObject>{}),
       renderer_(make_renderer(scene_, settings.renderer)),
       state_(state_history_settings(settings.renderer, settings.robot.id, settings.camera)) {}
 
@@ -180,7 +182,7 @@ bool RendererService::render_prediction() {
     }
     p.joints = std::move(guess.joints);
   }
-  p.result = renderer_->render(p.joints, p.pose, p.intrinsics);
+  p.result = renderer_->render(p.joints, p.pose, p.intrinsics, occupant_objects_);
   p.rendered = true;
   prediction_stats_.rendered++;
   return true;
@@ -225,7 +227,8 @@ RenderedFrame RendererService::render(const depth_image_t& frame) {
     const bool missed = prediction_ && prediction_->rendered;
     (missed ? prediction_stats_.misses : prediction_stats_.without)++;
     if (missed) ++consecutive_misses_;
-    result = renderer_->render(state.joints.joints, state.camera_pose.pose, intrinsics_of(frame));
+    result = renderer_->render(state.joints.joints, state.camera_pose.pose, intrinsics_of(frame),
+                               occupant_objects_);
   }
   // The kinematics and the arm's cover at the frame's own joints and
   // camera pose: the poses a render of them used (no second forward
@@ -233,9 +236,9 @@ RenderedFrame RendererService::render(const depth_image_t& frame) {
   // the tolerances) the frame's.
   std::optional<RenderedKinematics> kinematics;
   std::optional<RenderedArmCover> arm_cover;
+  std::optional<Eigen::Isometry3d> optical;
   if (result.usable) {
     robot_model::LinkPoses poses;
-    std::optional<Eigen::Isometry3d> optical;
     if (predicted) {
       poses = robot_model::forward_kinematics(scene_, state.joints.joints);
       optical = world_from_optical(scene_, poses, state.camera_pose.pose);
@@ -250,14 +253,15 @@ RenderedFrame RendererService::render(const depth_image_t& frame) {
       arm_cover = rendered_arm_cover(arm_cover_, poses, *optical, occupant_ ? &*occupant_ : nullptr);
     }
   }
-  RenderedFrame out = make_output(frame, std::move(result), kinematics, arm_cover);
+  RenderedFrame out = make_output(frame, std::move(result), kinematics, arm_cover, optical);
   plan_prediction(frame);
   return out;
 }
 
 RenderedFrame RendererService::make_output(const depth_image_t& frame, RenderResult result,
                                            const std::optional<RenderedKinematics>& kinematics,
-                                           const std::optional<RenderedArmCover>& arm_cover) const {
+                                           const std::optional<RenderedArmCover>& arm_cover,
+                                           const std::optional<Eigen::Isometry3d>& world_from_optical) const {
   RenderedFrame out;
   if (!result.usable) {
     out.labels =
@@ -267,6 +271,16 @@ RenderedFrame RendererService::make_output(const depth_image_t& frame, RenderRes
   out.labels = make_link_labels(frame, scene_.num_robot_links, scene_.link_names(), std::move(result.labels));
   if (kinematics) set_rendered_kinematics(*kinematics, &out.labels);
   if (arm_cover) set_rendered_arm_cover(*arm_cover, &out.labels);
+  if (occupant_) {
+    // The render drew the occupant (labels kLabelOccupantFirst + shape),
+    // so the labels must carry its shapes, or the frame is not usable.
+    if (!arm_cover || !world_from_optical) {
+      out.labels = make_unusable_link_labels(frame, scene_.num_robot_links, scene_.link_names(),
+                                             "no camera pose to place the occupant's shapes in");
+      return out;
+    }
+    set_rendered_occupant(*occupant_, *settings_.occupant, *world_from_optical, &out.labels);
+  }
   // The model's depth is exact: calibrated (no distance calibration to
   // apply), no amplitude.
   out.depth = make_depth_image(frame.camera_id, intrinsics_of(frame), frame.utime, frame.seq,

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "tofguard/risk/user_presence.hpp"
+
 namespace tofguard::risk {
 namespace {
 
@@ -61,6 +63,7 @@ speed_limit_t RiskMonitor::speed_limit(const discrepancy_t& frame) const {
 
 void RiskMonitor::set_occupant(const OccupantSettings& occupant) {
   body_region_rules_ = body_region_rules(occupant, robot_model::moving_mass_kg(robot_));
+  occupant_ = occupant;
 }
 
 namespace {
@@ -105,6 +108,11 @@ ClassifiedFrame RiskMonitor::classify(const discrepancy_t& frame) const {
   // The arm faster than the user's body regions allow: only when the
   // camera shows nothing wrong (the protective field's own finding comes
   // from the rules above).
+  if (c.finding.cause == risk_t::CAUSE_NONE && occupant_) {
+    if (std::optional<FrameFinding> absent = user_not_where_modelled(frame, *occupant_)) {
+      c.finding = std::move(*absent);
+    }
+  }
   if (c.finding.cause == risk_t::CAUSE_NONE && !body_region_rules_.empty()) {
     if (std::optional<FrameFinding> faster = faster_than_the_user_allows(speed_limit(frame))) {
       c.finding = std::move(*faster);

@@ -10,7 +10,7 @@ namespace {
 RegionShape shape_of(const GeometryElement& g, const Eigen::Isometry3d& world_from_link,
                      const std::string& file, const std::string& link) {
   RegionShape shape;
-  shape.world_from_shape = world_from_link * g.link_from_geometry;
+  shape.frame_from_shape = world_from_link * g.link_from_geometry;
   switch (g.kind) {
     case GeometryElement::Kind::kBox:
       shape.kind = RegionShape::Kind::kBox;
@@ -96,24 +96,6 @@ OccupantModel load_occupant(const std::string& urdf, const Eigen::Isometry3d& wo
                      "body regions)");
   }
   return model;
-}
-
-double distance_to_shape_m(const RegionShape& shape, const Eigen::Vector3d& point_world) {
-  const Eigen::Vector3d p = shape.world_from_shape.inverse() * point_world;
-  switch (shape.kind) {
-    case RegionShape::Kind::kSphere:
-      return std::max(0.0, p.norm() - shape.radius_m);
-    case RegionShape::Kind::kBox: {
-      const Eigen::Vector3d outside = (p.cwiseAbs() - shape.box_half_size_m).cwiseMax(0.0);
-      return outside.norm();
-    }
-    case RegionShape::Kind::kCylinder: {
-      const double radial = std::max(0.0, std::hypot(p.x(), p.y()) - shape.radius_m);
-      const double axial = std::max(0.0, std::abs(p.z()) - shape.half_length_m);
-      return std::hypot(radial, axial);
-    }
-  }
-  return std::numeric_limits<double>::infinity();
 }
 
 double distance_to_part_m(const OccupantPart& part, const Eigen::Vector3d& point_world) {

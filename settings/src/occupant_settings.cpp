@@ -41,6 +41,10 @@ std::optional<OccupantSettings> read_occupant_settings(std::optional<YamlMap> se
   o.payload_kg = section->number("payload_kg", 0, 100);
   o.contact_force_factor = section->number("contact_force_factor", 1, 2);
   o.regions = read_regions(section->map("regions"));
+  YamlMap presence = section->map("presence");
+  o.presence_min_modelled_pixels = static_cast<int>(presence.integer("min_modelled_pixels", 1, 10000000));
+  o.presence_max_missing_fraction = presence.number("max_missing_fraction", 0.01, 0.99);
+  presence.finish();
   section->finish();
   return o;
 }

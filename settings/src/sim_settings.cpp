@@ -59,6 +59,20 @@ SimResidualSettings read_sim_residual(YamlMap map) {
   return r;
 }
 
+SimUserSettings read_sim_user(YamlMap map) {
+  SimUserSettings u;
+  u.urdf_path = map.existing_path("urdf");
+  u.seated_on = map.string("seated_on");
+  u.breathing_mm = map.number("breathing_mm", 0, 100);
+  u.breathing_period_s = map.number("breathing_period_s", 0.1, 1e6);
+  u.head_turn_rad = map.number("head_turn_deg", 0, 90) * M_PI / 180.0;
+  u.head_period_s = map.number("head_period_s", 0.1, 1e6);
+  u.hand_motion_m = map.number("hand_motion_m", 0, 1);
+  u.hand_period_s = map.number("hand_period_s", 0.1, 1e6);
+  map.finish();
+  return u;
+}
+
 }  // namespace
 
 SimCameraSettings read_sim_camera_settings(YamlMap map) {
@@ -92,6 +106,7 @@ SimCameraSettings read_sim_camera_settings(YamlMap map) {
   if (map.optional("faults")) {
     for (YamlMap& fault : map.maps("faults")) c.faults.push_back(read_sim_fault(fault));
   }
+  if (auto user = map.optional_map("user")) c.user = read_sim_user(*user);
   if (auto pan_tilt = map.optional_map("pan_tilt")) {
     c.pan_tilt_enabled = true;
     c.pan_amplitude_rad = pan_tilt->number("pan_amplitude_deg", 0, 180) * M_PI / 180.0;
@@ -145,6 +160,12 @@ JointsSimSettings read_joints_sim_settings(YamlMap map) {
     sim.plan_step_us = plan.milliseconds_as_us("step_ms", 1, 10000);
     if (sim.plan_step_us > sim.plan_horizon_us) plan.fail("step_ms", "a step no longer than horizon_ms");
     plan.finish();
+  }
+  if (auto follow = map.optional_map("follow_speed_limit")) {
+    sim.follow_speed_limit = true;
+    sim.speed_limit_margin = follow->number("margin", 0.1, 1);
+    sim.speed_ramp_per_s = follow->number("ramp_per_s", 0.01, 100);
+    follow->finish();
   }
   map.finish();
   return sim;

@@ -1,5 +1,6 @@
 #include "tofguard/sim/joints_sim_process.hpp"
 
+#include <cmath>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -16,7 +17,9 @@
 #include "tofguard/robot_model/kinematic_tree.hpp"
 #include "tofguard/safety_status_t.hpp"
 #include "tofguard/sim/simulated_arm.hpp"
+#include "tofguard/sim/speed_limit_follower.hpp"
 #include "tofguard/sim_joint_fault_t.hpp"
+#include "tofguard/speed_limit_t.hpp"
 
 namespace tofguard::sim {
 namespace {
@@ -42,10 +45,16 @@ class JointsSimWiring {
         sim_(settings.joints_sim),
         arm_(*arm),
         node_(settings.lcm, settings.channels, "tofguard-joints-sim"),
-        plan_period_us_(static_cast<int64_t>(1e6 / sim_.plan_rate_hz)) {}
+        plan_period_us_(static_cast<int64_t>(1e6 / sim_.plan_rate_hz)) {
+    // Commissioning runs without a safety chain, so without a limit.
+    if (sim_.follow_speed_limit && !settings.moves_without_permission) {
+      follower_.emplace(sim_.speed_limit_margin, sim_.speed_ramp_per_s);
+    }
+  }
 
   void run() {
     subscribe_status();
+    if (follower_) subscribe_speed_limit();
     subscribe_faults();
     const int64_t period_us = static_cast<int64_t>(1e6 / sim_.rate_hz);
     last_step_us_ = monotonic_us();
@@ -70,7 +79,7 @@ class JointsSimWiring {
           check_safety_status);
       return;
     }
-    verifier_.emplace(settings_.auth.key, settings_.auth.max_age_us);
+    if (!verifier_) verifier_.emplace(settings_.auth.key, settings_.auth.max_age_us);
     node_.subscribe<authenticated_message_t>(
         node_.safety(), channels.status_auth, [this](const authenticated_message_t& m) {
           const ChannelNames& channels = settings_.channels;
@@ -82,6 +91,30 @@ class JointsSimWiring {
           }
           node_.counters().validation_errors++;
           node_.errors().report(channels.status_auth, channels.status_auth + ": refused: " + why);
+        });
+  }
+
+  // The speed limit as the status: verified on SAFETY_SPEED_LIMIT_AUTH
+  // with a key, else the plain channel.
+  void subscribe_speed_limit() {
+    const ChannelNames& channels = settings_.channels;
+    const auto take = [this](const speed_limit_t& limit) { follower_->on_limit(limit, monotonic_us()); };
+    if (!auth::authenticated(settings_.auth)) {
+      node_.subscribe<speed_limit_t>(node_.safety(), channels.speed_limit, take, check_speed_limit);
+      return;
+    }
+    if (!verifier_) verifier_.emplace(settings_.auth.key, settings_.auth.max_age_us);
+    node_.subscribe<authenticated_message_t>(
+        node_.safety(), channels.speed_limit_auth, [this, take](const authenticated_message_t& m) {
+          const ChannelNames& channels = settings_.channels;
+          std::string why;
+          const auto limit = verifier_->open<speed_limit_t>(m, channels.speed_limit, wall_utime(), &why);
+          if (limit && (why = check_speed_limit(*limit)).empty()) {
+            take(*limit);
+            return;
+          }
+          node_.counters().validation_errors++;
+          node_.errors().report(channels.speed_limit_auth, channels.speed_limit_auth + ": refused: " + why);
         });
   }
 
@@ -123,26 +156,38 @@ class JointsSimWiring {
     const bool allowed =
         settings_.moves_without_permission ||
         (status_allows_ && status_arrival_us_ >= 0 && now_us - status_arrival_us_ <= sim_.status_deadline_us);
-    arm_.step((now_us - last_step_us_) * 1e-6, allowed);
+    const double dt_s = (now_us - last_step_us_) * 1e-6;
+    const double scale = follower_ ? follower_->next_scale(now_us, dt_s) : 1.0;
+    arm_.step(dt_s, allowed, scale);
     last_step_us_ = now_us;
     const int64_t utime = wall_utime();
+    if (follower_) follower_->on_joint_state(utime, allowed ? scale : 0.0);
     const joint_state_t reported = to_message(arm_.reported_state(), settings_.robot.id, utime);
     const joint_state_t truth = to_message(arm_.true_state(), settings_.robot.id, utime);
     // The plan goes first: a replanned arm (halted, resumed, encoder jump)
     // is never seen off its old plan.
+    // A speed scale changed by more than kReplanScale since the last plan
+    // is a new plan too (the old one runs ahead of or behind the arm).
+    constexpr double kReplanScale = 0.05;
     if (sim_.publish_plan && (now_us >= next_plan_us_ || allowed != planned_allowed_ ||
-                              arm_.offsets_version() != planned_offsets_version_)) {
+                              arm_.offsets_version() != planned_offsets_version_ ||
+                              std::abs(scale - planned_scale_) > kReplanScale)) {
       publish_plan(utime);
       next_plan_us_ = now_us + plan_period_us_;
       planned_allowed_ = allowed;
       planned_offsets_version_ = arm_.offsets_version();
+      planned_scale_ = scale;
     }
     node_.safety().publish(settings_.channels.joint_state, &reported);
     node_.safety().publish(settings_.channels.sim_true_joint_state, &truth);
     node_.counters().frames_out++;
+    const std::string moving =
+        follower_
+            ? "moving at " + std::to_string(static_cast<int>(std::lround(100 * scale))) + " % of full speed"
+            : "moving";
     node_.heartbeat().set_status(settings_.moves_without_permission
                                      ? "moving without a permission (commissioning)"
-                                 : allowed ? "moving"
+                                 : allowed ? moving
                                            : "halted: no permission to move");
   }
 
@@ -151,6 +196,9 @@ class JointsSimWiring {
   SimulatedArm& arm_;
   LcmNode node_;
   std::optional<auth::MessageVerifier> verifier_;
+  // joints_sim.follow_speed_limit: the speed scale from SAFETY_SPEED_LIMIT.
+  std::optional<SpeedLimitFollower> follower_;
+  double planned_scale_ = 1;
   bool status_allows_ = false;
   int64_t status_arrival_us_ = -1;
   int64_t last_step_us_ = 0;
@@ -169,7 +217,8 @@ ProcessInfo joints_sim_info() {
           "The simulated arm: publishes JOINT_STATE (reported, with encoder faults) and\n"
           "SIM_TRUE_JOINT_STATE (the truth) at joints_sim.rate_hz, following the periodic\n"
           "motion of the config, and its plan on PLANNED_TRAJECTORY (joints_sim.plan);\n"
-          "halts while SAFETY_STATUS withdraws permission or is stale.\n"
+          "halts while SAFETY_STATUS withdraws permission or is stale; with\n"
+          "joints_sim.follow_speed_limit, slows to SAFETY_SPEED_LIMIT.\n"
           "--commissioning: moves without a permission (a commissioning recording,\n"
           "docs/camera.md); never with a safety chain in charge.\n"
           "Encoder faults: joints_sim.faults in the config, or sim_joint_fault_t on SIM_JOINT_FAULT."};

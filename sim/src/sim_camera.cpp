@@ -1,6 +1,8 @@
 #include "tofguard/sim/sim_camera.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace tofguard::sim {
 namespace {
@@ -17,13 +19,15 @@ bool SimulatedCamera::add_true_joint_state(int64_t utime, const std::vector<std:
 }
 
 SimulatedCamera::SimulatedCamera(const CameraSettings& camera, const SimCameraSettings& sim,
-                                 SceneRenderer* renderer, int64_t start_utime)
+                                 SceneRenderer* renderer, int64_t start_utime,
+                                 std::optional<SimulatedUser> user)
     : camera_(camera),
       sim_(sim),
       renderer_(renderer),
       start_utime_(start_utime),
       model_(sim, camera.intrinsics),
-      joints_(kMaxExtrapolationUs) {
+      joints_(kMaxExtrapolationUs),
+      user_(std::move(user)) {
   for (const SimCameraFaultSettings& f : sim.faults) {
     const int64_t start = start_utime + f.start_us;
     faults_.push_back({f, start, start + f.duration_us});
@@ -97,6 +101,11 @@ std::vector<SimBox> SimulatedCamera::boxes(int64_t utime) const {
   return out;
 }
 
+std::vector<RegionShape> SimulatedCamera::user_shapes(int64_t utime) const {
+  if (!user_) return {};
+  return user_->shapes_at(std::max<int64_t>(0, utime - start_utime_) * 1e-6);
+}
+
 SimulatedCamera::Frame SimulatedCamera::capture(int64_t utime, uint64_t frame_index) {
   Frame frame;
   for (const ActiveSimFault& f : faults_) {
@@ -119,8 +128,8 @@ SimulatedCamera::Frame SimulatedCamera::capture(int64_t utime, uint64_t frame_in
     frame.why = "true joint state: " + joints.unusable_reason;
     return frame;
   }
-  const RenderedDepth rendered =
-      renderer_->render(joints.joints, true_pose(utime), camera_.intrinsics, boxes(utime));
+  const RenderedDepth rendered = renderer_->render(joints.joints, true_pose(utime), camera_.intrinsics,
+                                                   boxes(utime), user_shapes(utime));
   if (!rendered.usable) {
     frame.outcome = Frame::Outcome::kRenderFailed;
     frame.why = "render failed: " + rendered.unusable_reason;

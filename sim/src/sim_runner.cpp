@@ -1,6 +1,8 @@
 #include <cmath>
 #include <iostream>
 #include <memory>
+#include <optional>
+#include <utility>
 
 #include "tofguard/camera/depth_calibration.hpp"
 #include "tofguard/common/camera_pose_message.hpp"
@@ -10,6 +12,7 @@
 #include "tofguard/common/wire_checks.hpp"
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/renderer/depth_renderer.hpp"
+#include "tofguard/renderer/rendered_occupant.hpp"
 #include "tofguard/robot_model/scene_model.hpp"
 #include "tofguard/sim/sim_camera.hpp"
 #include "tofguard/sim/sim_camera_runner.hpp"
@@ -33,12 +36,14 @@ class UrdfSceneRenderer : public SceneRenderer {
   }
 
   RenderedDepth render(const std::map<std::string, double>& joints, const CameraPose& pose,
-                       const Intrinsics& intrinsics, const std::vector<SimBox>& boxes) override {
+                       const Intrinsics& intrinsics, const std::vector<SimBox>& boxes,
+                       const std::vector<RegionShape>& user) override {
     std::vector<renderer::ExtraObject> extra;
     for (const SimBox& box : boxes) {
       extra.push_back(
           renderer::ExtraObject::box(box.size_m, Eigen::Isometry3d(Eigen::Translation3d(box.center_m))));
     }
+    for (const RegionShape& shape : user) extra.push_back(renderer::extra_object_of(shape));
     renderer::RenderResult result = renderer_->render(joints, pose, intrinsics, extra);
     RenderedDepth out;
     out.usable = result.usable;
@@ -48,6 +53,20 @@ class UrdfSceneRenderer : public SceneRenderer {
   }
 
   const std::string& description() const { return renderer_->description(); }
+
+  // The simulated user of `sim` seated in this scene; none without one.
+  // Throws robot_model::ModelError for a bad model or seat.
+  std::optional<SimulatedUser> simulated_user(const SimCameraSettings& sim) const {
+    if (!sim.user) return std::nullopt;
+    Eigen::Isometry3d world_from_seat;
+    try {
+      world_from_seat = robot_model::fixed_link_pose(scene_, sim.user->seated_on);
+    } catch (const robot_model::ModelError& e) {
+      throw robot_model::ModelError("camera.sim.user.seated_on '" + sim.user->seated_on + "': " + e.what());
+    }
+    return SimulatedUser(robot_model::load_occupant(sim.user->urdf_path, world_from_seat), world_from_seat,
+                         *sim.user);
+  }
 
  private:
   robot_model::SceneModel scene_;
@@ -74,8 +93,10 @@ ActiveSimFault to_fault(const sim_camera_fault_t& m, int64_t now_utime) {
 int run_sim_camera(const SimCameraProcessSettings& settings) {
   const CameraSettings& camera_config = settings.camera;
   std::unique_ptr<UrdfSceneRenderer> scene;
+  std::optional<SimulatedUser> user;
   try {
     scene = std::make_unique<UrdfSceneRenderer>(settings);
+    user = scene->simulated_user(settings.sim);
   } catch (const std::exception& e) {
     std::cerr << "tofguard-camera: cannot set up the simulated camera's renderer: " << e.what() << std::endl;
     return 1;
@@ -84,7 +105,7 @@ int run_sim_camera(const SimCameraProcessSettings& settings) {
             << scene->description() << std::endl;
 
   LcmNode node(settings.lcm, settings.channels, "tofguard-camera");
-  SimulatedCamera sim(camera_config, settings.sim, scene.get(), wall_utime());
+  SimulatedCamera sim(camera_config, settings.sim, scene.get(), wall_utime(), std::move(user));
   const camera::DepthCalibration calibration(settings.depth_calibration.coefficients_m);
   const camera::RadialToZ rays(camera_config.intrinsics);
   const bool calibrated = settings.depth_calibration.enabled;

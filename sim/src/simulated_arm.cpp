@@ -49,13 +49,14 @@ void SimulatedArm::update_state(bool moving) {
     const double w = 2 * M_PI / m.period_s;
     const double phase = w * motion_time_s_ + m.phase_rad;
     true_state_.position[i] = m.center + m.amplitude * std::sin(phase);
-    true_state_.velocity[i] = moving ? m.amplitude * w * std::cos(phase) : 0.0;
+    true_state_.velocity[i] = moving ? speed_scale_ * m.amplitude * w * std::cos(phase) : 0.0;
   }
 }
 
-void SimulatedArm::step(double dt_s, bool motion_allowed) {
+void SimulatedArm::step(double dt_s, bool motion_allowed, double speed_scale) {
   elapsed_s_ += dt_s;
-  if (motion_allowed) motion_time_s_ += dt_s;
+  speed_scale_ = std::clamp(speed_scale, 0.0, 1.0);
+  if (motion_allowed) motion_time_s_ += speed_scale_ * dt_s;
   for (auto it = scheduled_faults_.begin(); it != scheduled_faults_.end();) {
     if (elapsed_s_ >= it->at_s) {
       offsets_[it->joint] = it->offset;
@@ -86,7 +87,7 @@ ArmState SimulatedArm::reported_state() const {
 
 std::vector<double> SimulatedArm::planned_reported_positions(double ahead_s) const {
   std::vector<double> positions(motion_.size());
-  const double t = motion_time_s_ + (moving_ ? ahead_s : 0.0);
+  const double t = motion_time_s_ + (moving_ ? speed_scale_ * ahead_s : 0.0);
   for (size_t i = 0; i < motion_.size(); ++i) {
     const JointMotion& m = motion_[i];
     positions[i] =

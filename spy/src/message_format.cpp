@@ -129,6 +129,24 @@ std::string format(const discrepancy_t& m) {
     s << " " << m.link_name[i] << "=" << m.link_match[i] << "/" << m.link_compared[i] << "(far "
       << m.link_farther[i] << ", near " << m.link_nearer[i] << ")";
   }
+  // The user (docs/safety-chain.md, "The user"): the nearest region to the
+  // arm, and what the camera saw of the user.
+  if (m.num_body_regions > 0 &&
+      m.body_region_separation_m.size() == static_cast<size_t>(m.num_body_regions)) {
+    int nearest = 0;
+    int64_t modelled = 0, missing = 0, seen = 0;
+    for (int k = 0; k < m.num_body_regions; ++k) {
+      if (m.body_region_separation_m[k] < m.body_region_separation_m[nearest]) nearest = k;
+      if (static_cast<size_t>(k) < m.body_region_modelled_pixels.size()) {
+        modelled += m.body_region_modelled_pixels[k];
+        missing += m.body_region_missing_pixels[k];
+        seen += m.body_region_seen_pixels[k];
+      }
+    }
+    s << std::setprecision(2) << " | user: nearest " << m.body_region[nearest] << " "
+      << m.body_region_separation_m[nearest] << " m (model), seen " << seen << " px, missing " << missing
+      << " of " << modelled << " modelled px";
+  }
   return s.str();
 }
 

@@ -317,6 +317,7 @@ TEST(WireChecks, LinkLabelsBodyRegions) {
   l.num_body_regions = 2;
   l.body_region = {"face", "hand"};
   l.body_region_separation_m = {0.3f, 0.0f};
+  l.body_region_envelope_m = {0.05f, 0.1f};
   EXPECT_EQ(check_link_labels(l), "");
   link_labels_t bad = l;
   bad.body_region[1] = "hands";  // no such region
@@ -333,6 +334,67 @@ TEST(WireChecks, LinkLabelsBodyRegions) {
   bad = l;
   bad.body_region_separation_m.pop_back();
   EXPECT_EQ(field_of(bad), "body_region_separation_m");
+}
+
+TEST(WireChecks, LinkLabelsOccupantShapes) {
+  link_labels_t l = labels_with_kinematics();
+  l.num_body_regions = 2;
+  l.body_region = {"face", "hand"};
+  l.body_region_separation_m = {0.3f, 0.0f};
+  l.body_region_envelope_m = {0.05f, 0.1f};
+  l.num_occupant_shapes = 2;
+  l.occupant_shape_kind = {link_labels_t::SHAPE_BOX, link_labels_t::SHAPE_CYLINDER};
+  l.occupant_shape_region = {0, 1};
+  l.occupant_shape_center_m = {{0.1f, 0.2f, 1.5f}, {0.0f, 0.0f, 1.2f}};
+  // The cylinder's axis along the optical x: a quarter turn about y.
+  l.occupant_shape_rotation = {{1, 0, 0, 0, 1, 0, 0, 0, 1}, {0, 0, 1, 0, 1, 0, -1, 0, 0}};
+  l.occupant_shape_size_m = {{0.03f, 0.065f, 0.08f}, {0.04f, 0.13f, 0.0f}};
+  EXPECT_EQ(check_link_labels(l), "");
+  link_labels_t bad = l;
+  bad.body_region_envelope_m.pop_back();
+  EXPECT_EQ(field_of(bad), "body_region_envelope_m");
+  bad = l;
+  bad.body_region_envelope_m[1] = -0.1f;
+  EXPECT_EQ(field_of(bad), "body_region_envelope_m[1]");
+  bad = l;
+  bad.occupant_shape_kind[1] = 3;
+  EXPECT_EQ(field_of(bad), "occupant_shape_kind[1]");
+  bad = l;
+  bad.occupant_shape_region[0] = 2;  // only two regions
+  EXPECT_EQ(field_of(bad), "occupant_shape_region[0]");
+  bad = l;
+  bad.occupant_shape_rotation[1] = {1, 0, 0, 0, 1, 0, 0, 0, -1};  // a reflection
+  EXPECT_EQ(field_of(bad), "occupant_shape_rotation[1]");
+  bad = l;
+  bad.occupant_shape_size_m[0][2] = -0.01f;
+  EXPECT_EQ(field_of(bad), "occupant_shape_size_m[0]");
+  bad = l;
+  bad.occupant_shape_center_m[0].pop_back();
+  EXPECT_EQ(field_of(bad), "occupant_shape_center_m[0]");
+  bad = l;
+  bad.num_occupant_shapes = 3;
+  EXPECT_EQ(field_of(bad), "occupant_shape_kind");
+}
+
+TEST(WireChecks, SpeedLimit) {
+  speed_limit_t l{};
+  l.max_arm_speed_m_s = 0.3;
+  l.set_by = speed_limit_t::SET_BY_BODY_REGION;
+  l.arm_speed_m_s = -1;
+  l.valid_for_ms = 150;
+  EXPECT_EQ(check_speed_limit(l), "");
+  speed_limit_t bad = l;
+  bad.max_arm_speed_m_s = std::nan("");
+  EXPECT_EQ(check_speed_limit(bad).substr(0, 17), "max_arm_speed_m_s");
+  bad = l;
+  bad.set_by = 4;
+  EXPECT_EQ(check_speed_limit(bad).substr(0, 6), "set_by");
+  bad = l;
+  bad.arm_speed_m_s = -0.5;
+  EXPECT_EQ(check_speed_limit(bad).substr(0, 13), "arm_speed_m_s");
+  bad = l;
+  bad.valid_for_ms = 0;
+  EXPECT_EQ(check_speed_limit(bad).substr(0, 12), "valid_for_ms");
 }
 
 TEST(WireChecks, Heartbeat) {

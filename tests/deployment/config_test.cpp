@@ -382,9 +382,10 @@ TEST(Config, MissingFileIsNamed) {
 // The occupant: absent in the embedded default (nobody modelled); given, it
 // is read whole, and every mistake in it is one line naming the key.
 TEST(Config, TheOccupantSectionIsOptionalAndReadWhole) {
-  EXPECT_FALSE(deployment::load_config(sim_yaml_path(), nullptr).occupant.has_value());
-  const deployment::Config config =
-      deployment::load_config(sim_config_variant("config-occupant", {}, occupant_section()), nullptr);
+  EXPECT_FALSE(deployment::load_config(sim_config_variant("config-no-occupant", {}, "occupant: ~\n"), nullptr)
+                   .occupant.has_value());
+  // The embedded default seats its user as occupant_section() does.
+  const deployment::Config config = deployment::load_config(sim_yaml_path(), nullptr);
   ASSERT_TRUE(config.occupant.has_value());
   const OccupantSettings& o = *config.occupant;
   EXPECT_EQ(o.seated_on, "wheelchair");
@@ -394,6 +395,15 @@ TEST(Config, TheOccupantSectionIsOptionalAndReadWhole) {
   EXPECT_DOUBLE_EQ(o.regions.at(BodyRegion::kFace).envelope_m, 0.05);
   EXPECT_DOUBLE_EQ(o.regions.at(BodyRegion::kFace).clearance_m.value_or(-1), 0.03);
   EXPECT_FALSE(o.regions.at(BodyRegion::kHand).clearance_m.has_value());
+  EXPECT_EQ(o.presence_min_modelled_pixels, 200);
+  EXPECT_DOUBLE_EQ(o.presence_max_missing_fraction, 0.5);
+  const deployment::Config same =
+      deployment::load_config(sim_config_variant("config-occupant", {}, occupant_section()), nullptr);
+  ASSERT_TRUE(same.occupant.has_value());
+  for (const auto& [region, r] : o.regions) {
+    EXPECT_DOUBLE_EQ(same.occupant->regions.at(region).envelope_m, r.envelope_m) << body_region_name(region);
+    EXPECT_EQ(same.occupant->regions.at(region).clearance_m, r.clearance_m) << body_region_name(region);
+  }
 }
 
 TEST(Config, OccupantMistakesNameTheKey) {

@@ -597,5 +597,141 @@ TEST(SilhouetteMask, FollowsItsRuleOnEveryPairOfNeighbours) {
   EXPECT_GT(silhouettes, 1000);  // the scenes have silhouettes to find
 }
 
+// ---- The wheelchair's user (docs/safety-chain.md, "The user") ----
+
+namespace user {
+
+// The user's chest as the model has it: a box whose front face is at
+// 1.6 m, seen over columns 110..149 and rows 60..119 (fx = fy = 200, the
+// principal point at the image centre), 10 columns (8 cm) beside link2.
+constexpr int kU0 = 110, kU1 = 150, kV0 = 60, kV1 = 120;
+constexpr int16_t kFrontMm = 1600;
+constexpr double kEnvelopeM = 0.03;
+
+Box chest(int shift_px = 0, int16_t depth_mm = kFrontMm) {
+  return {kU0 + shift_px, kV0, kU1 + shift_px, kV1, depth_mm, link_labels_t::OCCUPANT_FIRST};
+}
+
+// The labels' region "chest" (envelope 3 cm) and its one box, in the
+// optical frame: the face at z = 1.6 m over exactly the columns and rows
+// above (pixel edges at u - 0.5 and u1 - 0.5), 0.2 m deep.
+void add_chest(link_labels_t* labels) {
+  const double z = kFrontMm * 1e-3;
+  const double cx = kWidth / 2.0, cy = kHeight / 2.0;
+  const double x0 = (kU0 - 0.5 - cx) * z / kFocalPx, x1 = (kU1 - 0.5 - cx) * z / kFocalPx;
+  const double y0 = (kV0 - 0.5 - cy) * z / kFocalPx, y1 = (kV1 - 0.5 - cy) * z / kFocalPx;
+  labels->num_body_regions = 1;
+  labels->body_region = {"chest"};
+  labels->body_region_separation_m = {0.08f};
+  labels->body_region_envelope_m = {static_cast<float>(kEnvelopeM)};
+  labels->num_occupant_shapes = 1;
+  labels->occupant_shape_kind = {link_labels_t::SHAPE_BOX};
+  labels->occupant_shape_region = {0};
+  labels->occupant_shape_center_m = {
+      {static_cast<float>((x0 + x1) / 2), static_cast<float>((y0 + y1) / 2), static_cast<float>(z + 0.1)}};
+  labels->occupant_shape_rotation = {{1, 0, 0, 0, 1, 0, 0, 0, 1}};
+  labels->occupant_shape_size_m = {
+      {static_cast<float>((x1 - x0) / 2), static_cast<float>((y1 - y0) / 2), 0.1f}};
+}
+
+// The default arm with the user's chest beside it, the model's image, and
+// the camera's image of `seen` (with noise).
+discrepancy_t compare_with_user(const std::vector<Box>& seen) {
+  std::vector<Box> modelled = default_arm();
+  modelled.push_back(chest());
+  const SyntheticImage model = draw(modelled);
+  link_labels_t labels = labels_frame(model.label, 7);
+  add_pixel_cover(&labels, model.depth_mm);
+  add_chest(&labels);
+  const DiscrepancyFrame f = compute_discrepancy(depth_frame(with_noise(draw(seen).depth_mm, 5), 7),
+                                                 depth_frame(model.depth_mm, 7), labels, sim_options());
+  EXPECT_TRUE(f.summary.usable) << f.summary.unusable_reason;
+  return f.summary;
+}
+
+std::vector<Box> arm_and(const std::vector<Box>& more) {
+  std::vector<Box> scene = default_arm();
+  scene.insert(scene.end(), more.begin(), more.end());
+  return scene;
+}
+
+// The model's chest pixels (the silhouette lies on the floor's side of
+// the rendered step, none on the chest's).
+constexpr int kChestCounted = 40 * 60;
+
+}  // namespace user
+
+TEST(DiscrepancyUser, TheUserAsModelledIsSeenAndNoObject) {
+  const discrepancy_t s = user::compare_with_user(user::arm_and({user::chest()}));
+  ASSERT_EQ(s.num_body_regions, 1);
+  EXPECT_EQ(s.body_region_modelled_pixels[0], user::kChestCounted);
+  EXPECT_EQ(s.body_region_seen_pixels[0], user::kChestCounted);
+  EXPECT_EQ(s.body_region_missing_pixels[0], 0);
+  EXPECT_EQ(s.num_unexpected_surface, 0);
+  EXPECT_EQ(s.near_arm_pixels, 0);
+  EXPECT_FLOAT_EQ(s.unexplained_area_within_m2.back(), 0);
+  // The user's pixels are no link's, and not in the frame's scores.
+  EXPECT_EQ(s.link_compared[3], kPixels - 2400 - 40 * 60);
+  // Nothing of the user is seen off the model.
+  EXPECT_FLOAT_EQ(s.body_region_seen_separation_m[0], -1);
+}
+
+// The user 3 px (2.4 cm at 1.6 m) towards the arm: the newly covered band
+// is an unexplained surface 1.6 m away before the floor, but within the
+// chest's 3 cm envelope, so it is the user, seen off the model; the band
+// the user left shows the floor, farther than the envelope: missing.
+// Neither is an object or a blob.
+TEST(DiscrepancyUser, AUserMovedWithinTheEnvelopeIsStillTheUser) {
+  const discrepancy_t s = user::compare_with_user(user::arm_and({user::chest(-3)}));
+  EXPECT_EQ(s.near_arm_pixels, 0);
+  EXPECT_FLOAT_EQ(s.unexplained_area_within_m2.back(), 0);
+  EXPECT_EQ(s.largest_blob_pixels, 0);
+  EXPECT_EQ(s.body_region_missing_pixels[0], 3 * 60);
+  // Seen: the model's pixels less the missing band, plus the band before
+  // the floor (3 x 60, less the floor's silhouette column beside the
+  // rendered step and what the opening takes off).
+  EXPECT_GE(s.body_region_seen_pixels[0], user::kChestCounted - 3 * 60 + 2 * 56);
+  EXPECT_LE(s.body_region_seen_pixels[0], user::kChestCounted - 3 * 60 + 3 * 60);
+  // The band off the model nearest the arm: column 107 at 1.6 m, 7 cm
+  // beside link2's last column (1.5 m) and 10 cm behind it, less the
+  // cover sphere's 5 mm: 11.7 cm; the camera's noise (7 mm at 1.6 m, the
+  // least of 180 pixels about -2.8 sigma) brings it nearer by up to 2 cm.
+  EXPECT_GT(s.body_region_seen_separation_m[0], 0.09);
+  EXPECT_LT(s.body_region_seen_separation_m[0], 0.118);
+}
+
+// A hand lifted out of every envelope, 1.5 m away in columns 102..105
+// (7-11 cm before and beside the chest's model): an unknown object beside
+// the arm, as without a user.
+TEST(DiscrepancyUser, AHandOutsideEveryEnvelopeIsAnUnknownObject) {
+  const discrepancy_t s =
+      user::compare_with_user(user::arm_and({user::chest(), {102, 62, 106, 72, 1500, 0}}));
+  EXPECT_GE(s.near_arm_pixels, 2 * 8);  // the opening keeps the 4 x 10 block's inside
+  EXPECT_LE(s.near_arm_pixels, 4 * 10);
+  EXPECT_GT(s.unexplained_area_within_m2.back(), 0);
+  EXPECT_EQ(s.body_region_missing_pixels[0], 0);
+}
+
+// Nobody in the chair: every modelled pixel of the user sees the floor
+// 0.4 m behind, farther than the envelope.
+TEST(DiscrepancyUser, AnEmptyChairLeavesEveryModelledPixelMissing) {
+  const discrepancy_t s = user::compare_with_user(default_arm());
+  EXPECT_EQ(s.body_region_modelled_pixels[0], user::kChestCounted);
+  EXPECT_EQ(s.body_region_missing_pixels[0], user::kChestCounted);
+  EXPECT_EQ(s.body_region_seen_pixels[0], 0);
+  EXPECT_FLOAT_EQ(s.body_region_seen_separation_m[0], -1);
+  EXPECT_EQ(s.largest_blob_pixels, 0);
+}
+
+// Something before the user by more than the envelope (a caregiver's hand
+// over the chest, 1.45 m away, 15 cm before it) is not the user.
+TEST(DiscrepancyUser, SomethingBeforeTheUserBeyondTheEnvelopeIsNotTheUser) {
+  const discrepancy_t s =
+      user::compare_with_user(user::arm_and({user::chest(), {112, 62, 120, 72, 1450, 0}}));
+  EXPECT_GT(s.near_arm_pixels, 0);
+  EXPECT_GT(s.unexplained_area_within_m2.back(), 0);
+  EXPECT_EQ(s.body_region_missing_pixels[0], 0);
+}
+
 }  // namespace
 }  // namespace tofguard::test

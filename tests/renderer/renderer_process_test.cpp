@@ -31,9 +31,16 @@ robot_model::JointPositions arm_at(int64_t utime, int64_t t0) {
   return q;
 }
 
+// config/sim.yaml without its occupant: these tests compare the process's
+// frames with the library's renders of the arm and the scene
+// (renderer_service_test renders the user).
+const std::string& config_path() {
+  static const std::string path = tofguard::test::sim_config_variant("renderer-process", {}, "occupant: ~\n");
+  return path;
+}
+
 struct Bench {
-  deployment::Config config =
-      deployment::load_config(tofguard::test::source_dir() + "/config/sim.yaml", nullptr);
+  deployment::Config config = deployment::load_config(config_path(), nullptr);
   lcm::LCM safety{config.lcm.url};
   lcm::LCM images{config.lcm.image_url};
   std::map<int64_t, depth_image_t> rendered;  // by seq
@@ -95,9 +102,8 @@ struct Bench {
 };
 
 TEST(RendererProcess, RendersFramesAtInterpolatedJointsAndMarksUnusableOnes) {
-  tofguard::test::Subprocess process("renderer-process",
-                                     {tofguard::test::bin_dir() + "/tofguard-renderer", "--config",
-                                      tofguard::test::source_dir() + "/config/sim.yaml"});
+  tofguard::test::Subprocess process(
+      "renderer-process", {tofguard::test::bin_dir() + "/tofguard-renderer", "--config", config_path()});
   Bench bench;
 
   // Until the process is up, keep sending joint states and a frame between
@@ -244,9 +250,9 @@ int differing_pixels(const depth_image_t& out, const link_labels_t& labels, cons
 }
 
 TEST(RendererProcess, FollowsAMovingCameraAtEachFramesUtime) {
-  tofguard::test::Subprocess process("renderer-process-moving-camera",
-                                     {tofguard::test::bin_dir() + "/tofguard-renderer", "--config",
-                                      tofguard::test::source_dir() + "/config/sim.yaml"});
+  tofguard::test::Subprocess process(
+      "renderer-process-moving-camera",
+      {tofguard::test::bin_dir() + "/tofguard-renderer", "--config", config_path()});
   Bench bench;
   const deployment::Config& config = bench.config;
   // The configured pose panned by `deg` about the world's vertical axis.
@@ -345,9 +351,9 @@ std::pair<int, int> prediction_counts(const heartbeat_t& hb) {
 }
 
 TEST(RendererProcess, APlannedFrameIsRenderedAheadAndIdenticalToTheNormalRendering) {
-  tofguard::test::Subprocess process("renderer-process-prediction",
-                                     {tofguard::test::bin_dir() + "/tofguard-renderer", "--config",
-                                      tofguard::test::source_dir() + "/config/sim.yaml"});
+  tofguard::test::Subprocess process(
+      "renderer-process-prediction",
+      {tofguard::test::bin_dir() + "/tofguard-renderer", "--config", config_path()});
   Bench bench;
   const deployment::Config& config = bench.config;
   ASSERT_TRUE(

@@ -8,6 +8,7 @@
 #include "tofguard/common/wire_checks.hpp"
 #include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/renderer/prediction_schedule.hpp"
+#include "tofguard/renderer/rendered_occupant.hpp"
 #include "tofguard/renderer/renderer_service.hpp"
 #include "tofguard/robot_model/arm_spheres.hpp"
 #include "tool_support.hpp"
@@ -51,6 +52,13 @@ depth_image_t frame(int64_t utime, int64_t seq, const Intrinsics& k) {
   return f;
 }
 
+// The config's occupant as the service renders it.
+std::vector<ExtraObject> seated_user(const deployment::Config& config, const robot_model::SceneModel& scene) {
+  if (!config.occupant) return {};
+  return occupant_render_objects(robot_model::load_occupant(
+      config.occupant->urdf_path, robot_model::fixed_link_pose(scene, config.occupant->seated_on)));
+}
+
 robot_model::JointPositions arm(double s) {
   robot_model::JointPositions q;
   for (int i = 1; i <= 7; ++i) q["a" + std::to_string(i)] = 0.1 * i * s;
@@ -80,12 +88,19 @@ TEST(RendererService, PublishesTheModelAtTheInterpolatedJointsInMillimetres) {
   EXPECT_EQ(out.labels.num_robot_links, 10);
   EXPECT_EQ(out.labels.num_links, static_cast<int>(out.labels.link_name.size()));
 
-  // The same as the library at arm(1.25), rounded to millimetres.
+  // The same as the library at arm(1.25) with the seated user's shapes,
+  // rounded to millimetres.
   const robot_model::SceneModel scene = robot_model::load_scene(
       config.robot.urdf_path, config.environment.urdf_paths, scene_options(config.renderer, config.robot));
   DepthRenderer renderer(scene, config.renderer.near_m, config.renderer.far_m);
-  const RenderResult expected = renderer.render(arm(1.25), config.camera.pose, k);
+  const std::vector<ExtraObject> user = seated_user(config, scene);
+  const RenderResult expected = renderer.render(arm(1.25), config.camera.pose, k, user);
   ASSERT_TRUE(expected.usable);
+  // The user is seen, labelled by shape, and the labels carry every shape.
+  EXPECT_EQ(out.labels.num_occupant_shapes, static_cast<int>(user.size()));
+  int user_pixels = 0;
+  for (int16_t l : out.labels.label) user_pixels += l >= kLabelOccupantFirst ? 1 : 0;
+  EXPECT_GT(user_pixels, 1000);
   int robot_pixels = 0;
   for (size_t i = 0; i < expected.depth_m.size(); ++i) {
     // Rounded to the nearest millimetre; the service interpolates the
@@ -97,17 +112,19 @@ TEST(RendererService, PublishesTheModelAtTheInterpolatedJointsInMillimetres) {
   }
   EXPECT_GT(robot_pixels, 1000);
   // And different from the arm at either bracketing message.
-  EXPECT_NE(renderer.render(arm(1.0), config.camera.pose, k).depth_m, expected.depth_m);
+  EXPECT_NE(renderer.render(arm(1.0), config.camera.pose, k, user).depth_m, expected.depth_m);
 }
 
 // With an occupant the labels carry each body region's separation from the
 // arm's cover at the frame's joints: robot_model's, rounded down to a
 // float; without one, none.
 TEST(RendererService, TheLabelsCarryTheUsersBodyRegionsSeparations) {
-  RendererService without(deployment::renderer_process_settings(sim_config()));
+  const deployment::Config nobody = deployment::load_config(
+      tofguard::test::sim_config_variant("renderer-no-occupant", {}, "occupant: ~\n"), nullptr);
+  RendererService without(deployment::renderer_process_settings(nobody));
   ASSERT_TRUE(without.on_joint_state(joint_state(1'000'000, arm(1.0))));
   ASSERT_TRUE(without.on_joint_state(joint_state(1'010'000, arm(1.0))));
-  const RenderedFrame plain = without.render(frame(1'002'500, 42, sim_config().camera.intrinsics));
+  const RenderedFrame plain = without.render(frame(1'002'500, 42, nobody.camera.intrinsics));
   ASSERT_TRUE(plain.labels.usable) << plain.labels.unusable_reason;
   EXPECT_EQ(plain.labels.num_body_regions, 0);
   const deployment::Config config = deployment::load_config(
@@ -280,7 +297,7 @@ TEST(RendererService, WithoutAPlanTheNextFrameIsGuessedFromTheJointStates) {
   // rounding, as above).
   const auto expect_rendered_at = [&](const RenderedFrame& out, const robot_model::JointPositions& joints) {
     ASSERT_TRUE(out.depth.has_value()) << out.labels.unusable_reason;
-    const RenderResult expected = renderer.render(joints, config.camera.pose, k);
+    const RenderResult expected = renderer.render(joints, config.camera.pose, k, seated_user(config, scene));
     ASSERT_TRUE(expected.usable);
     for (size_t i = 0; i < expected.depth_m.size(); ++i) {
       ASSERT_LE(std::abs(out.depth->depth_mm[i] - expected.depth_m[i] * 1000), 0.5 + 1e-3) << "pixel " << i;

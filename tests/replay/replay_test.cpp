@@ -63,6 +63,12 @@ const std::string& replay_config_path() {
                     {"/bin/bash", source_dir() + "/scripts/record-scenario", "--write-config", p, "--replay"},
                     &out, &err);
     if (code != 0) throw std::runtime_error("record-scenario --write-config failed: " + out + err);
+    // The recordings in tests/data show the wheelchair empty: the chain
+    // that replays them models no user (with the default's user it would
+    // rightly stop: the user is not where the model seats them).
+    std::string text = read_file(p);
+    erase_config_section(&text, "occupant");
+    write_file(p, text);
     return p;
   }();
   return path;

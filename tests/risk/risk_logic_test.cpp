@@ -564,6 +564,11 @@ TEST(RiskMonitor, TheArmFasterThanTheUsersFaceAllowsIsStoppedAfterTheDebounce) {
     // The face 20 cm away (15 cm beyond its 5 cm envelope); the rest 1 m.
     d.body_region_separation_m.push_back(region == BodyRegion::kFace ? 0.20f : 1.0f);
   }
+  // The user seen where modelled.
+  d.body_region_modelled_pixels.assign(kNumBodyRegions, 100);
+  d.body_region_missing_pixels.assign(kNumBodyRegions, 0);
+  d.body_region_seen_pixels.assign(kNumBodyRegions, 100);
+  d.body_region_seen_separation_m.assign(kNumBodyRegions, -1.0f);
   // a1 at `speed` rad/s: the arm's bound is 0.35 m * speed.
   auto state_at = [&](double speed, int64_t utime) {
     joint_state_t s{};
@@ -616,6 +621,61 @@ TEST(RiskMonitor, TheArmFasterThanTheUsersFaceAllowsIsStoppedAfterTheDebounce) {
                 std::string::npos)
           << verdicts[2].detail;
     }
+  }
+}
+
+// The user not where the model seats them: with more than 200 of the
+// user's pixels seen, more than half of them farther than their envelope
+// is an unclassified finding after the debounce; half or less, or too few
+// pixels to say, is none.
+TEST(RiskMonitor, AnEmptyChairIsSaidAndStopsTheArm) {
+  const deployment::Config with_user =
+      deployment::load_config(sim_config_variant("risk-logic-presence", {}, occupant_section()), nullptr);
+  discrepancy_t d = summary_of(default_arm(), 40);
+  d.num_body_regions = kNumBodyRegions;
+  d.body_region.clear();
+  for (const BodyRegion region : all_body_regions()) d.body_region.push_back(body_region_name(region));
+  d.body_region_separation_m.assign(kNumBodyRegions, 1.0f);
+  d.body_region_seen_pixels.assign(kNumBodyRegions, 0);
+  d.body_region_seen_separation_m.assign(kNumBodyRegions, -1.0f);
+  struct Case {
+    int modelled_per_region;
+    int missing_per_region;
+    bool stopped;
+  };
+  // 12 regions: 240 pixels of which 11/20 missing; 10/20 missing; 132
+  // pixels, all missing (too few to say).
+  for (const Case c : {Case{20, 11, true}, Case{20, 10, false}, Case{11, 11, false}}) {
+    d.body_region_modelled_pixels.assign(kNumBodyRegions, c.modelled_per_region);
+    d.body_region_missing_pixels.assign(kNumBodyRegions, c.missing_per_region);
+    RiskMonitor m(with_user.risk, with_user.channels, friend_arm(), kRateHz, kStart);
+    m.set_occupant(*with_user.occupant);
+    std::vector<risk_t> verdicts;
+    for (int i = 0; i < 3; ++i) {
+      const int64_t now = kStart + i * 33 * kMs;
+      feed_all(&m, now);
+      discrepancy_t frame = d;
+      frame.seq = 40 + i;
+      frame.utime = d.utime + i * 33'000;
+      verdicts.push_back(judged_at_once(&m, frame, now));
+    }
+    const std::string what =
+        std::to_string(c.missing_per_region) + " of " + std::to_string(c.modelled_per_region);
+    if (!c.stopped) {
+      for (const risk_t& r : verdicts)
+        EXPECT_NE(r.cause, risk_t::CAUSE_UNCLASSIFIED) << what << ": " << r.detail;
+      continue;
+    }
+    EXPECT_EQ(verdicts[0].level, risk_t::WARNING) << what;
+    EXPECT_EQ(verdicts[2].level, risk_t::DANGEROUS) << what;
+    EXPECT_EQ(verdicts[2].cause, risk_t::CAUSE_UNCLASSIFIED);
+    EXPECT_NE(verdicts[2].detail.find(
+                  "the user is not where the occupant model seats them (missing fraction): 55 % "
+                  "of the 240 modelled user pixels"),
+              std::string::npos)
+        << verdicts[2].detail;
+    EXPECT_NE(verdicts[2].detail.find("mostly missing: skull_and_forehead, face,"), std::string::npos)
+        << verdicts[2].detail;
   }
 }
 

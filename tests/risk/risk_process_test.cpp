@@ -59,10 +59,13 @@ class RiskProcess : public ::testing::Test {
     good_ = summary(1, 0);
     shifted_ = summary(1, 16);
     process_ = std::make_unique<Subprocess>(
-        "risk-process", std::vector<std::string>{
-                            bin_dir() + "/tofguard-risk", "--config",
-                            chain_config("risk", {{"    wait_ms: 0\n",
-                                                   "    wait_ms: 60\n"}})});  // these tests watch the wait
+        "risk-process",
+        std::vector<std::string>{
+            bin_dir() + "/tofguard-risk", "--config",
+            // these tests watch the wait; their synthetic
+            // frames carry no user (risk_logic_test judges
+            // the user's)
+            sim_config_variant("chain-risk", {{"    wait_ms: 0\n", "    wait_ms: 60\n"}}, "occupant: ~\n")});
     ASSERT_TRUE(wait_until([&] { return !bus_.last_heartbeat("tofguard-risk").process.empty(); }, kDeadline,
                            [&] { bus_.poll(); }))
         << process_->stderr_text();

@@ -1,10 +1,11 @@
 // tofguard-joints-sim as a real process over real LCM (private network
 // namespace): halted without permission, moving with it, halted again when
 // the permission goes stale, moving without one only when commissioning;
-// run-time encoder faults.
+// following the speed limit; run-time encoder faults.
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 #include "signed_publisher.hpp"
@@ -14,6 +15,7 @@
 #include "tofguard/planned_trajectory_t.hpp"
 #include "tofguard/safety_status_t.hpp"
 #include "tofguard/sim_joint_fault_t.hpp"
+#include "tofguard/speed_limit_t.hpp"
 #include "tool_support.hpp"
 
 namespace tofguard::test {
@@ -28,6 +30,10 @@ struct Listener {
   SignedPublisher signed_lcm{lcm};
   bool allow = false;
   int64_t last_status_us = 0;
+  // The speed limit sent with each status (config/sim.yaml's arm follows
+  // it), as tofguard-risk would: m/s, and the arm's speed bound of the
+  // newest joint state, here the sum of its joint speeds x 1 m.
+  double limit_m_s = 100;
   Listener() {
     lcm.subscribe("JOINT_STATE", &Listener::on_reported, this);
     lcm.subscribe("SIM_TRUE_JOINT_STATE", &Listener::on_truth, this);
@@ -45,13 +51,25 @@ struct Listener {
   void pump() {
     if (allow && monotonic_us() - last_status_us > 20000) {
       last_status_us = monotonic_us();
-      safety_status_t s;
+      safety_status_t s{};
       s.utime = wall_utime();
       s.motion_allowed = true;
       s.reason = "test";
       signed_lcm.publish("SAFETY_STATUS", s);  // as a keyed tofguard-intervene does
+      speed_limit_t limit{};
+      limit.utime = reported.utime;
+      limit.max_arm_speed_m_s = limit_m_s;
+      limit.set_by = speed_limit_t::SET_BY_BODY_REGION;
+      limit.arm_speed_m_s = reported_bound_m_s();
+      limit.valid_for_ms = 150;
+      signed_lcm.publish("SAFETY_SPEED_LIMIT", limit);
     }
     lcm.handleTimeout(5);
+  }
+  double reported_bound_m_s() const {
+    double sum = 0;
+    for (double x : reported.velocity) sum += std::abs(x);
+    return sum;
   }
   double max_speed() const {
     double v = 0;
@@ -140,6 +158,39 @@ TEST(JointsSimProcess, PublishesThePlanItFollows) {
     }
   }
   EXPECT_GT(compared, 50);
+}
+
+// config/sim.yaml's arm follows SAFETY_SPEED_LIMIT_AUTH: with a limit of
+// 0.3 m/s its bound (here the sum of its joint speeds x 1 m, about 2.7 m/s
+// at full speed) stays at 80 % of it, give or take the limit's lag behind
+// the arm; with the limit at 0 it stands.
+TEST(JointsSimProcess, FollowsTheSpeedLimit) {
+  Subprocess sim("joints-sim-speed-limit",
+                 {bin_dir() + "/tofguard-joints-sim", "--config", source_dir() + "/config/sim.yaml"});
+  Listener l;
+  l.allow = true;
+  l.limit_m_s = 0.3;
+  ASSERT_TRUE(wait_until([&] { return l.max_speed() > 0.01; }, std::chrono::seconds(5), [&] { l.pump(); }))
+      << sim.stderr_text();
+  // Settled after a second; then two seconds of joint states.
+  const int64_t settle_until_us = monotonic_us() + 1'000'000;
+  wait_until([&] { return monotonic_us() > settle_until_us; }, std::chrono::seconds(2), [&] { l.pump(); });
+  l.all_reported.clear();
+  const int64_t end_us = monotonic_us() + 2'000'000;
+  wait_until([&] { return monotonic_us() > end_us; }, std::chrono::seconds(3), [&] { l.pump(); });
+  ASSERT_GT(l.all_reported.size(), 150u);
+  double highest = 0;
+  double total = 0;
+  for (const joint_state_t& s : l.all_reported) {
+    double bound = 0;
+    for (double v : s.velocity) bound += std::abs(v);
+    highest = std::max(highest, bound);
+    total += bound;
+  }
+  EXPECT_LE(highest, 0.3) << "the arm's bound above the limit";
+  EXPECT_GT(total / l.all_reported.size(), 0.1) << "the arm hardly moves under the limit";
+  l.limit_m_s = 0;
+  ASSERT_TRUE(wait_until([&] { return l.max_speed() == 0.0; }, std::chrono::seconds(1), [&] { l.pump(); }));
 }
 
 // --commissioning: the arm moves with no SAFETY_STATUS at all (a camera's

@@ -18,7 +18,8 @@ namespace {
 class FakeRenderer : public SceneRenderer {
  public:
   RenderedDepth render(const std::map<std::string, double>& joints, const CameraPose& pose,
-                       const Intrinsics& in, const std::vector<SimBox>& boxes) override {
+                       const Intrinsics& in, const std::vector<SimBox>& boxes,
+                       const std::vector<RegionShape>& /*user*/) override {
     last_joints = joints;
     last_pose = pose;
     last_boxes = boxes;

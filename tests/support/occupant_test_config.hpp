@@ -28,7 +28,8 @@ inline std::string occupant_section() {
          "    forearm: {envelope_m: 0.08}\n"
          "    hand: {envelope_m: 0.10}\n"
          "    thigh: {envelope_m: 0.03}\n"
-         "    lower_leg: {envelope_m: 0.05}\n";
+         "    lower_leg: {envelope_m: 0.05}\n"
+         "  presence: {min_modelled_pixels: 200, max_missing_fraction: 0.5}\n";
 }
 
 }  // namespace tofguard::test

@@ -35,6 +35,8 @@
 #include "tofguard/motion_estimate_t.hpp"
 #include "tofguard/risk_t.hpp"
 #include "tofguard/robot_model/kinematics.hpp"
+#include "tofguard/robot_model/occupant_model.hpp"
+#include "tofguard/robot_model/scene_model.hpp"
 #include "tofguard/safety_status_t.hpp"
 #include "tofguard/sim_camera_fault_t.hpp"
 #include "tofguard/sim_joint_fault_t.hpp"
@@ -242,6 +244,33 @@ class Chain {
       }
     }
     safety_.publish(config_.channels.sim_camera_fault, &f);
+  }
+  // A box of `size_m` standing still at `at_m` (world frame) from now on.
+  void intrude(const Eigen::Vector3d& at_m, const Eigen::Vector3d& size_m) {
+    sim_camera_fault_t f{};
+    f.utime = wall_utime();
+    f.camera_id = config_.camera.id;
+    f.kind = sim_camera_fault_t::INTRUDING_OBJECT;
+    f.duration_s = 1000;
+    for (int i = 0; i < 3; ++i) {
+      f.object_size_m[i] = size_m[i];
+      f.object_position_m[i] = at_m[i];
+    }
+    safety_.publish(config_.channels.sim_camera_fault, &f);
+  }
+  // Where the seated user's `link` (its first shape's centre) is in the
+  // world, as the config's occupant model seats it.
+  Eigen::Vector3d user_part_m(const std::string& link) {
+    const robot_model::SceneModel scene = robot_model::load_scene(
+        config_.robot.urdf_path, config_.environment.urdf_paths, robot_model::SceneOptions{});
+    EXPECT_TRUE(config_.occupant.has_value());
+    const robot_model::OccupantModel user = robot_model::load_occupant(
+        config_.occupant->urdf_path, robot_model::fixed_link_pose(scene, config_.occupant->seated_on));
+    for (const robot_model::OccupantPart& part : user.parts) {
+      if (part.link_name == link) return part.shapes.front().frame_from_shape.translation();
+    }
+    ADD_FAILURE() << "no user link " << link;
+    return Eigen::Vector3d::Zero();
   }
   void joint_fault(const std::string& joint, double offset_rad) {
     sim_joint_fault_t f;
@@ -534,6 +563,39 @@ TEST(SafetyChainE2E, NominalMotionThenEveryFaultStopsTheArmWithItsCause) {
         << risk_cause_name(stop.cause) << ": " << stop.reason;
     chain.start("tofguard-renderer");
     chain.bring_to_motion("renderer restarted");
+  }
+}
+
+// The user in the chair (config/sim.yaml's occupant and simulated user):
+// their own moving body never stops the arm (the nominal part above runs
+// with them), but a hand lifted out of its envelope into the arm's reach
+// and a caregiver's hand before the user are unknown objects, stopped as
+// docs/detection.md's objects are.
+TEST(SafetyChainE2E, AHandOutsideTheUsersEnvelopesIsAnUnknownObject) {
+  Chain chain;
+  chain.bring_to_motion("start of the test");
+  if (HasFatalFailure()) return;
+  safety_status_t stop;
+  // The world's z is up (the wheelchair stands on the floor).
+  const Eigen::Vector3d hand = chain.user_part_m("hand_right");
+  const Eigen::Vector3d chest = chain.user_part_m("chest");
+  {
+    SCOPED_TRACE("the user's right hand lifted 25 cm (its envelope: 10 cm)");
+    const int64_t latency = chain.stop_latency_after_frame(
+        [&] { chain.intrude(hand + Eigen::Vector3d(0, 0, 0.25), Eigen::Vector3d(0.10, 0.08, 0.03)); }, &stop);
+    EXPECT_STOP(latency, stop, risk_t::CAUSE_UNKNOWN_OBJECT);
+    chain.camera_fault(sim_camera_fault_t::CLEAR);
+    chain.bring_to_motion("hand lowered");
+    if (HasFatalFailure()) return;
+  }
+  {
+    SCOPED_TRACE("a caregiver's hand 20 cm before the user's chest (its envelope: 3 cm)");
+    const int64_t latency = chain.stop_latency_after_frame(
+        [&] { chain.intrude(chest + Eigen::Vector3d(0.30, 0, 0.05), Eigen::Vector3d(0.10, 0.08, 0.03)); },
+        &stop);
+    EXPECT_STOP(latency, stop, risk_t::CAUSE_UNKNOWN_OBJECT);
+    chain.camera_fault(sim_camera_fault_t::CLEAR);
+    chain.bring_to_motion("caregiver gone");
   }
 }
 

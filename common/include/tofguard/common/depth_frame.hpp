@@ -62,9 +62,12 @@ constexpr int16_t kLabelRobotFirst = link_labels_t::ROBOT_FIRST;
 // 1000..1999: environment link num_robot_links + (label -
 // kLabelEnvironmentFirst) of link_name.
 constexpr int16_t kLabelEnvironmentFirst = link_labels_t::ENVIRONMENT_FIRST;
-// 2000..: never on the wire. The renderer's per-call extra objects (the
-// simulated camera's intruding object), index label - kLabelExtraObjectFirst.
-constexpr int16_t kLabelExtraObjectFirst = 2000;
+// 2000..: the renderer's per-call extra objects, index label -
+// kLabelExtraObjectFirst: the monitor's occupant shapes (on the wire as
+// link_labels_t::OCCUPANT_FIRST + shape index) or the simulated camera's
+// people and objects (never on the wire).
+constexpr int16_t kLabelExtraObjectFirst = link_labels_t::OCCUPANT_FIRST;
+constexpr int16_t kLabelOccupantFirst = link_labels_t::OCCUPANT_FIRST;
 
 // How many robot and environment links the label values can name.
 constexpr int kMaxLabelledRobotLinks = kLabelEnvironmentFirst - kLabelRobotFirst;
@@ -81,6 +84,14 @@ constexpr int16_t label_of_link(int link, int num_robot_links) {
 // for kLabelNothing, an extra object, or a value outside the links there
 // are (num_robot_links robot links, num_links - num_robot_links environment
 // links). Called per pixel: inline.
+// The occupant shape a label value names (kLabelOccupantFirst + k, k <
+// num_occupant_shapes of the labels); -1 for any other value.
+constexpr int occupant_shape_of_label(int label, int num_occupant_shapes) {
+  return label >= kLabelOccupantFirst && label < kLabelOccupantFirst + num_occupant_shapes
+             ? label - kLabelOccupantFirst
+             : -1;
+}
+
 constexpr int link_of_label(int label, int num_robot_links, int num_links) {
   if (label >= kLabelRobotFirst && label < kLabelRobotFirst + num_robot_links)
     return label - kLabelRobotFirst;

@@ -18,6 +18,7 @@
 #include "tofguard/safety_status_t.hpp"
 #include "tofguard/sim_camera_fault_t.hpp"
 #include "tofguard/sim_joint_fault_t.hpp"
+#include "tofguard/speed_limit_t.hpp"
 
 namespace tofguard {
 
@@ -39,6 +40,9 @@ std::string check_arm_cover(const link_labels_t& labels);
 std::string check_risk(const risk_t& risk);
 // stop and cause must be one of the constants.
 std::string check_safety_status(const safety_status_t& status);
+// max_arm_speed_m_s finite >= 0, set_by one of the constants, arm_speed_m_s
+// finite >= 0 or -1 (not bounded), valid_for_ms > 0.
+std::string check_speed_limit(const speed_limit_t& limit);
 // utime > 0, seq >= 0, a camera_id, trigger one of the constants; an
 // unusable estimate needs its reason and nothing else. A usable one: unique
 // non-empty joint names, finite positions, sigmas >= 0 and finite, unit

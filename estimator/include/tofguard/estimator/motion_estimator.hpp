@@ -204,9 +204,13 @@ double correction_angle_rad(const EstimateResult& result);
 class MotionEstimator {
  public:
   // `renderer` must render `scene` (the same model) and outlive this.
+  // `occupant`: the wheelchair user's shapes (renderer::
+  // occupant_render_objects; empty: none), drawn into every render so that
+  // the user hides what is behind them; their pixels are no link's and are
+  // not fitted (the user is judged by envelopes, not by this model).
   // Throws std::invalid_argument for options out of range.
   MotionEstimator(const robot_model::SceneModel& scene, renderer::DepthRenderer* renderer,
-                  const EstimatorOptions& options);
+                  const EstimatorOptions& options, std::vector<renderer::ExtraObject> occupant = {});
 
   // Estimates what `frame` shows, with the options' free parameters (at
   // the working resolution, EstimatorOptions::max_working_pixels).
@@ -287,6 +291,7 @@ class MotionEstimator {
 
   const robot_model::SceneModel& scene_;
   renderer::DepthRenderer* renderer_;
+  std::vector<renderer::ExtraObject> occupant_;
   EstimatorOptions options_;
   int num_params_ = 0;  // actuated joints
   // Per link: the movable joints from the link up to the root.

@@ -140,7 +140,8 @@ class RendererService {
   };
   RenderedFrame make_output(const depth_image_t& frame, RenderResult result,
                             const std::optional<RenderedKinematics>& kinematics,
-                            const std::optional<RenderedArmCover>& arm_cover) const;
+                            const std::optional<RenderedArmCover>& arm_cover,
+                            const std::optional<Eigen::Isometry3d>& world_from_optical) const;
   void learn_period(const depth_image_t& frame);
   void plan_prediction(const depth_image_t& frame);
   bool covers_actuated_joints(const robot_model::JointPositions& joints) const;
@@ -155,6 +156,8 @@ class RendererService {
   robot_model::ArmSpheres arm_cover_;
   // The occupant (settings.occupant), seated where the config says.
   std::optional<robot_model::OccupantModel> occupant_;
+  // Its shapes, drawn into every render (rendered_occupant.hpp).
+  std::vector<ExtraObject> occupant_objects_;
   std::unique_ptr<DepthRenderer> renderer_;
   robot_state::StateHistory state_;
   std::optional<depth_image_t> pending_;

@@ -97,8 +97,10 @@ class RiskMonitor {
   // The wheelchair's occupant: its body regions' rules (body_region_rules
   // .hpp, with the arm's moving mass from its URDF) set the speed limit
   // too, and a frame whose arm is faster than a region's limit is an
-  // UNKNOWN_OBJECT finding naming the region (debounced as the others).
-  // Throws robot_model::ModelError for an arm without masses.
+  // UNKNOWN_OBJECT finding naming the region (debounced as the others);
+  // a frame that shows the user missing from the model's place
+  // (user_presence.hpp) stops the arm as an unclassified finding. Throws robot_model::ModelError for an arm
+  // without masses.
   void set_occupant(const OccupantSettings& occupant);
   const std::string& last_refusal() const { return last_refusal_; }
   // A valid estimate (check_motion_estimate, this camera, the robot's
@@ -142,6 +144,7 @@ class RiskMonitor {
   double response_time_s_ = 0;
   // The occupant's rules (set_occupant); empty without one.
   std::vector<BodyRegionRule> body_region_rules_;
+  std::optional<OccupantSettings> occupant_;
   int64_t last_frame_utime_ = 0;
   // The newest frame taken in order (seq, utime) and the seqs judged lately.
   bool any_frame_ = false;

@@ -22,21 +22,14 @@
 #include <Eigen/Geometry>
 
 #include "tofguard/common/body_region.hpp"
+#include "tofguard/common/region_shape.hpp"
 #include "tofguard/robot_model/kinematic_tree.hpp"
 
 namespace tofguard::robot_model {
 
-// One primitive of a region, in the world frame.
-struct RegionShape {
-  enum class Kind { kBox, kSphere, kCylinder };
-  Kind kind = Kind::kBox;
-  // The shape's own frame in the world: a box centred on it, a cylinder
-  // centred on it along its z axis.
-  Eigen::Isometry3d world_from_shape = Eigen::Isometry3d::Identity();
-  Eigen::Vector3d box_half_size_m = Eigen::Vector3d::Zero();
-  double radius_m = 0;       // sphere, cylinder
-  double half_length_m = 0;  // cylinder
-};
+// One primitive of a region (common/region_shape.hpp); its
+// frame_from_shape is in the world frame here.
+using RegionShape = tofguard::RegionShape;
 
 // One link of the occupant URDF.
 struct OccupantPart {
@@ -65,9 +58,8 @@ Eigen::Isometry3d fixed_link_pose(const KinematicTree& tree, const std::string& 
 // link and what was expected.
 OccupantModel load_occupant(const std::string& urdf, const Eigen::Isometry3d& world_from_root);
 
-// Exact distance (m) from `point_world` to the shape's surface, 0 inside.
-double distance_to_shape_m(const RegionShape& shape, const Eigen::Vector3d& point_world);
-// The smallest over the part's shapes.
+// The smallest distance (m) from `point_world` to the part's shapes'
+// surfaces (tofguard::distance_to_shape_m), 0 inside.
 double distance_to_part_m(const OccupantPart& part, const Eigen::Vector3d& point_world);
 
 }  // namespace tofguard::robot_model

@@ -5,6 +5,7 @@
 // microseconds, converted once when the file is read.
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "tofguard/common/camera_profile.hpp"
@@ -12,6 +13,7 @@
 #include "tofguard/common/lcm_settings.hpp"
 #include "tofguard/common/robot_settings.hpp"
 #include "tofguard/common/yaml_reader.hpp"
+#include "tofguard/settings/occupant_settings.hpp"
 #include "tofguard/settings/renderer_settings.hpp"
 
 namespace tofguard::settings {
@@ -70,6 +72,10 @@ struct EstimatorProcessSettings {
   // it does not fit is not estimated.
   std::shared_ptr<const CameraProfile> camera_profile;
   EstimatorSettings estimator;
+  // The wheelchair's occupant (absent: none): rendered as tofguard-renderer
+  // renders it, so that the user hides what is behind them and is not
+  // taken for a camera or joint error.
+  std::optional<OccupantSettings> occupant;
 };
 
 }  // namespace tofguard::settings

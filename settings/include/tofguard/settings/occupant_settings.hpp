@@ -44,6 +44,14 @@ struct OccupantSettings {
   // regions: every body region (common/body_region.hpp), each given; the
   // head and the neck (body_region_is_no_contact) with a clearance_m.
   std::map<BodyRegion, BodyRegionSettings> regions;
+  // presence: is the user where the model seats them? When the camera
+  // shows at least min_modelled_pixels of the modelled user (its own
+  // pixels, silhouettes left out) and more than max_missing_fraction of
+  // them see farther than the region's envelope, the chair is empty or the
+  // user has slid or fallen: the model no longer describes the scene, and
+  // the arm stops (docs/safety-chain.md, "The user").
+  int presence_min_modelled_pixels = 0;
+  double presence_max_missing_fraction = 0;
 };
 
 // Reads the optional section; nullopt when absent. Throws ConfigError.

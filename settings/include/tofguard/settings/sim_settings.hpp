@@ -5,6 +5,7 @@
 // the arm's motion parameters stay in seconds (they describe a sine, not a
 // deadline).
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -62,6 +63,18 @@ struct JointsSimSettings {
   double plan_rate_hz = 0;
   int64_t plan_horizon_us = 0;
   int64_t plan_step_us = 0;
+  // follow_speed_limit (optional; absent: the arm keeps its speed, as a
+  // controller that ignores SAFETY_SPEED_LIMIT): the arm slows its motion
+  // (a time scale in [0, 1] on the periodic motion) to keep its speed
+  // bound at most margin times the newest verified limit, and to 0 when
+  // the limit has expired (its valid_for_ms). It learns its full-speed bound
+  // from each limit (the limit's arm_speed_m_s over the scale of the joint
+  // state it was computed from); speeding back up is limited to
+  // ramp_per_s of full speed per second (when the limit rises, or while
+  // it has no bound to go by).
+  bool follow_speed_limit = false;
+  double speed_limit_margin = 1;
+  double speed_ramp_per_s = 0;
 };
 
 // Reads (and finishes) the `joints_sim` section.
@@ -161,6 +174,28 @@ struct SimResidualSettings {
 // The simulated ToF camera's error model (camera.sim, required when
 // camera.source is sim). Distances r are radial (along the pixel's ray),
 // metres.
+// camera.sim.user (optional; absent: the chair is empty): the simulated
+// wheelchair user the camera sees, the truth the monitor knows only through
+// its occupant model and envelopes (config occupant:). Moves about the
+// model's pose, t seconds since the camera started:
+//   breathing: the chest and the abdomen forward by breathing_mm/2 *
+//     (1 - cos(2 pi t / breathing_period_s)) (0..breathing_mm);
+//   head: the skull, face and neck turned about the neck's vertical axis by
+//     head_turn_deg * sin(2 pi t / head_period_s);
+//   hand: the right hand forward and back along the seat by hand_motion_m *
+//     sin(2 pi t / hand_period_s).
+// Forward and vertical are the seat frame's x and z (the occupant URDF's).
+struct SimUserSettings {
+  std::string urdf_path;  // urdf (resolved): an occupant model
+  std::string seated_on;  // the environment link it sits on
+  double breathing_mm = 0;
+  double breathing_period_s = 1;
+  double head_turn_rad = 0;  // head_turn_deg in the file
+  double head_period_s = 1;
+  double hand_motion_m = 0;
+  double hand_period_s = 1;
+};
+
 struct SimCameraSettings {
   uint64_t seed = 0;
   // systematic_error_m: systematic error e(r) = sum_i systematic_error_m[i]
@@ -205,6 +240,7 @@ struct SimCameraSettings {
   double pan_period_s = 1;
   double tilt_amplitude_rad = 0;
   double tilt_period_s = 1;
+  std::optional<SimUserSettings> user;
 };
 
 // Reads (and finishes) the `camera.sim` section.
@@ -248,4 +284,5 @@ using settings::SimCameraProcessSettings;
 using settings::SimCameraSettings;
 using settings::SimFaultToolSettings;
 using settings::SimResidualSettings;
+using settings::SimUserSettings;
 }  // namespace tofguard::sim

@@ -18,6 +18,7 @@
 #include "tofguard/common/camera_settings.hpp"
 #include "tofguard/robot_state/joint_history.hpp"
 #include "tofguard/settings/sim_settings.hpp"
+#include "tofguard/sim/simulated_user.hpp"
 #include "tofguard/sim/tof_error_model.hpp"
 
 namespace tofguard::sim {
@@ -42,7 +43,7 @@ class SceneRenderer {
   virtual ~SceneRenderer() = default;
   virtual RenderedDepth render(const std::map<std::string, double>& joint_positions,
                                const CameraPose& camera_pose, const Intrinsics& intrinsics,
-                               const std::vector<SimBox>& boxes) = 0;
+                               const std::vector<SimBox>& boxes, const std::vector<RegionShape>& user) = 0;
 };
 
 // One injected fault with absolute times (microseconds since the epoch).
@@ -55,8 +56,10 @@ struct ActiveSimFault {
 class SimulatedCamera {
  public:
   // `start_utime`: when the camera started (config faults count from it).
+  // `user`: the simulated wheelchair user (camera.sim.user), none for an
+  // empty chair.
   SimulatedCamera(const CameraSettings& camera, const SimCameraSettings& sim, SceneRenderer* renderer,
-                  int64_t start_utime);
+                  int64_t start_utime, std::optional<SimulatedUser> user = std::nullopt);
 
   // A true joint state of the simulated arm (SIM_TRUE_JOINT_STATE). The
   // frame's joints are interpolated between the states around its capture
@@ -96,6 +99,8 @@ class SimulatedCamera {
   std::optional<CameraPose> reported_pose(int64_t utime) const;
   // Intruding boxes at `utime`.
   std::vector<SimBox> boxes(int64_t utime) const;
+  // The simulated user's shapes at `utime` (world frame); none without one.
+  std::vector<RegionShape> user_shapes(int64_t utime) const;
 
  private:
   bool active(const ActiveSimFault& f, int64_t utime) const {
@@ -117,6 +122,7 @@ class SimulatedCamera {
   robot_state::JointHistory joints_;
   std::vector<ActiveSimFault> faults_;
   std::optional<TofImage> last_image_;
+  std::optional<SimulatedUser> user_;
 };
 
 }  // namespace tofguard::sim

@@ -30,8 +30,10 @@ class SimulatedArm {
                const std::string& config_file);
 
   // Advances by dt_s of process time. The motion time advances only while
-  // `motion_allowed`, so a halted arm resumes where it stopped.
-  void step(double dt_s, bool motion_allowed);
+  // `motion_allowed`, so a halted arm resumes where it stopped, and then by
+  // speed_scale * dt_s (in [0, 1]: a slowed arm follows the same path,
+  // its velocities scaled alike).
+  void step(double dt_s, bool motion_allowed, double speed_scale = 1.0);
 
   // Sets joint `joint`'s encoder offset (0 clears it); false if unknown.
   bool set_encoder_offset(const std::string& joint, double offset);
@@ -39,7 +41,8 @@ class SimulatedArm {
   const ArmState& true_state() const { return true_state_; }
   // The arm's plan: the reported (encoder) positions `ahead_s` seconds of
   // process time from now, assuming it keeps its current permission: the
-  // periodic motion while moving, where it is while halted. What a
+  // periodic motion (at the current speed scale) while moving, where it
+  // is while halted. What a
   // controller following its encoders plans (an encoder offset is in the
   // plan, so a faulty encoder does not make the arm "leave its plan").
   std::vector<double> planned_reported_positions(double ahead_s) const;
@@ -61,6 +64,7 @@ class SimulatedArm {
   int offsets_version_ = 0;
   double motion_time_s_ = 0;
   bool moving_ = false;
+  double speed_scale_ = 1;
   ArmState true_state_;
 };
 
