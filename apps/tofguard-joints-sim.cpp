@@ -14,11 +14,15 @@ int main(int argc, char** argv) {
       argc, argv, info, [](const deployment::Config& config, const std::vector<std::string>& arguments) {
         sim::JointsSimProcessSettings settings = deployment::joints_sim_process_settings(config);
         for (const std::string& a : arguments) {
-          if (a != "--commissioning") {
-            std::cerr << "tofguard-joints-sim: unknown argument '" << a << "' (expected --commissioning)\n";
+          if (a == "--commissioning") {
+            settings.moves_without_permission = true;
+          } else if (a == "--task") {
+            settings.follows_task = true;
+          } else {
+            std::cerr << "tofguard-joints-sim: unknown argument '" << a
+                      << "' (expected --commissioning or --task)\n";
             return kConfigErrorExitCode;
           }
-          settings.moves_without_permission = true;
         }
         return sim::run_joints_sim(settings);
       });

@@ -86,6 +86,7 @@ ChannelNames read_channel_names(YamlMap map) {
   name("planned_trajectory", &c.planned_trajectory);
   name("sim_true_joint_state", &c.sim_true_joint_state);
   name("sim_joint_fault", &c.sim_joint_fault);
+  name("sim_controller_fault", &c.sim_controller_fault);
   name("sim_camera_fault", &c.sim_camera_fault);
   map.finish();
   return c;

@@ -699,6 +699,11 @@ std::string check_sim_camera_fault(const sim_camera_fault_t& f) {
   return "";
 }
 
+std::string check_sim_controller_fault(const sim_controller_fault_t& f) {
+  if (f.utime <= 0) return expected("utime", "a time > 0 (us since the epoch)", static_cast<double>(f.utime));
+  return "";
+}
+
 std::string check_sim_joint_fault(const sim_joint_fault_t& f) {
   if (f.joint.empty()) return "joint: expected a joint name, got an empty string";
   if (!std::isfinite(f.offset))

@@ -142,6 +142,22 @@ JointsSimSettings read_joints_sim_settings(YamlMap map) {
     sim.motion.push_back(jm);
   }
   motion.finish();
+  if (auto task = map.optional_map("task")) {
+    sim.task_move_s = task->number("move_s", 0.1, 1e4);
+    for (YamlMap& w : task->maps("waypoints")) {
+      TaskWaypoint waypoint;
+      waypoint.name = w.string("name");
+      waypoint.hold_s = w.number("hold_s", 0, 1e4);
+      YamlMap joints = w.map("joints");
+      for (const auto& joint : joints.keys()) waypoint.joints[joint] = joints.number(joint, -100, 100);
+      joints.finish();
+      w.finish();
+      sim.task_waypoints.push_back(waypoint);
+    }
+    if (sim.task_waypoints.size() < 2)
+      task->fail("waypoints", "at least two waypoints (a task goes somewhere)");
+    task->finish();
+  }
   if (map.optional("faults")) {
     for (auto& f : map.maps("faults")) {
       EncoderFault fault;

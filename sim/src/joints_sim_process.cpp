@@ -1,6 +1,7 @@
 #include "tofguard/sim/joints_sim_process.hpp"
 
 #include <cmath>
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -18,6 +19,7 @@
 #include "tofguard/safety_status_t.hpp"
 #include "tofguard/sim/simulated_arm.hpp"
 #include "tofguard/sim/speed_limit_follower.hpp"
+#include "tofguard/sim_controller_fault_t.hpp"
 #include "tofguard/sim_joint_fault_t.hpp"
 #include "tofguard/speed_limit_t.hpp"
 
@@ -56,6 +58,7 @@ class JointsSimWiring {
     subscribe_status();
     if (follower_) subscribe_speed_limit();
     subscribe_faults();
+    subscribe_controller_faults();
     const int64_t period_us = static_cast<int64_t>(1e6 / sim_.rate_hz);
     last_step_us_ = monotonic_us();
     node_.add_timer(period_us, [this] { step(); });
@@ -68,54 +71,54 @@ class JointsSimWiring {
     status_arrival_us_ = monotonic_us();
   }
 
-  // The simulated arm's controller does what a real one must
-  // (docs/security.md): with a key it moves only on a verified
-  // SAFETY_STATUS_AUTH; the plain SAFETY_STATUS is not read at all.
-  void subscribe_status() {
-    const ChannelNames& channels = settings_.channels;
+  // `T` on `channel` as the arm's controller takes what may let it move
+  // (docs/security.md): with a key only verified on `auth_channel`, the
+  // plain channel not read at all; without one, the plain channel. What is
+  // refused is counted and said.
+  template <typename T>
+  void subscribe_signed(const std::string& channel, const std::string& auth_channel,
+                        std::string (*check)(const T&), std::function<void(const T&)> take) {
     if (!auth::authenticated(settings_.auth)) {
-      node_.subscribe<safety_status_t>(
-          node_.safety(), channels.status, [this](const safety_status_t& s) { on_status(s); },
-          check_safety_status);
+      node_.subscribe<T>(node_.safety(), channel, take, check);
       return;
     }
     if (!verifier_) verifier_.emplace(settings_.auth.key, settings_.auth.max_age_us);
     node_.subscribe<authenticated_message_t>(
-        node_.safety(), channels.status_auth, [this](const authenticated_message_t& m) {
-          const ChannelNames& channels = settings_.channels;
+        node_.safety(), auth_channel,
+        [this, channel, auth_channel, check, take](const authenticated_message_t& m) {
           std::string why;
-          const auto status = verifier_->open<safety_status_t>(m, channels.status, wall_utime(), &why);
-          if (status && (why = check_safety_status(*status)).empty()) {
-            on_status(*status);
+          const auto message = verifier_->open<T>(m, channel, wall_utime(), &why);
+          if (message && (why = check(*message)).empty()) {
+            take(*message);
             return;
           }
           node_.counters().validation_errors++;
-          node_.errors().report(channels.status_auth, channels.status_auth + ": refused: " + why);
+          node_.errors().report(auth_channel, auth_channel + ": refused: " + why);
         });
   }
 
-  // The speed limit as the status: verified on SAFETY_SPEED_LIMIT_AUTH
-  // with a key, else the plain channel.
+  void subscribe_status() {
+    subscribe_signed<safety_status_t>(settings_.channels.status, settings_.channels.status_auth,
+                                      check_safety_status,
+                                      [this](const safety_status_t& s) { on_status(s); });
+  }
+
   void subscribe_speed_limit() {
-    const ChannelNames& channels = settings_.channels;
-    const auto take = [this](const speed_limit_t& limit) { follower_->on_limit(limit, monotonic_us()); };
-    if (!auth::authenticated(settings_.auth)) {
-      node_.subscribe<speed_limit_t>(node_.safety(), channels.speed_limit, take, check_speed_limit);
-      return;
-    }
-    if (!verifier_) verifier_.emplace(settings_.auth.key, settings_.auth.max_age_us);
-    node_.subscribe<authenticated_message_t>(
-        node_.safety(), channels.speed_limit_auth, [this, take](const authenticated_message_t& m) {
-          const ChannelNames& channels = settings_.channels;
-          std::string why;
-          const auto limit = verifier_->open<speed_limit_t>(m, channels.speed_limit, wall_utime(), &why);
-          if (limit && (why = check_speed_limit(*limit)).empty()) {
-            take(*limit);
-            return;
-          }
-          node_.counters().validation_errors++;
-          node_.errors().report(channels.speed_limit_auth, channels.speed_limit_auth + ": refused: " + why);
-        });
+    subscribe_signed<speed_limit_t>(
+        settings_.channels.speed_limit, settings_.channels.speed_limit_auth, check_speed_limit,
+        [this](const speed_limit_t& limit) { follower_->on_limit(limit, monotonic_us()); });
+  }
+
+  void subscribe_controller_faults() {
+    node_.subscribe<sim_controller_fault_t>(
+        node_.safety(), settings_.channels.sim_controller_fault,
+        [this](const sim_controller_fault_t& fault) {
+          ignores_speed_limit_ = fault.ignore_speed_limit;
+          std::cerr << "tofguard-joints-sim: controller fault: "
+                    << (ignores_speed_limit_ ? "ignores the speed limit" : "follows the speed limit again")
+                    << std::endl;
+        },
+        check_sim_controller_fault);
   }
 
   void subscribe_faults() {
@@ -157,7 +160,9 @@ class JointsSimWiring {
         settings_.moves_without_permission ||
         (status_allows_ && status_arrival_us_ >= 0 && now_us - status_arrival_us_ <= sim_.status_deadline_us);
     const double dt_s = (now_us - last_step_us_) * 1e-6;
-    const double scale = follower_ ? follower_->next_scale(now_us, dt_s) : 1.0;
+    // The follower keeps learning while a controller fault ignores it.
+    double scale = follower_ ? follower_->next_scale(now_us, dt_s) : 1.0;
+    if (ignores_speed_limit_) scale = 1.0;
     arm_.step(dt_s, allowed, scale);
     last_step_us_ = now_us;
     const int64_t utime = wall_utime();
@@ -199,6 +204,8 @@ class JointsSimWiring {
   // joints_sim.follow_speed_limit: the speed scale from SAFETY_SPEED_LIMIT.
   std::optional<SpeedLimitFollower> follower_;
   double planned_scale_ = 1;
+  // SIM_CONTROLLER_FAULT: full speed whatever the limit says.
+  bool ignores_speed_limit_ = false;
   bool status_allows_ = false;
   int64_t status_arrival_us_ = -1;
   int64_t last_step_us_ = 0;
@@ -219,9 +226,11 @@ ProcessInfo joints_sim_info() {
           "motion of the config, and its plan on PLANNED_TRAJECTORY (joints_sim.plan);\n"
           "halts while SAFETY_STATUS withdraws permission or is stale; with\n"
           "joints_sim.follow_speed_limit, slows to SAFETY_SPEED_LIMIT.\n"
+          "--task: follows joints_sim.task (the assistive task) instead of the periodic motion.\n"
           "--commissioning: moves without a permission (a commissioning recording,\n"
           "docs/camera.md); never with a safety chain in charge.\n"
-          "Encoder faults: joints_sim.faults in the config, or sim_joint_fault_t on SIM_JOINT_FAULT."};
+          "Encoder faults: joints_sim.faults in the config, or sim_joint_fault_t on SIM_JOINT_FAULT;\n"
+          "a controller that ignores the speed limit: sim_controller_fault_t on SIM_CONTROLLER_FAULT."};
 }
 
 int run_joints_sim(const JointsSimProcessSettings& settings) {
@@ -234,7 +243,8 @@ int run_joints_sim(const JointsSimProcessSettings& settings) {
   } catch (const robot_model::ModelError& e) {
     throw ConfigError(e.what());
   }
-  const auto arm = std::make_unique<SimulatedArm>(settings.joints_sim, urdf_joints, settings.config_file);
+  const auto arm = std::make_unique<SimulatedArm>(settings.joints_sim, urdf_joints, settings.config_file,
+                                                  settings.follows_task);
   JointsSimWiring(settings, arm.get()).run();
   return 0;
 }

@@ -10,6 +10,7 @@
 #include "tofguard/common/clock.hpp"
 #include "tofguard/common/config_error.hpp"
 #include "tofguard/sim_camera_fault_t.hpp"
+#include "tofguard/sim_controller_fault_t.hpp"
 #include "tofguard/sim_joint_fault_t.hpp"
 
 namespace tofguard::sim {
@@ -17,6 +18,7 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: tofguard-sim-fault [--config FILE] --joint NAME --offset-deg DEGREES\n"
+    "       tofguard-sim-fault [--config FILE] --ignore-speed-limit on|off\n"
     "       tofguard-sim-fault [--config FILE] --camera-fault KIND [--duration-s S]\n"
     "           [--size-m X,Y,Z] [--position-m X,Y,Z] [--velocity-m-per-s X,Y,Z]\n"
     "           [--drift-m-per-s X,Y,Z] [--drift-rad-per-s X,Y,Z]\n"
@@ -65,6 +67,8 @@ ProcessInfo sim_fault_info() {
                    "Injects faults into the running simulator (simulation only).\n"
                    "  --joint NAME --offset-deg DEGREES: an encoder fault in tofguard-joints-sim\n"
                    "    (0 clears it).\n"
+                   "  --ignore-speed-limit on|off: tofguard-joints-sim's controller stops following\n"
+                   "    SAFETY_SPEED_LIMIT (a bad plan at full speed) or follows it again.\n"
                    "  --camera-fault KIND: a fault in the simulated camera (SIM_CAMERA_FAULT):\n"
                    "    clear, frozen_image, stall, pose_drift (--drift-m-per-s X,Y,Z in the\n"
                    "    camera pose's frame, --drift-rad-per-s about the optical axes) or\n"
@@ -120,6 +124,23 @@ int run_sim_fault(const SimFaultToolSettings& settings, const std::vector<std::s
     fault.utime = wall_utime();
     const int code = publish(settings, settings.channels.sim_camera_fault, fault);
     if (code == 0) std::cout << "camera fault: " << kind << " on " << fault.camera_id << std::endl;
+    return code;
+  }
+
+  if (options.count("--ignore-speed-limit")) {
+    const std::string value = options["--ignore-speed-limit"];
+    if (options.size() != 1 || (value != "on" && value != "off")) {
+      return usage_error("expected --ignore-speed-limit on|off alone");
+    }
+    sim_controller_fault_t fault{};
+    fault.utime = wall_utime();
+    fault.ignore_speed_limit = value == "on";
+    const int code = publish(settings, settings.channels.sim_controller_fault, fault);
+    if (code == 0) {
+      std::cout << (fault.ignore_speed_limit ? "controller fault: the arm ignores the speed limit"
+                                             : "controller fault cleared: the arm follows the speed limit")
+                << std::endl;
+    }
     return code;
   }
 

@@ -5,9 +5,38 @@
 #include <set>
 
 namespace tofguard::sim {
+namespace {
+
+// The task's waypoints in URDF order; a ConfigError (from `error`) unless
+// each gives exactly the URDF's movable joints.
+template <class Error>
+std::vector<std::vector<double>> task_positions(const JointsSimSettings& config,
+                                                const std::vector<std::string>& urdf_joints,
+                                                const std::string& all, const Error& error) {
+  if (config.task_waypoints.empty()) throw error("task", "a task (waypoints and move_s) for --task");
+  std::vector<std::vector<double>> out;
+  for (const TaskWaypoint& w : config.task_waypoints) {
+    const std::string key = "task.waypoints[" + w.name + "].joints";
+    if (w.joints.size() != urdf_joints.size()) {
+      throw error(key, "every movable joint of the URDF (" + all + "), " + std::to_string(w.joints.size()) +
+                           " given");
+    }
+    std::vector<double> q;
+    for (const auto& joint : urdf_joints) {
+      const auto it = w.joints.find(joint);
+      if (it == w.joints.end())
+        throw error(key, "every movable joint of the URDF (" + all + "), missing " + joint);
+      q.push_back(it->second);
+    }
+    out.push_back(q);
+  }
+  return out;
+}
+
+}  // namespace
 
 SimulatedArm::SimulatedArm(const JointsSimSettings& config, const std::vector<std::string>& urdf_joints,
-                           const std::string& config_file) {
+                           const std::string& config_file, bool task) {
   auto error = [&](const std::string& key, const std::string& what) {
     return ConfigError(config_file + ": joints_sim." + key + ": " + what);
   };
@@ -32,6 +61,11 @@ SimulatedArm::SimulatedArm(const JointsSimSettings& config, const std::vector<st
       throw error("faults", "unknown joint '" + f.joint + "', expected one of: " + all);
     }
   }
+  if (task) {
+    task_positions_ = task_positions(config, urdf_joints, all, error);
+    for (const TaskWaypoint& w : config.task_waypoints) task_hold_s_.push_back(w.hold_s);
+    task_move_s_ = config.task_move_s;
+  }
   scheduled_faults_ = config.faults;
   for (const auto& m : motion_) {
     true_state_.name.push_back(m.joint);
@@ -42,14 +76,49 @@ SimulatedArm::SimulatedArm(const JointsSimSettings& config, const std::vector<st
   update_state(false);
 }
 
+SimulatedArm::TaskPhase SimulatedArm::task_phase(double t_s) const {
+  double cycle_s = 0;
+  for (double hold : task_hold_s_) cycle_s += hold + task_move_s_;
+  double t = std::fmod(t_s, cycle_s);
+  const size_t n = task_positions_.size();
+  for (size_t k = 0; k < n; ++k) {
+    if (t < task_hold_s_[k]) return {k, k, 0, 0};
+    t -= task_hold_s_[k];
+    if (t < task_move_s_) {
+      // Cosine speed profile: at rest at both waypoints.
+      const double x = t / task_move_s_;
+      return {k, (k + 1) % n, (1 - std::cos(M_PI * x)) / 2, M_PI / (2 * task_move_s_) * std::sin(M_PI * x)};
+    }
+    t -= task_move_s_;
+  }
+  return {0, 0, 0, 0};
+}
+
+double SimulatedArm::position_at(size_t i, double t_s) const {
+  if (!task_positions_.empty()) {
+    const TaskPhase p = task_phase(t_s);
+    const double a = task_positions_[p.from][i];
+    return a + (task_positions_[p.to][i] - a) * p.blend;
+  }
+  const JointMotion& m = motion_[i];
+  return m.center + m.amplitude * std::sin(2 * M_PI / m.period_s * t_s + m.phase_rad);
+}
+
+double SimulatedArm::velocity_at(size_t i, double t_s) const {
+  if (!task_positions_.empty()) {
+    const TaskPhase p = task_phase(t_s);
+    return (task_positions_[p.to][i] - task_positions_[p.from][i]) * p.blend_rate;
+  }
+  const JointMotion& m = motion_[i];
+  const double w = 2 * M_PI / m.period_s;
+  return m.amplitude * w * std::cos(w * t_s + m.phase_rad);
+}
+
 void SimulatedArm::update_state(bool moving) {
   moving_ = moving;
   for (size_t i = 0; i < motion_.size(); ++i) {
-    const JointMotion& m = motion_[i];
-    const double w = 2 * M_PI / m.period_s;
-    const double phase = w * motion_time_s_ + m.phase_rad;
-    true_state_.position[i] = m.center + m.amplitude * std::sin(phase);
-    true_state_.velocity[i] = moving ? speed_scale_ * m.amplitude * w * std::cos(phase) : 0.0;
+    true_state_.position[i] = position_at(i, motion_time_s_);
+    true_state_.velocity[i] = moving ? speed_scale_ * velocity_at(i, motion_time_s_) : 0.0;
   }
 }
 
@@ -88,11 +157,8 @@ ArmState SimulatedArm::reported_state() const {
 std::vector<double> SimulatedArm::planned_reported_positions(double ahead_s) const {
   std::vector<double> positions(motion_.size());
   const double t = motion_time_s_ + (moving_ ? speed_scale_ * ahead_s : 0.0);
-  for (size_t i = 0; i < motion_.size(); ++i) {
-    const JointMotion& m = motion_[i];
-    positions[i] =
-        m.center + m.amplitude * std::sin(2 * M_PI / m.period_s * t + m.phase_rad) + offsets_.at(m.joint);
-  }
+  for (size_t i = 0; i < motion_.size(); ++i)
+    positions[i] = position_at(i, t) + offsets_.at(motion_[i].joint);
   return positions;
 }
 

@@ -25,6 +25,7 @@
 #include "tofguard/risk_t.hpp"
 #include "tofguard/safety_status_t.hpp"
 #include "tofguard/sim_camera_fault_t.hpp"
+#include "tofguard/sim_controller_fault_t.hpp"
 #include "tofguard/sim_joint_fault_t.hpp"
 #include "tofguard/speed_limit_t.hpp"
 
@@ -150,6 +151,10 @@ std::string format(const discrepancy_t& m) {
   return s.str();
 }
 
+std::string format(const sim_controller_fault_t& m) {
+  return std::string("ignore_speed_limit=") + (m.ignore_speed_limit ? "yes" : "no");
+}
+
 std::string format(const sim_joint_fault_t& m) {
   std::ostringstream s;
   s << "joint=" << m.joint << " offset=" << m.offset;
@@ -230,7 +235,7 @@ const std::map<int64_t, std::pair<std::string, Formatter>>& formatters() {
       entry<sim_joint_fault_t>(),  entry<discrepancy_t>(),
       entry<motion_estimate_t>(),  entry<planned_trajectory_t>(),
       entry<sim_camera_fault_t>(), entry<authenticated_message_t>(),
-      entry<speed_limit_t>(),
+      entry<speed_limit_t>(),      entry<sim_controller_fault_t>(),
   };
   return table;
 }

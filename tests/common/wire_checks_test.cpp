@@ -312,12 +312,18 @@ TEST(WireChecks, LinkLabelsArmCover) {
   EXPECT_EQ(field_of(bad), "arm_sphere_radius_m");
 }
 
-TEST(WireChecks, LinkLabelsBodyRegions) {
+// Labels with two body regions, the face and a hand.
+link_labels_t labels_with_regions() {
   link_labels_t l = labels_with_kinematics();
   l.num_body_regions = 2;
   l.body_region = {"face", "hand"};
   l.body_region_separation_m = {0.3f, 0.0f};
   l.body_region_envelope_m = {0.05f, 0.1f};
+  return l;
+}
+
+TEST(WireChecks, LinkLabelsBodyRegions) {
+  link_labels_t l = labels_with_regions();
   EXPECT_EQ(check_link_labels(l), "");
   link_labels_t bad = l;
   bad.body_region[1] = "hands";  // no such region
@@ -337,11 +343,7 @@ TEST(WireChecks, LinkLabelsBodyRegions) {
 }
 
 TEST(WireChecks, LinkLabelsOccupantShapes) {
-  link_labels_t l = labels_with_kinematics();
-  l.num_body_regions = 2;
-  l.body_region = {"face", "hand"};
-  l.body_region_separation_m = {0.3f, 0.0f};
-  l.body_region_envelope_m = {0.05f, 0.1f};
+  link_labels_t l = labels_with_regions();
   l.num_occupant_shapes = 2;
   l.occupant_shape_kind = {link_labels_t::SHAPE_BOX, link_labels_t::SHAPE_CYLINDER};
   l.occupant_shape_region = {0, 1};

@@ -3,6 +3,8 @@
 // debouncing and deadlines on an explicit monotonic clock.
 #include <gtest/gtest.h>
 
+#include <functional>
+
 #include <iomanip>
 #include <limits>
 #include <sstream>
@@ -533,6 +535,27 @@ risk_t judged_at_once(RiskMonitor* m, discrepancy_t frame, int64_t now) {
   return verdicts.empty() ? risk_t{} : verdicts.front();
 }
 
+// The verdicts on three frames 33 ms apart made from `d` (seq 40, 41, 42)
+// by a monitor with the occupant of `with_user`, each judged at once;
+// `before(frame, now)` runs before each is judged (e.g. a joint state).
+std::vector<risk_t> three_frames_with_user(
+    const deployment::Config& with_user, const discrepancy_t& d,
+    const std::function<void(RiskMonitor*, const discrepancy_t&, int64_t)>& before = nullptr) {
+  RiskMonitor m(with_user.risk, with_user.channels, friend_arm(), kRateHz, kStart);
+  m.set_occupant(*with_user.occupant);
+  std::vector<risk_t> verdicts;
+  for (int i = 0; i < 3; ++i) {
+    const int64_t now = kStart + i * 33 * kMs;
+    feed_all(&m, now);
+    discrepancy_t frame = d;
+    frame.seq = 40 + i;
+    frame.utime = d.utime + i * 33'000;
+    if (before) before(&m, frame, now);
+    verdicts.push_back(judged_at_once(&m, frame, now));
+  }
+  return verdicts;
+}
+
 // The user's body regions (docs/safety-chain.md, "The user"): a frame
 // whose arm is faster than the face's limit is an unknown-object finding
 // naming the face, stopped after the debounce; slower, the limit is the
@@ -588,23 +611,15 @@ TEST(RiskMonitor, TheArmFasterThanTheUsersFaceAllowsIsStoppedAfterTheDebounce) {
   // number: the arm's speed cannot be bounded).
   for (const double speed : {0.9 * face_limit, 1.1 * face_limit, std::nan("")}) {
     const double per_joint = speed / 0.35;
-    RiskMonitor m(with_user.risk, with_user.channels, friend_arm(), kRateHz, kStart);
-    m.set_occupant(*with_user.occupant);
-    std::vector<risk_t> verdicts;
-    for (int i = 0; i < 3; ++i) {
-      const int64_t now = kStart + i * 33 * kMs;
-      feed_all(&m, now);
-      discrepancy_t frame = d;
-      frame.seq = 40 + i;
-      frame.utime = d.utime + i * 33'000;
-      m.on_joint_state(state_at(per_joint, frame.utime), now);
-      const speed_limit_t limit = m.speed_limit(frame);
-      EXPECT_EQ(limit.set_by, speed_limit_t::SET_BY_BODY_REGION) << limit.reason;
-      EXPECT_EQ(limit.body_region, "face");
-      EXPECT_NEAR(limit.max_arm_speed_m_s, face_limit, 1e-3) << limit.reason;
-      EXPECT_NEAR(limit.separation_m, 0.15, 1e-6);
-      verdicts.push_back(judged_at_once(&m, frame, now));
-    }
+    const std::vector<risk_t> verdicts =
+        three_frames_with_user(with_user, d, [&](RiskMonitor* m, const discrepancy_t& frame, int64_t now) {
+          m->on_joint_state(state_at(per_joint, frame.utime), now);
+          const speed_limit_t limit = m->speed_limit(frame);
+          EXPECT_EQ(limit.set_by, speed_limit_t::SET_BY_BODY_REGION) << limit.reason;
+          EXPECT_EQ(limit.body_region, "face");
+          EXPECT_NEAR(limit.max_arm_speed_m_s, face_limit, 1e-3) << limit.reason;
+          EXPECT_NEAR(limit.separation_m, 0.15, 1e-6);
+        });
     if (std::isnan(speed)) {
       EXPECT_EQ(verdicts[2].level, risk_t::DANGEROUS) << verdicts[2].detail;
       EXPECT_EQ(verdicts[2].cause, risk_t::CAUSE_UNKNOWN_OBJECT);
@@ -648,17 +663,7 @@ TEST(RiskMonitor, AnEmptyChairIsSaidAndStopsTheArm) {
   for (const Case c : {Case{20, 11, true}, Case{20, 10, false}, Case{11, 11, false}}) {
     d.body_region_modelled_pixels.assign(kNumBodyRegions, c.modelled_per_region);
     d.body_region_missing_pixels.assign(kNumBodyRegions, c.missing_per_region);
-    RiskMonitor m(with_user.risk, with_user.channels, friend_arm(), kRateHz, kStart);
-    m.set_occupant(*with_user.occupant);
-    std::vector<risk_t> verdicts;
-    for (int i = 0; i < 3; ++i) {
-      const int64_t now = kStart + i * 33 * kMs;
-      feed_all(&m, now);
-      discrepancy_t frame = d;
-      frame.seq = 40 + i;
-      frame.utime = d.utime + i * 33'000;
-      verdicts.push_back(judged_at_once(&m, frame, now));
-    }
+    const std::vector<risk_t> verdicts = three_frames_with_user(with_user, d);
     const std::string what =
         std::to_string(c.missing_per_region) + " of " + std::to_string(c.modelled_per_region);
     if (!c.stopped) {

@@ -14,6 +14,7 @@
 #include "tofguard/joint_state_t.hpp"
 #include "tofguard/planned_trajectory_t.hpp"
 #include "tofguard/safety_status_t.hpp"
+#include "tofguard/sim_controller_fault_t.hpp"
 #include "tofguard/sim_joint_fault_t.hpp"
 #include "tofguard/speed_limit_t.hpp"
 #include "tool_support.hpp"
@@ -189,6 +190,17 @@ TEST(JointsSimProcess, FollowsTheSpeedLimit) {
   }
   EXPECT_LE(highest, 0.3) << "the arm's bound above the limit";
   EXPECT_GT(total / l.all_reported.size(), 0.1) << "the arm hardly moves under the limit";
+  // A controller fault (SIM_CONTROLLER_FAULT): full speed whatever the
+  // limit says, then following it again.
+  sim_controller_fault_t fault{};
+  fault.utime = wall_utime();
+  fault.ignore_speed_limit = true;
+  l.lcm.publish("SIM_CONTROLLER_FAULT", &fault);
+  EXPECT_TRUE(
+      wait_until([&] { return l.reported_bound_m_s() > 0.6; }, std::chrono::seconds(5), [&] { l.pump(); }))
+      << "the arm kept to the limit";
+  fault.ignore_speed_limit = false;
+  l.lcm.publish("SIM_CONTROLLER_FAULT", &fault);
   l.limit_m_s = 0;
   ASSERT_TRUE(wait_until([&] { return l.max_speed() == 0.0; }, std::chrono::seconds(1), [&] { l.pump(); }));
 }
@@ -210,7 +222,9 @@ TEST(JointsSimProcess, MovesWithoutPermissionOnlyWhenCommissioning) {
                          "--commision"},
                         &out, &err),
             2);
-  EXPECT_NE(err.find("unknown argument '--commision' (expected --commissioning)"), std::string::npos) << err;
+  EXPECT_NE(err.find("unknown argument '--commision' (expected --commissioning or --task)"),
+            std::string::npos)
+      << err;
 }
 
 }  // namespace

@@ -55,6 +55,51 @@ TEST(SimulatedArm, EncoderFaultsChangeOnlyTheReportedPosition) {
   EXPECT_FALSE(arm.set_encoder_offset("j9", 1.0));
 }
 
+// The task: hold at each waypoint, then a cosine move to the next (at rest
+// at both ends, fastest half way: pi/2 x the mean speed), the last back to
+// the first; a slowed arm takes longer along the same path.
+TEST(SimulatedArm, FollowsItsTaskWaypointsInACycle) {
+  JointsSimSettings c = two_joints();
+  c.task_move_s = 2.0;
+  c.task_waypoints = {{"table", 1.0, {{"j1", 0.0}, {"j2", 0.0}}},
+                      {"mouth", 0.5, {{"j1", 1.0}, {"j2", -0.4}}}};
+  SimulatedArm arm(c, {"j1", "j2"}, "test.yaml", /*task=*/true);
+  EXPECT_DOUBLE_EQ(arm.true_state().position[0], 0.0);
+  arm.step(0.9, true);  // holding at the table
+  EXPECT_DOUBLE_EQ(arm.true_state().position[0], 0.0);
+  EXPECT_DOUBLE_EQ(arm.true_state().velocity[0], 0.0);
+  arm.step(1.1, true);  // t = 2.0: half way to the mouth, fastest
+  EXPECT_NEAR(arm.true_state().position[0], 0.5, 1e-12);
+  EXPECT_NEAR(arm.true_state().position[1], -0.2, 1e-12);
+  EXPECT_NEAR(arm.true_state().velocity[0], M_PI / 2 * 1.0 / 2.0, 1e-12);
+  arm.step(1.0, true, 0.5);  // at half speed: a quarter of the move more
+  EXPECT_NEAR(arm.true_state().position[0], (1 - std::cos(M_PI * 0.75)) / 2, 1e-12);
+  EXPECT_NEAR(arm.true_state().velocity[0], 0.5 * M_PI / 4 * std::sin(M_PI * 0.75), 1e-12);
+  arm.step(0.5 + 0.5, true);  // t = 3.5: at the mouth, holding
+  EXPECT_NEAR(arm.true_state().position[0], 1.0, 1e-12);
+  EXPECT_DOUBLE_EQ(arm.true_state().velocity[0], 0.0);
+  arm.step(1.0, true);  // t = 4.5: half way back to the table
+  EXPECT_NEAR(arm.true_state().position[0], 0.5, 1e-12);
+  EXPECT_NEAR(arm.true_state().velocity[0], -M_PI / 4, 1e-12);
+  arm.step(1.5, true);  // t = 6.0, 0.5 s into the next cycle: holding at the table
+  EXPECT_NEAR(arm.true_state().position[0], 0.0, 1e-12);
+  EXPECT_DOUBLE_EQ(arm.true_state().velocity[0], 0.0);
+}
+
+TEST(SimulatedArm, ATaskMustGiveEveryJointAtEveryWaypoint) {
+  JointsSimSettings c = two_joints();
+  EXPECT_THROW(SimulatedArm(c, {"j1", "j2"}, "test.yaml", true), ConfigError);  // no task
+  c.task_move_s = 1.0;
+  c.task_waypoints = {{"table", 1.0, {{"j1", 0.0}, {"j2", 0.0}}}, {"mouth", 1.0, {{"j1", 1.0}}}};
+  try {
+    SimulatedArm arm(c, {"j1", "j2"}, "test.yaml", true);
+    FAIL() << "accepted a waypoint without j2";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("joints_sim.task.waypoints[mouth].joints"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(SimulatedArm, MotionMustCoverExactlyTheUrdfJoints) {
   auto message = [](const JointsSimSettings& c, const std::vector<std::string>& joints) {
     try {

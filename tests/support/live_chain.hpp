@@ -59,10 +59,16 @@ class LiveChain {
   }
 
   void start(const std::string& process) {
-    processes_[process] = std::make_unique<Subprocess>(
-        name_ + "-" + process + "-" + std::to_string(++starts_),
-        std::vector<std::string>{bin_dir() + "/" + process, "--config", config_path_});
+    std::vector<std::string> argv{bin_dir() + "/" + process, "--config", config_path_};
+    if (const auto more = arguments.find(process); more != arguments.end()) {
+      argv.insert(argv.end(), more->second.begin(), more->second.end());
+    }
+    processes_[process] =
+        std::make_unique<Subprocess>(name_ + "-" + process + "-" + std::to_string(++starts_), argv);
   }
+  // Arguments after --config FILE, by process (e.g. tofguard-joints-sim's
+  // --task), for the processes started after they are set.
+  std::map<std::string, std::vector<std::string>> arguments;
   Subprocess& process(const std::string& name) { return *processes_.at(name); }
   std::string stderr_of_all() {
     std::string text;

@@ -188,5 +188,27 @@ TEST(Viewer, VerdictText) {
   EXPECT_EQ(view::verdict_text(set), "seq 42  DANGEROUS joint error, suspect a4 | a4 off");
 }
 
+// The user's line: the region nearest the arm (the labels') and the frame's
+// limit; none without body regions.
+TEST(Viewer, UserText) {
+  view::FrameSet set;
+  set.camera = frame(42, true);
+  EXPECT_EQ(view::user_text(set), "");
+  link_labels_t labels{};
+  labels.num_body_regions = 3;
+  labels.body_region = {"face", "chest", "hand"};
+  labels.body_region_separation_m = {0.19f, 0.17f, 0.021f};
+  set.labels = labels;
+  EXPECT_EQ(view::user_text(set), "user: hand nearest, 0.02 m");
+  speed_limit_t limit{};
+  limit.seq = 42;
+  limit.max_arm_speed_m_s = 0.38;
+  limit.set_by = speed_limit_t::SET_BY_BODY_REGION;
+  limit.body_region = "face";
+  limit.separation_m = 0.14;
+  set.limit = limit;
+  EXPECT_EQ(view::user_text(set), "user: hand nearest, 0.02 m | limit 0.38 m/s, set by face at 0.14 m");
+}
+
 }  // namespace
 }  // namespace tofguard::test

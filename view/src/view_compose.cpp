@@ -2,6 +2,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <type_traits>
 
@@ -89,6 +90,32 @@ std::string verdict_text(const FrameSet& frames) {
   return text;
 }
 
+std::string user_text(const FrameSet& frames) {
+  if (!frames.labels || frames.labels->num_body_regions <= 0 ||
+      frames.labels->body_region_separation_m.size() !=
+          static_cast<size_t>(frames.labels->num_body_regions)) {
+    return "";
+  }
+  const link_labels_t& l = *frames.labels;
+  const auto nearest = std::min_element(l.body_region_separation_m.begin(), l.body_region_separation_m.end());
+  char text[160];
+  std::snprintf(text, sizeof text, "user: %s nearest, %.2f m",
+                l.body_region[nearest - l.body_region_separation_m.begin()].c_str(), *nearest);
+  std::string out = text;
+  if (frames.limit) {
+    const speed_limit_t& limit = *frames.limit;
+    std::snprintf(text, sizeof text, " | limit %.2f m/s, set by %s", limit.max_arm_speed_m_s,
+                  limit.body_region.empty() ? speed_limit_setter_name(limit.set_by).c_str()
+                                            : limit.body_region.c_str());
+    out += text;
+    if (limit.separation_m >= 0) {
+      std::snprintf(text, sizeof text, " at %.2f m", limit.separation_m);
+      out += text;
+    }
+  }
+  return out;
+}
+
 cv::Mat3b compose_view(const FrameSet& frames, const discrepancy::DiscrepancyOptions& options,
                        double max_depth_mm, double full_scale_mm, const FieldSizes& fields) {
   const int w = frames.camera.width;
@@ -126,7 +153,8 @@ cv::Mat3b compose_view(const FrameSet& frames, const discrepancy::DiscrepancyOpt
       dis = blank_panel(w, h, scale, "unusable: " + frame.summary.unusable_reason.substr(0, 40));
     }
   }
-  const int banner = 28;
+  const std::string user = user_text(frames);
+  const int banner = user.empty() ? 28 : 48;
   cv::Mat3b view(banner + camera.rows, 3 * camera.cols, cv::Vec3b(0, 0, 0));
   camera.copyTo(view(cv::Rect(0, banner, camera.cols, camera.rows)));
   rendered.copyTo(view(cv::Rect(camera.cols, banner, camera.cols, camera.rows)));
@@ -137,6 +165,10 @@ cv::Mat3b compose_view(const FrameSet& frames, const discrepancy::DiscrepancyOpt
   if (frames.risk && frames.risk->level == risk_t::SAFE) colour = cv::Scalar(80, 220, 80);
   cv::putText(view, verdict_text(frames).substr(0, 110), cv::Point(6, 19), cv::FONT_HERSHEY_SIMPLEX, 0.5,
               colour, 1, cv::LINE_AA);
+  if (!user.empty()) {
+    cv::putText(view, user.substr(0, 110), cv::Point(6, 39), cv::FONT_HERSHEY_SIMPLEX, 0.5,
+                cv::Scalar(230, 230, 230), 1, cv::LINE_AA);
+  }
   return view;
 }
 
@@ -150,6 +182,7 @@ LogFrames read_log_frames(const std::string& path, const ChannelNames& channels,
   std::map<int64_t, depth_image_t> rendered;
   std::map<int64_t, link_labels_t> labels;
   std::map<int64_t, risk_t> risks;
+  std::map<int64_t, speed_limit_t> limits;
   // Decodes the event as the type of *message; counts it as skipped if it
   // is not one.
   auto decode = [&](const lcm::LogEvent* event, auto* message) {
@@ -174,12 +207,16 @@ LogFrames read_log_frames(const std::string& path, const ChannelNames& channels,
     } else if (event->channel == channels.risk) {
       risk_t m;
       if (decode(event, &m) && m.seq >= 0) risks[m.seq] = m;
+    } else if (event->channel == channels.speed_limit) {
+      speed_limit_t m;
+      if (decode(event, &m) && m.seq >= 0 && check_speed_limit(m).empty()) limits[m.seq] = m;
     }
   }
   for (auto& [seq, frames] : result.by_seq) {
     if (auto it = rendered.find(seq); it != rendered.end()) frames.rendered = it->second;
     if (auto it = labels.find(seq); it != labels.end()) frames.labels = it->second;
     if (auto it = risks.find(seq); it != risks.end()) frames.risk = it->second;
+    if (auto it = limits.find(seq); it != limits.end()) frames.limit = it->second;
   }
   return result;
 }

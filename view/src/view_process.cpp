@@ -89,11 +89,15 @@ int live(const ViewSettings& settings) {
     void risk(const lcm::ReceiveBuffer*, const std::string&, const risk_t* m) {
       if (m->seq >= 0) (*pending)[m->seq].risk = *m;
     }
+    void limit(const lcm::ReceiveBuffer*, const std::string&, const speed_limit_t* m) {
+      if (m->seq >= 0 && check_speed_limit(*m).empty()) (*pending)[m->seq].limit = *m;
+    }
   } handler{&pending, &settings};
   images.subscribe(settings.channels.depth, &Handler::depth, &handler);
   images.subscribe(settings.channels.rendered, &Handler::rendered, &handler);
   images.subscribe(settings.channels.labels, &Handler::labels, &handler);
   safety.subscribe(settings.channels.risk, &Handler::risk, &handler);
+  safety.subscribe(settings.channels.speed_limit, &Handler::limit, &handler);
   const auto options = discrepancy::discrepancy_options(settings.discrepancy);
   cv::namedWindow("tofguard-view", cv::WINDOW_AUTOSIZE);
   while (!stop_requested()) {

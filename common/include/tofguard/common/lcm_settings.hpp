@@ -56,6 +56,7 @@ struct ChannelNames {
   // camera) and run-time encoder fault injection.
   std::string sim_true_joint_state = "SIM_TRUE_JOINT_STATE";
   std::string sim_joint_fault = "SIM_JOINT_FAULT";
+  std::string sim_controller_fault = "SIM_CONTROLLER_FAULT";
   // Simulation only: run-time fault injection into the simulated camera.
   std::string sim_camera_fault = "SIM_CAMERA_FAULT";
 };

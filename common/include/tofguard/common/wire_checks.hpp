@@ -17,6 +17,7 @@
 #include "tofguard/risk_t.hpp"
 #include "tofguard/safety_status_t.hpp"
 #include "tofguard/sim_camera_fault_t.hpp"
+#include "tofguard/sim_controller_fault_t.hpp"
 #include "tofguard/sim_joint_fault_t.hpp"
 #include "tofguard/speed_limit_t.hpp"
 
@@ -64,5 +65,7 @@ std::string check_heartbeat(const heartbeat_t& heartbeat);
 std::string check_sim_camera_fault(const sim_camera_fault_t& fault);
 // A joint name and a finite offset (rad, or m for a prismatic joint).
 std::string check_sim_joint_fault(const sim_joint_fault_t& fault);
+// utime > 0.
+std::string check_sim_controller_fault(const sim_controller_fault_t& fault);
 
 }  // namespace tofguard

@@ -5,6 +5,7 @@
 // the arm's motion parameters stay in seconds (they describe a sine, not a
 // deadline).
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -43,6 +44,14 @@ struct EncoderFault {
   double at_s = 0;
 };
 
+// One pose of the simulated arm's task (joints_sim.task.waypoints): every
+// movable joint's position (rad, m for prismatic joints), held for hold_s.
+struct TaskWaypoint {
+  std::string name;
+  double hold_s = 0;
+  std::map<std::string, double> joints;
+};
+
 struct JointsSimSettings {
   // rate_hz: JOINT_STATE rate.
   double rate_hz = 0;
@@ -52,6 +61,12 @@ struct JointsSimSettings {
   int64_t status_deadline_us = 0;
   // motion: every movable joint of the URDF, in the order published.
   std::vector<JointMotion> motion;
+  // task (optional; tofguard-joints-sim --task follows it instead of
+  // motion): a cycle of waypoints, each held for its hold_s, then moved to
+  // the next (the last to the first) in move_s seconds along a straight
+  // line in joint space with a cosine speed profile (at rest at both ends).
+  std::vector<TaskWaypoint> task_waypoints;
+  double task_move_s = 0;
   // faults (optional).
   std::vector<EncoderFault> faults;
   // plan.{publish, rate_hz, horizon_ms, step_ms}: the arm's own plan on
@@ -98,6 +113,9 @@ struct JointsSimProcessSettings {
   // its frames (docs/camera.md, "Commissioning a camera"). Never in a
   // deployment: the simulator's alone.
   bool moves_without_permission = false;
+  // tofguard-joints-sim --task: the arm follows joints_sim.task instead of
+  // the periodic motion (the assistive task scripts/demo shows).
+  bool follows_task = false;
 };
 
 // ---- The simulated ToF camera (camera.sim) ----
@@ -285,4 +303,5 @@ using settings::SimCameraSettings;
 using settings::SimFaultToolSettings;
 using settings::SimResidualSettings;
 using settings::SimUserSettings;
+using settings::TaskWaypoint;
 }  // namespace tofguard::sim

@@ -26,8 +26,11 @@ class SimulatedArm {
   // (robot_model::KinematicTree::actuated_joint_names). Throws ConfigError
   // (naming `config_file` and the joints_sim key) when the motion does not
   // cover exactly those joints or a fault names an unknown joint.
+  // `task`: follow joints_sim.task's waypoints instead of the periodic
+  // motion (ConfigError when the config has none, or a waypoint does not
+  // give exactly the URDF's movable joints).
   SimulatedArm(const JointsSimSettings& config, const std::vector<std::string>& urdf_joints,
-               const std::string& config_file);
+               const std::string& config_file, bool task = false);
 
   // Advances by dt_s of process time. The motion time advances only while
   // `motion_allowed`, so a halted arm resumes where it stopped, and then by
@@ -56,8 +59,23 @@ class SimulatedArm {
 
  private:
   void update_state(bool moving);
+  // Joint i's position and its velocity at full speed at motion time t_s.
+  double position_at(size_t i, double t_s) const;
+  double velocity_at(size_t i, double t_s) const;
+  // The task's segment at motion time t_s: from waypoint `from` to `to`
+  // (the same while holding), blend in [0, 1] and d(blend)/dt.
+  struct TaskPhase {
+    size_t from = 0, to = 0;
+    double blend = 0, blend_rate = 0;
+  };
+  TaskPhase task_phase(double t_s) const;
 
   std::vector<JointMotion> motion_;  // in URDF order
+  // The task (empty: the periodic motion): each waypoint's positions in
+  // URDF order, its hold, and the move time between waypoints.
+  std::vector<std::vector<double>> task_positions_;
+  std::vector<double> task_hold_s_;
+  double task_move_s_ = 0;
   std::vector<EncoderFault> scheduled_faults_;
   std::map<std::string, double> offsets_;
   double elapsed_s_ = 0;

@@ -16,6 +16,7 @@
 #include "tofguard/link_labels_t.hpp"
 #include "tofguard/risk_t.hpp"
 #include "tofguard/settings/view_settings.hpp"
+#include "tofguard/speed_limit_t.hpp"
 
 namespace tofguard::view {
 
@@ -23,7 +24,8 @@ struct FrameSet {
   depth_image_t camera;
   std::optional<depth_image_t> rendered;
   std::optional<link_labels_t> labels;
-  std::optional<risk_t> risk;  // the verdict on this frame, if known
+  std::optional<risk_t> risk;          // the verdict on this frame, if known
+  std::optional<speed_limit_t> limit;  // the speed limit for this frame, if known
 };
 
 // Per camera pixel, where its surface lies (labels' arm cover; CV_8U):
@@ -46,9 +48,15 @@ cv::Mat3b compose_view(const FrameSet& frames, const discrepancy::DiscrepancyOpt
 // The verdict line: e.g. "seq 42  DANGEROUS joint error, suspect a4 | ...",
 // or "seq 42  no verdict".
 std::string verdict_text(const FrameSet& frames);
+// The user's line, under the verdict (docs/safety-chain.md, "The user"):
+// the body region nearest the arm and its separation (the labels', from
+// the model) and the frame's speed limit, e.g. "user: face nearest, 0.19 m
+// | limit 0.38 m/s, set by face at 0.14 m"; "" when the labels carry no
+// body regions.
+std::string user_text(const FrameSet& frames);
 
 // Reads a whole LCM log and groups its frames by camera seq: TOF_DEPTH
-// (camera), TOF_RENDERED, TOF_LABELS and SAFETY_RISK, by the channel names
+// (camera), TOF_RENDERED, TOF_LABELS, SAFETY_RISK and SAFETY_SPEED_LIMIT, by the channel names
 // given. Messages that do not decode are skipped and counted.
 struct LogFrames {
   std::map<int64_t, FrameSet> by_seq;
