@@ -250,10 +250,6 @@ struct PixelClasses {
   std::vector<int32_t> region_seen;
 };
 
-// Stage 3, pixel classes: I_dis = I_gen - I_ToF (mm) and the class of every
-// pixel (docs/safety-chain.md, "Pixel classes") into frame->pixel_class and
-// frame->dis_mm (allocated by the caller), with the masks and totals the
-// later stages need into `p` (fresh).
 // A pixel where the model shows the occupant (shape `shape`) and the
 // camera a surface, I_dis = `dis_mm`: within the tolerance and the region's
 // envelope it is the user as modelled (a match); nearer, something is in
@@ -281,6 +277,10 @@ int classify_occupant_pixel(int dis_mm, double tolerance_mm, int i, const Occupa
   return discrepancy_t::PIXEL_ENVIRONMENT_MISSING;
 }
 
+// Stage 3, pixel classes: I_dis = I_gen - I_ToF (mm) and the class of every
+// pixel (docs/safety-chain.md, "Pixel classes") into frame->pixel_class and
+// frame->dis_mm (allocated by the caller), with the masks and totals the
+// later stages need into `p` (fresh).
 void classify_pixels(const depth_image_t& camera, const depth_image_t& rendered, const link_labels_t& labels,
                      const std::vector<uint8_t>& silhouette, const Tolerance& tolerance,
                      const OccupantShapes& occupant, DiscrepancyFrame* frame, PixelClasses* classes) {

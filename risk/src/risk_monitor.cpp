@@ -105,14 +105,16 @@ ClassifiedFrame RiskMonitor::classify(const discrepancy_t& frame) const {
   c.frame = frame;
   c.finding = classify_frame(frame, robot_, settings_, context);
   c.model_mismatch = is_model_mismatch(c.finding.cause);
-  // The arm faster than the user's body regions allow: only when the
-  // camera shows nothing wrong (the protective field's own finding comes
-  // from the rules above).
+  // The user not where the model seats them (an empty chair): only when
+  // the camera shows nothing else wrong.
   if (c.finding.cause == risk_t::CAUSE_NONE && occupant_) {
     if (std::optional<FrameFinding> absent = user_not_where_modelled(frame, *occupant_)) {
       c.finding = std::move(*absent);
     }
   }
+  // The arm faster than the user's body regions allow: only when the
+  // camera shows nothing wrong (the protective field's own finding comes
+  // from the rules above).
   if (c.finding.cause == risk_t::CAUSE_NONE && !body_region_rules_.empty()) {
     if (std::optional<FrameFinding> faster = faster_than_the_user_allows(speed_limit(frame))) {
       c.finding = std::move(*faster);
