@@ -5,6 +5,7 @@
 #include <cmath>
 #include <iomanip>
 #include <limits>
+#include <optional>
 #include <sstream>
 
 #include <opencv2/imgproc.hpp>
@@ -621,6 +622,36 @@ void unexplained_surfaces(const depth_image_t& camera, const link_labels_t& labe
   }
 }
 
+// Stage 2b, the arm hidden by the user: `camera` with no return wherever a
+// robot link's pixel shows a nearer surface (beyond the tolerance) that
+// lies within a body region's envelope of the user: the user's own hand
+// before a link. Such a pixel says nothing about the link (what is behind
+// the hand cannot be seen), so the per-link counts and the evidence take
+// it as they take a pixel without a return; the pixel classes and the
+// unexplained surfaces still see it (as the user). nullopt when no pixel
+// is hidden so (or there is no user).
+std::optional<depth_image_t> arm_hidden_by_user(const depth_image_t& camera, const depth_image_t& rendered,
+                                                const link_labels_t& labels, const OccupantShapes& occupant,
+                                                const Tolerance& tolerance) {
+  if (occupant.empty()) return std::nullopt;
+  std::optional<depth_image_t> out;
+  const int width = camera.width;
+  const int num_pixels = width * camera.height;
+  for (int i = 0; i < num_pixels; ++i) {
+    const int t = camera.depth_mm[i];
+    const int g = rendered.depth_mm[i];
+    const int link = link_of_label(labels.label[i], labels.num_robot_links, labels.num_links);
+    if (t <= 0 || g <= 0 || link < 0 || link >= labels.num_robot_links || g - t <= tolerance.at(t)) continue;
+    const double z = metres_from_mm(t);
+    const Eigen::Vector3d point((i % width - camera.cx) * z / camera.fx,
+                                (i / width - camera.cy) * z / camera.fy, z);
+    if (occupant.region_holding(point) < 0) continue;
+    if (!out) out = camera;
+    out->depth_mm[i] = 0;
+  }
+  return out;
+}
+
 // The frame's identity and size, nothing judged: not usable, no
 // invalid pixels counted (unusable_summary counts them; a usable frame's
 // pixel stages do).
@@ -781,6 +812,10 @@ DiscrepancyFrame compare_frames(const depth_image_t& camera, const depth_image_t
   s.link_median_dis_mm.assign(num_links, 0.0f);
 
   const std::vector<uint8_t> silhouette = silhouette_mask(rendered, options.silhouette_jump_mm);
+  const OccupantShapes occupant(labels);
+  const std::optional<depth_image_t> unhidden =
+      arm_hidden_by_user(camera, rendered, labels, occupant, options.tolerance);
+  const depth_image_t& camera_for_arm = unhidden ? *unhidden : camera;
   std::vector<double> reach;  // the pixel stages' (joint_reach)
   // Stages 3 to 6 need nothing from the evidence, nor it from them (they
   // write other fields of the summary; the joints' reach, too, is the
@@ -791,7 +826,6 @@ DiscrepancyFrame compare_frames(const depth_image_t& camera, const depth_image_t
     frame.pixel_class.create(camera.height, camera.width);
     frame.dis_mm.create(camera.height, camera.width);
     PixelClasses classes(camera.height, camera.width);
-    const OccupantShapes occupant(labels);
     classify_pixels(camera, rendered, labels, silhouette, options.tolerance, occupant, &frame, &classes);
 
     // The seed's score and the class counts.
@@ -809,15 +843,15 @@ DiscrepancyFrame compare_frames(const depth_image_t& camera, const depth_image_t
     s.mismatch_fraction =
         s.num_compared > 0 ? static_cast<float>(s.num_compared - s.num_match) / s.num_compared : 0.0f;
 
-    per_link_statistics(frame, camera, rendered, labels, silhouette, &s);
+    per_link_statistics(frame, camera_for_arm, rendered, labels, silhouette, &s);
     const PixelFootprint footprint(camera, rendered);
     largest_blob(classes.mismatch_mask, options.opening_radius_px, footprint, &s);
     unexplained_surfaces(camera, labels, frame, classes, occupant, options, footprint, &s);
     if (s.field_available) reach = joint_reach_m(labels);
   });
   // Stage 7, evidence (evidence.hpp).
-  compute_evidence(camera, rendered, labels, silhouette, options.silhouette_jump_mm, options.tolerance.noise,
-                   options.evidence, &s, workers, &pixel_stages);
+  compute_evidence(camera_for_arm, rendered, labels, silhouette, options.silhouette_jump_mm,
+                   options.tolerance.noise, options.evidence, &s, workers, &pixel_stages);
   pixel_stages.run_once();
   joint_reach(reach, &s);
   body_regions(labels, &s);

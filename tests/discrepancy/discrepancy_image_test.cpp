@@ -612,26 +612,32 @@ Box chest(int shift_px = 0, int16_t depth_mm = kFrontMm) {
   return {kU0 + shift_px, kV0, kU1 + shift_px, kV1, depth_mm, link_labels_t::OCCUPANT_FIRST};
 }
 
-// The labels' region "chest" (envelope 3 cm) and its one box, in the
-// optical frame: the face at z = 1.6 m over exactly the columns and rows
-// above (pixel edges at u - 0.5 and u1 - 0.5), 0.2 m deep.
-void add_chest(link_labels_t* labels) {
-  const double z = kFrontMm * 1e-3;
+// Adds to the labels a body region `name` (envelope `envelope_m`) with one
+// box in the optical frame: its face at `front_mm` over exactly columns
+// u0..u1-1 and rows v0..v1-1 (pixel edges at u - 0.5), 0.2 m deep.
+void add_user_box(link_labels_t* labels, const std::string& name, double envelope_m, int u0, int u1, int v0,
+                  int v1, int16_t front_mm) {
+  const double z = front_mm * 1e-3;
   const double cx = kWidth / 2.0, cy = kHeight / 2.0;
-  const double x0 = (kU0 - 0.5 - cx) * z / kFocalPx, x1 = (kU1 - 0.5 - cx) * z / kFocalPx;
-  const double y0 = (kV0 - 0.5 - cy) * z / kFocalPx, y1 = (kV1 - 0.5 - cy) * z / kFocalPx;
-  labels->num_body_regions = 1;
-  labels->body_region = {"chest"};
-  labels->body_region_separation_m = {0.08f};
-  labels->body_region_envelope_m = {static_cast<float>(kEnvelopeM)};
-  labels->num_occupant_shapes = 1;
-  labels->occupant_shape_kind = {link_labels_t::SHAPE_BOX};
-  labels->occupant_shape_region = {0};
-  labels->occupant_shape_center_m = {
-      {static_cast<float>((x0 + x1) / 2), static_cast<float>((y0 + y1) / 2), static_cast<float>(z + 0.1)}};
-  labels->occupant_shape_rotation = {{1, 0, 0, 0, 1, 0, 0, 0, 1}};
-  labels->occupant_shape_size_m = {
-      {static_cast<float>((x1 - x0) / 2), static_cast<float>((y1 - y0) / 2), 0.1f}};
+  const double x0 = (u0 - 0.5 - cx) * z / kFocalPx, x1 = (u1 - 0.5 - cx) * z / kFocalPx;
+  const double y0 = (v0 - 0.5 - cy) * z / kFocalPx, y1 = (v1 - 0.5 - cy) * z / kFocalPx;
+  labels->num_body_regions++;
+  labels->body_region.push_back(name);
+  labels->body_region_separation_m.push_back(0.08f);
+  labels->body_region_envelope_m.push_back(static_cast<float>(envelope_m));
+  labels->num_occupant_shapes++;
+  labels->occupant_shape_kind.push_back(link_labels_t::SHAPE_BOX);
+  labels->occupant_shape_region.push_back(static_cast<int16_t>(labels->num_body_regions - 1));
+  labels->occupant_shape_center_m.push_back(
+      {static_cast<float>((x0 + x1) / 2), static_cast<float>((y0 + y1) / 2), static_cast<float>(z + 0.1)});
+  labels->occupant_shape_rotation.push_back({1, 0, 0, 0, 1, 0, 0, 0, 1});
+  labels->occupant_shape_size_m.push_back(
+      {static_cast<float>((x1 - x0) / 2), static_cast<float>((y1 - y0) / 2), 0.1f});
+}
+
+// The labels' region "chest" (envelope 3 cm) and its one box.
+void add_chest(link_labels_t* labels) {
+  add_user_box(labels, "chest", kEnvelopeM, kU0, kU1, kV0, kV1, kFrontMm);
 }
 
 // The default arm with the user's chest beside it, the model's image, and
@@ -710,6 +716,41 @@ TEST(DiscrepancyUser, AHandOutsideEveryEnvelopeIsAnUnknownObject) {
   EXPECT_LE(s.near_arm_pixels, 4 * 10);
   EXPECT_GT(s.unexplained_area_within_m2.back(), 0);
   EXPECT_EQ(s.body_region_missing_pixels[0], 0);
+}
+
+// The user's hand before a link: its model (region "hand", envelope 10 cm,
+// 1.4 m away) just past link2's end (columns 102..109, rows 62..69), the
+// real hand 6 columns (4 cm) nearer the arm, before link2's last 4
+// columns. Those 32 pixels say nothing about link2: they are the user's,
+// not an object near the arm, and link2 counts them as without a return,
+// not as nearer; the same surface with no user modelled is an object
+// before the link.
+TEST(DiscrepancyUser, TheUsersHandBeforeALinkHidesItAndIsNoObject) {
+  std::vector<Box> modelled = default_arm();
+  modelled.push_back({102, 62, 110, 70, 1400, link_labels_t::OCCUPANT_FIRST});
+  const SyntheticImage model = draw(modelled);
+  std::vector<Box> seen = default_arm();
+  seen.push_back({96, 62, 104, 70, 1400, 0});
+  const depth_image_t camera = depth_frame(draw(seen).depth_mm, 7);
+  link_labels_t labels = labels_frame(model.label, 7);
+  add_pixel_cover(&labels, model.depth_mm);
+  link_labels_t without_user = labels;
+  for (int16_t& l : without_user.label)
+    l = l == link_labels_t::OCCUPANT_FIRST ? link_labels_t::ENVIRONMENT_FIRST : l;
+  user::add_user_box(&labels, "hand", 0.10, 102, 110, 62, 70, 1400);
+  const discrepancy_t with =
+      compute_discrepancy(camera, depth_frame(model.depth_mm, 7), labels, sim_options()).summary;
+  ASSERT_TRUE(with.usable) << with.unusable_reason;
+  EXPECT_EQ(with.num_occluded, 32);
+  EXPECT_EQ(with.link_nearer[2], 0);
+  EXPECT_EQ(with.link_invalid[2], 32);
+  EXPECT_EQ(with.near_arm_pixels, 0);
+  EXPECT_GT(with.body_region_seen_pixels[0], 32);
+  const discrepancy_t without =
+      compute_discrepancy(camera, depth_frame(model.depth_mm, 7), without_user, sim_options()).summary;
+  ASSERT_TRUE(without.usable) << without.unusable_reason;
+  EXPECT_EQ(without.link_nearer[2], 32);
+  EXPECT_GT(without.near_arm_pixels, 0);
 }
 
 // Nobody in the chair: every modelled pixel of the user sees the floor
