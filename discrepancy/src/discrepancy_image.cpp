@@ -511,6 +511,14 @@ int surface_depth_mm(const int16_t* tof, const uint8_t* unexplained, int i, int 
   return placed == std::numeric_limits<int>::max() ? d : placed;
 }
 
+// The point pixel i of `camera` sees at Z = `z_m` along the optical axis:
+// the camera's optical frame (x right, y down, z forward), metres.
+Eigen::Vector3d optical_point_m(const depth_image_t& camera, int i, double z_m) {
+  const int width = camera.width;
+  return Eigen::Vector3d((i % width - camera.cx) * z_m / camera.fx, (i / width - camera.cy) * z_m / camera.fy,
+                         z_m);
+}
+
 // The user's seen surfaces per body region: the pixel classes' counts,
 // the unexplained surfaces found within an envelope, and each region's
 // smallest seen distance to the arm's cover (-1: none seen, or no cover).
@@ -578,29 +586,26 @@ void unexplained_surfaces(const depth_image_t& camera, const link_labels_t& labe
   double near_area = 0;
   for (int i = 0; i < num_pixels; ++i) {
     if (candidate[i] == 0) continue;
-    // The camera-frame point (optical frame, m) of pixel i at its depth.
-    const auto point = [&] {
-      const double z = metres_from_mm(
-          surface_depth_mm(tof, candidate, i, width, camera.height, options.silhouette_jump_mm));
-      return Eigen::Vector3d((i % width - camera.cx) * z / camera.fx, (i / width - camera.cy) * z / camera.fy,
-                             z);
-    };
+    const bool measured = s->field_available && pixel_class[i] != discrepancy_t::PIXEL_OCCLUDED;
+    // The camera-frame point of pixel i at its depth, once, where needed.
+    Eigen::Vector3d point = Eigen::Vector3d::Zero();
+    if (measured || !occupant.empty()) {
+      point = optical_point_m(camera, i,
+                              metres_from_mm(surface_depth_mm(tof, candidate, i, width, camera.height,
+                                                              options.silhouette_jump_mm)));
+    }
     if (!occupant.empty()) {
       // A surface within a region's envelope is the user (hiding the arm
       // or not): not an unknown object, but how near the user's seen body
       // is to the arm.
-      const Eigen::Vector3d p = point();
-      if (const int region = occupant.region_holding(p); region >= 0) {
+      if (const int region = occupant.region_holding(point); region >= 0) {
         // Beyond up_to_m the search gives some value >= it: up_to_m, never
         // more than the truth.
-        user.saw(region, s->field_available ? std::min(arm.distance_m(p, up_to_m), up_to_m) : -1.0);
+        user.saw(region, s->field_available ? std::min(arm.distance_m(point, up_to_m), up_to_m) : -1.0);
         continue;
       }
     }
-    double distance_m = 0;
-    if (s->field_available && pixel_class[i] != discrepancy_t::PIXEL_OCCLUDED) {
-      distance_m = arm.distance_m(point(), up_to_m);
-    }
+    const double distance_m = measured ? arm.distance_m(point, up_to_m) : 0.0;
     const double area = footprint.m2(i);
     if (distance_m <= options.near_arm_m) {
       s->near_arm_pixels++;
@@ -642,10 +647,7 @@ std::optional<depth_image_t> arm_hidden_by_user(const depth_image_t& camera, con
     const int g = rendered.depth_mm[i];
     const int link = link_of_label(labels.label[i], labels.num_robot_links, labels.num_links);
     if (t <= 0 || g <= 0 || link < 0 || link >= labels.num_robot_links || g - t <= tolerance.at(t)) continue;
-    const double z = metres_from_mm(t);
-    const Eigen::Vector3d point((i % width - camera.cx) * z / camera.fx,
-                                (i / width - camera.cy) * z / camera.fy, z);
-    if (occupant.region_holding(point) < 0) continue;
+    if (occupant.region_holding(optical_point_m(camera, i, metres_from_mm(t))) < 0) continue;
     if (!out) out = camera;
     out->depth_mm[i] = 0;
   }
