@@ -228,30 +228,27 @@ class Chain {
   }
 
   void camera_fault(int32_t kind, double duration_s = 1000) {
+    if (kind == sim_camera_fault_t::INTRUDING_OBJECT) {
+      // A 10 cm box (a hand) standing still 15 cm beside the forearm's
+      // joint (link5's origin), to the image's left (the arm stands in the
+      // image's right half): within 0.2 m of the arm, not in front of it.
+      intrude(object_beside_forearm_m(-0.15), Eigen::Vector3d::Constant(0.10), duration_s);
+      return;
+    }
     sim_camera_fault_t f{};
     f.utime = wall_utime();
     f.camera_id = config_.camera.id;
     f.kind = kind;
     f.duration_s = duration_s;
-    if (kind == sim_camera_fault_t::INTRUDING_OBJECT) {
-      // A 10 cm box (a hand) standing still 15 cm beside the forearm's
-      // joint (link5's origin), to the image's left (the arm stands in the
-      // image's right half): within 0.2 m of the arm, not in front of it.
-      const Eigen::Vector3d at = object_beside_forearm_m(-0.15);
-      for (int i = 0; i < 3; ++i) {
-        f.object_size_m[i] = 0.10;
-        f.object_position_m[i] = at[i];
-      }
-    }
     safety_.publish(config_.channels.sim_camera_fault, &f);
   }
   // A box of `size_m` standing still at `at_m` (world frame) from now on.
-  void intrude(const Eigen::Vector3d& at_m, const Eigen::Vector3d& size_m) {
+  void intrude(const Eigen::Vector3d& at_m, const Eigen::Vector3d& size_m, double duration_s = 1000) {
     sim_camera_fault_t f{};
     f.utime = wall_utime();
     f.camera_id = config_.camera.id;
     f.kind = sim_camera_fault_t::INTRUDING_OBJECT;
-    f.duration_s = 1000;
+    f.duration_s = duration_s;
     for (int i = 0; i < 3; ++i) {
       f.object_size_m[i] = size_m[i];
       f.object_position_m[i] = at_m[i];
