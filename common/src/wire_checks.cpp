@@ -701,6 +701,10 @@ std::string check_sim_camera_fault(const sim_camera_fault_t& f) {
 
 std::string check_sim_controller_fault(const sim_controller_fault_t& f) {
   if (f.utime <= 0) return expected("utime", "a time > 0 (us since the epoch)", static_cast<double>(f.utime));
+  if (!std::isfinite(f.drive_rad_s))
+    return expected("drive_rad_s", "a finite speed (rad/s, or m/s for a prismatic joint)", f.drive_rad_s);
+  if (f.drive_joint.empty() && f.drive_rad_s != 0)
+    return expected("drive_rad_s", "0 when drive_joint is empty (no drive)", f.drive_rad_s);
   return "";
 }
 

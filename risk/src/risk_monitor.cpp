@@ -83,7 +83,7 @@ std::optional<FrameFinding> faster_than_the_user_allows(const speed_limit_t& lim
   f.score = unbounded ? std::numeric_limits<double>::infinity() : limit.arm_speed_m_s;
   f.threshold = limit.max_arm_speed_m_s;
   const std::string where = fixed(limit.separation_m * 100, 0) + " cm from the user's " + limit.body_region +
-                            ", limit " + fixed(limit.max_arm_speed_m_s, 2) + " m/s (m/s)";
+                            ", limit " + fixed(limit.max_arm_speed_m_s, 2) + " m/s";
   f.detail = unbounded ? "arm speed not bounded, " + where
                        : "arm at " + fixed(limit.arm_speed_m_s, 2) + " m/s, " + where;
   return f;

@@ -113,10 +113,20 @@ class JointsSimWiring {
     node_.subscribe<sim_controller_fault_t>(
         node_.safety(), settings_.channels.sim_controller_fault,
         [this](const sim_controller_fault_t& fault) {
+          if (!arm_.set_drive(fault.drive_joint, fault.drive_rad_s)) {
+            node_.counters().validation_errors++;
+            node_.errors().report(settings_.channels.sim_controller_fault,
+                                  settings_.channels.sim_controller_fault +
+                                      ": drive_joint: expected a joint of the arm or nothing, got '" +
+                                      fault.drive_joint + "'");
+            return;
+          }
           ignores_speed_limit_ = fault.ignore_speed_limit;
           std::cerr << "tofguard-joints-sim: controller fault: "
-                    << (ignores_speed_limit_ ? "ignores the speed limit" : "follows the speed limit again")
-                    << std::endl;
+                    << (ignores_speed_limit_ ? "ignores the speed limit" : "follows the speed limit again");
+          if (!fault.drive_joint.empty())
+            std::cerr << ", drives " << fault.drive_joint << " at " << fault.drive_rad_s << " rad/s";
+          std::cerr << std::endl;
         },
         check_sim_controller_fault);
   }
@@ -174,13 +184,13 @@ class JointsSimWiring {
     // A speed scale changed by more than kReplanScale since the last plan
     // is a new plan too (the old one runs ahead of or behind the arm).
     constexpr double kReplanScale = 0.05;
-    if (sim_.publish_plan && (now_us >= next_plan_us_ || allowed != planned_allowed_ ||
-                              arm_.offsets_version() != planned_offsets_version_ ||
-                              std::abs(scale - planned_scale_) > kReplanScale)) {
+    if (sim_.publish_plan &&
+        (now_us >= next_plan_us_ || allowed != planned_allowed_ ||
+         arm_.plan_version() != planned_plan_version_ || std::abs(scale - planned_scale_) > kReplanScale)) {
       publish_plan(utime);
       next_plan_us_ = now_us + plan_period_us_;
       planned_allowed_ = allowed;
-      planned_offsets_version_ = arm_.offsets_version();
+      planned_plan_version_ = arm_.plan_version();
       planned_scale_ = scale;
     }
     node_.safety().publish(settings_.channels.joint_state, &reported);
@@ -190,10 +200,12 @@ class JointsSimWiring {
         follower_
             ? "moving at " + std::to_string(static_cast<int>(std::lround(100 * scale))) + " % of full speed"
             : "moving";
-    node_.heartbeat().set_status(settings_.moves_without_permission
-                                     ? "moving without a permission (commissioning)"
-                                 : allowed ? moving
-                                           : "halted: no permission to move");
+    const std::string stage = arm_.task_stage();
+    node_.heartbeat().set_status((settings_.moves_without_permission
+                                      ? "moving without a permission (commissioning)"
+                                  : allowed ? moving
+                                            : "halted: no permission to move") +
+                                 (stage.empty() ? "" : "; task: " + stage));
   }
 
   const JointsSimProcessSettings& settings_;
@@ -214,7 +226,7 @@ class JointsSimWiring {
   const int64_t plan_period_us_;
   int64_t next_plan_us_ = 0;
   bool planned_allowed_ = false;
-  int planned_offsets_version_ = 0;
+  int planned_plan_version_ = 0;
 };
 
 }  // namespace
@@ -230,7 +242,8 @@ ProcessInfo joints_sim_info() {
           "--commissioning: moves without a permission (a commissioning recording,\n"
           "docs/camera.md); never with a safety chain in charge.\n"
           "Encoder faults: joints_sim.faults in the config, or sim_joint_fault_t on SIM_JOINT_FAULT;\n"
-          "a controller that ignores the speed limit: sim_controller_fault_t on SIM_CONTROLLER_FAULT."};
+          "a controller that ignores the speed limit or drives a joint: sim_controller_fault_t on\n"
+          "SIM_CONTROLLER_FAULT."};
 }
 
 int run_joints_sim(const JointsSimProcessSettings& settings) {

@@ -19,6 +19,7 @@ namespace {
 constexpr const char* kUsage =
     "usage: tofguard-sim-fault [--config FILE] --joint NAME --offset-deg DEGREES\n"
     "       tofguard-sim-fault [--config FILE] --ignore-speed-limit on|off\n"
+    "       tofguard-sim-fault [--config FILE] --drive-joint NAME --drive-rad-s SPEED\n"
     "       tofguard-sim-fault [--config FILE] --camera-fault KIND [--duration-s S]\n"
     "           [--size-m X,Y,Z] [--position-m X,Y,Z] [--velocity-m-per-s X,Y,Z]\n"
     "           [--drift-m-per-s X,Y,Z] [--drift-rad-per-s X,Y,Z]\n"
@@ -140,6 +141,25 @@ int run_sim_fault(const SimFaultToolSettings& settings, const std::vector<std::s
       std::cout << (fault.ignore_speed_limit ? "controller fault: the arm ignores the speed limit"
                                              : "controller fault cleared: the arm follows the speed limit")
                 << std::endl;
+    }
+    return code;
+  }
+
+  if (options.count("--drive-joint")) {
+    double rad_s = 0;
+    if (options.size() != 2 || !options.count("--drive-rad-s") ||
+        !parse_number(options["--drive-rad-s"], &rad_s)) {
+      return usage_error("expected --drive-joint NAME --drive-rad-s SPEED (rad/s) alone");
+    }
+    sim_controller_fault_t fault{};
+    fault.utime = wall_utime();
+    fault.ignore_speed_limit = true;
+    fault.drive_joint = options["--drive-joint"];
+    fault.drive_rad_s = rad_s;
+    const int code = publish(settings, settings.channels.sim_controller_fault, fault);
+    if (code == 0) {
+      std::cout << "controller fault: the arm ignores the speed limit and drives " << fault.drive_joint
+                << " at " << rad_s << " rad/s (end it with --ignore-speed-limit off)" << std::endl;
     }
     return code;
   }

@@ -63,7 +63,10 @@ SimulatedArm::SimulatedArm(const JointsSimSettings& config, const std::vector<st
   }
   if (task) {
     task_positions_ = task_positions(config, urdf_joints, all, error);
-    for (const TaskWaypoint& w : config.task_waypoints) task_hold_s_.push_back(w.hold_s);
+    for (const TaskWaypoint& w : config.task_waypoints) {
+      task_hold_s_.push_back(w.hold_s);
+      task_names_.push_back(w.name);
+    }
     task_move_s_ = config.task_move_s;
   }
   scheduled_faults_ = config.faults;
@@ -73,6 +76,7 @@ SimulatedArm::SimulatedArm(const JointsSimSettings& config, const std::vector<st
   }
   true_state_.position.resize(motion_.size());
   true_state_.velocity.resize(motion_.size());
+  driven_.assign(motion_.size(), 0.0);
   update_state(false);
 }
 
@@ -92,6 +96,24 @@ SimulatedArm::TaskPhase SimulatedArm::task_phase(double t_s) const {
     t -= task_move_s_;
   }
   return {0, 0, 0, 0};
+}
+
+double SimulatedArm::drive_velocity(size_t i) const {
+  if (static_cast<int>(i) == drive_index_) return drive_rad_s_;
+  if (driven_[i] == 0) return 0;
+  return driven_[i] > 0 ? -kDriveReturnRadS * speed_scale_ : kDriveReturnRadS * speed_scale_;
+}
+
+double SimulatedArm::driven_after(size_t i, double dt_s) const {
+  if (static_cast<int>(i) == drive_index_) return driven_[i] + drive_rad_s_ * dt_s;
+  const double left = std::max(0.0, std::abs(driven_[i]) - kDriveReturnRadS * speed_scale_ * dt_s);
+  return std::copysign(left, driven_[i]);
+}
+
+std::string SimulatedArm::task_stage() const {
+  if (task_positions_.empty()) return "";
+  const TaskPhase p = task_phase(motion_time_s_);
+  return (p.from == p.to ? "at " : "to ") + task_names_[p.to];
 }
 
 double SimulatedArm::position_at(size_t i, double t_s) const {
@@ -117,8 +139,9 @@ double SimulatedArm::velocity_at(size_t i, double t_s) const {
 void SimulatedArm::update_state(bool moving) {
   moving_ = moving;
   for (size_t i = 0; i < motion_.size(); ++i) {
-    true_state_.position[i] = position_at(i, motion_time_s_);
-    true_state_.velocity[i] = moving ? speed_scale_ * velocity_at(i, motion_time_s_) : 0.0;
+    true_state_.position[i] = position_at(i, motion_time_s_) + driven_[i];
+    true_state_.velocity[i] =
+        moving ? speed_scale_ * velocity_at(i, motion_time_s_) + drive_velocity(i) : 0.0;
   }
 }
 
@@ -126,10 +149,11 @@ void SimulatedArm::step(double dt_s, bool motion_allowed, double speed_scale) {
   elapsed_s_ += dt_s;
   speed_scale_ = std::clamp(speed_scale, 0.0, 1.0);
   if (motion_allowed) motion_time_s_ += speed_scale_ * dt_s;
+  for (size_t i = 0; i < driven_.size() && motion_allowed; ++i) driven_[i] = driven_after(i, dt_s);
   for (auto it = scheduled_faults_.begin(); it != scheduled_faults_.end();) {
     if (elapsed_s_ >= it->at_s) {
       offsets_[it->joint] = it->offset;
-      ++offsets_version_;
+      ++plan_version_;
       it = scheduled_faults_.erase(it);
     } else {
       ++it;
@@ -142,7 +166,20 @@ bool SimulatedArm::set_encoder_offset(const std::string& joint, double offset) {
   auto it = offsets_.find(joint);
   if (it == offsets_.end()) return false;
   it->second = offset;
-  ++offsets_version_;
+  ++plan_version_;
+  return true;
+}
+
+bool SimulatedArm::set_drive(const std::string& joint, double rad_s) {
+  int index = -1;
+  for (size_t i = 0; i < motion_.size() && !joint.empty(); ++i) {
+    if (motion_[i].joint == joint) index = static_cast<int>(i);
+  }
+  if (!joint.empty() && index < 0) return false;
+  drive_index_ = index;
+  drive_rad_s_ = index >= 0 ? rad_s : 0.0;
+  ++plan_version_;
+  update_state(moving_);
   return true;
 }
 
@@ -158,7 +195,8 @@ std::vector<double> SimulatedArm::planned_reported_positions(double ahead_s) con
   std::vector<double> positions(motion_.size());
   const double t = motion_time_s_ + (moving_ ? speed_scale_ * ahead_s : 0.0);
   for (size_t i = 0; i < motion_.size(); ++i)
-    positions[i] = position_at(i, t) + offsets_.at(motion_[i].joint);
+    positions[i] =
+        position_at(i, t) + (moving_ ? driven_after(i, ahead_s) : driven_[i]) + offsets_.at(motion_[i].joint);
   return positions;
 }
 

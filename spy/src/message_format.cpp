@@ -152,7 +152,12 @@ std::string format(const discrepancy_t& m) {
 }
 
 std::string format(const sim_controller_fault_t& m) {
-  return std::string("ignore_speed_limit=") + (m.ignore_speed_limit ? "yes" : "no");
+  std::ostringstream s;
+  s << "ignore_speed_limit=" << (m.ignore_speed_limit ? "yes" : "no");
+  if (!m.drive_joint.empty())
+    s << " drive " << m.drive_joint << " at " << std::fixed << std::setprecision(2) << m.drive_rad_s
+      << " rad/s";
+  return s.str();
 }
 
 std::string format(const sim_joint_fault_t& m) {

@@ -423,6 +423,24 @@ TEST(WireChecks, SimCameraFault) {
   EXPECT_EQ(check_sim_camera_fault(f), "object_size_m: expected 3 sizes > 0");
 }
 
+TEST(WireChecks, SimControllerFault) {
+  sim_controller_fault_t f{};
+  f.utime = 1;
+  f.ignore_speed_limit = true;
+  EXPECT_EQ(check_sim_controller_fault(f), "");
+  f.drive_joint = "a1";
+  f.drive_rad_s = -1.5;
+  EXPECT_EQ(check_sim_controller_fault(f), "");
+  f.drive_rad_s = std::nan("");
+  EXPECT_EQ(check_sim_controller_fault(f).substr(0, 11), "drive_rad_s");
+  f.drive_joint = "";
+  f.drive_rad_s = 0.5;  // a speed without a joint
+  EXPECT_EQ(check_sim_controller_fault(f).substr(0, 11), "drive_rad_s");
+  f.drive_rad_s = 0;
+  f.utime = 0;
+  EXPECT_EQ(check_sim_controller_fault(f).substr(0, 5), "utime");
+}
+
 TEST(WireChecks, SimJointFault) {
   sim_joint_fault_t f{};
   f.joint = "a4";

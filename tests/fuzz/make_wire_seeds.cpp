@@ -30,6 +30,7 @@
 #include "tofguard/risk_t.hpp"
 #include "tofguard/safety_status_t.hpp"
 #include "tofguard/sim_camera_fault_t.hpp"
+#include "tofguard/sim_controller_fault_t.hpp"
 #include "tofguard/sim_joint_fault_t.hpp"
 
 namespace {
@@ -300,6 +301,12 @@ void tools_and_faults() {
   j.joint = "a4";
   j.offset = 0.1745;
   write("sim_joint_fault", j);
+  sim_controller_fault_t f{};
+  f.utime = 1000;
+  f.ignore_speed_limit = true;
+  f.drive_joint = "a1";
+  f.drive_rad_s = 1.5;
+  write("sim_controller_fault", f);
   discrepancy_image_t d{};
   d.utime = 1000;
   d.camera_id = "tof-mast";

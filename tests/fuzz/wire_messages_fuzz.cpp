@@ -33,6 +33,7 @@
 #include "tofguard/risk_t.hpp"
 #include "tofguard/safety_status_t.hpp"
 #include "tofguard/sim_camera_fault_t.hpp"
+#include "tofguard/sim_controller_fault_t.hpp"
 #include "tofguard/sim_joint_fault_t.hpp"
 
 namespace {
@@ -95,6 +96,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
                          [&](const sim_camera_fault_t& m) { sink += consume(check_sim_camera_fault(m)); });
   as<sim_joint_fault_t>(data, size,
                         [&](const sim_joint_fault_t& m) { sink += consume(check_sim_joint_fault(m)); });
+  as<sim_controller_fault_t>(
+      data, size, [&](const sim_controller_fault_t& m) { sink += consume(check_sim_controller_fault(m)); });
   // No process checks these beyond decoding them: tofguard-intervene takes
   // a reset_request_t as it is, tofguard-reset a reset_reply_t, tofguard-spy
   // and tofguard-view everything (spy_format_fuzz formats them).

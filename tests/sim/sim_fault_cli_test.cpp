@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "tofguard/sim_camera_fault_t.hpp"
+#include "tofguard/sim_controller_fault_t.hpp"
 #include "tofguard/sim_joint_fault_t.hpp"
 #include "tool_support.hpp"
 
@@ -19,9 +20,14 @@ struct Listener {
   lcm::LCM lcm{"udpm://239.255.76.67:7667?ttl=0"};
   std::optional<sim_joint_fault_t> joint;
   std::optional<sim_camera_fault_t> camera;
+  std::optional<sim_controller_fault_t> controller;
   Listener() {
     lcm.subscribe("SIM_JOINT_FAULT", &Listener::on_joint, this);
     lcm.subscribe("SIM_CAMERA_FAULT", &Listener::on_camera, this);
+    lcm.subscribe("SIM_CONTROLLER_FAULT", &Listener::on_controller, this);
+  }
+  void on_controller(const lcm::ReceiveBuffer*, const std::string&, const sim_controller_fault_t* m) {
+    controller = *m;
   }
   void on_joint(const lcm::ReceiveBuffer*, const std::string&, const sim_joint_fault_t* m) { joint = *m; }
   void on_camera(const lcm::ReceiveBuffer*, const std::string&, const sim_camera_fault_t* m) { camera = *m; }
@@ -43,6 +49,20 @@ TEST(SimFaultCli, EncoderFault) {
   ASSERT_TRUE(l.joint);
   EXPECT_EQ(l.joint->joint, "a4");
   EXPECT_NEAR(l.joint->offset, 0.174533, 1e-6);
+}
+
+// A drive ignores the limit too; "--ignore-speed-limit off" ends both.
+TEST(SimFaultCli, AJointDrivenAndTheControllerFixed) {
+  Listener l;
+  ASSERT_EQ(l.run({"--drive-joint", "a1", "--drive-rad-s", "-1.5"}), 0);
+  ASSERT_TRUE(l.controller);
+  EXPECT_TRUE(l.controller->ignore_speed_limit);
+  EXPECT_EQ(l.controller->drive_joint, "a1");
+  EXPECT_DOUBLE_EQ(l.controller->drive_rad_s, -1.5);
+  ASSERT_EQ(l.run({"--ignore-speed-limit", "off"}), 0);
+  EXPECT_FALSE(l.controller->ignore_speed_limit);
+  EXPECT_EQ(l.controller->drive_joint, "");
+  EXPECT_EQ(l.controller->drive_rad_s, 0);
 }
 
 TEST(SimFaultCli, IntrudingObjectWithItsBox) {
@@ -83,6 +103,9 @@ TEST(SimFaultCli, BadArgumentsAreUsageErrorsAndPublishNothing) {
   EXPECT_EQ(l.run({"--camera-fault", "stall", "--duration-s", "-1"}, &err), 2);
   EXPECT_EQ(l.run({"--joint", "a4", "--offset-deg", "ten"}, &err), 2);
   EXPECT_EQ(l.run({"--joint", "a4"}, &err), 2);
+  EXPECT_EQ(l.run({"--drive-joint", "a1", "--drive-rad-s", "fast"}, &err), 2);
+  EXPECT_NE(err.find("expected --drive-joint NAME --drive-rad-s SPEED"), std::string::npos) << err;
+  EXPECT_EQ(l.run({"--drive-joint", "a1"}, &err), 2);
   // Without a config there is no camera id to address.
   const int code =
       run_command("sim-fault", {bin_dir() + "/tofguard-sim-fault", "--camera-fault", "stall"}, nullptr, &err);
@@ -90,6 +113,7 @@ TEST(SimFaultCli, BadArgumentsAreUsageErrorsAndPublishNothing) {
   EXPECT_NE(err.find("needs --config"), std::string::npos) << err;
   EXPECT_FALSE(l.camera);
   EXPECT_FALSE(l.joint);
+  EXPECT_FALSE(l.controller);
 }
 
 }  // namespace

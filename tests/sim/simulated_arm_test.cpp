@@ -55,6 +55,38 @@ TEST(SimulatedArm, EncoderFaultsChangeOnlyTheReportedPosition) {
   EXPECT_FALSE(arm.set_encoder_offset("j9", 1.0));
 }
 
+// A drive (a controller fault): the joint moves at its speed on top of
+// the motion, unscaled, only while allowed, and in the plan; ended, the
+// joint comes back to its motion at the fixed controller's pace.
+TEST(SimulatedArm, ADrivenJointMovesAtItsSpeedOnTopOfTheMotion) {
+  SimulatedArm arm(two_joints(), {"j1", "j2"}, "test.yaml");
+  EXPECT_EQ(arm.task_stage(), "");  // no task
+  const int plan_version = arm.plan_version();
+  EXPECT_FALSE(arm.set_drive("j9", 1.0));
+  EXPECT_EQ(arm.plan_version(), plan_version);
+  ASSERT_TRUE(arm.set_drive("j1", 0.5));
+  EXPECT_EQ(arm.plan_version(), plan_version + 1);
+  arm.step(0.4, true, 0.25);  // j1's motion stands (amplitude 0)
+  EXPECT_NEAR(arm.true_state().position[0], -1.0 + 0.2, 1e-12);
+  EXPECT_NEAR(arm.true_state().velocity[0], 0.5, 1e-12);
+  EXPECT_NEAR(arm.planned_reported_positions(0.2)[0], -1.0 + 0.3, 1e-12);
+  arm.step(1.0, false);  // halted: the drive stops too
+  EXPECT_NEAR(arm.true_state().position[0], -0.8, 1e-12);
+  EXPECT_EQ(arm.true_state().velocity[0], 0.0);
+  EXPECT_NEAR(arm.planned_reported_positions(0.2)[0], -0.8, 1e-12);
+  // Ended: the fixed controller brings j1 back to its motion at 0.25 rad/s
+  // x the speed scale.
+  ASSERT_TRUE(arm.set_drive("", 0.0));
+  arm.step(0.4, true, 0.5);
+  EXPECT_NEAR(arm.true_state().position[0], -0.85, 1e-12);
+  EXPECT_NEAR(arm.true_state().velocity[0], -0.125, 1e-12);
+  EXPECT_NEAR(arm.planned_reported_positions(0.4)[0], -0.9, 1e-12);
+  EXPECT_NEAR(arm.planned_reported_positions(10)[0], -1.0, 1e-12);
+  arm.step(1.0, true);
+  EXPECT_NEAR(arm.true_state().position[0], -1.0, 1e-12);
+  EXPECT_EQ(arm.true_state().velocity[0], 0.0);
+}
+
 // The task: hold at each waypoint, then a cosine move to the next (at rest
 // at both ends, fastest half way: pi/2 x the mean speed), the last back to
 // the first; a slowed arm takes longer along the same path.
@@ -67,11 +99,13 @@ TEST(SimulatedArm, FollowsItsTaskWaypointsInACycle) {
   EXPECT_DOUBLE_EQ(arm.true_state().position[0], 0.0);
   arm.step(0.9, true);  // holding at the table
   EXPECT_DOUBLE_EQ(arm.true_state().position[0], 0.0);
+  EXPECT_EQ(arm.task_stage(), "at table");
   EXPECT_DOUBLE_EQ(arm.true_state().velocity[0], 0.0);
   arm.step(1.1, true);  // t = 2.0: half way to the mouth, fastest
   EXPECT_NEAR(arm.true_state().position[0], 0.5, 1e-12);
   EXPECT_NEAR(arm.true_state().position[1], -0.2, 1e-12);
   EXPECT_NEAR(arm.true_state().velocity[0], M_PI / 2 * 1.0 / 2.0, 1e-12);
+  EXPECT_EQ(arm.task_stage(), "to mouth");
   arm.step(1.0, true, 0.5);  // at half speed: a quarter of the move more
   EXPECT_NEAR(arm.true_state().position[0], (1 - std::cos(M_PI * 0.75)) / 2, 1e-12);
   EXPECT_NEAR(arm.true_state().velocity[0], 0.5 * M_PI / 4 * std::sin(M_PI * 0.75), 1e-12);
@@ -81,6 +115,7 @@ TEST(SimulatedArm, FollowsItsTaskWaypointsInACycle) {
   arm.step(1.0, true);  // t = 4.5: half way back to the table
   EXPECT_NEAR(arm.true_state().position[0], 0.5, 1e-12);
   EXPECT_NEAR(arm.true_state().velocity[0], -M_PI / 4, 1e-12);
+  EXPECT_EQ(arm.task_stage(), "to table");
   arm.step(1.5, true);  // t = 6.0, 0.5 s into the next cycle: holding at the table
   EXPECT_NEAR(arm.true_state().position[0], 0.0, 1e-12);
   EXPECT_DOUBLE_EQ(arm.true_state().velocity[0], 0.0);

@@ -39,13 +39,20 @@ inline const std::vector<std::string>& chain_process_names() {
 
 class LiveChain {
  public:
+  // A config already written (e.g. ideal_camera_config's).
+  struct ConfigFile {
+    explicit ConfigFile(std::string config_path) : path(std::move(config_path)) {}
+    std::string path;
+  };
   // config/sim.yaml as sim_config_variant(name, replacements, appended);
   // starts every process of chain_process_names() unless `start` is false.
   explicit LiveChain(const std::string& name,
                      const std::vector<std::pair<std::string, std::string>>& replacements = {},
                      bool start = true)
+      : LiveChain(name, ConfigFile{sim_config_variant(name, replacements)}, start) {}
+  LiveChain(const std::string& name, const ConfigFile& config_file, bool start)
       : name_(name),
-        config_path_(sim_config_variant(name, replacements)),
+        config_path_(config_file.path),
         config_(deployment::load_config(config_path_, nullptr)),
         safety_(config_.lcm.url),
         images_(config_.lcm.image_url) {

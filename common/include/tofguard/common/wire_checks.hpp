@@ -65,7 +65,7 @@ std::string check_heartbeat(const heartbeat_t& heartbeat);
 std::string check_sim_camera_fault(const sim_camera_fault_t& fault);
 // A joint name and a finite offset (rad, or m for a prismatic joint).
 std::string check_sim_joint_fault(const sim_joint_fault_t& fault);
-// utime > 0.
+// utime > 0; a finite drive_rad_s, 0 without a drive_joint.
 std::string check_sim_controller_fault(const sim_controller_fault_t& fault);
 
 }  // namespace tofguard

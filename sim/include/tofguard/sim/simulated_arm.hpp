@@ -40,22 +40,34 @@ class SimulatedArm {
 
   // Sets joint `joint`'s encoder offset (0 clears it); false if unknown.
   bool set_encoder_offset(const std::string& joint, double offset);
+  // A controller fault: from now on, while the arm may move, joint `joint`
+  // is also driven at `rad_s` (rad/s, m/s for a prismatic joint; not
+  // slowed by the speed scale) from where it is, in its motion and its
+  // plan. An empty `joint` ends the drive: the controller, fixed, brings
+  // what the drive added back to the motion at kDriveReturnRadS times the
+  // speed scale, while the arm may move. False (and nothing changed) for
+  // an unknown joint.
+  bool set_drive(const std::string& joint, double rad_s);
+  static constexpr double kDriveReturnRadS = 0.25;
 
   const ArmState& true_state() const { return true_state_; }
   // The arm's plan: the reported (encoder) positions `ahead_s` seconds of
   // process time from now, assuming it keeps its current permission: the
-  // periodic motion (at the current speed scale) while moving, where it
-  // is while halted. What a
-  // controller following its encoders plans (an encoder offset is in the
-  // plan, so a faulty encoder does not make the arm "leave its plan").
+  // periodic motion (at the current speed scale) and any drive while
+  // moving, where it is while halted. What a controller following its
+  // encoders plans (an encoder offset is in the plan, so a faulty encoder
+  // does not make the arm "leave its plan"; a drive is its own command).
   std::vector<double> planned_reported_positions(double ahead_s) const;
   // What the encoders report: true position + offset; velocity as true.
   ArmState reported_state() const;
   double elapsed_s() const { return elapsed_s_; }
-  // Counts changes of the encoder offsets (a controller replans when its
-  // encoders jump).
-  int offsets_version() const { return offsets_version_; }
+  // Counts the changes a controller replans for: its encoders jumping (an
+  // encoder offset set) and a drive set or ended.
+  int plan_version() const { return plan_version_; }
   bool moving() const { return moving_; }
+  // Where the task stands: "at <waypoint>" while holding there, "to
+  // <waypoint>" while moving to it; empty without a task.
+  std::string task_stage() const;
 
  private:
   void update_state(bool moving);
@@ -69,17 +81,27 @@ class SimulatedArm {
     double blend = 0, blend_rate = 0;
   };
   TaskPhase task_phase(double t_s) const;
+  // Joint i's speed from a drive (set_drive) or its return, while moving;
+  // what drives will have added to its position dt_s of process time on.
+  double drive_velocity(size_t i) const;
+  double driven_after(size_t i, double dt_s) const;
 
   std::vector<JointMotion> motion_;  // in URDF order
   // The task (empty: the periodic motion): each waypoint's positions in
   // URDF order, its hold, and the move time between waypoints.
   std::vector<std::vector<double>> task_positions_;
   std::vector<double> task_hold_s_;
+  std::vector<std::string> task_names_;
   double task_move_s_ = 0;
   std::vector<EncoderFault> scheduled_faults_;
   std::map<std::string, double> offsets_;
+  // set_drive: the driven joint (URDF order; -1: none), its speed, and
+  // what drives have added to each joint's position so far.
+  int drive_index_ = -1;
+  double drive_rad_s_ = 0;
+  std::vector<double> driven_;
   double elapsed_s_ = 0;
-  int offsets_version_ = 0;
+  int plan_version_ = 0;
   double motion_time_s_ = 0;
   bool moving_ = false;
   double speed_scale_ = 1;
