@@ -17,13 +17,13 @@
 namespace tofguard::test {
 namespace {
 
-// config/sim.yaml's silhouette allowance, as the variants below replace it.
-const char* const kSimSilhouetteAllowance =
-    "    silhouette_allowance: {band_px: 12, step_mm: 10, bias_mm: 6.0, by_link: {base_link: 0.2, gripper: "
-    "6.0,\n"
-    "      link1: 1.8, link2: 0.2, link3: 0.9, link4: 1.0, link5: 1.6, link6: 3.4, link7: 4.4}}\n";
-
 std::string sim_yaml_path() { return source_dir() + "/config/sim.yaml"; }
+
+// config/sim.yaml's silhouette allowance (its lines), as the variants below
+// replace it.
+std::string sim_silhouette_allowance() {
+  return config_line(read_file(sim_yaml_path()), "    silhouette_allowance: {");
+}
 
 // sim.yaml with `from` replaced by `to` (which must occur), in the test
 // output folder.
@@ -203,15 +203,15 @@ INSTANTIATE_TEST_SUITE_P(
                   "  worker_threads: many\n",
                   {"discrepancy.worker_threads", "expected an integer in [1, 64] or auto", "'many'"}},
         BadConfig{"silhouette-allowance-without-band",
-                  kSimSilhouetteAllowance,
+                  sim_silhouette_allowance(),
                   "    silhouette_allowance: {bias_mm: 2.3}\n",
                   {"discrepancy.evidence.silhouette_allowance.band_px", "missing key"}},
         BadConfig{"silhouette-allowance-by-link-not-a-number",
-                  kSimSilhouetteAllowance,
+                  sim_silhouette_allowance(),
                   "    silhouette_allowance: {band_px: 11, bias_mm: 2.3, by_link: {link7: wide}}\n",
                   {"discrepancy.evidence.silhouette_allowance.by_link.link7", "'wide'"}},
         BadConfig{"silhouette-allowance-step-zero",
-                  kSimSilhouetteAllowance,
+                  sim_silhouette_allowance(),
                   "    silhouette_allowance: {band_px: 11, step_mm: 0, bias_mm: 2.3}\n",
                   {"discrepancy.evidence.silhouette_allowance.step_mm", "'0'"}},
         BadConfig{"worker-threads-zero",
@@ -272,13 +272,13 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(Config, TheSilhouetteAllowanceTakesEachLinksOwnBoundAndItsStep) {
   // config/sim.yaml's, over two lines as tofguard-tune's can be pasted.
   const deployment::Config sim = deployment::load_config(sim_yaml_path(), nullptr);
-  EXPECT_EQ(sim.discrepancy.evidence_silhouette_bias_mm, 6.0);
+  EXPECT_EQ(sim.discrepancy.evidence_silhouette_bias_mm, 6.2);
   EXPECT_EQ(sim.discrepancy.evidence_silhouette_band_px, 12);
   EXPECT_EQ(sim.discrepancy.evidence_silhouette_band_step_mm, 10.0);
   EXPECT_EQ(sim.discrepancy.evidence_silhouette_bias_by_link_mm.size(), 9u);
-  EXPECT_EQ(sim.discrepancy.evidence_silhouette_bias_by_link_mm.at("link7"), 4.4);
-  EXPECT_EQ(sim.discrepancy.evidence_silhouette_bias_by_link_mm.at("link2"), 0.2);
-  const std::string path = sim_variant("silhouette-by-link", kSimSilhouetteAllowance,
+  EXPECT_EQ(sim.discrepancy.evidence_silhouette_bias_by_link_mm.at("link7"), 5.2);
+  EXPECT_EQ(sim.discrepancy.evidence_silhouette_bias_by_link_mm.at("link2"), 0.5);
+  const std::string path = sim_variant("silhouette-by-link", sim_silhouette_allowance(),
                                        "    silhouette_allowance: {band_px: 11, bias_mm: 2.3, by_link: "
                                        "{link1: 2.3, link7: 0.4}}\n");
   const deployment::Config config = deployment::load_config(path, nullptr);
