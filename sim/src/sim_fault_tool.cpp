@@ -61,6 +61,20 @@ int publish(const SimFaultToolSettings& settings, const std::string& channel, co
   return 0;
 }
 
+// A sim_controller_fault_t (it replaces the fault the last one set) on
+// SIM_CONTROLLER_FAULT; `said` printed once it is out.
+int send_controller_fault(const SimFaultToolSettings& settings, bool ignore_speed_limit,
+                          const std::string& drive_joint, double drive_rad_s, const std::string& said) {
+  sim_controller_fault_t fault{};
+  fault.utime = wall_utime();
+  fault.ignore_speed_limit = ignore_speed_limit;
+  fault.drive_joint = drive_joint;
+  fault.drive_rad_s = drive_rad_s;
+  const int code = publish(settings, settings.channels.sim_controller_fault, fault);
+  if (code == 0) std::cout << said << std::endl;
+  return code;
+}
+
 }  // namespace
 
 ProcessInfo sim_fault_info() {
@@ -69,7 +83,10 @@ ProcessInfo sim_fault_info() {
                    "  --joint NAME --offset-deg DEGREES: an encoder fault in tofguard-joints-sim\n"
                    "    (0 clears it).\n"
                    "  --ignore-speed-limit on|off: tofguard-joints-sim's controller stops following\n"
-                   "    SAFETY_SPEED_LIMIT (a bad plan at full speed) or follows it again.\n"
+                   "    SAFETY_SPEED_LIMIT (a bad plan at full speed) or follows it again (off also\n"
+                   "    ends a drive).\n"
+                   "  --drive-joint NAME --drive-rad-s SPEED: the controller ignores the limit and\n"
+                   "    drives joint NAME at SPEED (rad/s, signed) on top of its motion.\n"
                    "  --camera-fault KIND: a fault in the simulated camera (SIM_CAMERA_FAULT):\n"
                    "    clear, frozen_image, stall, pose_drift (--drift-m-per-s X,Y,Z in the\n"
                    "    camera pose's frame, --drift-rad-per-s about the optical axes) or\n"
@@ -133,16 +150,9 @@ int run_sim_fault(const SimFaultToolSettings& settings, const std::vector<std::s
     if (options.size() != 1 || (value != "on" && value != "off")) {
       return usage_error("expected --ignore-speed-limit on|off alone");
     }
-    sim_controller_fault_t fault{};
-    fault.utime = wall_utime();
-    fault.ignore_speed_limit = value == "on";
-    const int code = publish(settings, settings.channels.sim_controller_fault, fault);
-    if (code == 0) {
-      std::cout << (fault.ignore_speed_limit ? "controller fault: the arm ignores the speed limit"
-                                             : "controller fault cleared: the arm follows the speed limit")
-                << std::endl;
-    }
-    return code;
+    return send_controller_fault(settings, value == "on", "", 0,
+                                 value == "on" ? "controller fault: the arm ignores the speed limit"
+                                               : "controller fault cleared: the arm follows the speed limit");
   }
 
   if (options.count("--drive-joint")) {
@@ -151,17 +161,11 @@ int run_sim_fault(const SimFaultToolSettings& settings, const std::vector<std::s
         !parse_number(options["--drive-rad-s"], &rad_s)) {
       return usage_error("expected --drive-joint NAME --drive-rad-s SPEED (rad/s) alone");
     }
-    sim_controller_fault_t fault{};
-    fault.utime = wall_utime();
-    fault.ignore_speed_limit = true;
-    fault.drive_joint = options["--drive-joint"];
-    fault.drive_rad_s = rad_s;
-    const int code = publish(settings, settings.channels.sim_controller_fault, fault);
-    if (code == 0) {
-      std::cout << "controller fault: the arm ignores the speed limit and drives " << fault.drive_joint
-                << " at " << rad_s << " rad/s (end it with --ignore-speed-limit off)" << std::endl;
-    }
-    return code;
+    const std::string joint = options["--drive-joint"];
+    std::ostringstream said;
+    said << "controller fault: the arm ignores the speed limit and drives " << joint << " at " << rad_s
+         << " rad/s (end it with --ignore-speed-limit off)";
+    return send_controller_fault(settings, true, joint, rad_s, said.str());
   }
 
   sim_joint_fault_t fault;

@@ -80,10 +80,14 @@ SimulatedArm::SimulatedArm(const JointsSimSettings& config, const std::vector<st
   update_state(false);
 }
 
-SimulatedArm::TaskPhase SimulatedArm::task_phase(double t_s) const {
+double SimulatedArm::task_cycle_s() const {
   double cycle_s = 0;
   for (double hold : task_hold_s_) cycle_s += hold + task_move_s_;
-  double t = std::fmod(t_s, cycle_s);
+  return cycle_s;
+}
+
+SimulatedArm::TaskPhase SimulatedArm::task_phase(double t_s) const {
+  double t = std::fmod(t_s, task_cycle_s());
   const size_t n = task_positions_.size();
   for (size_t k = 0; k < n; ++k) {
     if (t < task_hold_s_[k]) return {k, k, 0, 0};
@@ -149,7 +153,9 @@ void SimulatedArm::step(double dt_s, bool motion_allowed, double speed_scale) {
   elapsed_s_ += dt_s;
   speed_scale_ = std::clamp(speed_scale, 0.0, 1.0);
   if (motion_allowed) motion_time_s_ += speed_scale_ * dt_s;
-  for (size_t i = 0; i < driven_.size() && motion_allowed; ++i) driven_[i] = driven_after(i, dt_s);
+  if (motion_allowed) {
+    for (size_t i = 0; i < driven_.size(); ++i) driven_[i] = driven_after(i, dt_s);
+  }
   for (auto it = scheduled_faults_.begin(); it != scheduled_faults_.end();) {
     if (elapsed_s_ >= it->at_s) {
       offsets_[it->joint] = it->offset;

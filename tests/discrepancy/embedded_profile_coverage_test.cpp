@@ -114,12 +114,9 @@ TEST(EmbeddedProfile, CoversTheDistancesTheArmReachesOverItsTask) {
   const std::vector<std::string> joints =
       robot_model::load_kinematic_tree(config.robot.urdf_path).actuated_joint_names;
   sim::SimulatedArm arm(config.joints_sim, joints, "config/sim.yaml", /*task=*/true);
-  double cycle_s = 0;
-  for (const sim::TaskWaypoint& w : config.joints_sim.task_waypoints)
-    cycle_s += w.hold_s + config.joints_sim.task_move_s;
   CoverageScan scan(config);
   constexpr double kTaskStepS = 0.1;
-  for (double t_s = 0; t_s < 2 * cycle_s; t_s += kTaskStepS) {
+  for (double t_s = 0; t_s < 2 * arm.task_cycle_s(); t_s += kTaskStepS) {
     robot_model::JointPositions q;
     const sim::ArmState& state = arm.true_state();
     for (size_t i = 0; i < state.name.size(); ++i) q[state.name[i]] = state.position[i];

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "joint_motion.hpp"
 #include "judge_campaign.hpp"
 #include "occupant_test_config.hpp"
 #include "tofguard/deployment/config.hpp"
@@ -30,9 +31,7 @@ using namespace robot_model;
 
 JointPositions joints_at(const sim::JointsSimSettings& sim, double t_s) {
   JointPositions q;
-  for (const sim::JointMotion& m : sim.motion) {
-    q[m.joint] = m.center + m.amplitude * std::sin(2 * M_PI * t_s / m.period_s + m.phase_rad);
-  }
+  for (const sim::JointMotion& m : sim.motion) q[m.joint] = joint_position(m, t_s);
   return q;
 }
 

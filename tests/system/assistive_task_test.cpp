@@ -65,18 +65,20 @@ struct TaskWatch {
       const auto [it, first] = head_separation_m.emplace(*region, beyond_m);
       double& smallest = it->second;
       if (!first) smallest = std::min(smallest, beyond_m);
-      if (*region == BodyRegion::kFace) face_separation_m = std::min(face_separation_m, beyond_m);
     }
   }
   double a3_rad = 0, a3_rad_s = 0;
   speed_limit_t lowest_limit{};
   int limits = 0, limits_by_region = 0;
   std::map<BodyRegion, double> envelope_m;
-  // The face's smallest separation (beyond its envelope) since last reset.
-  double face_separation_m = std::numeric_limits<double>::infinity();
-  // The same for each region with a clearance (the head and the neck),
-  // since the map was last cleared.
+  // Each region with a clearance (the head and the neck): its smallest
+  // separation beyond its envelope since the map was last cleared.
   std::map<BodyRegion, double> head_separation_m;
+  // The face's (+infinity: not seen since).
+  double face_separation_m() const {
+    const auto it = head_separation_m.find(BodyRegion::kFace);
+    return it == head_separation_m.end() ? std::numeric_limits<double>::infinity() : it->second;
+  }
   // When watching: the arrival (monotonic) of the first limit the arm's
   // speed bound exceeded (-1: none yet).
   bool watch_over_limit = false;
@@ -96,7 +98,7 @@ TEST(AssistiveTask, ACycleWithoutAStopThenABadPlanAtTheFaceIsStopped) {
 
   // One cycle: to the mouth, then back to the table (at the limits' pace).
   const int stops_before = chain.stops_seen();
-  watch.face_separation_m = std::numeric_limits<double>::infinity();
+  watch.head_separation_m.clear();
   watch.lowest_limit = speed_limit_t{};
   watch.limits = 0;
   watch.limits_by_region = 0;
@@ -108,10 +110,10 @@ TEST(AssistiveTask, ACycleWithoutAStopThenABadPlanAtTheFaceIsStopped) {
   EXPECT_TRUE(chain.motion_allowed());
   std::cout << "one cycle: " << watch.limits << " limits, " << watch.limits_by_region
             << " set by a body region; the lowest " << watch.lowest_limit.max_arm_speed_m_s << " m/s ("
-            << watch.lowest_limit.reason << "); the face at least " << watch.face_separation_m
+            << watch.lowest_limit.reason << "); the face at least " << watch.face_separation_m()
             << " m beyond its envelope" << std::endl;
   EXPECT_GT(watch.limits_by_region, 0);
-  EXPECT_GE(watch.face_separation_m,
+  EXPECT_GE(watch.face_separation_m(),
             chain.config().occupant->regions.at(BodyRegion::kFace).clearance_m.value());
 
   // The bad plan: on the way to the mouth, the controller ignores the limit.
@@ -120,7 +122,7 @@ TEST(AssistiveTask, ACycleWithoutAStopThenABadPlanAtTheFaceIsStopped) {
   sim_controller_fault_t fault{};
   fault.utime = wall_utime();
   fault.ignore_speed_limit = true;
-  watch.face_separation_m = std::numeric_limits<double>::infinity();
+  watch.head_separation_m.clear();
   watch.watch_over_limit = true;
   const int64_t injected_us = monotonic_us();
   chain.safety().publish(chain.config().channels.sim_controller_fault, &fault);
@@ -138,13 +140,13 @@ TEST(AssistiveTask, ACycleWithoutAStopThenABadPlanAtTheFaceIsStopped) {
   std::cout << "bad plan: stop " << latency_us / 1000.0 << " ms after the first limit exceeded ("
             << (watch.first_over_limit_us - injected_us) / 1000.0
             << " ms after the controller ignored it): " << stop.reason << "; the face at least "
-            << watch.face_separation_m << " m beyond its envelope" << std::endl;
+            << watch.face_separation_m() << " m beyond its envelope" << std::endl;
   EXPECT_EQ(risk_cause_name(stop.cause), risk_cause_name(risk_t::CAUSE_UNKNOWN_OBJECT)) << stop.reason;
   EXPECT_NE(stop.reason.find(" from the user's "), std::string::npos) << stop.reason;
   // The debounce's two more frames (67 ms at 30 Hz) and the chain's
   // 200 ms budget.
   EXPECT_LE(latency_us, 300'000);
-  EXPECT_GE(watch.face_separation_m,
+  EXPECT_GE(watch.face_separation_m(),
             chain.config().occupant->regions.at(BodyRegion::kFace).clearance_m.value());
   fault.utime = wall_utime();
   fault.ignore_speed_limit = false;

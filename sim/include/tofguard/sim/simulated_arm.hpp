@@ -68,6 +68,9 @@ class SimulatedArm {
   // Where the task stands: "at <waypoint>" while holding there, "to
   // <waypoint>" while moving to it; empty without a task.
   std::string task_stage() const;
+  // One cycle of the task (every waypoint's hold and the moves between
+  // them), seconds of motion time; 0 without a task.
+  double task_cycle_s() const;
 
  private:
   void update_state(bool moving);
