@@ -367,7 +367,8 @@ std::string check_occupant_shapes(const link_labels_t& labels) {
 }
 
 // discrepancy_t's per-region sightings: counts per region, 0 <= missing <=
-// modelled, seen >= 0, and a seen separation that is -1 or finite >= 0.
+// modelled, seen >= 0, and a seen separation that is -1 or finite >= 0;
+// the robot pixels hidden by the user 0..num_pixels.
 std::string check_region_sightings(const discrepancy_t& d) {
   const int32_t n = d.num_body_regions;
   const std::string count = "num_body_regions";
@@ -396,6 +397,9 @@ std::string check_region_sightings(const discrepancy_t& d) {
       return expected("body_region_seen_separation_m" + at, "-1 (none seen) or a finite separation >= 0 (m)",
                       sep);
     }
+  }
+  if (!(d.num_robot_hidden_by_user >= 0 && d.num_robot_hidden_by_user <= d.num_pixels)) {
+    return expected("num_robot_hidden_by_user", "0..num_pixels", d.num_robot_hidden_by_user);
   }
   return "";
 }

@@ -634,10 +634,11 @@ void unexplained_surfaces(const depth_image_t& camera, const link_labels_t& labe
 // the hand cannot be seen), so the per-link counts and the evidence take
 // it as they take a pixel without a return; the pixel classes and the
 // unexplained surfaces still see it (as the user). nullopt when no pixel
-// is hidden so (or there is no user).
+// is hidden so (or there is no user); `*hidden_pixels` counts them.
 std::optional<depth_image_t> arm_hidden_by_user(const depth_image_t& camera, const depth_image_t& rendered,
                                                 const link_labels_t& labels, const OccupantShapes& occupant,
-                                                const Tolerance& tolerance) {
+                                                const Tolerance& tolerance, int32_t* hidden_pixels) {
+  *hidden_pixels = 0;
   if (occupant.empty()) return std::nullopt;
   std::optional<depth_image_t> out;
   const int width = camera.width;
@@ -650,6 +651,7 @@ std::optional<depth_image_t> arm_hidden_by_user(const depth_image_t& camera, con
     if (occupant.region_holding(optical_point_m(camera, i, metres_from_mm(t))) < 0) continue;
     if (!out) out = camera;
     out->depth_mm[i] = 0;
+    ++*hidden_pixels;
   }
   return out;
 }
@@ -816,7 +818,7 @@ DiscrepancyFrame compare_frames(const depth_image_t& camera, const depth_image_t
   const std::vector<uint8_t> silhouette = silhouette_mask(rendered, options.silhouette_jump_mm);
   const OccupantShapes occupant(labels);
   const std::optional<depth_image_t> unhidden =
-      arm_hidden_by_user(camera, rendered, labels, occupant, options.tolerance);
+      arm_hidden_by_user(camera, rendered, labels, occupant, options.tolerance, &s.num_robot_hidden_by_user);
   const depth_image_t& camera_for_arm = unhidden ? *unhidden : camera;
   std::vector<double> reach;  // the pixel stages' (joint_reach)
   // Stages 3 to 6 need nothing from the evidence, nor it from them (they

@@ -146,7 +146,7 @@ std::string format(const discrepancy_t& m) {
     }
     s << std::setprecision(2) << " | user: nearest " << m.body_region[nearest] << " "
       << m.body_region_separation_m[nearest] << " m (model), seen " << seen << " px, missing " << missing
-      << " of " << modelled << " modelled px";
+      << " of " << modelled << " modelled px, hiding " << m.num_robot_hidden_by_user << " arm px";
   }
   return s.str();
 }

@@ -744,12 +744,14 @@ TEST(DiscrepancyUser, TheUsersHandBeforeALinkHidesItAndIsNoObject) {
   EXPECT_EQ(with.num_occluded, 32);
   EXPECT_EQ(with.link_nearer[2], 0);
   EXPECT_EQ(with.link_invalid[2], 32);
+  EXPECT_EQ(with.num_robot_hidden_by_user, 32);
   EXPECT_EQ(with.near_arm_pixels, 0);
   EXPECT_GT(with.body_region_seen_pixels[0], 32);
   const discrepancy_t without =
       compute_discrepancy(camera, depth_frame(model.depth_mm, 7), without_user, sim_options()).summary;
   ASSERT_TRUE(without.usable) << without.unusable_reason;
   EXPECT_EQ(without.link_nearer[2], 32);
+  EXPECT_EQ(without.num_robot_hidden_by_user, 0);
   EXPECT_GT(without.near_arm_pixels, 0);
 }
 

@@ -10,7 +10,12 @@
 // the room (wheelchair, table, wall, floor) and the camera are placed in
 // the base's frame: the default arm's mount (config/models/friend_arm.urdf,
 // the room's frame to the default arm's base_link, no rotation) inverted.
+#include <Eigen/Geometry>
+
+#include <cstdio>
+#include <filesystem>
 #include <optional>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
