@@ -60,10 +60,10 @@ inline std::string room_under_the_mount(const std::string& name, const Eigen::Ve
   return path;
 }
 
-// The Kinova Gen3's assistive task beside the user: a cup from the table
-// to 35 cm before the face model's centre and back. Found by a search over
-// the arm's joints (the gripper's target, then every pose on the straight
-// joint path checked) that keeps the arm's cover at least 17 cm from the
+// The Kinova Gen3's assistive task beside the user: a cup from 18 cm above
+// the table to 38 cm before the face model's centre and back. Found by a
+// search over the arm's joints (the end effector's target, then every pose
+// on the straight joint path checked) that keeps the arm's cover at least 17 cm from the
 // head and the neck, 8 cm from the rest of the user, 3 cm above the table
 // and 0.92 m from the camera (its profile covers 0.88-3.38 m) along the
 // whole move. The nominal motion (without --task) swings about "table".
