@@ -609,7 +609,7 @@ TEST(SafetyChainE2E, AHandOutsideTheUsersEnvelopesIsAnUnknownObject) {
   {
     // A 4 cm box 8 cm above the hand's model and 9 cm towards the arm's
     // base (y falls to the right), within its 10 cm envelope: from the
-    // camera behind the user it stands before the base and link1.
+    // camera behind the user it stands before the arm's base.
     SCOPED_TRACE("the user's right hand raised within its envelope before the arm");
     const int stops_before = chain.stops_seen();
     chain.intrude(hand + Eigen::Vector3d(-0.02, -0.09, 0.08), Eigen::Vector3d::Constant(0.04));
