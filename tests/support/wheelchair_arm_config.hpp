@@ -42,9 +42,9 @@ inline Eigen::Vector3d default_arm_mount_m() {
 // output_dir()/<name>-room.urdf.
 inline std::string room_under_the_mount(const std::string& name, const Eigen::Vector3d& mount_m) {
   std::string text = read_file(source_dir() + "/config/models/wheelchair_environment.urdf");
-  for (size_t at = text.find("<parent link=\"world\"/>"); at != std::string::npos;
-       at = text.find("<parent link=\"world\"/>", at)) {
-    text.replace(at, 22, "<parent link=\"room\"/>");
+  const std::string world_parent = "<parent link=\"world\"/>";
+  for (size_t at = text.find(world_parent); at != std::string::npos; at = text.find(world_parent, at)) {
+    text.replace(at, world_parent.size(), "<parent link=\"room\"/>");
   }
   const std::string root = "<link name=\"world\"/>";
   const auto at = text.find(root);

@@ -72,6 +72,20 @@ struct TaskWatch {
       if (!first) smallest = std::min(smallest, beyond_m);
     }
   }
+  // Counts afresh from now on: the limits, the head's separations, the
+  // user hiding the arm; with `over_limit`, also the first limit the arm
+  // exceeds.
+  void start_counting(bool over_limit) {
+    lowest_limit = speed_limit_t{};
+    limits = 0;
+    limits_by_region = 0;
+    frames_arm_hidden_by_user = 0;
+    most_arm_hidden_by_user = 0;
+    head_separation_m.clear();
+    watch_over_limit = over_limit;
+    first_over_limit_us = -1;
+    first_over_limit = speed_limit_t{};
+  }
   speed_limit_t lowest_limit{};
   int limits = 0, limits_by_region = 0;
   // Frames in which the user's body hid some of the arm's pixels, and the
@@ -109,12 +123,7 @@ void start_the_task(LiveChain& chain, const std::string& why) {
 void a_cycle_without_a_stop(LiveChain& chain, TaskWatch& watch) {
   // One cycle: to the mouth, then back to the table (at the limits' pace).
   const int stops_before = chain.stops_seen();
-  watch.head_separation_m.clear();
-  watch.lowest_limit = speed_limit_t{};
-  watch.limits = 0;
-  watch.limits_by_region = 0;
-  watch.frames_arm_hidden_by_user = 0;
-  watch.most_arm_hidden_by_user = 0;
+  watch.start_counting(/*over_limit=*/false);
   ASSERT_TRUE(wait_for_stage(&chain, "at mouth", std::chrono::seconds(60)))
       << "never at the mouth: " << task_stage(chain) << ", last risk " << chain.describe_last_risk();
   ASSERT_TRUE(wait_for_stage(&chain, "at table", std::chrono::seconds(60)))
@@ -148,8 +157,7 @@ TEST(AssistiveTask, ACycleWithoutAStopThenABadPlanAtTheFaceIsStopped) {
   sim_controller_fault_t fault{};
   fault.utime = wall_utime();
   fault.ignore_speed_limit = true;
-  watch.head_separation_m.clear();
-  watch.watch_over_limit = true;
+  watch.start_counting(/*over_limit=*/true);
   const int64_t injected_us = monotonic_us();
   chain.safety().publish(chain.config().channels.sim_controller_fault, &fault);
   ASSERT_TRUE(chain.wait([&] { return !chain.motion_allowed(); }, std::chrono::seconds(5)))
@@ -207,14 +215,12 @@ FaceApproach approach_the_face(LiveChain& chain, TaskWatch& watch, const std::st
   approach.rad_s = rad_s;
   EXPECT_TRUE(wait_for_stage(&chain, "at mouth", std::chrono::seconds(60)))
       << "never at the mouth: " << task_stage(chain) << ", last risk " << chain.describe_last_risk();
-  watch.head_separation_m.clear();
   sim_controller_fault_t fault{};
   fault.utime = wall_utime();
   fault.ignore_speed_limit = true;
   fault.drive_joint = joint;
   fault.drive_rad_s = rad_s;
-  watch.watch_over_limit = true;
-  watch.first_over_limit_us = -1;
+  watch.start_counting(/*over_limit=*/true);
   const int64_t injected_us = monotonic_us();
   chain.safety().publish(chain.config().channels.sim_controller_fault, &fault);
   EXPECT_TRUE(chain.wait([&] { return !chain.motion_allowed(); }, std::chrono::seconds(5)))
