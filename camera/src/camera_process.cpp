@@ -3,8 +3,11 @@
 namespace tofguard::camera {
 
 ProcessInfo process_info() {
-  return {"tofguard-camera",
-          "Publishes depth frames on TOF_DEPTH from a USB ToF camera (libuvc) or the simulated ToF camera."};
+  ProcessInfo info{
+      "tofguard-camera",
+      "Publishes depth frames on TOF_DEPTH from a USB ToF camera (libuvc) or the simulated ToF camera."};
+  info.per_camera = true;
+  return info;
 }
 
 }  // namespace tofguard::camera

@@ -40,11 +40,11 @@ bool stop_requested() { return g_stop_requested; }
 
 LcmNode::LcmNode(const LcmSettings& lcm, const ChannelNames& channels, const std::string& process_name,
                  double heartbeat_rate_hz)
-    : process_name_(process_name),
+    : process_name_(process_name + channels.camera_suffix),
       safety_(open_lcm(lcm.url)),
       images_(lcm.image_url == lcm.url ? nullptr : open_lcm(lcm.image_url)),
-      errors_(process_name),
-      heartbeat_(safety_.get(), channels.heartbeat, process_name, heartbeat_rate_hz) {
+      errors_(process_name_),
+      heartbeat_(safety_.get(), channels.heartbeat, process_name_, heartbeat_rate_hz) {
   // LCM 1.3 joins a multicast group lazily (first getFileno()/handle()),
   // and publishing needs no receive socket: each URL is joined in join(),
   // on the first subscription on it.

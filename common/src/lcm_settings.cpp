@@ -59,6 +59,16 @@ std::string bus_exposure_warning(const std::string& url) {
   return "";
 }
 
+ChannelNames camera_channel_names(const ChannelNames& base, const std::string& camera_suffix) {
+  ChannelNames c = base;
+  for (std::string* name : {&c.depth, &c.camera_pose, &c.rendered, &c.labels, &c.discrepancy,
+                            &c.motion_estimate, &c.sim_camera_fault}) {
+    *name += camera_suffix;
+  }
+  c.camera_suffix = camera_suffix;
+  return c;
+}
+
 ChannelNames read_channel_names(YamlMap map) {
   ChannelNames c;
   auto name = [&map](const char* key, std::string* out) {

@@ -21,6 +21,100 @@ std::vector<std::string> start_warnings(const Config& config) {
   return warnings;
 }
 
+namespace {
+
+// One camera's section (`camera`, or an entry of `cameras`); `profile_key`:
+// whether its profile is its own key (an entry of `cameras`) rather than
+// discrepancy.camera_profile (a lone `camera`).
+CameraSection read_camera_section(YamlMap& camera, bool profile_key) {
+  CameraSection c;
+  c.id = camera.string("id");
+  c.source = camera.choice("source", {"sim", "uvc"});
+  c.rate_hz = camera.number("rate_hz", 0.1, 1000);
+  YamlMap intrinsics = camera.map("intrinsics");
+  c.intrinsics = read_intrinsics(intrinsics);
+  intrinsics.finish();
+  c.pose = read_camera_pose(camera.map("pose"));
+  if (camera.optional("depth_calibration")) {
+    c.depth_calibration = camera::read_depth_calibration_settings(camera.map("depth_calibration"));
+  }
+  if (c.source == "uvc" || camera.optional("uvc")) c.uvc = camera::read_uvc_settings(camera.map("uvc"));
+  if (c.source == "sim" || camera.optional("sim")) c.sim = sim::read_sim_camera_settings(camera.map("sim"));
+  if (profile_key && camera.optional("camera_profile")) {
+    c.profile =
+        std::make_shared<const CameraProfile>(read_camera_profile(camera.existing_path("camera_profile")));
+  }
+  return c;
+}
+
+// The profile must be its camera's: checked here, once, as a frame of it
+// would be (profile_mismatch). `where` fails at the profile's key.
+void check_profile_is_the_cameras(const CameraSection& camera, const YamlMap& where, const std::string& key) {
+  if (!camera.profile) return;
+  depth_image_t frame;
+  frame.camera_id = camera.id;
+  frame.width = camera.intrinsics.width;
+  frame.height = camera.intrinsics.height;
+  frame.fx = camera.intrinsics.fx;
+  frame.fy = camera.intrinsics.fy;
+  frame.cx = camera.intrinsics.cx;
+  frame.cy = camera.intrinsics.cy;
+  if (const std::string why = profile_mismatch(*camera.profile, frame); !why.empty())
+    where.fail(key, "a profile of camera '" + camera.id + "'", why);
+}
+
+// `camera` (one camera; its profile is discrepancy.camera_profile) or
+// `cameras` (a list; each names its own profile), never both. Ids are
+// unique; the first camera's names carry no suffix, every other's "/<id>".
+std::vector<CameraSection> read_cameras(YamlMap& root, YamlMap& discrepancy,
+                                        const std::shared_ptr<const CameraProfile>& lone_camera_profile) {
+  std::vector<CameraSection> cameras;
+  if (root.has("cameras")) {
+    if (root.has("camera")) root.fail("camera", "either a camera section or a cameras list, not both");
+    if (lone_camera_profile) {
+      discrepancy.fail("camera_profile", "no profile here with a cameras list: each camera names its own",
+                       "cameras[i].camera_profile");
+    }
+    std::vector<YamlMap> entries = root.maps("cameras");
+    if (entries.empty()) root.fail("cameras", "a list of at least one camera", "an empty list");
+    for (YamlMap& entry : entries) {
+      CameraSection c = read_camera_section(entry, true);
+      for (const CameraSection& other : cameras) {
+        if (other.id == c.id) entry.fail("id", "an id no other camera has", "'" + c.id + "' again");
+      }
+      check_profile_is_the_cameras(c, entry, "camera_profile");
+      c.name_suffix = cameras.empty() ? "" : "/" + c.id;
+      entry.finish();
+      cameras.push_back(std::move(c));
+    }
+  } else {
+    YamlMap camera = root.map("camera");
+    CameraSection c = read_camera_section(camera, false);
+    camera.finish();
+    c.profile = lone_camera_profile;
+    check_profile_is_the_cameras(c, discrepancy, "camera_profile");
+    cameras.push_back(std::move(c));
+  }
+  return cameras;
+}
+
+}  // namespace
+
+Config select_camera(const Config& config, const std::string& id) {
+  std::string ids;
+  for (const CameraSection& camera : config.cameras) {
+    if (camera.id == id) {
+      Config selected = config;
+      selected.camera = camera;
+      selected.channels = camera_channel_names(config.channels, camera.name_suffix);
+      selected.discrepancy.camera_profile = camera.profile;
+      return selected;
+    }
+    ids += (ids.empty() ? "'" : ", '") + camera.id + "'";
+  }
+  throw ConfigError(config.file + ": cameras: no camera '" + id + "'; the config has " + ids);
+}
+
 Config load_config(const std::string& path, const char* lcm_default_url_env) {
   YamlMap root = load_yaml_file(path);
   Config config;
@@ -32,44 +126,13 @@ Config load_config(const std::string& path, const char* lcm_default_url_env) {
   config.environment = read_environment_settings(root.optional_map("environment"));
   config.occupant = settings::read_occupant_settings(root.optional_map("occupant"));
 
-  {
-    YamlMap camera = root.map("camera");
-    CameraSection& c = config.camera;
-    c.id = camera.string("id");
-    c.source = camera.choice("source", {"sim", "uvc"});
-    c.rate_hz = camera.number("rate_hz", 0.1, 1000);
-    YamlMap intrinsics = camera.map("intrinsics");
-    c.intrinsics = read_intrinsics(intrinsics);
-    intrinsics.finish();
-    c.pose = read_camera_pose(camera.map("pose"));
-    if (camera.optional("depth_calibration")) {
-      c.depth_calibration = camera::read_depth_calibration_settings(camera.map("depth_calibration"));
-    }
-    if (c.source == "uvc" || camera.optional("uvc")) c.uvc = camera::read_uvc_settings(camera.map("uvc"));
-    if (c.source == "sim" || camera.optional("sim")) c.sim = sim::read_sim_camera_settings(camera.map("sim"));
-    camera.finish();
-  }
-
   config.renderer = renderer::read_renderer_settings(root.map("renderer"));
   // Safety chain sections (required: no silent defaults for thresholds).
-  {
-    YamlMap discrepancy = root.map("discrepancy");
-    config.discrepancy = discrepancy::read_discrepancy_settings(discrepancy);
-    // The profile must be this camera's: checked here, once, as a frame of
-    // it would be (profile_mismatch).
-    if (config.discrepancy.camera_profile) {
-      depth_image_t frame;
-      frame.camera_id = config.camera.id;
-      frame.width = config.camera.intrinsics.width;
-      frame.height = config.camera.intrinsics.height;
-      frame.fx = config.camera.intrinsics.fx;
-      frame.fy = config.camera.intrinsics.fy;
-      frame.cx = config.camera.intrinsics.cx;
-      frame.cy = config.camera.intrinsics.cy;
-      if (const std::string why = profile_mismatch(*config.discrepancy.camera_profile, frame); !why.empty())
-        discrepancy.fail("camera_profile", "a profile of the camera section's camera", why);
-    }
-  }
+  YamlMap discrepancy = root.map("discrepancy");
+  config.discrepancy = discrepancy::read_discrepancy_settings(discrepancy);
+  config.cameras = read_cameras(root, discrepancy, config.discrepancy.camera_profile);
+  config.camera = config.cameras.front();
+  config.discrepancy.camera_profile = config.camera.profile;
   config.risk = risk::read_risk_settings(root.map("risk"));
   config.estimator = estimator::read_estimator_settings(root.map("estimator"));
   config.joints_sim = sim::read_joints_sim_settings(root.map("joints_sim"));

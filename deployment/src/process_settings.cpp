@@ -1,5 +1,9 @@
 #include "tofguard/deployment/process_settings.hpp"
 
+#include <algorithm>
+
+#include "tofguard/common/process.hpp"
+
 namespace tofguard::deployment {
 
 renderer::RendererProcessSettings renderer_process_settings(const Config& config) {
@@ -29,8 +33,18 @@ risk::RiskProcessSettings risk_process_settings(const Config& config) {
   s.channels = config.channels;
   s.occupant = config.occupant;
   s.robot_urdf_path = config.robot.urdf_path;
-  s.camera_id = config.camera.id;
-  s.camera_rate_hz = config.camera.rate_hz;
+  for (const CameraSection& camera : config.cameras) {
+    risk::RiskCamera c;
+    c.id = camera.id;
+    c.rate_hz = camera.rate_hz;
+    c.channels = camera_channel_names(config.channels, camera.name_suffix);
+    for (const std::string& process : config.risk.required_heartbeats) {
+      const std::vector<std::string>& per_camera = per_camera_process_names();
+      const bool of_a_camera = std::find(per_camera.begin(), per_camera.end(), process) != per_camera.end();
+      c.required_heartbeats.push_back(of_a_camera ? process + camera.name_suffix : process);
+    }
+    s.cameras.push_back(std::move(c));
+  }
   s.auth = config.auth;
   s.risk = config.risk;
   return s;

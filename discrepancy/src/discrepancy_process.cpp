@@ -13,10 +13,13 @@
 namespace tofguard::discrepancy {
 
 ProcessInfo process_info() {
-  return {"tofguard-discrepancy",
-          "Pairs camera and rendered frames by seq and computes I_dis = I_gen - I_ToF: TOF_DEPTH, "
-          "TOF_RENDERED, TOF_LABELS -> SAFETY_DISCREPANCY (discrepancy_t), and optionally the colour "
-          "image (discrepancy_image_t)."};
+  ProcessInfo info{
+      "tofguard-discrepancy",
+      "Pairs camera and rendered frames by seq and computes I_dis = I_gen - I_ToF: TOF_DEPTH, "
+      "TOF_RENDERED, TOF_LABELS -> SAFETY_DISCREPANCY (discrepancy_t), and optionally the colour "
+      "image (discrepancy_image_t)."};
+  info.per_camera = true;
+  return info;
 }
 
 int run_discrepancy(const DiscrepancyProcessSettings& settings) {

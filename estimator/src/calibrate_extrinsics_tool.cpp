@@ -16,6 +16,7 @@ ProcessInfo calibrate_extrinsics_info() {
       "arm moving with known joint angles, starting from the config's camera.pose; prints the YAML block for "
       "camera.pose. Usage: tofguard-calibrate-extrinsics --config FILE LOG [--out FILE] [--frames N]"};
   info.takes_arguments = true;
+  info.per_camera = true;
   return info;
 }
 

@@ -20,12 +20,14 @@
 namespace tofguard::estimator {
 
 ProcessInfo process_info() {
-  return {
+  ProcessInfo info{
       "tofguard-estimator",
       "Estimates which joint offsets and which camera-pose correction best explain the camera's depth image "
       "(docs/estimator.md): TOF_DEPTH, JOINT_STATE, CAMERA_POSE, SAFETY_DISCREPANCY, SAFETY_RISK -> "
       "MOTION_ESTIMATE, for every frame whose discrepancy passes the warning level or that tofguard-risk "
       "judged a model mismatch, and periodically."};
+  info.per_camera = true;
+  return info;
 }
 
 EstimatorOptions options_from_settings(const EstimatorProcessSettings& settings) {

@@ -19,11 +19,13 @@
 namespace tofguard::renderer {
 
 ProcessInfo process_info() {
-  return {
+  ProcessInfo info{
       "tofguard-renderer",
       "Renders the arm's model at the reported joint angles from the camera's pose: TOF_DEPTH, JOINT_STATE, "
       "CAMERA_POSE, PLANNED_TRAJECTORY (rendering the next frame ahead) -> TOF_RENDERED, TOF_LABELS.\n"
       "Also: tofguard-renderer render --help (one image to PNG files)."};
+  info.per_camera = true;
+  return info;
 }
 
 namespace {

@@ -2,7 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "tofguard/auth/message_signer.hpp"
 #include "tofguard/auth/signed_publish.hpp"
@@ -11,6 +15,7 @@
 #include "tofguard/common/lcm_node.hpp"
 #include "tofguard/common/wire_checks.hpp"
 #include "tofguard/risk/risk_monitor.hpp"
+#include "tofguard/risk/verdict_fusion.hpp"
 
 namespace tofguard::risk {
 
@@ -23,109 +28,202 @@ ProcessInfo process_info() {
       "speed limit, SAFETY_SPEED_LIMIT (speed_limit_t)."};
 }
 
-int run_risk(const RiskProcessSettings& settings) {
-  RiskMonitor monitor(settings.risk, settings.channels,
-                      robot_model::load_kinematic_tree(settings.robot_urdf_path), settings.camera_rate_hz,
-                      monotonic_us());
-  if (settings.occupant) monitor.set_occupant(*settings.occupant);
-  const std::string camera_id = settings.camera_id;
-  LcmNode node(settings.lcm, settings.channels, process_info().name);
-  int64_t dangerous = 0;
-  // With a key, each verdict goes out signed first (the copy a keyed
-  // tofguard-intervene acts on), then plain (for people, logs and tools).
-  std::optional<auth::MessageSigner> signer;
-  if (auth::authenticated(settings.auth)) signer.emplace(settings.auth.key, wall_utime());
+namespace {
 
-  auto publish = [&](const risk_t& r) {
-    auth::publish_signed(node.safety(), signer ? &*signer : nullptr, settings.channels.risk,
-                         settings.channels.risk_auth, r, wall_utime());
-    node.counters().frames_out++;
-    if (r.seq >= 0) node.heartbeat().set_last_frame_utime(r.utime);
-    if (r.level == risk_t::DANGEROUS) ++dangerous;
-    const RiskMonitor::EstimateStats& e = monitor.estimate_stats();
-    node.heartbeat().set_status(
+// One camera's judgement: its monitor, fed from its own channels.
+struct CameraJudge {
+  RiskCamera camera;
+  std::unique_ptr<RiskMonitor> monitor;
+};
+
+std::vector<CameraJudge> camera_judges(const RiskProcessSettings& settings) {
+  std::vector<CameraJudge> judges;
+  const robot_model::KinematicTree robot = robot_model::load_kinematic_tree(settings.robot_urdf_path);
+  for (const RiskCamera& camera : settings.cameras) {
+    RiskSettings risk = settings.risk;
+    risk.required_heartbeats = camera.required_heartbeats;
+    CameraJudge judge{
+        camera, std::make_unique<RiskMonitor>(risk, camera.channels, robot, camera.rate_hz, monotonic_us())};
+    if (settings.occupant) judge.monitor->set_occupant(*settings.occupant);
+    judges.push_back(std::move(judge));
+  }
+  return judges;
+}
+
+VerdictFusion verdict_fusion(const std::vector<CameraJudge>& judges) {
+  std::vector<std::string> ids;
+  std::vector<std::string> depth_channels;
+  for (const CameraJudge& judge : judges) {
+    ids.push_back(judge.camera.id);
+    depth_channels.push_back(judge.camera.channels.depth);
+  }
+  return VerdictFusion(ids, depth_channels);
+}
+
+// The wiring of one process: every camera's inputs to its monitor, the
+// shared inputs to all, the fused verdicts and the speed limits out.
+class RiskProcess {
+ public:
+  explicit RiskProcess(const RiskProcessSettings& settings)
+      : settings_(settings),
+        judges_(camera_judges(settings)),
+        fusion_(verdict_fusion(judges_)),
+        node_(settings.lcm, settings.channels, process_info().name) {
+    // With a key, each verdict goes out signed first (the copy a keyed
+    // tofguard-intervene acts on), then plain (for people, logs and tools).
+    if (auth::authenticated(settings.auth)) signer_.emplace(settings.auth.key, wall_utime());
+    for (size_t camera = 0; camera < judges_.size(); ++camera) subscribe_camera(camera);
+    subscribe_shared();
+    node_.add_timer(settings.risk.check_period_us, [this] { check_due_and_deadlines(); });
+    node_.heartbeat().set_status("ok: waiting for frames");
+  }
+
+  void run() { node_.run(); }
+
+ private:
+  void publish(size_t camera, const risk_t& verdict) {
+    const risk_t r = fusion_.fuse(camera, verdict);
+    auth::publish_signed(node_.safety(), signer_ ? &*signer_ : nullptr, settings_.channels.risk,
+                         settings_.channels.risk_auth, r, wall_utime());
+    node_.counters().frames_out++;
+    if (r.seq >= 0) node_.heartbeat().set_last_frame_utime(r.utime);
+    if (r.level == risk_t::DANGEROUS) ++dangerous_;
+    const RiskMonitor::EstimateStats& e = judges_[camera].monitor->estimate_stats();
+    node_.heartbeat().set_status(
         "last verdict: level " + std::to_string(r.level) + " cause " + std::to_string(r.cause) + " (" +
-        r.detail + "); " + std::to_string(dangerous) +
-        " dangerous so far; estimates: " + std::to_string(e.received) + " received, " +
+        r.detail + "); " + std::to_string(dangerous_) + " dangerous so far; estimates of " +
+        judges_[camera].camera.id + ": " + std::to_string(e.received) + " received, " +
         std::to_string(e.used) + " used, " + std::to_string(e.explained_nothing) + " explained nothing, " +
         std::to_string(e.missing) + " missing, " + std::to_string(e.late) + " late");
-  };
+  }
 
-  auto publish_all = [&](const std::vector<risk_t>& verdicts) {
-    for (const risk_t& r : verdicts) publish(r);
-  };
+  void publish_all(size_t camera, const std::vector<risk_t>& verdicts) {
+    for (const risk_t& r : verdicts) publish(camera, r);
+  }
+
   // The controller's speed limit, signed first as the verdicts are.
-  auto publish_limit = [&](const speed_limit_t& limit) {
-    auth::publish_signed(node.safety(), signer ? &*signer : nullptr, settings.channels.speed_limit,
-                         settings.channels.speed_limit_auth, limit, wall_utime());
-  };
-  node.subscribe<discrepancy_t>(
-      node.safety(), settings.channels.discrepancy,
-      [&](const discrepancy_t& d) {
-        const int64_t refused_before = monitor.refused_frames();
-        publish_all(monitor.on_frame(d, monotonic_us()));
-        if (monitor.refused_frames() != refused_before) {
-          // A duplicate or out-of-order frame: no verdict (RiskMonitor::on_frame).
-          node.counters().frames_dropped++;
-          node.errors().report(settings.channels.discrepancy + " order",
-                               settings.channels.discrepancy + ": refused: " + monitor.last_refusal());
-        } else {
-          publish_limit(monitor.speed_limit(d));
-        }
-      },
-      check_discrepancy);
-  node.subscribe<motion_estimate_t>(
-      node.safety(), settings.channels.motion_estimate,
-      [&](const motion_estimate_t& e) { publish_all(monitor.on_estimate(e, monotonic_us())); },
-      [&](const motion_estimate_t& e) {
-        std::string problem = check_motion_estimate(e);
-        if (problem.empty() && e.camera_id != camera_id) {
-          problem = "camera_id: expected '" + camera_id + "', got '" + e.camera_id + "'";
-        }
-        if (problem.empty() && e.usable) problem = monitor.check_joint_names(e.joint_name, "joint_name");
-        return problem;
-      });
-  node.subscribe<planned_trajectory_t>(
-      node.safety(), settings.channels.planned_trajectory,
-      [&](const planned_trajectory_t& p) { monitor.on_plan(p); },
-      [&](const planned_trajectory_t& p) {
-        std::string problem = check_planned_trajectory(p);
-        if (problem.empty()) problem = monitor.check_joint_names(p.joint_name, "joint_name");
-        return problem;
-      });
-  node.subscribe<depth_image_t>(
-      node.images(), settings.channels.depth, [&](const depth_image_t&) { monitor.on_depth(monotonic_us()); },
-      [camera_id](const depth_image_t& image) { return check_depth_image_from(image, camera_id); });
-  node.subscribe<joint_state_t>(
-      node.safety(), settings.channels.joint_state,
-      [&](const joint_state_t& s) {
-        const std::string refused = monitor.on_joint_state(s, monotonic_us());
-        if (!refused.empty()) {
-          node.counters().frames_dropped++;
-          node.errors().report(settings.channels.joint_state + " order",
-                               settings.channels.joint_state + ": refused: " + refused);
-        }
-      },
-      [&](const joint_state_t& s) {
-        std::string problem = check_joint_state(s);
-        if (problem.empty()) problem = monitor.check_joint_names(s);
-        return problem;
-      });
-  node.subscribe<camera_pose_t>(
-      node.safety(), settings.channels.camera_pose,
-      [&](const camera_pose_t&) { monitor.on_camera_pose(monotonic_us()); }, check_camera_pose);
-  node.subscribe<heartbeat_t>(
-      node.safety(), settings.channels.heartbeat,
-      [&](const heartbeat_t& hb) { monitor.on_heartbeat(hb, monotonic_us()); }, check_heartbeat);
-  node.add_timer(settings.risk.check_period_us, [&] {
-    publish_all(monitor.release_due(monotonic_us()));
-    if (const auto timeout = monitor.check_deadlines(monotonic_us())) {
-      publish(*timeout);
-      publish_limit(stand_still_limit(settings.risk, timeout->utime, camera_id, timeout->detail));
+  void publish_limit(const speed_limit_t& limit) {
+    auth::publish_signed(node_.safety(), signer_ ? &*signer_ : nullptr, settings_.channels.speed_limit,
+                         settings_.channels.speed_limit_auth, limit, wall_utime());
+  }
+
+  void on_frame(size_t camera, const discrepancy_t& d) {
+    RiskMonitor& monitor = *judges_[camera].monitor;
+    const std::string& channel = judges_[camera].camera.channels.discrepancy;
+    const int64_t refused_before = monitor.refused_frames();
+    publish_all(camera, monitor.on_frame(d, monotonic_us()));
+    if (monitor.refused_frames() != refused_before) {
+      // A duplicate or out-of-order frame: no verdict (RiskMonitor::on_frame).
+      node_.counters().frames_dropped++;
+      node_.errors().report(channel + " order", channel + ": refused: " + monitor.last_refusal());
+    } else {
+      publish_limit(monitor.speed_limit(d));
     }
-  });
-  node.heartbeat().set_status("ok: waiting for frames");
-  node.run();
+  }
+
+  void subscribe_camera(size_t camera) {
+    RiskMonitor& monitor = *judges_[camera].monitor;
+    const RiskCamera& c = judges_[camera].camera;
+    node_.subscribe<discrepancy_t>(
+        node_.safety(), c.channels.discrepancy,
+        [this, camera](const discrepancy_t& d) { on_frame(camera, d); },
+        [id = c.id](const discrepancy_t& d) {
+          std::string problem = check_discrepancy(d);
+          if (problem.empty() && d.camera_id != id) {
+            problem = "camera_id: expected '" + id + "', got '" + d.camera_id + "'";
+          }
+          return problem;
+        });
+    node_.subscribe<motion_estimate_t>(
+        node_.safety(), c.channels.motion_estimate,
+        [this, camera, &monitor](const motion_estimate_t& e) {
+          publish_all(camera, monitor.on_estimate(e, monotonic_us()));
+        },
+        [&monitor, id = c.id](const motion_estimate_t& e) {
+          std::string problem = check_motion_estimate(e);
+          if (problem.empty() && e.camera_id != id) {
+            problem = "camera_id: expected '" + id + "', got '" + e.camera_id + "'";
+          }
+          if (problem.empty() && e.usable) problem = monitor.check_joint_names(e.joint_name, "joint_name");
+          return problem;
+        });
+    node_.subscribe<depth_image_t>(
+        node_.images(), c.channels.depth,
+        [&monitor](const depth_image_t&) { monitor.on_depth(monotonic_us()); },
+        [id = c.id](const depth_image_t& image) { return check_depth_image_from(image, id); });
+    node_.subscribe<camera_pose_t>(
+        node_.safety(), c.channels.camera_pose,
+        [&monitor](const camera_pose_t&) { monitor.on_camera_pose(monotonic_us()); }, check_camera_pose);
+  }
+
+  void subscribe_shared() {
+    RiskMonitor& first = *judges_.front().monitor;
+    node_.subscribe<planned_trajectory_t>(
+        node_.safety(), settings_.channels.planned_trajectory,
+        [this](const planned_trajectory_t& p) {
+          for (CameraJudge& judge : judges_) judge.monitor->on_plan(p);
+        },
+        [&first](const planned_trajectory_t& p) {
+          std::string problem = check_planned_trajectory(p);
+          if (problem.empty()) problem = first.check_joint_names(p.joint_name, "joint_name");
+          return problem;
+        });
+    node_.subscribe<joint_state_t>(
+        node_.safety(), settings_.channels.joint_state, [this](const joint_state_t& s) { on_joint_state(s); },
+        [&first](const joint_state_t& s) {
+          std::string problem = check_joint_state(s);
+          if (problem.empty()) problem = first.check_joint_names(s);
+          return problem;
+        });
+    node_.subscribe<heartbeat_t>(
+        node_.safety(), settings_.channels.heartbeat,
+        [this](const heartbeat_t& hb) {
+          for (CameraJudge& judge : judges_) judge.monitor->on_heartbeat(hb, monotonic_us());
+        },
+        check_heartbeat);
+  }
+
+  // Every camera's monitor takes the state; it is refused (and counted
+  // once) when the first refuses it, as all have seen the same stream.
+  void on_joint_state(const joint_state_t& s) {
+    std::string refused;
+    for (CameraJudge& judge : judges_) {
+      const std::string why = judge.monitor->on_joint_state(s, monotonic_us());
+      if (refused.empty()) refused = why;
+    }
+    if (!refused.empty()) {
+      node_.counters().frames_dropped++;
+      node_.errors().report(settings_.channels.joint_state + " order",
+                            settings_.channels.joint_state + ": refused: " + refused);
+    }
+  }
+
+  void check_due_and_deadlines() {
+    for (size_t camera = 0; camera < judges_.size(); ++camera) {
+      RiskMonitor& monitor = *judges_[camera].monitor;
+      publish_all(camera, monitor.release_due(monotonic_us()));
+      if (const auto timeout = monitor.check_deadlines(monotonic_us())) {
+        publish(camera, *timeout);
+        publish_limit(
+            stand_still_limit(settings_.risk, timeout->utime, judges_[camera].camera.id, timeout->detail));
+      }
+    }
+  }
+
+  const RiskProcessSettings& settings_;
+  std::vector<CameraJudge> judges_;
+  VerdictFusion fusion_;
+  LcmNode node_;
+  std::optional<auth::MessageSigner> signer_;
+  int64_t dangerous_ = 0;
+};
+
+}  // namespace
+
+int run_risk(const RiskProcessSettings& settings) {
+  if (settings.cameras.empty()) throw std::runtime_error("tofguard-risk: no camera to judge");
+  RiskProcess process(settings);
+  process.run();
   return 0;
 }
 

@@ -94,6 +94,7 @@ ProcessInfo sim_fault_info() {
                    "    the world frame); --duration-s S (default 1000).",
                    /*config_required=*/false};
   info.takes_arguments = true;
+  info.per_camera = true;
   return info;
 }
 

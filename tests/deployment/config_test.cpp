@@ -13,6 +13,7 @@
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/deployment/process_settings.hpp"
 #include "tool_support.hpp"
+#include "two_camera_config.hpp"
 
 namespace tofguard::test {
 namespace {
@@ -438,6 +439,107 @@ TEST(Config, OccupantMistakesNameTheKey) {
     const std::string message = config_error(path);
     EXPECT_EQ(message.find('\n'), std::string::npos) << "not one line: " << message;
     EXPECT_NE(message.find(path), std::string::npos) << message;
+    for (const std::string& part : m.expected) {
+      EXPECT_NE(message.find(part), std::string::npos)
+          << m.name << ": '" << part << "' missing from: " << message;
+    }
+  }
+}
+
+// Several cameras: a `cameras` list; the first camera keeps the channel
+// names a lone camera has, every other's per-camera channels and processes
+// carry its id.
+TEST(Config, ACamerasListGivesEachCameraItsChannelsAndProfile) {
+  const deployment::Config config = deployment::load_config(two_camera_config("config-two-cameras"), nullptr);
+  ASSERT_EQ(config.cameras.size(), 2u);
+  EXPECT_EQ(config.cameras[0].id, "tof-mast");
+  EXPECT_EQ(config.cameras[1].id, "tof-side");
+  EXPECT_EQ(config.cameras[0].name_suffix, "");
+  EXPECT_EQ(config.cameras[1].name_suffix, "/tof-side");
+  ASSERT_TRUE(config.cameras[0].profile && config.cameras[1].profile);
+  EXPECT_EQ(config.cameras[0].profile->camera_id, "tof-mast");
+  EXPECT_EQ(config.cameras[1].profile->camera_id, "tof-side");
+  EXPECT_NEAR(config.cameras[1].pose.translation_m.y(), 0.70, 1e-12);
+  EXPECT_EQ(config.cameras[1].sim.seed, 2u);
+  // Until a process selects one, the first.
+  EXPECT_EQ(config.camera.id, "tof-mast");
+  EXPECT_EQ(config.channels.depth, "TOF_DEPTH");
+
+  const deployment::Config side = deployment::select_camera(config, "tof-side");
+  EXPECT_EQ(side.camera.id, "tof-side");
+  EXPECT_EQ(side.discrepancy.camera_profile, config.cameras[1].profile);
+  EXPECT_EQ(side.channels.depth, "TOF_DEPTH/tof-side");
+  EXPECT_EQ(side.channels.rendered, "TOF_RENDERED/tof-side");
+  EXPECT_EQ(side.channels.labels, "TOF_LABELS/tof-side");
+  EXPECT_EQ(side.channels.camera_pose, "CAMERA_POSE/tof-side");
+  EXPECT_EQ(side.channels.discrepancy, "SAFETY_DISCREPANCY/tof-side");
+  EXPECT_EQ(side.channels.motion_estimate, "MOTION_ESTIMATE/tof-side");
+  EXPECT_EQ(side.channels.sim_camera_fault, "SIM_CAMERA_FAULT/tof-side");
+  EXPECT_EQ(side.channels.camera_suffix, "/tof-side");
+  // What every camera shares keeps its name.
+  EXPECT_EQ(side.channels.joint_state, "JOINT_STATE");
+  EXPECT_EQ(side.channels.risk, "SAFETY_RISK");
+  EXPECT_EQ(side.channels.heartbeat, "SAFETY_HEARTBEAT");
+  EXPECT_EQ(side.channels.speed_limit, "SAFETY_SPEED_LIMIT");
+
+  try {
+    deployment::select_camera(config, "tof-roof");
+    ADD_FAILURE() << "an unknown camera was selected";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("no camera 'tof-roof'; the config has 'tof-mast', 'tof-side'"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+// tofguard-risk judges every camera, each on its own channels and with the
+// heartbeats of its own processes required.
+TEST(Config, RiskJudgesEveryCameraOnItsOwnChannels) {
+  const deployment::Config config =
+      deployment::load_config(two_camera_config("config-two-cameras-risk"), nullptr);
+  const risk::RiskProcessSettings risk = deployment::risk_process_settings(config);
+  ASSERT_EQ(risk.cameras.size(), 2u);
+  EXPECT_EQ(risk.cameras[0].channels.discrepancy, "SAFETY_DISCREPANCY");
+  EXPECT_EQ(risk.cameras[1].channels.discrepancy, "SAFETY_DISCREPANCY/tof-side");
+  EXPECT_EQ(risk.cameras[1].rate_hz, 30);
+  EXPECT_EQ(risk.cameras[0].required_heartbeats,
+            (std::vector<std::string>{"tofguard-camera", "tofguard-renderer", "tofguard-discrepancy"}));
+  EXPECT_EQ(risk.cameras[1].required_heartbeats,
+            (std::vector<std::string>{"tofguard-camera/tof-side", "tofguard-renderer/tof-side",
+                                      "tofguard-discrepancy/tof-side"}));
+  // A lone camera is a list of one.
+  const risk::RiskProcessSettings lone =
+      deployment::risk_process_settings(deployment::load_config(sim_yaml_path(), nullptr));
+  ASSERT_EQ(lone.cameras.size(), 1u);
+  EXPECT_EQ(lone.cameras[0].id, "tof-mast");
+  EXPECT_EQ(lone.cameras[0].channels.depth, "TOF_DEPTH");
+}
+
+TEST(Config, CameraListMistakesNameTheKey) {
+  const std::string sim_yaml = read_file(sim_yaml_path());
+  const std::string mast_profile = source_dir() + "/config/sim-camera-profile.yaml";
+  const struct {
+    std::string name;
+    std::vector<std::pair<std::string, std::string>> replacements;
+    std::string appended;
+    std::vector<std::string> expected;
+  } mistakes[] = {
+      {"both", {}, sim_camera_section(sim_yaml), {"camera", "either a camera section or a cameras list"}},
+      {"same-id", {{"- id: tof-side\n", "- id: tof-mast\n"}}, "", {"cameras", "id", "'tof-mast' again"}},
+      {"profile-in-discrepancy",
+       {{"  max_depth_mm: ", "  camera_profile: " + mast_profile + "\n  max_depth_mm: "}},
+       "",
+       {"discrepancy.camera_profile", "each camera names its own"}},
+      {"another-cameras-profile",
+       {{"sim-side-camera-profile.yaml", "sim-camera-profile.yaml"}},
+       "",
+       {"camera_profile", "a profile of camera 'tof-side'", "tof-mast"}},
+  };
+  for (const auto& m : mistakes) {
+    const std::string path = two_camera_config("config-cameras-" + m.name, m.replacements, m.appended);
+    const std::string message = config_error(path);
+    EXPECT_EQ(message.find('\n'), std::string::npos) << m.name << ": not one line: " << message;
+    EXPECT_NE(message.find(path), std::string::npos) << m.name << ": " << message;
     for (const std::string& part : m.expected) {
       EXPECT_NE(message.find(part), std::string::npos)
           << m.name << ": '" << part << "' missing from: " << message;

@@ -7,7 +7,9 @@
 
 #include <csignal>
 
+#include "tofguard/common/process.hpp"
 #include "tool_support.hpp"
+#include "two_camera_config.hpp"
 
 namespace tofguard::test {
 namespace {
@@ -89,6 +91,41 @@ TEST(ProcessConfig, HelpExitsZero) {
     EXPECT_EQ(run_command(std::string("help-") + process, {bin_dir() + "/" + process, "--help"}, &out, &err),
               0);
     EXPECT_NE(out.find(std::string("usage: ") + process), std::string::npos) << out;
+  }
+}
+
+// With several cameras a process of one camera must be told which it
+// serves (--camera ID); the others take no --camera. Which are which is
+// per_camera_process_names(), the list tofguard-risk and the launch tests
+// expand per camera: each process's --help says the same.
+TEST(ProcessConfig, AProcessOfOneCameraMustBeToldWhichCamera) {
+  const std::string path = two_camera_config("process-two-cameras");
+  const std::vector<std::string>& per_camera = per_camera_process_names();
+  for (const std::string& process : per_camera) {
+    std::string out, err;
+    ASSERT_EQ(run_command("help-" + process, {bin_dir() + "/" + process, "--help"}, &out, &err), 0) << err;
+    EXPECT_NE(out.find("[--camera ID]"), std::string::npos) << process << ": " << out;
+  }
+  for (const char* process : kProcesses) {
+    SCOPED_TRACE(process);
+    const bool of_a_camera = std::find(per_camera.begin(), per_camera.end(), process) != per_camera.end();
+    std::string out, err;
+    ASSERT_EQ(run_command(std::string("help-") + process, {bin_dir() + "/" + process, "--help"}, &out, &err),
+              0);
+    EXPECT_EQ(out.find("[--camera ID]") != std::string::npos, of_a_camera) << out;
+    if (!of_a_camera) continue;
+    const int code = run_command(std::string("no-camera-") + process,
+                                 {bin_dir() + "/" + process, "--config", path}, &out, &err);
+    EXPECT_EQ(code, 2) << err;
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+    EXPECT_NE(err.find("2 cameras (tof-mast, tof-side); name the one this process serves with --camera ID"),
+              std::string::npos)
+        << err;
+    const int unknown =
+        run_command(std::string("unknown-camera-") + process,
+                    {bin_dir() + "/" + process, "--config", path, "--camera", "tof-roof"}, &out, &err);
+    EXPECT_EQ(unknown, 2) << err;
+    EXPECT_NE(err.find("no camera 'tof-roof'"), std::string::npos) << err;
   }
 }
 

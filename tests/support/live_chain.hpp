@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <functional>
 #include <iostream>
@@ -19,6 +20,7 @@
 
 #include "recovery_deadline.hpp"
 #include "tofguard/common/clock.hpp"
+#include "tofguard/common/process.hpp"
 #include "tofguard/common/risk_names.hpp"
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/heartbeat_t.hpp"
@@ -34,6 +36,22 @@ inline const std::vector<std::string>& chain_process_names() {
   static const std::vector<std::string> names = {
       "tofguard-intervene",  "tofguard-risk",   "tofguard-discrepancy", "tofguard-renderer",
       "tofguard-joints-sim", "tofguard-camera", "tofguard-estimator"};
+  return names;
+}
+
+// The processes of `config`'s chain, in chain_process_names() order: a
+// process of one camera (per_camera_process_names) once per camera, named
+// with the camera's suffix ("tofguard-renderer/tof-side"), the others once.
+inline std::vector<std::string> chain_processes_of(const deployment::Config& config) {
+  std::vector<std::string> names;
+  const std::vector<std::string>& per_camera = per_camera_process_names();
+  for (const std::string& p : chain_process_names()) {
+    if (std::find(per_camera.begin(), per_camera.end(), p) == per_camera.end()) {
+      names.push_back(p);
+      continue;
+    }
+    for (const deployment::CameraSection& camera : config.cameras) names.push_back(p + camera.name_suffix);
+  }
   return names;
 }
 
@@ -61,21 +79,39 @@ class LiveChain {
     safety_.subscribe(config_.channels.risk, &LiveChain::on_risk, this);
     safety_.subscribe(config_.channels.heartbeat, &LiveChain::on_heartbeat, this);
     if (start) {
-      for (const std::string& p : chain_process_names()) this->start(p);
+      for (const std::string& p : chain_processes_of(config_)) this->start(p);
     }
   }
 
+  // `process` as chain_processes_of names it: with several cameras a
+  // process of one camera is started with --camera (the first camera's for
+  // a name without a suffix).
   void start(const std::string& process) {
-    std::vector<std::string> argv{bin_dir() + "/" + process, "--config", config_path_};
+    const std::string binary = process.substr(0, process.find('/'));
+    std::vector<std::string> argv;
+    if (const auto prefix = argv_prefix.find(process); prefix != argv_prefix.end()) argv = prefix->second;
+    argv.insert(argv.end(), {bin_dir() + "/" + binary, "--config", config_path_});
+    const std::vector<std::string>& per_camera = per_camera_process_names();
+    if (config_.cameras.size() > 1 &&
+        std::find(per_camera.begin(), per_camera.end(), binary) != per_camera.end()) {
+      const auto slash = process.find('/');
+      argv.insert(argv.end(), {"--camera", slash == std::string::npos ? config_.cameras.front().id
+                                                                      : process.substr(slash + 1)});
+    }
     if (const auto more = arguments.find(process); more != arguments.end()) {
       argv.insert(argv.end(), more->second.begin(), more->second.end());
     }
+    std::string file_name = process;  // the output files' name: no '/'
+    std::replace(file_name.begin(), file_name.end(), '/', '@');
     processes_[process] =
-        std::make_unique<Subprocess>(name_ + "-" + process + "-" + std::to_string(++starts_), argv);
+        std::make_unique<Subprocess>(name_ + "-" + file_name + "-" + std::to_string(++starts_), argv);
   }
   // Arguments after --config FILE, by process (e.g. tofguard-joints-sim's
   // --task), for the processes started after they are set.
   std::map<std::string, std::vector<std::string>> arguments;
+  // Commands a process is started through, by process (e.g.
+  // SecondHost::argv_prefix(): on another host).
+  std::map<std::string, std::vector<std::string>> argv_prefix;
   Subprocess& process(const std::string& name) { return *processes_.at(name); }
   std::string stderr_of_all() {
     std::string text;

@@ -38,6 +38,7 @@ ProcessInfo tune_info() {
       "\"Commissioning a camera\") from the recording, tune on the corrected frames and write it. Exit "
       "code 1 when the recording is not usable."};
   info.takes_arguments = true;
+  info.per_camera = true;
   return info;
 }
 

@@ -130,6 +130,7 @@ ProcessInfo process_info() {
                    "nearer than the model; blue: farther) side by side with the verdict: live in a window,\n"
                    "or with --log FILE --out DIR|FILE.mp4 exported from a log (one PNG per camera frame)."};
   info.takes_arguments = true;
+  info.per_camera = true;
   return info;
 }
 

@@ -32,8 +32,10 @@ class LcmNode {
  public:
   // Opens both URLs (one LCM instance when they are equal); throws
   // std::runtime_error naming the URL when LCM cannot start. Heartbeats go
-  // out on channels.heartbeat at `heartbeat_rate_hz`. Each URL is joined on
-  // the first subscription on it (below).
+  // out on channels.heartbeat at `heartbeat_rate_hz`, as `process_name` with
+  // the camera's channels.camera_suffix appended (the processes of a second
+  // camera are "tofguard-renderer/<id>", ...). Each URL is joined on the
+  // first subscription on it (below).
   LcmNode(const LcmSettings& lcm, const ChannelNames& channels, const std::string& process_name,
           double heartbeat_rate_hz = 20);
   ~LcmNode();

@@ -59,7 +59,20 @@ struct ChannelNames {
   std::string sim_controller_fault = "SIM_CONTROLLER_FAULT";
   // Simulation only: run-time fault injection into the simulated camera.
   std::string sim_camera_fault = "SIM_CAMERA_FAULT";
+  // What the camera these names belong to appends to its per-camera
+  // channels and to its processes' names (heartbeat_t.process): "" for the
+  // first camera and for the processes of no camera, "/<camera id>" for
+  // every other (camera_channel_names).
+  std::string camera_suffix;
 };
+
+// One camera's names in a deployment of several: its per-camera channels
+// (depth, camera_pose, rendered, labels, discrepancy, motion_estimate,
+// sim_camera_fault) are `base`'s with `camera_suffix` appended; the others
+// (joint state, risk, status, reset, heartbeat, power, speed limit, plan)
+// every camera shares. With camera_suffix "" the names are `base`'s: the
+// first camera's channels keep the names a single camera has.
+ChannelNames camera_channel_names(const ChannelNames& base, const std::string& camera_suffix);
 
 // The safety URL: the config's lcm.url, else LCM_DEFAULT_URL, else
 // kHostLocalLcmUrl.

@@ -15,11 +15,13 @@
 // hertz, _mm millimetres. Durations are converted once, here, to integer
 // microseconds (fields named _us). Relative paths are resolved against the
 // config file's folder.
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "tofguard/auth/auth_settings.hpp"
+#include "tofguard/common/camera_profile.hpp"
 #include "tofguard/common/camera_settings.hpp"
 #include "tofguard/common/config_error.hpp"
 #include "tofguard/common/lcm_settings.hpp"
@@ -36,8 +38,9 @@
 
 namespace tofguard::deployment {
 
-// The `camera` section: the camera every process shares (id, rate_hz,
-// intrinsics, pose) and the sources' own settings.
+// One camera: the `camera` section, or one entry of the `cameras` list. What
+// every process of that camera shares (id, rate_hz, intrinsics, pose) and
+// the sources' own settings.
 struct CameraSection : CameraSettings {
   // source: "sim" (the simulated ToF camera) or "uvc" (a USB Video Class
   // camera).
@@ -48,6 +51,14 @@ struct CameraSection : CameraSettings {
   // and filled when present.
   camera::UvcSettings uvc;
   sim::SimCameraSettings sim;
+  // The camera's commissioned profile (docs/camera.md, "Commissioning a
+  // camera"): cameras[i].camera_profile, or for a lone `camera` section
+  // discrepancy.camera_profile; null without one.
+  std::shared_ptr<const CameraProfile> profile;
+  // What this camera's channels and processes are called: "" for the first
+  // camera (its channels keep the names of `channels`, its processes theirs),
+  // "/<id>" appended for every other (camera_channel_names, lcm_settings.hpp).
+  std::string name_suffix;
 };
 
 struct Config {
@@ -60,6 +71,11 @@ struct Config {
   EnvironmentSettings environment;
   // Optional: the wheelchair's occupant (absent: nobody is modelled).
   std::optional<OccupantSettings> occupant;
+  // Every camera, in config order: the `cameras` list, or the lone `camera`
+  // section as a list of one.
+  std::vector<CameraSection> cameras;
+  // The camera this process serves (select_camera below), and `channels`
+  // are its channel names; until a camera is selected, the first.
   CameraSection camera;
   renderer::RendererSettings renderer;
   discrepancy::DiscrepancySettings discrepancy;
@@ -74,6 +90,11 @@ struct Config {
 // Loads and validates `path`; throws ConfigError. `lcm_default_url_env` is
 // the value of LCM_DEFAULT_URL (nullptr when unset).
 Config load_config(const std::string& path, const char* lcm_default_url_env);
+
+// The config as the processes of camera `id` see it: `camera` that camera,
+// `channels` its channel names, discrepancy.camera_profile its profile.
+// Throws ConfigError naming the configured ids when `id` is none of them.
+Config select_camera(const Config& config, const std::string& id);
 
 // The loud lines every process prints at start for this config: running
 // without authentication, an LCM bus open beyond the host.

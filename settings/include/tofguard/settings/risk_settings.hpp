@@ -155,16 +155,32 @@ struct RiskSettings {
 RiskSettings read_risk_settings(YamlMap section);
 
 // Everything tofguard-risk needs.
+// One camera tofguard-risk judges (config `camera`, or an entry of
+// `cameras`).
+struct RiskCamera {
+  // camera.id: frames and estimates of another camera are rejected.
+  std::string id;
+  // camera.rate_hz: frames per second, for the evidence tests' threshold
+  // (false stops per hour = hypotheses * frames per hour / e^h).
+  double rate_hz = 0;
+  // Its channels (camera_channel_names): its frames, depth images, pose and
+  // estimates arrive on its own.
+  ChannelNames channels;
+  // risk.required_heartbeats as this camera's processes are named: a
+  // process of one camera (common/process.hpp, per_camera_process_names)
+  // with the camera's suffix.
+  std::vector<std::string> required_heartbeats;
+};
+
 struct RiskProcessSettings {
   LcmSettings lcm;
+  // The channels every camera shares (joint state, verdicts, heartbeats...).
   ChannelNames channels;
   // robot.urdf: the arm's kinematic tree (which joint moves which link).
   std::string robot_urdf_path;
-  // camera.id: frames and estimates of another camera are rejected.
-  std::string camera_id;
-  // camera.rate_hz: frames per second, for the evidence tests' threshold
-  // (false stops per hour = hypotheses * frames per hour / e^h).
-  double camera_rate_hz = 0;
+  // Every camera, in config order; each is judged on its own and the
+  // verdicts are fused (risk/verdict_fusion.hpp).
+  std::vector<RiskCamera> cameras;
   // With a key every verdict also goes out signed on channels.risk_auth
   // (the only risk stream a keyed tofguard-intervene trusts).
   auth::AuthSettings auth;
@@ -187,6 +203,7 @@ double iso13855_intrusion_distance_m(double detection_capability_m);
 namespace tofguard::risk {
 using settings::iso13855_intrusion_distance_m;
 using settings::read_risk_settings;
+using settings::RiskCamera;
 using settings::RiskProcessSettings;
 using settings::RiskSettings;
 }  // namespace tofguard::risk

@@ -1,0 +1,89 @@
+// The one verdict stream of several cameras (verdict_fusion.hpp): every
+// published verdict is the worst of every camera's latest, so no camera's
+// stop, open diagnosis or silence is hidden by another camera's view.
+#include "tofguard/risk/verdict_fusion.hpp"
+
+#include <gtest/gtest.h>
+
+namespace tofguard::risk {
+namespace {
+
+risk_t verdict(int64_t seq, int8_t level, int8_t cause = risk_t::CAUSE_NONE,
+               const std::string& detail = "ok") {
+  risk_t r;
+  r.utime = 1000 + seq;
+  r.seq = seq;
+  r.level = level;
+  r.cause = cause;
+  r.suspect = "";
+  r.detail = detail;
+  return r;
+}
+
+VerdictFusion two_cameras() {
+  return VerdictFusion({"tof-mast", "tof-side"}, {"TOF_DEPTH", "TOF_DEPTH/tof-side"});
+}
+
+TEST(VerdictFusion, OneCameraPassesEveryVerdictAsItIs) {
+  VerdictFusion fusion({"tof-mast"}, {"TOF_DEPTH"});
+  const risk_t out = fusion.fuse(0, verdict(7, risk_t::SAFE));
+  EXPECT_EQ(out.seq, 7);
+  EXPECT_EQ(out.level, risk_t::SAFE);
+  EXPECT_EQ(out.detail, "ok");
+}
+
+TEST(VerdictFusion, ACameraWithoutAVerdictKeepsTheArmStoppedAndIsNamed) {
+  VerdictFusion fusion = two_cameras();
+  const risk_t out = fusion.fuse(0, verdict(1, risk_t::SAFE));
+  EXPECT_EQ(out.level, risk_t::DANGEROUS);
+  EXPECT_EQ(out.cause, risk_t::CAUSE_SENSOR_FAULT);
+  EXPECT_EQ(out.suspect, "TOF_DEPTH/tof-side");
+  EXPECT_EQ(out.detail, "tof-side: no frame of this camera judged yet");
+  // Once both have judged a frame, the safe verdicts pass, named.
+  fusion.fuse(1, verdict(1, risk_t::SAFE));
+  const risk_t both = fusion.fuse(0, verdict(2, risk_t::SAFE));
+  EXPECT_EQ(both.level, risk_t::SAFE);
+  EXPECT_EQ(both.seq, 2);
+  EXPECT_EQ(both.detail, "tof-mast: ok");
+}
+
+TEST(VerdictFusion, OneCamerasStopHoldsWhateverTheOtherSees) {
+  VerdictFusion fusion = two_cameras();
+  fusion.fuse(0, verdict(1, risk_t::SAFE));
+  fusion.fuse(1, verdict(1, risk_t::SAFE));
+  const risk_t side_stop =
+      fusion.fuse(1, verdict(2, risk_t::DANGEROUS, risk_t::CAUSE_CALIBRATION_ERROR, "camera moved"));
+  EXPECT_EQ(side_stop.level, risk_t::DANGEROUS);
+  EXPECT_EQ(side_stop.detail, "tof-side: camera moved");
+  // The mast camera's safe frames do not clear it: the side camera's
+  // diagnosis is published with each of them.
+  for (int64_t seq = 2; seq < 5; ++seq) {
+    const risk_t out = fusion.fuse(0, verdict(seq, risk_t::SAFE));
+    EXPECT_EQ(out.level, risk_t::DANGEROUS);
+    EXPECT_EQ(out.cause, risk_t::CAUSE_CALIBRATION_ERROR);
+    EXPECT_EQ(out.detail, "tof-side: camera moved");
+  }
+  // A warning of the mast camera is less than the side camera's stop.
+  EXPECT_EQ(fusion.fuse(0, verdict(5, risk_t::WARNING)).detail, "tof-side: camera moved");
+  // The side camera's diagnosis closes: the mast camera's warning is the worst.
+  const risk_t cleared = fusion.fuse(1, verdict(3, risk_t::SAFE));
+  EXPECT_EQ(cleared.level, risk_t::WARNING);
+  EXPECT_EQ(cleared.detail, "tof-mast: ok");
+}
+
+TEST(VerdictFusion, AStalledCamerasTimeoutHoldsUntilItsNextVerdict) {
+  VerdictFusion fusion = two_cameras();
+  fusion.fuse(0, verdict(1, risk_t::SAFE));
+  fusion.fuse(1, verdict(1, risk_t::SAFE));
+  risk_t timeout = verdict(-1, risk_t::DANGEROUS, risk_t::CAUSE_SENSOR_FAULT, "TOF_DEPTH/tof-side stale");
+  timeout.suspect = "TOF_DEPTH/tof-side";
+  fusion.fuse(1, timeout);
+  const risk_t out = fusion.fuse(0, verdict(2, risk_t::SAFE));
+  EXPECT_EQ(out.level, risk_t::DANGEROUS);
+  EXPECT_EQ(out.seq, -1);
+  EXPECT_EQ(out.suspect, "TOF_DEPTH/tof-side");
+  EXPECT_EQ(out.detail, "tof-side: TOF_DEPTH/tof-side stale");
+}
+
+}  // namespace
+}  // namespace tofguard::risk
