@@ -3,6 +3,7 @@
 #include <string>
 #include <vector>
 
+#include "tofguard/common/config_error.hpp"
 #include "tofguard/deployment/process_runner.hpp"
 #include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/launch/launch_process.hpp"
@@ -14,7 +15,15 @@ int main(int argc, char** argv) {
   std::string config_flag = "--config";
   if (argc >= 2 && argv[1][0] != '-') args.insert(args.begin() + 1, config_flag.data());
   return deployment::run_process(static_cast<int>(args.size()), args.data(), launch::process_info(),
-                                 [](const deployment::Config& config, const std::vector<std::string>&) {
-                                   return launch::run_launch(deployment::launch_process_settings(config));
+                                 [](const deployment::Config& config, const std::vector<std::string>& rest) {
+                                   launch::LaunchProcessSettings settings =
+                                       deployment::launch_process_settings(config);
+                                   if (rest.size() == 2 && rest[0] == "--host" && !rest[1].empty()) {
+                                     settings.host = rest[1];
+                                   } else if (!rest.empty()) {
+                                     throw ConfigError("unexpected argument '" + rest[0] +
+                                                       "' (usage: tofguard-launch CONFIG [--host NAME])");
+                                   }
+                                   return launch::run_launch(settings);
                                  });
 }

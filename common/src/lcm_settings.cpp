@@ -92,6 +92,9 @@ ChannelNames read_channel_names(YamlMap map) {
   name("reset_auth", &c.reset_auth);
   name("speed_limit", &c.speed_limit);
   name("speed_limit_auth", &c.speed_limit_auth);
+  name("camera_release", &c.camera_release);
+  name("camera_release_auth", &c.camera_release_auth);
+  name("camera_release_reply", &c.camera_release_reply);
   name("motion_estimate", &c.motion_estimate);
   name("planned_trajectory", &c.planned_trajectory);
   name("sim_true_joint_state", &c.sim_true_joint_state);

@@ -33,6 +33,7 @@ std::vector<ProcessSpec> process_specs(const LaunchProcessSettings& settings,
   std::vector<ProcessSpec> specs;
   for (size_t i = 0; i < launch.processes.size(); ++i) {
     const LaunchedProcess& p = launch.processes[i];
+    if (p.host != settings.host) continue;
     ProcessSpec spec;
     spec.name = p.name;
     spec.required = p.required;
@@ -51,6 +52,12 @@ std::vector<ProcessSpec> process_specs(const LaunchProcessSettings& settings,
     }
     spec.argv[0] = program;
     specs.push_back(spec);
+  }
+  if (specs.empty()) {
+    throw ConfigError(settings.config_file + ": launch.processes: expected a process for " +
+                      (settings.host.empty() ? std::string("the main computer (no host key)")
+                                             : "host '" + settings.host + "' (--host)") +
+                      ", got none");
   }
   return specs;
 }
@@ -97,12 +104,16 @@ RestartPolicy restart_policy(const LaunchSettings& launch) {
 }  // namespace
 
 ProcessInfo process_info() {
-  return {"tofguard-launch",
-          "Starts the process group of the deployment config (launch.processes, in order), shows\n"
-          "each process's state, restarts crashed processes with back-off (a process that keeps\n"
-          "crashing is reported and left stopped), records every channel with lcm-logger into\n"
-          "rotating files under launch.log_dir, and stops all of them on Ctrl-C / SIGTERM.\n"
-          "Usage: tofguard-launch CONFIG"};
+  ProcessInfo info{"tofguard-launch",
+                   "Starts the process group of the deployment config (launch.processes, in order), shows\n"
+                   "each process's state, restarts crashed processes with back-off (a process that keeps\n"
+                   "crashing is reported and left stopped), records every channel with lcm-logger into\n"
+                   "rotating files under launch.log_dir, and stops all of them on Ctrl-C / SIGTERM.\n"
+                   "With --host NAME only the processes whose `host` is NAME (a second computer of the\n"
+                   "deployment; it records nothing: the main computer does).\n"
+                   "Usage: tofguard-launch CONFIG [--host NAME]"};
+  info.takes_arguments = true;
+  return info;
 }
 
 int run_launch(const LaunchProcessSettings& settings) {
@@ -118,7 +129,8 @@ int run_launch(const LaunchProcessSettings& settings) {
                       launch.log_dir + ": " + ec.message());
   }
   const std::string recordings = launch.log_dir + "/recordings";
-  if (launch.recorder.enabled && !add_recorders(settings, recordings, &specs)) {
+  // The black box records on the main computer, which hears every channel.
+  if (launch.recorder.enabled && settings.host.empty() && !add_recorders(settings, recordings, &specs)) {
     std::cerr << "tofguard-launch: lcm-logger not found in PATH (liblcm-bin): run scripts/install-deps\n";
     return kConfigErrorExitCode;
   }

@@ -9,11 +9,15 @@
 #include <vector>
 
 #include "tofguard/auth/message_signer.hpp"
+#include "tofguard/auth/message_verifier.hpp"
 #include "tofguard/auth/signed_publish.hpp"
 #include "tofguard/camera_pose_t.hpp"
+#include "tofguard/camera_release_t.hpp"
 #include "tofguard/common/clock.hpp"
+#include "tofguard/common/decode.hpp"
 #include "tofguard/common/lcm_node.hpp"
 #include "tofguard/common/wire_checks.hpp"
+#include "tofguard/reset_reply_t.hpp"
 #include "tofguard/risk/risk_monitor.hpp"
 #include "tofguard/risk/verdict_fusion.hpp"
 
@@ -50,14 +54,14 @@ std::vector<CameraJudge> camera_judges(const RiskProcessSettings& settings) {
   return judges;
 }
 
-VerdictFusion verdict_fusion(const std::vector<CameraJudge>& judges) {
+VerdictFusion verdict_fusion(const std::vector<CameraJudge>& judges, const RiskSettings& risk) {
   std::vector<std::string> ids;
   std::vector<std::string> depth_channels;
   for (const CameraJudge& judge : judges) {
     ids.push_back(judge.camera.id);
     depth_channels.push_back(judge.camera.channels.depth);
   }
-  return VerdictFusion(ids, depth_channels);
+  return VerdictFusion(ids, depth_channels, risk.continue_after_named_camera_release);
 }
 
 // The wiring of one process: every camera's inputs to its monitor, the
@@ -67,13 +71,17 @@ class RiskProcess {
   explicit RiskProcess(const RiskProcessSettings& settings)
       : settings_(settings),
         judges_(camera_judges(settings)),
-        fusion_(verdict_fusion(judges_)),
+        fusion_(verdict_fusion(judges_, settings.risk)),
         node_(settings.lcm, settings.channels, process_info().name) {
     // With a key, each verdict goes out signed first (the copy a keyed
     // tofguard-intervene acts on), then plain (for people, logs and tools).
-    if (auth::authenticated(settings.auth)) signer_.emplace(settings.auth.key, wall_utime());
+    if (auth::authenticated(settings.auth)) {
+      signer_.emplace(settings.auth.key, wall_utime());
+      verifier_.emplace(settings.auth.key, settings.auth.max_age_us);
+    }
     for (size_t camera = 0; camera < judges_.size(); ++camera) subscribe_camera(camera);
     subscribe_shared();
+    subscribe_camera_release();
     node_.add_timer(settings.risk.check_period_us, [this] { check_due_and_deadlines(); });
     node_.heartbeat().set_status("ok: waiting for frames");
   }
@@ -82,7 +90,9 @@ class RiskProcess {
 
  private:
   void publish(size_t camera, const risk_t& verdict) {
-    const risk_t r = fusion_.fuse(camera, verdict);
+    const std::optional<risk_t> fused = fusion_.fuse(camera, verdict);
+    if (!fused) return;
+    const risk_t& r = *fused;
     auth::publish_signed(node_.safety(), signer_ ? &*signer_ : nullptr, settings_.channels.risk,
                          settings_.channels.risk_auth, r, wall_utime());
     node_.counters().frames_out++;
@@ -204,10 +214,73 @@ class RiskProcess {
       publish_all(camera, monitor.release_due(monotonic_us()));
       if (const auto timeout = monitor.check_deadlines(monotonic_us())) {
         publish(camera, *timeout);
+        // A released camera's silence is known and said in every verdict:
+        // the others' limits stand.
+        if (fusion_.released(camera)) continue;
         publish_limit(
             stand_still_limit(settings_.risk, timeout->utime, judges_[camera].camera.id, timeout->detail));
       }
     }
+  }
+
+  // An operator's release of a lost camera (verdict_fusion.hpp), answered
+  // on channels.camera_release_reply.
+  void on_camera_release(const camera_release_t& request) {
+    reset_reply_t reply;
+    reply.utime = wall_utime();
+    reply.request_id = request.request_id;
+    const size_t camera = fusion_.index_of(request.camera_id);
+    if (request.who.empty() || request.why.empty()) {
+      reply.reason = "refused: a release needs who and why";
+    } else if (camera == fusion_.cameras()) {
+      reply.reason = "refused: no camera '" + request.camera_id + "' in this deployment";
+    } else {
+      reply.reason = fusion_.release(camera, request.who, request.why);
+    }
+    reply.accepted = reply.reason.empty();
+    if (reply.accepted) reply.reason = "released: " + request.camera_id + " is left out until it is back";
+    std::cerr << "tofguard-risk: camera release of '" << request.camera_id << "' from '" << request.who
+              << "' (" << request.why << "): " << reply.reason << std::endl;
+    node_.safety().publish(settings_.channels.camera_release_reply, &reply);
+  }
+
+  void subscribe_camera_release() {
+    const ChannelNames& channels = settings_.channels;
+    if (!verifier_) {
+      node_.subscribe<camera_release_t>(node_.safety(), channels.camera_release,
+                                        [this](const camera_release_t& r) { on_camera_release(r); });
+      return;
+    }
+    // With a key only a signed release counts; a plain one is answered.
+    node_.subscribe<camera_release_t>(
+        node_.safety(), channels.camera_release, [this](const camera_release_t& r) {
+          refuse_release(r.request_id, "not authenticated (no tag): send it signed on " +
+                                           settings_.channels.camera_release_auth);
+        });
+    node_.subscribe<authenticated_message_t>(
+        node_.safety(), channels.camera_release_auth, [this](const authenticated_message_t& m) {
+          std::string why;
+          const std::optional<camera_release_t> request =
+              verifier_->open<camera_release_t>(m, settings_.channels.camera_release, wall_utime(), &why);
+          if (request) {
+            on_camera_release(*request);
+          } else if (const auto claimed =
+                         decode_message<camera_release_t>(m.payload.data(), m.payload_size)) {
+            refuse_release(claimed->request_id, "not authenticated: " + why);
+          }
+        });
+  }
+
+  void refuse_release(int64_t request_id, const std::string& why) {
+    node_.counters().validation_errors++;
+    node_.errors().report(settings_.channels.camera_release_auth,
+                          settings_.channels.camera_release + ": " + why);
+    reset_reply_t reply;
+    reply.utime = wall_utime();
+    reply.request_id = request_id;
+    reply.accepted = false;
+    reply.reason = "refused: " + why;
+    node_.safety().publish(settings_.channels.camera_release_reply, &reply);
   }
 
   const RiskProcessSettings& settings_;
@@ -215,6 +288,7 @@ class RiskProcess {
   VerdictFusion fusion_;
   LcmNode node_;
   std::optional<auth::MessageSigner> signer_;
+  std::optional<auth::MessageVerifier> verifier_;
   int64_t dangerous_ = 0;
 };
 

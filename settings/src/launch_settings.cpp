@@ -10,6 +10,10 @@ LaunchSettings read_launch_settings(YamlMap map) {
     process.command = p.strings("command");
     if (process.command.empty()) p.fail("command", "a non-empty list: program and arguments");
     process.required = p.boolean("required");
+    if (auto host = p.optional_string("host")) {
+      if (host->empty()) p.fail("host", "a computer's name (absent: the main computer)", "''");
+      process.host = *host;
+    }
     p.finish();
     launch.processes.push_back(process);
   }

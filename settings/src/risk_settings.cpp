@@ -134,6 +134,8 @@ RiskSettings read_risk_settings(YamlMap map) {
   read_deadlines(map.map("deadlines_ms"), &r);
   read_camera_pose(map.map("camera_pose"), &r);
   r.required_heartbeats = map.strings("required_heartbeats");
+  r.continue_after_named_camera_release =
+      map.choice("camera_loss", {"stop", "continue_after_named_reset"}) == "continue_after_named_reset";
   read_sensor(map.map("sensor"), &r);
   read_joint_error(map.map("joint_error"), &r);
   read_calibration_error(map.map("calibration_error"), &r);

@@ -175,5 +175,42 @@ TEST(Launcher, RecorderWritesEveryChannelToRotatingFiles) {
   EXPECT_EQ(launch.wait(std::chrono::seconds(10)), 0);
 }
 
+// A second computer's processes (launch.processes[i].host): `tofguard-launch
+// --host NAME` starts only those, and records nothing (the main computer
+// records the black box); the main computer starts only those without a
+// host.
+TEST(Launcher, EachComputerStartsItsOwnProcesses) {
+  const std::string log_dir = output_dir() + "/launch-hosts";
+  std::filesystem::remove_all(log_dir);
+  const std::string config = sim_config_variant(
+      "launch-hosts", {},
+      launch_section(
+          log_dir,
+          "    - {name: judge, command: [/bin/sleep, '1000'], required: true}\n"
+          "    - {name: side-camera, command: [/bin/sleep, '1000'], required: true, host: side-pc}\n",
+          /*recorder=*/true));
+  Subprocess side("launch-hosts-side", {bin_dir() + "/tofguard-launch", config, "--host", "side-pc"});
+  ASSERT_TRUE(wait_until([&] { return pids_in(side.stdout_text(), "side-camera").size() == 1; },
+                         std::chrono::seconds(5)))
+      << side.stdout_text() << side.stderr_text();
+  EXPECT_NE(side.stdout_text().find("starting 1 processes"), std::string::npos) << side.stdout_text();
+  EXPECT_TRUE(pids_in(side.stdout_text(), "judge").empty()) << side.stdout_text();
+  EXPECT_EQ(side.stdout_text().find("recorder-"), std::string::npos) << side.stdout_text();
+  side.signal(SIGINT);
+  EXPECT_EQ(side.wait(std::chrono::seconds(10)), 0) << side.stdout_text();
+
+  std::string out, err;
+  EXPECT_EQ(run_command("launch-hosts-none", {bin_dir() + "/tofguard-launch", config, "--host", "roof-pc"},
+                        &out, &err),
+            2);
+  EXPECT_NE(err.find("launch.processes: expected a process for host 'roof-pc' (--host), got none"),
+            std::string::npos)
+      << err;
+  EXPECT_EQ(run_command("launch-hosts-bad", {bin_dir() + "/tofguard-launch", config, "--hots", "side-pc"},
+                        &out, &err),
+            2);
+  EXPECT_NE(err.find("unexpected argument '--hots'"), std::string::npos) << err;
+}
+
 }  // namespace
 }  // namespace tofguard::test

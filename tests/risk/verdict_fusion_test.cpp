@@ -26,7 +26,7 @@ VerdictFusion two_cameras() {
 
 TEST(VerdictFusion, OneCameraPassesEveryVerdictAsItIs) {
   VerdictFusion fusion({"tof-mast"}, {"TOF_DEPTH"});
-  const risk_t out = fusion.fuse(0, verdict(7, risk_t::SAFE));
+  const risk_t out = *fusion.fuse(0, verdict(7, risk_t::SAFE));
   EXPECT_EQ(out.seq, 7);
   EXPECT_EQ(out.level, risk_t::SAFE);
   EXPECT_EQ(out.detail, "ok");
@@ -34,14 +34,14 @@ TEST(VerdictFusion, OneCameraPassesEveryVerdictAsItIs) {
 
 TEST(VerdictFusion, ACameraWithoutAVerdictKeepsTheArmStoppedAndIsNamed) {
   VerdictFusion fusion = two_cameras();
-  const risk_t out = fusion.fuse(0, verdict(1, risk_t::SAFE));
+  const risk_t out = *fusion.fuse(0, verdict(1, risk_t::SAFE));
   EXPECT_EQ(out.level, risk_t::DANGEROUS);
   EXPECT_EQ(out.cause, risk_t::CAUSE_SENSOR_FAULT);
   EXPECT_EQ(out.suspect, "TOF_DEPTH/tof-side");
   EXPECT_EQ(out.detail, "tof-side: no frame of this camera judged yet");
   // Once both have judged a frame, the safe verdicts pass, named.
   fusion.fuse(1, verdict(1, risk_t::SAFE));
-  const risk_t both = fusion.fuse(0, verdict(2, risk_t::SAFE));
+  const risk_t both = *fusion.fuse(0, verdict(2, risk_t::SAFE));
   EXPECT_EQ(both.level, risk_t::SAFE);
   EXPECT_EQ(both.seq, 2);
   EXPECT_EQ(both.detail, "tof-mast: ok");
@@ -52,21 +52,21 @@ TEST(VerdictFusion, OneCamerasStopHoldsWhateverTheOtherSees) {
   fusion.fuse(0, verdict(1, risk_t::SAFE));
   fusion.fuse(1, verdict(1, risk_t::SAFE));
   const risk_t side_stop =
-      fusion.fuse(1, verdict(2, risk_t::DANGEROUS, risk_t::CAUSE_CALIBRATION_ERROR, "camera moved"));
+      *fusion.fuse(1, verdict(2, risk_t::DANGEROUS, risk_t::CAUSE_CALIBRATION_ERROR, "camera moved"));
   EXPECT_EQ(side_stop.level, risk_t::DANGEROUS);
   EXPECT_EQ(side_stop.detail, "tof-side: camera moved");
   // The mast camera's safe frames do not clear it: the side camera's
   // diagnosis is published with each of them.
   for (int64_t seq = 2; seq < 5; ++seq) {
-    const risk_t out = fusion.fuse(0, verdict(seq, risk_t::SAFE));
+    const risk_t out = *fusion.fuse(0, verdict(seq, risk_t::SAFE));
     EXPECT_EQ(out.level, risk_t::DANGEROUS);
     EXPECT_EQ(out.cause, risk_t::CAUSE_CALIBRATION_ERROR);
     EXPECT_EQ(out.detail, "tof-side: camera moved");
   }
   // A warning of the mast camera is less than the side camera's stop.
-  EXPECT_EQ(fusion.fuse(0, verdict(5, risk_t::WARNING)).detail, "tof-side: camera moved");
+  EXPECT_EQ(fusion.fuse(0, verdict(5, risk_t::WARNING))->detail, "tof-side: camera moved");
   // The side camera's diagnosis closes: the mast camera's warning is the worst.
-  const risk_t cleared = fusion.fuse(1, verdict(3, risk_t::SAFE));
+  const risk_t cleared = *fusion.fuse(1, verdict(3, risk_t::SAFE));
   EXPECT_EQ(cleared.level, risk_t::WARNING);
   EXPECT_EQ(cleared.detail, "tof-mast: ok");
 }
@@ -78,11 +78,56 @@ TEST(VerdictFusion, AStalledCamerasTimeoutHoldsUntilItsNextVerdict) {
   risk_t timeout = verdict(-1, risk_t::DANGEROUS, risk_t::CAUSE_SENSOR_FAULT, "TOF_DEPTH/tof-side stale");
   timeout.suspect = "TOF_DEPTH/tof-side";
   fusion.fuse(1, timeout);
-  const risk_t out = fusion.fuse(0, verdict(2, risk_t::SAFE));
+  const risk_t out = *fusion.fuse(0, verdict(2, risk_t::SAFE));
   EXPECT_EQ(out.level, risk_t::DANGEROUS);
   EXPECT_EQ(out.seq, -1);
   EXPECT_EQ(out.suspect, "TOF_DEPTH/tof-side");
   EXPECT_EQ(out.detail, "tof-side: TOF_DEPTH/tof-side stale");
+}
+
+// risk.camera_loss continue_after_named_reset: a lost camera released by
+// name is left out, said in every verdict, until it judges SAFE again.
+TEST(VerdictFusion, AReleasedLostCameraIsLeftOutAndSaidUntilItIsBack) {
+  VerdictFusion fusion({"tof-mast", "tof-side"}, {"TOF_DEPTH", "TOF_DEPTH/tof-side"},
+                       /*releases_allowed=*/true);
+  fusion.fuse(0, verdict(1, risk_t::SAFE));
+  // Not lost: nothing to release.
+  fusion.fuse(1, verdict(1, risk_t::SAFE));
+  EXPECT_EQ(fusion.release(1, "nurse", "camera knocked"),
+            "refused: tof-side is not lost: its latest verdict is SAFE");
+  risk_t timeout = verdict(-1, risk_t::DANGEROUS, risk_t::CAUSE_SENSOR_FAULT, "TOF_DEPTH/tof-side stale");
+  fusion.fuse(1, timeout);
+  EXPECT_EQ(fusion.fuse(0, verdict(2, risk_t::SAFE))->level, risk_t::DANGEROUS);
+  // The last camera judging cannot be released; the lost one can.
+  EXPECT_EQ(fusion.release(0, "nurse", "x"), "refused: tof-mast is not lost: its latest verdict is SAFE");
+  EXPECT_EQ(fusion.release(1, "nurse", "side camera unplugged"), "");
+  EXPECT_TRUE(fusion.released(1));
+  const risk_t without = *fusion.fuse(0, verdict(3, risk_t::SAFE));
+  EXPECT_EQ(without.level, risk_t::SAFE);
+  EXPECT_EQ(without.detail, "tof-mast: ok [tof-side left out: released by nurse: side camera unplugged]");
+  // Its timeouts go on and publish nothing; the mast camera still stops the arm.
+  EXPECT_FALSE(fusion.fuse(1, timeout).has_value());
+  EXPECT_EQ(fusion.release(0, "nurse", "x"), "refused: tof-mast is not lost: its latest verdict is SAFE");
+  EXPECT_EQ(fusion.fuse(0, verdict(4, risk_t::DANGEROUS, risk_t::CAUSE_JOINT_ERROR, "a3"))->level,
+            risk_t::DANGEROUS);
+  EXPECT_EQ(fusion.release(0, "nurse", "x"),
+            "refused: tof-mast's finding is a joint error, not a fault of the "
+            "camera: it holds (tof-mast: a3)");
+  fusion.fuse(0, verdict(5, risk_t::SAFE));
+  // Back: its first SAFE frame verdict counts it again.
+  const risk_t back = *fusion.fuse(1, verdict(9, risk_t::SAFE));
+  EXPECT_FALSE(fusion.released(1));
+  EXPECT_EQ(back.detail, "tof-side: ok");
+  EXPECT_EQ(fusion.fuse(1, timeout)->level, risk_t::DANGEROUS);
+}
+
+TEST(VerdictFusion, WithCameraLossStopNoCameraIsReleased) {
+  VerdictFusion fusion = two_cameras();
+  fusion.fuse(0, verdict(1, risk_t::SAFE));
+  fusion.fuse(1, verdict(-1, risk_t::DANGEROUS, risk_t::CAUSE_SENSOR_FAULT, "stale"));
+  EXPECT_EQ(fusion.release(1, "nurse", "x"),
+            "refused: risk.camera_loss is stop: a lost camera stops the arm until it is back");
+  EXPECT_EQ(fusion.fuse(0, verdict(2, risk_t::SAFE))->level, risk_t::DANGEROUS);
 }
 
 }  // namespace

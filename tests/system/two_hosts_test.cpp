@@ -3,14 +3,17 @@
 // two hosts joined by a cable (second_host.hpp: two network namespaces and
 // a veth pair). The second host runs the side camera's tofguard-camera,
 // -renderer, -discrepancy and -estimator and the arm's controller
-// (tofguard-joints-sim); this host the mast camera's and the judgement
-// (tofguard-risk, tofguard-intervene). LCM crosses the cable (udpm,
+// (tofguard-joints-sim), started by its own tofguard-launch --host side-pc
+// from the launch section of the same config; this host the mast camera's
+// and the judgement (tofguard-risk, tofguard-intervene). LCM crosses the cable (udpm,
 // ttl=1): the side camera's discrepancy, depth images and heartbeats this
 // way, the joint states that way, and the signed status and speed limit the
 // arm's controller verifies. Both hosts read one clock here; on two
 // computers their clocks must agree within what docs/architecture.md,
 // "Several computers", sets.
 #include <gtest/gtest.h>
+
+#include <csignal>
 
 #include <iostream>
 #include <map>
@@ -31,21 +34,58 @@ std::string verdict_camera(const risk_t& r) {
   return colon == std::string::npos ? "" : r.detail.substr(0, colon);
 }
 
+// The processes the second host runs (the side camera's and the arm's
+// controller), as its launcher names them (no '/': a name is a log file's).
+const std::vector<std::pair<std::string, std::string>>& second_host_processes() {
+  static const std::vector<std::pair<std::string, std::string>> processes = {
+      {"tofguard-camera/tof-side", "side-camera"},
+      {"tofguard-renderer/tof-side", "side-renderer"},
+      {"tofguard-discrepancy/tof-side", "side-discrepancy"},
+      {"tofguard-estimator/tof-side", "side-estimator"},
+      {"tofguard-joints-sim", "joints-sim"}};
+  return processes;
+}
+
+// The launch section's entries for the second host (host: side-pc).
+std::string second_host_launch_section() {
+  std::string entries;
+  for (const auto& [process, name] : second_host_processes()) {
+    const auto slash = process.find('/');
+    const std::string binary = process.substr(0, slash);
+    const std::string camera = slash == std::string::npos ? "" : ", --camera, " + process.substr(slash + 1);
+    const bool required = binary != "tofguard-estimator";
+    entries += "    - {name: " + name + ", command: [" + binary + ", --config, \"{config}\"" + camera +
+               "], required: " + (required ? "true" : "false") + ", host: side-pc}\n";
+  }
+  return "launch:\n  processes:\n" + entries +
+         "  restart_backoff_initial_ms: 200\n  restart_backoff_max_ms: 5000\n  max_restarts: 5\n"
+         "  restart_window_s: 60\n  log_dir: " +
+         output_dir() +
+         "/two-hosts-logs\n  recorder: {enabled: true, max_file_mb: 50, max_total_mb: 500, max_age_h: 24}\n";
+}
+
 // The two-camera deployment with both LCM URLs routed beyond the host
-// (ttl=1): over the cable and no farther.
+// (ttl=1): over the cable and no farther; its launch section starts the
+// second host's processes there.
 std::string two_host_config() {
-  return two_camera_config("two-hosts", {{"7667?ttl=0", "7667?ttl=1"}, {"7668?ttl=0", "7668?ttl=1"}});
+  return two_camera_config("two-hosts", {{"7667?ttl=0", "7667?ttl=1"}, {"7668?ttl=0", "7668?ttl=1"}},
+                           second_host_launch_section());
 }
 
 TEST(TwoHosts, TheSecondCamerasProcessesOnASecondComputerJudgedHere) {
   SecondHost second_host;
   LiveChain chain("two-hosts", LiveChain::ConfigFile{two_host_config()}, false);
-  for (const std::string process :
-       {"tofguard-camera/tof-side", "tofguard-renderer/tof-side", "tofguard-discrepancy/tof-side",
-        "tofguard-estimator/tof-side", "tofguard-joints-sim"}) {
-    chain.argv_prefix[process] = second_host.argv_prefix();
+  // The second host: its own launcher, from the same config.
+  std::vector<std::string> launch_argv = second_host.argv_prefix();
+  launch_argv.insert(launch_argv.end(),
+                     {bin_dir() + "/tofguard-launch", chain.config_path(), "--host", "side-pc"});
+  Subprocess second_launcher("two-hosts-launch-side-pc", launch_argv);
+  // This host: the rest.
+  for (const std::string& p : chain_processes_of(chain.config())) {
+    bool there = false;
+    for (const auto& [process, name] : second_host_processes()) there = there || process == p;
+    if (!there) chain.start(p);
   }
-  for (const std::string& p : chain_processes_of(chain.config())) chain.start(p);
   std::map<std::string, int64_t> verdicts_by_camera;
   chain.on_frame_verdict = [&](const risk_t& r) { ++verdicts_by_camera[verdict_camera(r)]; };
 
@@ -60,7 +100,8 @@ TEST(TwoHosts, TheSecondCamerasProcessesOnASecondComputerJudgedHere) {
     std::cout << "10 s over two hosts: " << chain.stops_seen() - stops_before << " stops, "
               << verdicts_by_camera["tof-mast"] << " verdicts of tof-mast, " << verdicts_by_camera["tof-side"]
               << " of tof-side (judged on this host from the second host's discrepancy)" << std::endl;
-    EXPECT_EQ(chain.stops_seen(), stops_before) << chain.last_status().reason;
+    EXPECT_EQ(chain.stops_seen(), stops_before)
+        << chain.last_status().reason << second_launcher.stdout_text();
     EXPECT_GE(verdicts_by_camera["tof-side"], 200);
     EXPECT_GE(verdicts_by_camera["tof-mast"], 200);
     // The second host's processes are heard here.
@@ -89,6 +130,8 @@ TEST(TwoHosts, TheSecondCamerasProcessesOnASecondComputerJudgedHere) {
     second_host.link(true);
     chain.bring_to_motion("the cable plugged back");
   }
+  second_launcher.signal(SIGINT);
+  EXPECT_EQ(second_launcher.wait(std::chrono::seconds(10)), 0) << second_launcher.stdout_text();
 }
 
 }  // namespace

@@ -48,6 +48,12 @@ struct ChannelNames {
   // never allows motion that SAFETY_STATUS withdraws.
   std::string speed_limit = "SAFETY_SPEED_LIMIT";
   std::string speed_limit_auth = "SAFETY_SPEED_LIMIT_AUTH";
+  // With several cameras: an operator's release of a lost camera
+  // (camera_release_t, tofguard-reset --release-camera) to tofguard-risk,
+  // its signed companion, and tofguard-risk's answer (reset_reply_t).
+  std::string camera_release = "SAFETY_CAMERA_RELEASE";
+  std::string camera_release_auth = "SAFETY_CAMERA_RELEASE_AUTH";
+  std::string camera_release_reply = "SAFETY_CAMERA_RELEASE_REPLY";
   // tofguard-estimator's joint offsets and camera correction
   // (motion_estimate_t) and the arm controller's plan (planned_trajectory_t).
   std::string motion_estimate = "MOTION_ESTIMATE";

@@ -23,6 +23,12 @@ struct LaunchedProcess {
   // the chain is unsafe without it (the risk classifier sees its heartbeat
   // missing).
   bool required = true;
+  // host (optional): the computer the process runs on, as `tofguard-launch
+  // --host NAME` names it (a camera's processes on a second PC: docs/
+  // architecture.md, "Several computers"); absent: the main computer, the
+  // one tofguard-launch without --host runs, which also records the black
+  // box.
+  std::string host;
 };
 
 // launch.recorder: the black-box recorder: lcm-logger on both LCM URLs into
@@ -64,6 +70,9 @@ struct LaunchProcessSettings {
   // Both URLs are recorded.
   LcmSettings lcm;
   LaunchSettings launch;
+  // --host NAME: this computer's processes (LaunchedProcess::host); "" the
+  // main computer's.
+  std::string host;
 };
 
 }  // namespace tofguard::settings

@@ -41,6 +41,15 @@ struct RiskSettings {
   // required_heartbeats: processes (heartbeat_t.process) whose heartbeat
   // must keep coming.
   std::vector<std::string> required_heartbeats;
+  // camera_loss (with several cameras): what a lost camera (its own
+  // verdict a fault of the camera: stalled, frozen, silent, unusable,
+  // moved) lets the arm do. "stop": stopped until that camera judges the
+  // arm again. "continue_after_named_reset": stopped until an operator's
+  // release naming the camera (camera_release_t, tofguard-reset
+  // --release-camera) and a reset; then the remaining cameras judge alone,
+  // every verdict saying which camera is left out, until it is back
+  // (risk/verdict_fusion.hpp).
+  bool continue_after_named_camera_release = false;
   // debounce_frames: a model mismatch (joint, calibration, object,
   // unclassified) is WARNING until it has held for this many consecutive
   // frames, then DANGEROUS.
