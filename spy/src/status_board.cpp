@@ -39,8 +39,7 @@ void StatusBoard::on_message(const std::string& channel, const void* data, int s
     }
   } else if (type == "risk_t") {
     if (auto m = decode_message<risk_t>(data, size)) {
-      risk_ = m;
-      risk_arrival_us_ = now_us;
+      on_risk(*m, now_us);
       if (m->seq >= 0) camera_utime = m->utime;
     }
   } else if (type == "speed_limit_t") {
@@ -51,11 +50,47 @@ void StatusBoard::on_message(const std::string& channel, const void* data, int s
   } else if (type == "heartbeat_t") {
     if (auto m = decode_message<heartbeat_t>(data, size)) heartbeats_[m->process] = {*m, now_us};
   } else if (type == "depth_image_t") {
-    if (auto m = decode_message<depth_image_t>(data, size)) camera_utime = m->utime;
+    if (auto m = decode_message<depth_image_t>(data, size)) {
+      camera_utime = m->utime;
+      std::deque<int64_t>& arrivals = cameras_[m->camera_id].frame_arrivals_us;
+      arrivals.push_back(now_us);
+      while (!arrivals.empty() && now_us - arrivals.front() > kRateWindowUs) arrivals.pop_front();
+    }
   } else if (type == "link_labels_t") {
     if (auto m = decode_message<link_labels_t>(data, size)) camera_utime = m->utime;
   }
   if (camera_utime > 0) stats.latency_us = now_utime - camera_utime;
+}
+
+void StatusBoard::on_risk(const risk_t& risk, int64_t now_us) {
+  risk_ = risk;
+  risk_arrival_us_ = now_us;
+  const auto colon = risk.detail.find(": ");
+  if (colon == std::string::npos) return;
+  const auto camera = cameras_.find(risk.detail.substr(0, colon));
+  if (camera == cameras_.end()) return;
+  camera->second.verdict = risk;
+  camera->second.verdict_arrival_us = now_us;
+}
+
+void StatusBoard::render_cameras(std::ostream& s, int64_t now_us) const {
+  s << "CAMERAS (frames over 2 s; the latest verdict naming each):\n";
+  if (cameras_.empty()) s << "  no depth frame received\n";
+  for (const auto& [id, camera] : cameras_) {
+    size_t recent = 0;
+    for (int64_t t : camera.frame_arrivals_us) recent += now_us - t <= kRateWindowUs;
+    const int64_t frame_age_us =
+        camera.frame_arrivals_us.empty() ? 0 : now_us - camera.frame_arrivals_us.back();
+    s << "  " << std::left << std::setw(12) << id << std::right << std::fixed << std::setprecision(1)
+      << std::setw(6) << recent / (kRateWindowUs * 1e-6) << " Hz, last frame " << age(frame_age_us)
+      << (frame_age_us > 200'000 ? " STALE" : "");
+    if (camera.verdict) {
+      s << ", " << risk_level_name(camera.verdict->level) << " " << age(now_us - camera.verdict_arrival_us)
+        << " ago";
+      if (camera.verdict->level != risk_t::SAFE) s << ": " << camera.verdict->detail.substr(id.size() + 2);
+    }
+    s << "\n";
+  }
 }
 
 std::string StatusBoard::render(int64_t now_us, int64_t) const {
@@ -96,6 +131,7 @@ std::string StatusBoard::render(int64_t now_us, int64_t) const {
       << (limit_age_us > limit_->valid_for_ms * 1000LL ? ", EXPIRED: 0 m/s" : "") << ")\n  " << limit_->reason
       << "\n";
   }
+  render_cameras(s, now_us);
   s << "PROCESSES (heartbeats):\n";
   if (heartbeats_.empty()) s << "  none received\n";
   for (const auto& [name, entry] : heartbeats_) {

@@ -182,6 +182,31 @@ TEST(Spy, StatusBoardShowsPermissionRiskHeartbeatsRatesAndLatency) {
   EXPECT_NE(later.find("MISSING"), std::string::npos) << later;
 }
 
+// With two cameras the board shows each: its frame rate, its last frame's
+// age, and the latest verdict that named it.
+TEST(Spy, StatusBoardShowsEachCamera) {
+  spy::StatusBoard board;
+  const int64_t t0_us = 5'000'000;
+  for (const std::string id : {"tof-mast", "tof-side"}) {
+    depth_image_t image = sample_depth_image();
+    image.camera_id = id;
+    const std::vector<uint8_t> bytes = encoded(image);
+    board.on_message("TOF_DEPTH", bytes.data(), static_cast<int>(bytes.size()), t0_us, 0);
+  }
+  risk_t verdict = sample_risk();
+  verdict.level = risk_t::DANGEROUS;
+  verdict.detail = "tof-side: timeout: TOF_DEPTH/tof-side stale";
+  const std::vector<uint8_t> bytes = encoded(verdict);
+  board.on_message("SAFETY_RISK", bytes.data(), static_cast<int>(bytes.size()), t0_us + 100'000, 0);
+  const std::string text = board.render(t0_us + 300'000, 0);
+  EXPECT_NE(text.find("CAMERAS"), std::string::npos) << text;
+  EXPECT_NE(text.find("tof-mast       0.5 Hz, last frame 0.30 s STALE\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("tof-side       0.5 Hz, last frame 0.30 s STALE, DANGEROUS 0.20 s ago: timeout: "
+                      "TOF_DEPTH/tof-side stale"),
+            std::string::npos)
+      << text;
+}
+
 }  // namespace
 }  // namespace tofguard::test
 

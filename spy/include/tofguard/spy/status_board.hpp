@@ -1,8 +1,11 @@
 #pragma once
 // The spy's refreshing status board: the permission to move and why, the
-// latest risk with cause and suspect, the arm's speed limit, each process's heartbeat age and
-// counters, each channel's rate, and the end-to-end latency from the camera
-// frame's capture utime. Pure: every call gets the clocks.
+// latest risk with cause and suspect, the arm's speed limit, each camera
+// (its frame rate, its last frame's age and the latest verdict that named
+// it: with several cameras tofguard-risk's verdict is the worst of theirs,
+// its detail starting with the camera's id), each process's heartbeat age
+// and counters, each channel's rate, and the end-to-end latency from the
+// camera frame's capture utime. Pure: every call gets the clocks.
 //
 // Latency is wall clock at arrival minus the message's camera utime, so it
 // is only meaningful live (a replayed log carries old utimes); rates and
@@ -11,6 +14,7 @@
 #include <deque>
 #include <map>
 #include <optional>
+#include <ostream>
 #include <string>
 
 #include "tofguard/heartbeat_t.hpp"
@@ -30,6 +34,14 @@ class StatusBoard {
     std::deque<int64_t> arrivals_us;  // last 2 s
     std::optional<int64_t> latency_us;
   };
+  // A camera, by depth_image_t.camera_id.
+  struct CameraStats {
+    std::deque<int64_t> frame_arrivals_us;  // last 2 s
+    std::optional<risk_t> verdict;          // the latest whose detail names it
+    int64_t verdict_arrival_us = 0;
+  };
+  void on_risk(const risk_t& risk, int64_t now_us);
+  void render_cameras(std::ostream& s, int64_t now_us) const;
   std::optional<safety_status_t> status_;
   int64_t status_arrival_us_ = 0;
   std::optional<risk_t> risk_;
@@ -38,6 +50,7 @@ class StatusBoard {
   int64_t limit_arrival_us_ = 0;
   std::map<std::string, std::pair<heartbeat_t, int64_t>> heartbeats_;  // by process: message, arrival
   std::map<std::string, ChannelStats> channels_;
+  std::map<std::string, CameraStats> cameras_;
 };
 
 }  // namespace tofguard::spy
