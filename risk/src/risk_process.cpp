@@ -18,6 +18,7 @@
 #include "tofguard/common/lcm_node.hpp"
 #include "tofguard/common/wire_checks.hpp"
 #include "tofguard/reset_reply_t.hpp"
+#include "tofguard/risk/arm_coverage.hpp"
 #include "tofguard/risk/risk_monitor.hpp"
 #include "tofguard/risk/verdict_fusion.hpp"
 
@@ -72,6 +73,7 @@ class RiskProcess {
       : settings_(settings),
         judges_(camera_judges(settings)),
         fusion_(verdict_fusion(judges_, settings.risk)),
+        coverage_(judges_.size(), settings.risk.min_link_pixels),
         node_(settings.lcm, settings.channels, process_info().name) {
     // With a key, each verdict goes out signed first (the copy a keyed
     // tofguard-intervene acts on), then plain (for people, logs and tools).
@@ -90,9 +92,11 @@ class RiskProcess {
 
  private:
   void publish(size_t camera, const risk_t& verdict) {
-    const std::optional<risk_t> fused = fusion_.fuse(camera, verdict);
+    std::optional<risk_t> fused = fusion_.fuse(camera, verdict);
     if (!fused) return;
-    const risk_t& r = *fused;
+    risk_t& r = *fused;
+    if (judges_.size() > 1 && r.seq >= 0)
+      r.detail += unseen_links_text(unseen_links(), coverage_.robot_links());
     auth::publish_signed(node_.safety(), signer_ ? &*signer_ : nullptr, settings_.channels.risk,
                          settings_.channels.risk_auth, r, wall_utime());
     node_.counters().frames_out++;
@@ -117,7 +121,15 @@ class RiskProcess {
                          settings_.channels.speed_limit_auth, limit, wall_utime());
   }
 
+  // The robot links no camera still judging sees (arm_coverage.hpp).
+  std::vector<std::string> unseen_links() const {
+    std::vector<bool> counted(judges_.size());
+    for (size_t c = 0; c < judges_.size(); ++c) counted[c] = !fusion_.released(c);
+    return coverage_.unseen_links(counted);
+  }
+
   void on_frame(size_t camera, const discrepancy_t& d) {
+    coverage_.on_frame(camera, d);
     RiskMonitor& monitor = *judges_[camera].monitor;
     const std::string& channel = judges_[camera].camera.channels.discrepancy;
     const int64_t refused_before = monitor.refused_frames();
@@ -286,6 +298,7 @@ class RiskProcess {
   const RiskProcessSettings& settings_;
   std::vector<CameraJudge> judges_;
   VerdictFusion fusion_;
+  ArmCoverage coverage_;
   LcmNode node_;
   std::optional<auth::MessageSigner> signer_;
   std::optional<auth::MessageVerifier> verifier_;

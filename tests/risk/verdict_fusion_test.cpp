@@ -1,9 +1,12 @@
 // The one verdict stream of several cameras (verdict_fusion.hpp): every
 // published verdict is the worst of every camera's latest, so no camera's
-// stop, open diagnosis or silence is hidden by another camera's view.
+// stop, open diagnosis or silence is hidden by another camera's view; and
+// the links no camera sees (arm_coverage.hpp).
 #include "tofguard/risk/verdict_fusion.hpp"
 
 #include <gtest/gtest.h>
+
+#include "tofguard/risk/arm_coverage.hpp"
 
 namespace tofguard::risk {
 namespace {
@@ -128,6 +131,43 @@ TEST(VerdictFusion, WithCameraLossStopNoCameraIsReleased) {
   EXPECT_EQ(fusion.release(1, "nurse", "x"),
             "refused: risk.camera_loss is stop: a lost camera stops the arm until it is back");
   EXPECT_EQ(fusion.fuse(0, verdict(2, risk_t::SAFE))->level, risk_t::DANGEROUS);
+}
+
+discrepancy_t frame_seeing(const std::vector<int>& compared, const std::vector<int>& nearer) {
+  discrepancy_t f{};
+  f.usable = true;
+  f.num_robot_links = 3;
+  f.num_links = 4;
+  f.link_name = {"link1", "link2", "gripper", "table"};
+  f.link_compared = {compared[0], compared[1], compared[2], 500};
+  f.link_nearer = {nearer[0], nearer[1], nearer[2], 0};
+  return f;
+}
+
+// The links no camera sees: a link is seen by a camera whose latest frame
+// compares at least min_link_pixels of it without something in front.
+TEST(ArmCoverage, ALinkIsUnseenOnlyWhenNoCountedCameraSeesIt) {
+  ArmCoverage coverage(2, /*min_link_pixels=*/30);
+  EXPECT_TRUE(coverage.unseen_links({true, true}).empty()) << "no frame yet: nothing to say";
+  // The mast camera sees link1 only: the user's arm is before link2 (40
+  // compared, 20 nearer) and the gripper is out of its view.
+  coverage.on_frame(0, frame_seeing({100, 40, 0}, {0, 20, 0}));
+  EXPECT_TRUE(coverage.unseen_links({true, true}).empty()) << "the side camera has had no frame";
+  EXPECT_EQ(coverage.unseen_links({true, false}), (std::vector<std::string>{"link2", "gripper"}));
+  // The side camera sees link2 and the gripper.
+  coverage.on_frame(1, frame_seeing({0, 60, 35}, {0, 0, 5}));
+  EXPECT_EQ(coverage.unseen_links({true, true}), (std::vector<std::string>{}));
+  // Its next frame sees the gripper with only 29 px: unseen by both.
+  coverage.on_frame(1, frame_seeing({0, 60, 34}, {0, 0, 5}));
+  EXPECT_EQ(coverage.unseen_links({true, true}), (std::vector<std::string>{"gripper"}));
+  EXPECT_EQ(unseen_links_text(coverage.unseen_links({true, true}), coverage.robot_links()),
+            " [seen by no camera: gripper (1 of 3 robot links)]");
+  // An unusable frame says nothing about the links.
+  discrepancy_t unusable = frame_seeing({0, 0, 0}, {0, 0, 0});
+  unusable.usable = false;
+  coverage.on_frame(1, unusable);
+  EXPECT_EQ(coverage.unseen_links({true, true}), (std::vector<std::string>{"gripper"}));
+  EXPECT_EQ(unseen_links_text({}, 3), "");
 }
 
 }  // namespace

@@ -132,6 +132,8 @@ class TwoCameras : public ::testing::Test {
   void on_frame_verdict(const risk_t& r) {
     ++verdicts_by_camera_[verdict_camera(r)];
     last_verdict_detail_ = r.detail;
+    const auto unseen = r.detail.find(" [seen by no camera: ");
+    if (unseen != std::string::npos) ++unseen_link_verdicts_[r.detail.substr(unseen)];
   }
 
   // `seconds` of the nominal motion: for each camera, the frames that
@@ -142,6 +144,7 @@ class TwoCameras : public ::testing::Test {
     depth_received_utime_.clear();
     verdict_received_utime_.clear();
     verdicts_by_camera_.clear();
+    unseen_link_verdicts_.clear();
     const int stops_before = chain_->stops_seen();
     measuring_ = true;
     recording_arrivals_ = true;
@@ -155,6 +158,8 @@ class TwoCameras : public ::testing::Test {
     measuring_ = false;
     EXPECT_EQ(chain_->stops_seen(), stops_before) << chain_->last_status().reason;
     for (const deployment::CameraSection& camera : chain_->config().cameras) report_latency(camera, seconds);
+    for (const auto& [text, count] : unseen_link_verdicts_)
+      std::cout << count << " verdicts:" << text << std::endl;
   }
 
   void report_latency(const deployment::CameraSection& camera, double seconds) {
@@ -183,6 +188,7 @@ class TwoCameras : public ::testing::Test {
   std::unique_ptr<LiveChain> chain_;
   std::map<std::string, int64_t> verdicts_by_camera_;
   std::string last_verdict_detail_;
+  std::map<std::string, int64_t> unseen_link_verdicts_;  // by the verdicts' "seen by no camera" text
   bool measuring_ = false;
   bool recording_arrivals_ = false;
   // (camera, seq) -> LCM's receive stamp (wall clock, microseconds).

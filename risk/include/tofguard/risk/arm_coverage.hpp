@@ -1,0 +1,45 @@
+#pragma once
+// Which of the arm's links no camera sees (docs/safety-chain.md, "Several
+// cameras"): a link is seen by a camera when its latest usable frame
+// compares at least risk.joint_error.min_link_pixels of the link's pixels
+// without a nearer surface before them (link_compared - link_nearer: the
+// pixels where the camera sees the link itself, not something in front of
+// it). Pure logic over discrepancy_t; tofguard-risk says the links seen by
+// no camera in its verdicts.
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "tofguard/discrepancy_t.hpp"
+
+namespace tofguard::risk {
+
+class ArmCoverage {
+ public:
+  ArmCoverage(size_t cameras, int min_link_pixels);
+
+  // Camera `camera`'s latest usable frame (an unusable one says nothing
+  // about the links and is left out).
+  void on_frame(size_t camera, const discrepancy_t& frame);
+
+  // The robot links (in the order of the first camera's frame that named
+  // them) that no camera with `counted[camera]` true sees in its latest
+  // frame; empty while a counted camera has had no usable frame.
+  std::vector<std::string> unseen_links(const std::vector<bool>& counted) const;
+  // The robot links named by the cameras' frames.
+  size_t robot_links() const { return link_names_.size(); }
+
+ private:
+  int min_link_pixels_;
+  std::vector<std::string> link_names_;
+  // Per camera, the robot links its latest usable frame sees; false before
+  // its first one (`framed_`).
+  std::vector<std::vector<std::string>> seen_;
+  std::vector<bool> framed_;
+};
+
+// " [seen by no camera: link6, gripper (2 of 9 robot links)]", or "" when
+// `unseen` is empty.
+std::string unseen_links_text(const std::vector<std::string>& unseen, size_t robot_links);
+
+}  // namespace tofguard::risk
