@@ -91,10 +91,10 @@ ProcessInfo sim_fault_info() {
                    "    clear, frozen_image, stall, pose_drift (--drift-m-per-s X,Y,Z in the\n"
                    "    camera pose's frame, --drift-rad-per-s about the optical axes) or\n"
                    "    intruding_object (--size-m, --position-m, --velocity-m-per-s: a box in\n"
-                   "    the world frame); --duration-s S (default 1000).",
+                   "    the world frame); --duration-s S (default 1000). With several cameras\n"
+                   "    (cameras:) --camera ID names the camera.",
                    /*config_required=*/false};
   info.takes_arguments = true;
-  info.per_camera = true;
   return info;
 }
 
@@ -115,7 +115,10 @@ int run_sim_fault(const SimFaultToolSettings& settings, const std::vector<std::s
     if (!kinds.count(kind)) return usage_error("--camera-fault: unknown kind '" + kind + "'");
     fault.kind = kinds.at(kind);
     fault.camera_id = settings.camera_id;
-    if (fault.camera_id.empty()) return usage_error("--camera-fault needs --config FILE (the camera's id)");
+    if (fault.camera_id.empty()) {
+      return usage_error(
+          "--camera-fault needs the camera: --config FILE, and --camera ID when it has several");
+    }
     fault.duration_s = 1000;
     const std::map<std::string, double*> vectors = {{"--size-m", fault.object_size_m},
                                                     {"--position-m", fault.object_position_m},

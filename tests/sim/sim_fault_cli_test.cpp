@@ -12,29 +12,34 @@
 #include "tofguard/sim_controller_fault_t.hpp"
 #include "tofguard/sim_joint_fault_t.hpp"
 #include "tool_support.hpp"
+#include "two_camera_config.hpp"
 
 namespace tofguard::test {
 namespace {
 
 struct Listener {
   lcm::LCM lcm{"udpm://239.255.76.67:7667?ttl=0"};
+  std::optional<std::string> camera_channel;
   std::optional<sim_joint_fault_t> joint;
   std::optional<sim_camera_fault_t> camera;
   std::optional<sim_controller_fault_t> controller;
   Listener() {
     lcm.subscribe("SIM_JOINT_FAULT", &Listener::on_joint, this);
-    lcm.subscribe("SIM_CAMERA_FAULT", &Listener::on_camera, this);
+    lcm.subscribe("SIM_CAMERA_FAULT.*", &Listener::on_camera, this);
     lcm.subscribe("SIM_CONTROLLER_FAULT", &Listener::on_controller, this);
   }
   void on_controller(const lcm::ReceiveBuffer*, const std::string&, const sim_controller_fault_t* m) {
     controller = *m;
   }
   void on_joint(const lcm::ReceiveBuffer*, const std::string&, const sim_joint_fault_t* m) { joint = *m; }
-  void on_camera(const lcm::ReceiveBuffer*, const std::string&, const sim_camera_fault_t* m) { camera = *m; }
-  // Runs the tool on config/sim.yaml and handles what it published.
+  void on_camera(const lcm::ReceiveBuffer*, const std::string& channel, const sim_camera_fault_t* m) {
+    camera = *m;
+    camera_channel = channel;
+  }
+  std::string config = source_dir() + "/config/sim.yaml";
+  // Runs the tool on `config` and handles what it published.
   int run(const std::vector<std::string>& args, std::string* err = nullptr) {
-    std::vector<std::string> argv = {bin_dir() + "/tofguard-sim-fault", "--config",
-                                     source_dir() + "/config/sim.yaml"};
+    std::vector<std::string> argv = {bin_dir() + "/tofguard-sim-fault", "--config", config};
     argv.insert(argv.end(), args.begin(), args.end());
     const int code = run_command("sim-fault", argv, nullptr, err);
     while (lcm.handleTimeout(100) > 0) {
@@ -110,10 +115,29 @@ TEST(SimFaultCli, BadArgumentsAreUsageErrorsAndPublishNothing) {
   const int code =
       run_command("sim-fault", {bin_dir() + "/tofguard-sim-fault", "--camera-fault", "stall"}, nullptr, &err);
   EXPECT_EQ(code, 2);
-  EXPECT_NE(err.find("needs --config"), std::string::npos) << err;
+  EXPECT_NE(err.find("needs the camera: --config FILE"), std::string::npos) << err;
   EXPECT_FALSE(l.camera);
   EXPECT_FALSE(l.joint);
   EXPECT_FALSE(l.controller);
+}
+
+// With several cameras a camera fault names its camera (--camera ID) and
+// goes to that camera's channel; a joint fault needs none.
+TEST(SimFaultCli, WithTwoCamerasACameraFaultNamesItsCamera) {
+  Listener l;
+  l.config = two_camera_config("sim-fault-two-cameras");
+  ASSERT_EQ(l.run({"--joint", "a4", "--offset-deg", "10"}), 0);
+  EXPECT_TRUE(l.joint);
+  std::string err;
+  EXPECT_EQ(l.run({"--camera-fault", "stall"}, &err), 2);
+  EXPECT_NE(err.find("--camera ID when it has several"), std::string::npos) << err;
+  EXPECT_FALSE(l.camera);
+  ASSERT_EQ(l.run({"--camera", "tof-side", "--camera-fault", "stall"}), 0);
+  ASSERT_TRUE(l.camera);
+  EXPECT_EQ(l.camera->camera_id, "tof-side");
+  EXPECT_EQ(l.camera_channel, "SIM_CAMERA_FAULT/tof-side");
+  EXPECT_EQ(l.run({"--camera", "tof-roof", "--camera-fault", "stall"}, &err), 2);
+  EXPECT_NE(err.find("no camera 'tof-roof'"), std::string::npos) << err;
 }
 
 }  // namespace
