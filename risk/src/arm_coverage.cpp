@@ -13,10 +13,15 @@ void ArmCoverage::on_frame(size_t camera, const discrepancy_t& frame) {
   const int robot_links =
       std::min({frame.num_robot_links, frame.num_links, static_cast<int>(frame.link_name.size()),
                 static_cast<int>(frame.link_compared.size()), static_cast<int>(frame.link_nearer.size())});
+  const bool has_invalid = static_cast<int>(frame.link_invalid.size()) >= robot_links;
   for (int i = 0; i < robot_links; ++i) {
     const std::string& name = frame.link_name[i];
-    if (std::find(link_names_.begin(), link_names_.end(), name) == link_names_.end())
+    // Part of the arm's surface once a camera has rendered it (a link
+    // without geometry, such as a root frame, never is).
+    const bool rendered = frame.link_compared[i] + (has_invalid ? frame.link_invalid[i] : 0) > 0;
+    if (rendered && std::find(link_names_.begin(), link_names_.end(), name) == link_names_.end()) {
       link_names_.push_back(name);
+    }
     if (frame.link_compared[i] - frame.link_nearer[i] >= min_link_pixels_) seen.push_back(name);
   }
   seen_[camera] = std::move(seen);

@@ -133,14 +133,17 @@ TEST(VerdictFusion, WithCameraLossStopNoCameraIsReleased) {
   EXPECT_EQ(fusion.fuse(0, verdict(2, risk_t::SAFE))->level, risk_t::DANGEROUS);
 }
 
+// A frame of an arm with a root frame (no geometry, never rendered), two
+// links and a gripper, and a table.
 discrepancy_t frame_seeing(const std::vector<int>& compared, const std::vector<int>& nearer) {
   discrepancy_t f{};
   f.usable = true;
-  f.num_robot_links = 3;
-  f.num_links = 4;
-  f.link_name = {"link1", "link2", "gripper", "table"};
-  f.link_compared = {compared[0], compared[1], compared[2], 500};
-  f.link_nearer = {nearer[0], nearer[1], nearer[2], 0};
+  f.num_robot_links = 4;
+  f.num_links = 5;
+  f.link_name = {"world", "link1", "link2", "gripper", "table"};
+  f.link_compared = {0, compared[0], compared[1], compared[2], 500};
+  f.link_nearer = {0, nearer[0], nearer[1], nearer[2], 0};
+  f.link_invalid = {0, 0, 0, 1, 0};
   return f;
 }
 

@@ -22,11 +22,13 @@ class ArmCoverage {
   // about the links and is left out).
   void on_frame(size_t camera, const discrepancy_t& frame);
 
-  // The robot links (in the order of the first camera's frame that named
-  // them) that no camera with `counted[camera]` true sees in its latest
-  // frame; empty while a counted camera has had no usable frame.
+  // The robot links (in the order they were first rendered) that no camera
+  // with `counted[camera]` true sees in its latest frame; empty while a
+  // counted camera has had no usable frame. A link counts once some camera
+  // has rendered a pixel of it: a link without geometry (a root frame)
+  // never does, nor, so far, one that has never been in any camera's view.
   std::vector<std::string> unseen_links(const std::vector<bool>& counted) const;
-  // The robot links named by the cameras' frames.
+  // The robot links counted so far.
   size_t robot_links() const { return link_names_.size(); }
 
  private:
