@@ -36,16 +36,20 @@ double CameraProfile::distance_correction_at(double r_m) const {
 }
 
 std::string profile_mismatch(const CameraProfile& p, const depth_image_t& frame) {
+  return profile_mismatch(p, frame.camera_id, intrinsics_of(frame));
+}
+
+std::string profile_mismatch(const CameraProfile& p, const std::string& camera_id, const Intrinsics& in) {
   const std::string head = "camera profile " + (p.file.empty() ? std::string("(in memory)") : p.file) + ": ";
-  if (frame.camera_id != p.camera_id) {
-    return head + "made for camera_id '" + p.camera_id + "', the frame is from '" + frame.camera_id + "'";
+  if (camera_id != p.camera_id) {
+    return head + "made for camera_id '" + p.camera_id + "', the frame is from '" + camera_id + "'";
   }
-  if (frame.width != p.width || frame.height != p.height) {
+  if (in.width != p.width || in.height != p.height) {
     return head + "made for " + std::to_string(p.width) + "x" + std::to_string(p.height) + ", the frame is " +
-           std::to_string(frame.width) + "x" + std::to_string(frame.height);
+           std::to_string(in.width) + "x" + std::to_string(in.height);
   }
   const double mine[4] = {p.fx, p.fy, p.cx, p.cy};
-  const double theirs[4] = {frame.fx, frame.fy, frame.cx, frame.cy};
+  const double theirs[4] = {in.fx, in.fy, in.cx, in.cy};
   const char* names[4] = {"fx", "fy", "cx", "cy"};
   for (int k = 0; k < 4; ++k) {
     if (!(std::abs(mine[k] - theirs[k]) < kIntrinsicsTolerancePx)) {

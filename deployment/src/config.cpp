@@ -51,15 +51,7 @@ CameraSection read_camera_section(YamlMap& camera, bool profile_key) {
 // would be (profile_mismatch). `where` fails at the profile's key.
 void check_profile_is_the_cameras(const CameraSection& camera, const YamlMap& where, const std::string& key) {
   if (!camera.profile) return;
-  depth_image_t frame;
-  frame.camera_id = camera.id;
-  frame.width = camera.intrinsics.width;
-  frame.height = camera.intrinsics.height;
-  frame.fx = camera.intrinsics.fx;
-  frame.fy = camera.intrinsics.fy;
-  frame.cx = camera.intrinsics.cx;
-  frame.cy = camera.intrinsics.cy;
-  if (const std::string why = profile_mismatch(*camera.profile, frame); !why.empty())
+  if (const std::string why = profile_mismatch(*camera.profile, camera.id, camera.intrinsics); !why.empty())
     where.fail(key, "a profile of camera '" + camera.id + "'", why);
 }
 

@@ -27,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include "tofguard/common/camera_geometry.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/link_labels_t.hpp"
 
@@ -82,6 +83,10 @@ inline double z_per_radial(double fx, double fy, double cx, double cy, int u, in
 // Why `frame` is not this profile's camera (one line naming the field and
 // both values), or "" when it is.
 std::string profile_mismatch(const CameraProfile& profile, const depth_image_t& frame);
+// The same for camera `camera_id` with `intrinsics` (a configured camera,
+// before any frame of it).
+std::string profile_mismatch(const CameraProfile& profile, const std::string& camera_id,
+                             const Intrinsics& intrinsics);
 
 // The fewest mapped pixels of a 5x5 window whose median the fixed pattern
 // is taken against.
