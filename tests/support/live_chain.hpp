@@ -55,6 +55,13 @@ inline std::vector<std::string> chain_processes_of(const deployment::Config& con
   return names;
 }
 
+// With several cameras, the camera a fused verdict came from: its detail's
+// "<id>: " prefix (risk/verdict_fusion.hpp).
+inline std::string verdict_camera(const risk_t& r) {
+  const auto colon = r.detail.find(": ");
+  return colon == std::string::npos ? "" : r.detail.substr(0, colon);
+}
+
 class LiveChain {
  public:
   // A config already written (e.g. ideal_camera_config's).

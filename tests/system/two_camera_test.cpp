@@ -23,12 +23,6 @@
 namespace tofguard::test {
 namespace {
 
-// The camera a fused verdict came from: its detail's "<id>: " prefix.
-std::string verdict_camera(const risk_t& r) {
-  const auto colon = r.detail.find(": ");
-  return colon == std::string::npos ? "" : r.detail.substr(0, colon);
-}
-
 class TwoCameras : public ::testing::Test {
  protected:
   // The deployment of `config_path`, every process started.

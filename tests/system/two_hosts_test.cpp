@@ -28,12 +28,6 @@
 namespace tofguard::test {
 namespace {
 
-// The camera a fused verdict came from: its detail's "<id>: " prefix.
-std::string verdict_camera(const risk_t& r) {
-  const auto colon = r.detail.find(": ");
-  return colon == std::string::npos ? "" : r.detail.substr(0, colon);
-}
-
 // The processes the second host runs (the side camera's and the arm's
 // controller), as its launcher names them (no '/': a name is a log file's).
 const std::vector<std::pair<std::string, std::string>>& second_host_processes() {
