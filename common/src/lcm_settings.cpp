@@ -3,6 +3,8 @@
 #include <cstdlib>
 #include <regex>
 
+#include "tofguard/common/demand.hpp"
+
 namespace tofguard {
 
 std::string resolve_lcm_url(const std::string& from_config, const char* lcm_default_url_env) {
@@ -66,6 +68,20 @@ ChannelNames camera_channel_names(const ChannelNames& base, const std::string& c
     *name += camera_suffix;
   }
   c.camera_suffix = camera_suffix;
+  return c;
+}
+
+ChannelNames base_channel_names(const ChannelNames& camera) {
+  ChannelNames c = camera;
+  const std::string& suffix = camera.camera_suffix;
+  for (std::string* name : {&c.depth, &c.camera_pose, &c.rendered, &c.labels, &c.discrepancy,
+                            &c.motion_estimate, &c.sim_camera_fault}) {
+    TOFGUARD_DEMAND(name->size() >= suffix.size() &&
+                        name->compare(name->size() - suffix.size(), suffix.size(), suffix) == 0,
+                    "channel '" + *name + "' does not end in its camera's suffix '" + suffix + "'");
+    name->resize(name->size() - suffix.size());
+  }
+  c.camera_suffix.clear();
   return c;
 }
 

@@ -401,6 +401,9 @@ std::string check_region_sightings(const discrepancy_t& d) {
   if (!(d.num_robot_hidden_by_user >= 0 && d.num_robot_hidden_by_user <= d.num_pixels)) {
     return expected("num_robot_hidden_by_user", "0..num_pixels", d.num_robot_hidden_by_user);
   }
+  if (!(d.num_robot_hidden_by_objects >= 0 && d.num_robot_hidden_by_objects <= d.num_pixels)) {
+    return expected("num_robot_hidden_by_objects", "0..num_pixels", d.num_robot_hidden_by_objects);
+  }
   return "";
 }
 
@@ -492,6 +495,38 @@ std::string check_camera_pose(const camera_pose_t& pose) {
   return v ? v->line() : "";
 }
 
+namespace {
+
+// link_labels_t's world_from_optical, when given: finite, its rotation
+// orthonormal with det +1 (to 1e-6: written from doubles).
+std::string check_optical_pose(const link_labels_t& labels) {
+  if (!labels.optical_pose_given) return "";
+  for (int k = 0; k < 12; ++k) {
+    if (!std::isfinite(labels.world_from_optical[k])) {
+      return expected("world_from_optical[" + std::to_string(k) + "]", "finite numbers",
+                      labels.world_from_optical[k]);
+    }
+  }
+  const double* m = labels.world_from_optical;
+  double worst = 0;
+  for (int a = 0; a < 3; ++a) {
+    for (int b = 0; b < 3; ++b) {
+      // Column a . column b of R (R = m[4 r + c], c < 3).
+      const double dot = m[a] * m[b] + m[4 + a] * m[4 + b] + m[8 + a] * m[8 + b];
+      worst = std::max(worst, std::abs(dot - (a == b ? 1.0 : 0.0)));
+    }
+  }
+  const double det = m[0] * (m[5] * m[10] - m[6] * m[9]) - m[1] * (m[4] * m[10] - m[6] * m[8]) +
+                     m[2] * (m[4] * m[9] - m[5] * m[8]);
+  if (worst > 1e-6 || std::abs(det - 1.0) > 1e-6) {
+    return expected("world_from_optical", "a rotation (orthonormal, det +1, to 1e-6) beside the translation",
+                    worst > 1e-6 ? worst : det);
+  }
+  return "";
+}
+
+}  // namespace
+
 std::string check_link_labels(const link_labels_t& labels) {
   if (labels.utime <= 0) return expected("utime", "a capture time > 0", static_cast<double>(labels.utime));
   if (labels.num_robot_links < 0 || labels.num_robot_links > labels.num_links) {
@@ -510,6 +545,7 @@ std::string check_link_labels(const link_labels_t& labels) {
   }
   if (auto problem = check_kinematics(labels); !problem.empty()) return problem;
   if (auto problem = check_arm_cover(labels); !problem.empty()) return problem;
+  if (auto problem = check_optical_pose(labels); !problem.empty()) return problem;
   if (auto problem =
           check_body_regions(labels.num_body_regions, labels.body_region, labels.body_region_separation_m);
       !problem.empty())

@@ -1,6 +1,7 @@
 #include "tofguard/deployment/process_settings.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "tofguard/common/process.hpp"
 
@@ -24,6 +25,14 @@ discrepancy::DiscrepancyProcessSettings discrepancy_process_settings(const Confi
   s.channels = config.channels;
   s.camera_id = config.camera.id;
   s.discrepancy = config.discrepancy;
+  const ChannelNames base = base_channel_names(config.channels);
+  for (const CameraSection& camera : config.cameras) {
+    if (camera.id == config.camera.id) continue;
+    const ChannelNames its = camera_channel_names(base, camera.name_suffix);
+    s.witnesses.push_back({camera.id, its.depth, its.labels, camera.rate_hz, camera.profile});
+  }
+  s.detection_capability_m = std::sqrt(config.risk.unknown_object_min_area_m2);
+  s.approach_speed_m_s = config.risk.field_approach_speed_m_s;
   return s;
 }
 
@@ -63,6 +72,7 @@ estimator::EstimatorProcessSettings estimator_process_settings(const Config& con
   s.camera_profile = config.discrepancy.camera_profile;
   s.estimator = config.estimator;
   s.occupant = config.occupant;
+  if (config.cameras.size() > 1) s.hidden_nearer_than_m = config.discrepancy.near_arm_m;
   return s;
 }
 

@@ -562,10 +562,48 @@ class UserSightings {
 // every pixel when the labels carry no cover). Fills
 // near_arm_* (within near_arm_m) and the cumulative areas by distance
 // (field_*).
+// The volume behind the occluded pixels (hidden_distance_m), examined on
+// every second pixel in u and v: the pixel at even u and v of each 2 x 2
+// block stands for the block's others where it is occluded itself. Their
+// rays lie within 2 pixels of its own (at most 2 Z / fx apart: 18 mm at
+// 2 m before the default camera), under the detection capability of
+// 39 mm, so an object of that size behind one lies on the other's ray too;
+// a quarter of the rays to walk.
+class HiddenVolumeGrid {
+ public:
+  HiddenVolumeGrid(int width, int height)
+      : width_(width),
+        hidden_m_(static_cast<size_t>(width) * height, std::numeric_limits<double>::quiet_NaN()) {}
+
+  // Pixel i's hidden distance: its block's anchor's where that one has
+  // one, else `compute()`'s.
+  template <typename Compute>
+  double at(int i, const Compute& compute) {
+    const int u = i % width_;
+    const int v = i / width_;
+    const auto anchor = static_cast<size_t>((v & ~1) * width_ + (u & ~1));
+    if (!std::isnan(hidden_m_[anchor])) return hidden_m_[anchor];
+    const double h = compute();
+    hidden_m_[static_cast<size_t>(i)] = h;
+    return h;
+  }
+
+ private:
+  int width_;
+  std::vector<double> hidden_m_;
+};
+
+// Stage 6's look through other cameras' frames (witness_views.hpp): the
+// rendered frame gives each occluded pixel's arm point.
+struct LookThrough {
+  const depth_image_t& rendered;
+  const std::vector<WitnessView>& witnesses;
+};
+
 void unexplained_surfaces(const depth_image_t& camera, const link_labels_t& labels,
                           const DiscrepancyFrame& frame, const PixelClasses& classes,
                           const OccupantShapes& occupant, const DiscrepancyOptions& options,
-                          const PixelFootprint& footprint, discrepancy_t* s) {
+                          const PixelFootprint& footprint, const LookThrough& look, discrepancy_t* s) {
   UserSightings user(classes);
   s->near_arm_min_distance_m = -1;
   s->field_available = labels.num_arm_spheres > 0;
@@ -584,9 +622,15 @@ void unexplained_surfaces(const depth_image_t& camera, const link_labels_t& labe
   const double up_to_m = std::max(options.field_range_m, options.near_arm_m);
   double min_distance = std::numeric_limits<double>::infinity();
   double near_area = 0;
+  s->witness_frames = static_cast<int32_t>(look.witnesses.size());
+  const bool looking_through = s->field_available && !look.witnesses.empty() && labels.optical_pose_given;
+  const Eigen::Isometry3d world_from_camera =
+      looking_through ? world_from_optical(labels) : Eigen::Isometry3d::Identity();
+  HiddenVolumeGrid hidden(width, camera.height);
   for (int i = 0; i < num_pixels; ++i) {
     if (candidate[i] == 0) continue;
-    const bool measured = s->field_available && pixel_class[i] != discrepancy_t::PIXEL_OCCLUDED;
+    const bool occluded = pixel_class[i] == discrepancy_t::PIXEL_OCCLUDED;
+    const bool measured = s->field_available && (!occluded || looking_through);
     // The camera-frame point of pixel i at its depth, once, where needed.
     Eigen::Vector3d point = Eigen::Vector3d::Zero();
     if (measured || !occupant.empty()) {
@@ -605,7 +649,19 @@ void unexplained_surfaces(const depth_image_t& camera, const link_labels_t& labe
         continue;
       }
     }
-    const double distance_m = measured ? arm.distance_m(point, up_to_m) : 0.0;
+    double distance_m = measured ? arm.distance_m(point, up_to_m) : 0.0;
+    if (occluded && looking_through) {
+      // What may lie between the surface and the arm behind it.
+      const Eigen::Vector3d arm_point = optical_point_m(camera, i, metres_from_mm(look.rendered.depth_mm[i]));
+      // (Points of the volume no nearer than the surface itself cannot
+      // change the pixel's distance: searched up to it.)
+      const double surface_m = distance_m;
+      distance_m = std::min(distance_m, hidden.at(i, [&] {
+        return hidden_distance_m(point, arm_point, world_from_camera, look.witnesses, arm, options.tolerance,
+                                 options.hidden_volume, std::min(up_to_m, surface_m));
+      }));
+      if (distance_m > 0) s->occluded_seen_by_witnesses++;
+    }
     const double area = footprint.m2(i);
     if (distance_m <= options.near_arm_m) {
       s->near_arm_pixels++;
@@ -627,19 +683,26 @@ void unexplained_surfaces(const depth_image_t& camera, const link_labels_t& labe
   }
 }
 
-// Stage 2b, the arm hidden by the user: `camera` with no return wherever a
-// robot link's pixel shows a nearer surface (beyond the tolerance) that
-// lies within a body region's envelope of the user: the user's own hand
-// before a link. Such a pixel says nothing about the link (what is behind
-// the hand cannot be seen), so the per-link counts and the evidence take
-// it as they take a pixel without a return; the pixel classes and the
-// unexplained surfaces still see it (as the user). nullopt when no pixel
-// is hidden so (or there is no user); `*hidden_pixels` counts them.
-std::optional<depth_image_t> arm_hidden_by_user(const depth_image_t& camera, const depth_image_t& rendered,
-                                                const link_labels_t& labels, const OccupantShapes& occupant,
-                                                const Tolerance& tolerance, int32_t* hidden_pixels) {
-  *hidden_pixels = 0;
-  if (occupant.empty()) return std::nullopt;
+// Stage 2b, the arm hidden: `camera` with no return wherever a robot
+// link's pixel shows a nearer surface (beyond the tolerance) that says
+// nothing about the link behind it:
+// - one within a body region's envelope of the user: the user's own hand
+//   before a link (`*by_user`);
+// - with other cameras looking through (`far_objects`), one farther than
+//   options.near_arm_m from the arm's cover, where no moved link shows
+//   (`*by_objects`). With one camera such a surface stops the arm anyway.
+// The per-link counts and the evidence take such a pixel as they take one
+// without a return; the pixel classes and the unexplained surfaces still
+// see it. nullopt when no pixel is hidden so.
+std::optional<depth_image_t> arm_hidden(const depth_image_t& camera, const depth_image_t& rendered,
+                                        const link_labels_t& labels, const OccupantShapes& occupant,
+                                        const DiscrepancyOptions& options, bool far_objects, int32_t* by_user,
+                                        int32_t* by_objects) {
+  *by_user = 0;
+  *by_objects = 0;
+  const ArmDistance arm(labels);
+  far_objects = far_objects && !arm.empty();
+  if (occupant.empty() && !far_objects) return std::nullopt;
   std::optional<depth_image_t> out;
   const int width = camera.width;
   const int num_pixels = width * camera.height;
@@ -647,11 +710,18 @@ std::optional<depth_image_t> arm_hidden_by_user(const depth_image_t& camera, con
     const int t = camera.depth_mm[i];
     const int g = rendered.depth_mm[i];
     const int link = link_of_label(labels.label[i], labels.num_robot_links, labels.num_links);
-    if (t <= 0 || g <= 0 || link < 0 || link >= labels.num_robot_links || g - t <= tolerance.at(t)) continue;
-    if (occupant.region_holding(optical_point_m(camera, i, metres_from_mm(t))) < 0) continue;
+    if (t <= 0 || g <= 0 || link < 0 || link >= labels.num_robot_links || g - t <= options.tolerance.at(t))
+      continue;
+    const Eigen::Vector3d point = optical_point_m(camera, i, metres_from_mm(t));
+    if (!occupant.empty() && occupant.region_holding(point) >= 0) {
+      ++*by_user;
+    } else if (far_objects && arm.distance_m(point, 2 * options.near_arm_m) > options.near_arm_m) {
+      ++*by_objects;
+    } else {
+      continue;
+    }
     if (!out) out = camera;
     out->depth_mm[i] = 0;
-    ++*hidden_pixels;
   }
   return out;
 }
@@ -770,7 +840,7 @@ namespace {
 // compute_discrepancy on the frame as it is (after the camera profile).
 DiscrepancyFrame compare_frames(const depth_image_t& camera, const depth_image_t& rendered,
                                 const link_labels_t& labels, const DiscrepancyOptions& options,
-                                WorkerPool* workers) {
+                                WorkerPool* workers, const std::vector<WitnessView>& witnesses) {
   // The workers' first call comes after the checks and the silhouettes:
   // woken now, they are awake by then (WorkerPool: a wake-up through the
   // hypervisor is slow).
@@ -818,7 +888,8 @@ DiscrepancyFrame compare_frames(const depth_image_t& camera, const depth_image_t
   const std::vector<uint8_t> silhouette = silhouette_mask(rendered, options.silhouette_jump_mm);
   const OccupantShapes occupant(labels);
   const std::optional<depth_image_t> unhidden =
-      arm_hidden_by_user(camera, rendered, labels, occupant, options.tolerance, &s.num_robot_hidden_by_user);
+      arm_hidden(camera, rendered, labels, occupant, options, options.other_cameras || !witnesses.empty(),
+                 &s.num_robot_hidden_by_user, &s.num_robot_hidden_by_objects);
   const depth_image_t& camera_for_arm = unhidden ? *unhidden : camera;
   std::vector<double> reach;  // the pixel stages' (joint_reach)
   // Stages 3 to 6 need nothing from the evidence, nor it from them (they
@@ -850,7 +921,8 @@ DiscrepancyFrame compare_frames(const depth_image_t& camera, const depth_image_t
     per_link_statistics(frame, camera_for_arm, rendered, labels, silhouette, &s);
     const PixelFootprint footprint(camera, rendered);
     largest_blob(classes.mismatch_mask, options.opening_radius_px, footprint, &s);
-    unexplained_surfaces(camera, labels, frame, classes, occupant, options, footprint, &s);
+    unexplained_surfaces(camera, labels, frame, classes, occupant, options, footprint, {rendered, witnesses},
+                         &s);
     if (s.field_available) reach = joint_reach_m(labels);
   });
   // Stage 7, evidence (evidence.hpp).
@@ -889,8 +961,8 @@ std::string outside_profile(const CameraProfile& profile, const depth_image_t& r
 
 DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_image_t& rendered,
                                      const link_labels_t& labels, const DiscrepancyOptions& options,
-                                     WorkerPool* workers) {
-  if (!options.camera_profile) return compare_frames(camera, rendered, labels, options, workers);
+                                     WorkerPool* workers, const std::vector<WitnessView>& witnesses) {
+  if (!options.camera_profile) return compare_frames(camera, rendered, labels, options, workers, witnesses);
   // The camera's commissioned profile, checked against the frame (a frame
   // of another camera, size or intrinsics would be corrected wrongly).
   if (const std::string why = profile_mismatch(*options.camera_profile, camera); !why.empty()) {
@@ -905,7 +977,7 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
   }
   depth_image_t corrected = camera;
   apply_camera_profile(*options.camera_profile, &corrected, &labels);
-  return compare_frames(corrected, rendered, labels, options, workers);
+  return compare_frames(corrected, rendered, labels, options, workers, witnesses);
 }
 
 int64_t depth_hash(const std::vector<int16_t>& depth_mm) {

@@ -9,6 +9,7 @@
 #include "tofguard/common/wire_checks.hpp"
 #include "tofguard/discrepancy/discrepancy_image.hpp"
 #include "tofguard/discrepancy/frame_pairer.hpp"
+#include "tofguard/discrepancy/witness_frames.hpp"
 
 namespace tofguard::discrepancy {
 
@@ -22,12 +23,39 @@ ProcessInfo process_info() {
   return info;
 }
 
+namespace {
+
+// The other cameras' TOF_DEPTH and TOF_LABELS into `witnesses`.
+void subscribe_witnesses(LcmNode& node, const DiscrepancyProcessSettings& settings,
+                         WitnessFrames* witnesses) {
+  for (size_t c = 0; c < settings.witnesses.size(); ++c) {
+    const settings::WitnessCameraSettings& camera = settings.witnesses[c];
+    const std::string id = camera.id;
+    node.subscribe<depth_image_t>(
+        node.images(), camera.depth_channel,
+        [witnesses, c](const depth_image_t& image) { witnesses->add_depth(c, image); },
+        [id](const depth_image_t& image) { return check_depth_image_from(image, id); });
+    node.subscribe<link_labels_t>(
+        node.images(), camera.labels_channel,
+        [&node, witnesses, c, channel = camera.labels_channel](const link_labels_t& labels) {
+          if (const std::string why = witnesses->add_labels(c, labels); !why.empty())
+            node.errors().report(channel, channel + ": seq " + std::to_string(labels.seq) + ": " + why);
+        },
+        check_link_labels);
+  }
+}
+
+}  // namespace
+
 int run_discrepancy(const DiscrepancyProcessSettings& settings) {
   if (!keep_heap_resident())
     std::fprintf(stderr, "tofguard-discrepancy: warning: mallopt refused keep_heap_resident's settings\n");
   LcmNode node(settings.lcm, settings.channels, process_info().name);
   const DiscrepancySettings& dc = settings.discrepancy;
-  const DiscrepancyOptions options = discrepancy_options(dc);
+  DiscrepancyOptions options = discrepancy_options(dc);
+  options.hidden_volume = hidden_volume_options(settings.detection_capability_m, settings.approach_speed_m_s);
+  options.other_cameras = !settings.witnesses.empty();
+  WitnessFrames witnesses(settings.witnesses);
   FramePairer pairer(dc.pair_timeout_us, dc.max_pending_frames);
   RepeatCounter repeats;
   WorkerPool workers(dc.worker_threads);
@@ -53,8 +81,9 @@ int run_discrepancy(const DiscrepancyProcessSettings& settings) {
     for (PairedFrame& pair : out.paired) {
       const int64_t start_us = monotonic_us();
       const depth_image_t empty{};
-      DiscrepancyFrame frame = compute_discrepancy(pair.camera.image, pair.rendered ? *pair.rendered : empty,
-                                                   pair.labels, options, &workers);
+      DiscrepancyFrame frame =
+          compute_discrepancy(pair.camera.image, pair.rendered ? *pair.rendered : empty, pair.labels, options,
+                              &workers, witnesses.views_at(pair.camera.image.utime));
       frame.summary.depth_hash = pair.camera.depth_hash;
       frame.summary.repeat_count = pair.camera.repeat_count;
       frame.summary.compute_us = static_cast<int32_t>(monotonic_us() - start_us);
@@ -111,6 +140,7 @@ int run_discrepancy(const DiscrepancyProcessSettings& settings) {
         handle(out);
       },
       check_link_labels);
+  subscribe_witnesses(node, settings, &witnesses);
   // Expire waiting frames at a tenth of the pairing timeout (at least 1 ms).
   node.add_timer(std::max<int64_t>(1000, dc.pair_timeout_us / 10), [&] {
     PairingOutput out;

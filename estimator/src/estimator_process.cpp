@@ -38,6 +38,7 @@ EstimatorOptions options_from_settings(const EstimatorProcessSettings& settings)
   o.noise.sigma_per_m2_mm = settings.noise_sigma_per_m2_mm;
   o.max_iterations = settings.estimator.max_iterations;
   o.pixel_stride = settings.estimator.pixel_stride;
+  o.hidden_nearer_than_m = settings.hidden_nearer_than_m;
   return o;
 }
 

@@ -490,6 +490,9 @@ std::string MotionEstimator::linearize(const EstimatorFrame& frame, const State&
       const std::vector<ChainJoint>& chain = chains_[link];
       if (points == PointSet::kStatic && !chain.empty()) continue;
       if (!(rendered.depth_m[i] > 0)) continue;
+      if (options_.hidden_nearer_than_m > 0 && frame.depth_m[i] > 0 &&
+          rendered.depth_m[i] - frame.depth_m[i] > options_.hidden_nearer_than_m)
+        continue;
       // Contour term: a rendered occluding contour pixel against the
       // nearest measured one, distance along the contour's normal, pixels.
       add_contour_term(view, chain, u, v, lin);

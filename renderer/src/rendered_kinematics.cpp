@@ -139,6 +139,14 @@ void set_rendered_kinematics(const RenderedKinematics& k, link_labels_t* labels)
   }
 }
 
+void set_rendered_optical_pose(const Eigen::Isometry3d& world_from_optical, link_labels_t* labels) {
+  const Eigen::Matrix<double, 3, 4> m = world_from_optical.matrix().topRows<3>();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 4; ++c) labels->world_from_optical[4 * r + c] = m(r, c);
+  }
+  labels->optical_pose_given = true;
+}
+
 RenderedArmCover rendered_arm_cover(const robot_model::ArmSpheres& cover,
                                     const robot_model::LinkPoses& link_poses,
                                     const Eigen::Isometry3d& world_from_optical,

@@ -271,6 +271,7 @@ RenderedFrame RendererService::make_output(const depth_image_t& frame, RenderRes
   out.labels = make_link_labels(frame, scene_.num_robot_links, scene_.link_names(), std::move(result.labels));
   if (kinematics) set_rendered_kinematics(*kinematics, &out.labels);
   if (arm_cover) set_rendered_arm_cover(*arm_cover, &out.labels);
+  if (world_from_optical) set_rendered_optical_pose(*world_from_optical, &out.labels);
   if (occupant_) {
     // The render drew the occupant (labels kLabelOccupantFirst + shape),
     // so the labels must carry its shapes, or the frame is not usable.

@@ -312,6 +312,27 @@ TEST(WireChecks, LinkLabelsArmCover) {
   EXPECT_EQ(field_of(bad), "arm_sphere_radius_m");
 }
 
+TEST(WireChecks, LinkLabelsOpticalPose) {
+  link_labels_t l = labels_with_kinematics();
+  // Not given: not read.
+  l.world_from_optical[0] = std::nan("");
+  EXPECT_EQ(check_link_labels(l), "");
+  // A camera looking down (optical z along -z of the root frame) 1.8 m up.
+  const double pose[12] = {1, 0, 0, 0.2, 0, -1, 0, 0.1, 0, 0, -1, 1.8};
+  std::copy(pose, pose + 12, l.world_from_optical);
+  l.optical_pose_given = true;
+  EXPECT_EQ(check_link_labels(l), "");
+  link_labels_t bad = l;
+  bad.world_from_optical[3] = std::nan("");
+  EXPECT_EQ(field_of(bad), "world_from_optical[3]");
+  bad = l;
+  bad.world_from_optical[0] = 1.01;  // not a rotation
+  EXPECT_EQ(field_of(bad), "world_from_optical");
+  bad = l;
+  bad.world_from_optical[10] = 1;  // a reflection: det -1
+  EXPECT_EQ(field_of(bad), "world_from_optical");
+}
+
 // Labels with two body regions, the face and a hand.
 link_labels_t labels_with_regions() {
   link_labels_t l = labels_with_kinematics();

@@ -86,4 +86,15 @@ inline std::string two_camera_config(const std::string& name,
   return sim_config_variant(name, replacements, appended);
 }
 
+// config/sim.yaml with the side camera in place of its mast camera, alone
+// (a one-camera deployment seeing what tof-side sees), with its profile;
+// written to output_dir()/<name>.yaml.
+inline std::string side_camera_alone_config(const std::string& name) {
+  const std::string sim_yaml = read_file(source_dir() + "/config/sim.yaml");
+  return sim_config_variant(
+      name, {{sim_camera_section(sim_yaml), side_camera_section(sim_yaml)},
+             {config_line(sim_yaml, "  camera_profile: "),
+              "  camera_profile: " + source_dir() + "/config/sim-side-camera-profile.yaml\n"}});
+}
+
 }  // namespace tofguard::test

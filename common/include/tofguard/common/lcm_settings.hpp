@@ -79,6 +79,9 @@ struct ChannelNames {
 // every camera shares. With camera_suffix "" the names are `base`'s: the
 // first camera's channels keep the names a single camera has.
 ChannelNames camera_channel_names(const ChannelNames& base, const std::string& camera_suffix);
+// The inverse: the names every camera's derive from, from one camera's
+// (`camera`'s camera_suffix taken off its per-camera channels).
+ChannelNames base_channel_names(const ChannelNames& camera);
 
 // The safety URL: the config's lcm.url, else LCM_DEFAULT_URL, else
 // kHostLocalLcmUrl.

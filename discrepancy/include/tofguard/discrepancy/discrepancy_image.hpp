@@ -19,6 +19,7 @@
 #include "tofguard/common/worker_pool.hpp"
 #include "tofguard/depth_image_t.hpp"
 #include "tofguard/discrepancy/evidence.hpp"
+#include "tofguard/discrepancy/witness_views.hpp"
 #include "tofguard/discrepancy_image_t.hpp"
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/link_labels_t.hpp"
@@ -56,6 +57,15 @@ struct DiscrepancyOptions {
   double max_depth_mm = 8000;
   // The evidence stage (evidence.hpp).
   EvidenceOptions evidence;
+  // How the volume behind an occluded pixel is examined in other cameras'
+  // frames (witness_views.hpp).
+  HiddenVolumeOptions hidden_volume;
+  // The deployment has other cameras (tofguard-discrepancy: other cameras
+  // configured), whose frames may look through this one's: a robot pixel
+  // hidden by a surface beyond near_arm_m of the arm is taken as one
+  // without a return (discrepancy_t.num_robot_hidden_by_objects) in every
+  // frame, whether or not another camera's frame was at hand for it.
+  bool other_cameras = false;
   // The camera's commissioned profile (camera_profile.hpp; null: none):
   // every camera frame is corrected by it before it is compared, and a
   // frame it does not fit (camera id, size, intrinsics) is unusable.
@@ -83,9 +93,15 @@ struct DiscrepancyFrame {
 // workers (optional): the threads the naming search shares its joints
 // among (joint_search.hpp); nullptr runs it on the caller's thread. The
 // summary is the same either way.
+//
+// witnesses: other cameras' frames of about this frame's time
+// (witness_views.hpp). Where the labels carry the camera's pose and the
+// arm's cover, an occluded pixel is at the distance of what the witnesses
+// did not see behind it (discrepancy_t.occluded_seen_by_witnesses), not 0.
 DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_image_t& rendered,
                                      const link_labels_t& labels, const DiscrepancyOptions& options,
-                                     WorkerPool* workers = nullptr);
+                                     WorkerPool* workers = nullptr,
+                                     const std::vector<WitnessView>& witnesses = {});
 
 // compute_discrepancy's silhouette mask (row-major, 1 = beside a
 // silhouette): the pixels beside a rendered depth step larger than

@@ -57,6 +57,13 @@ struct EstimatorOptions {
   // The same for the static links' pixels (the environment) in the
   // iterations at a coarse robust scale (not the final one).
   int coarse_pixel_stride = 2;
+  // A model pixel whose measured depth is nearer than the rendered one by
+  // more than this (metres) is hidden by a surface no moved link can be
+  // (discrepancy.near_arm_m with several cameras): it takes no part,
+  // neither its depth nor its contour, so that an object before the arm
+  // does not turn the joints (another camera judges the arm there). 0:
+  // every pixel takes part.
+  double hidden_nearer_than_m = 0;
   // The camera's noise model (common/depth_noise.hpp, millimetres as the
   // config states it): residuals are weighted by (sigma(1 m) / sigma(Z))^2.
   DepthNoise noise{4.0, 1.2};

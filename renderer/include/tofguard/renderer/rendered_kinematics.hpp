@@ -83,6 +83,10 @@ std::optional<RenderedKinematics> rendered_kinematics(const robot_model::Kinemat
 // labels->num_robot_links entries.
 void set_rendered_kinematics(const RenderedKinematics& kinematics, link_labels_t* labels);
 
+// The camera's pose into link_labels_t.world_from_optical (row-major 3x4,
+// the optical frame in the model's root frame) and optical_pose_given.
+void set_rendered_optical_pose(const Eigen::Isometry3d& world_from_optical, link_labels_t* labels);
+
 // The arm's cover of spheres (robot_model/arm_spheres.hpp) as rendered:
 // placed at `link_poses` (usable, of the cover's model) and seen from
 // `world_from_optical`, for link_labels_t's arm_* fields (the protective

@@ -7,6 +7,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "tofguard/common/camera_profile.hpp"
 #include "tofguard/common/lcm_settings.hpp"
@@ -130,6 +131,22 @@ int auto_worker_threads();
 // Reads (and finishes) the `discrepancy` section.
 DiscrepancySettings read_discrepancy_settings(YamlMap section);
 
+// Another camera of the deployment, whose frames this camera's occluded
+// pixels are looked through (docs/safety-chain.md, "Several cameras: the
+// volume behind an occlusion").
+struct WitnessCameraSettings {
+  std::string id;
+  // Its TOF_DEPTH and TOF_LABELS (with its "/<id>" where it has one).
+  std::string depth_channel;
+  std::string labels_channel;
+  // camera.rate_hz: a frame of it is used within one frame period of the
+  // judged frame's capture.
+  double rate_hz = 0;
+  // Its commissioned profile (null: none): its frames are corrected by it
+  // before they are looked through.
+  std::shared_ptr<const CameraProfile> profile;
+};
+
 // Everything tofguard-discrepancy needs.
 struct DiscrepancyProcessSettings {
   LcmSettings lcm;
@@ -137,6 +154,13 @@ struct DiscrepancyProcessSettings {
   // camera.id: frames from another camera are rejected.
   std::string camera_id;
   DiscrepancySettings discrepancy;
+  // Every other camera of the deployment (none with one camera).
+  std::vector<WitnessCameraSettings> witnesses;
+  // The risk's detection capability, sqrt(risk.unknown_object_min_area_m2),
+  // m, and risk.field.approach_speed_m_s, m/s: how the volume behind an
+  // occlusion is examined (witness_views.hpp, hidden_volume_options).
+  double detection_capability_m = 0;
+  double approach_speed_m_s = 0;
 };
 
 }  // namespace tofguard::settings

@@ -76,6 +76,10 @@ struct EstimatorProcessSettings {
   // renders it, so that the user hides what is behind them and is not
   // taken for a camera or joint error.
   std::optional<OccupantSettings> occupant;
+  // With several cameras, discrepancy.near_arm_m: a model pixel whose
+  // measured depth is nearer by more than this takes no part
+  // (EstimatorOptions::hidden_nearer_than_m); 0 with one camera.
+  double hidden_nearer_than_m = 0;
 };
 
 }  // namespace tofguard::settings
