@@ -1,6 +1,7 @@
 #include "tofguard/risk/arm_coverage.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace tofguard::risk {
 
@@ -41,6 +42,25 @@ std::vector<std::string> ArmCoverage::unseen_links(const std::vector<bool>& coun
     if (!seen) unseen.push_back(link);
   }
   return unseen;
+}
+
+bool limit_unseen_arm(const std::vector<std::string>& unseen, size_t robot_links, double max_fraction,
+                      risk_t* verdict) {
+  if (robot_links == 0 || verdict->level == risk_t::DANGEROUS) return false;
+  const double fraction = static_cast<double>(unseen.size()) / static_cast<double>(robot_links);
+  if (!(fraction > max_fraction)) return false;
+  std::string names;
+  for (const std::string& link : unseen) names += (names.empty() ? "" : ", ") + link;
+  verdict->level = risk_t::DANGEROUS;
+  verdict->cause = risk_t::CAUSE_UNCLASSIFIED;
+  verdict->suspect = "risk.unseen_arm_max_fraction";
+  verdict->score = fraction;
+  verdict->threshold = max_fraction;
+  verdict->detail =
+      "arm not seen (fraction of robot links): " + names + ", " + std::to_string(unseen.size()) + " of " +
+      std::to_string(robot_links) + " robot links seen by no camera, limit " +
+      std::to_string(static_cast<int>(std::lround(100 * max_fraction))) + " %; " + verdict->detail;
+  return true;
 }
 
 std::string unseen_links_text(const std::vector<std::string>& unseen, size_t robot_links) {

@@ -155,27 +155,41 @@ std::vector<risk_t> RiskMonitor::judge(std::vector<ClassifiedFrame> released, in
     EvidenceStep evidence;
     // The sensor rules come first: a frame with a sensor or component fault
     // carries no evidence to trust (a frozen image would count twice).
-    if (!is_fault_cause(finding.cause)) {
-      evidence = evidence_.update(c.frame);
-      if (evidence.crossed) {
-        finding = std::move(evidence.finding);
-        finding.at_once = true;
-      } else if (evidence.warning && finding.cause == risk_t::CAUSE_NONE) {
-        finding = std::move(evidence.finding);
-        finding.warning_only = true;
-      }
-    }
+    if (!is_fault_cause(finding.cause)) evidence = weigh_evidence(c.frame, &finding);
     const bool was_open = decision_.diagnosis_open();
     // Clean for the diagnosis: every CUSUM below its warning level, and the
     // diagnosis's own hypothesis shows evidence that its fault is gone.
     const std::string latched = diagnosed_hypothesis(decision_.open_finding());
     if (!latched.empty()) evidence.summary += "; " + evidence_.clearing_summary(latched);
     verdicts.push_back(decision_.decide(c.frame, std::move(finding), deadlines_.first_expired(now_us),
-                                        evidence_.quiet() && evidence_.cleared(latched), evidence.summary));
+                                        evidence_clean(latched), evidence.summary));
     // A closed diagnosis starts the tests afresh.
     if (was_open && !decision_.diagnosis_open()) evidence_.reset();
   }
   return verdicts;
+}
+
+EvidenceStep RiskMonitor::weigh_evidence(const discrepancy_t& frame, FrameFinding* finding) {
+  EvidenceStep evidence = evidence_.update(frame);
+  EvidenceStep pooled = pooled_ != nullptr ? pooled_->update(frame) : EvidenceStep{};
+  if (pooled_ != nullptr) evidence.summary += "; pooled over the cameras: " + pooled.summary;
+  if (evidence.crossed) {
+    *finding = std::move(evidence.finding);
+    finding->at_once = true;
+  } else if (pooled.crossed) {
+    *finding = std::move(pooled.finding);
+    finding->detail = "pooled over the cameras: " + finding->detail;
+    finding->at_once = true;
+  } else if (finding->cause == risk_t::CAUSE_NONE && (evidence.warning || pooled.warning)) {
+    *finding = std::move(evidence.warning ? evidence.finding : pooled.finding);
+    finding->warning_only = true;
+  }
+  return evidence;
+}
+
+bool RiskMonitor::evidence_clean(const std::string& latched) const {
+  const bool own = evidence_.quiet() && evidence_.cleared(latched);
+  return own && (pooled_ == nullptr || (pooled_->quiet() && pooled_->cleared(latched)));
 }
 
 std::vector<risk_t> RiskMonitor::on_frame(const discrepancy_t& frame, int64_t now_us) {

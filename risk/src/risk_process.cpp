@@ -41,11 +41,11 @@ struct CameraJudge {
   std::unique_ptr<RiskMonitor> monitor;
 };
 
-std::vector<CameraJudge> camera_judges(const RiskProcessSettings& settings) {
+std::vector<CameraJudge> camera_judges(const RiskProcessSettings& settings,
+                                       const robot_model::KinematicTree& robot) {
   std::vector<CameraJudge> judges;
-  const robot_model::KinematicTree robot = robot_model::load_kinematic_tree(settings.robot_urdf_path);
   for (const RiskCamera& camera : settings.cameras) {
-    RiskSettings risk = settings.risk;
+    RiskSettings risk = several_cameras_evidence_settings(settings.risk, settings.cameras.size());
     risk.required_heartbeats = camera.required_heartbeats;
     CameraJudge judge{
         camera, std::make_unique<RiskMonitor>(risk, camera.channels, robot, camera.rate_hz, monotonic_us())};
@@ -53,6 +53,18 @@ std::vector<CameraJudge> camera_judges(const RiskProcessSettings& settings) {
     judges.push_back(std::move(judge));
   }
   return judges;
+}
+
+// Several cameras: the joints' tests pooled over every camera's frames, at
+// the cameras' summed frame rate (none with one camera).
+std::unique_ptr<SequentialEvidence> pooled_evidence(const RiskProcessSettings& settings,
+                                                    const robot_model::KinematicTree& robot) {
+  if (settings.cameras.size() < 2) return nullptr;
+  double rate_hz = 0;
+  for (const RiskCamera& camera : settings.cameras) rate_hz += camera.rate_hz;
+  return std::make_unique<SequentialEvidence>(
+      several_cameras_evidence_settings(settings.risk, settings.cameras.size()), robot, rate_hz,
+      /*camera_test=*/false);
 }
 
 VerdictFusion verdict_fusion(const std::vector<CameraJudge>& judges, const RiskSettings& risk) {
@@ -71,7 +83,9 @@ class RiskProcess {
  public:
   explicit RiskProcess(const RiskProcessSettings& settings)
       : settings_(settings),
-        judges_(camera_judges(settings)),
+        robot_(robot_model::load_kinematic_tree(settings.robot_urdf_path)),
+        pooled_(pooled_evidence(settings, robot_)),
+        judges_(camera_judges(settings, robot_)),
         fusion_(verdict_fusion(judges_, settings.risk)),
         coverage_(judges_.size(), settings.risk.min_link_pixels),
         node_(settings.lcm, settings.channels, process_info().name) {
@@ -81,6 +95,7 @@ class RiskProcess {
       signer_.emplace(settings.auth.key, wall_utime());
       verifier_.emplace(settings.auth.key, settings.auth.max_age_us);
     }
+    for (CameraJudge& judge : judges_) judge.monitor->set_pooled_evidence(pooled_.get());
     for (size_t camera = 0; camera < judges_.size(); ++camera) subscribe_camera(camera);
     subscribe_shared();
     subscribe_camera_release();
@@ -95,8 +110,11 @@ class RiskProcess {
     std::optional<risk_t> fused = fusion_.fuse(camera, verdict);
     if (!fused) return;
     risk_t& r = *fused;
-    if (judges_.size() > 1 && r.seq >= 0)
-      r.detail += unseen_links_text(unseen_links(), coverage_.robot_links());
+    if (judges_.size() > 1 && r.seq >= 0) {
+      const std::vector<std::string> unseen = unseen_links();
+      limit_unseen_arm(unseen, coverage_.robot_links(), settings_.risk.unseen_arm_max_fraction, &r);
+      r.detail += unseen_links_text(unseen, coverage_.robot_links());
+    }
     auth::publish_signed(node_.safety(), signer_ ? &*signer_ : nullptr, settings_.channels.risk,
                          settings_.channels.risk_auth, r, wall_utime());
     node_.counters().frames_out++;
@@ -296,6 +314,9 @@ class RiskProcess {
   }
 
   const RiskProcessSettings& settings_;
+  const robot_model::KinematicTree robot_;
+  // Declared before the monitors that point at it.
+  std::unique_ptr<SequentialEvidence> pooled_;
   std::vector<CameraJudge> judges_;
   VerdictFusion fusion_;
   ArmCoverage coverage_;

@@ -134,9 +134,16 @@ double cusum_threshold(int hypotheses, double rate_hz, double false_stop_period_
   return std::log(hypotheses * rate_hz * 3600.0 * false_stop_period_h);
 }
 
+RiskSettings several_cameras_evidence_settings(const RiskSettings& risk, size_t cameras) {
+  RiskSettings each = risk;
+  if (cameras > 1) each.evidence_false_stop_period_h *= static_cast<double>(cameras + 1);
+  return each;
+}
+
 SequentialEvidence::SequentialEvidence(const RiskSettings& risk, const robot_model::KinematicTree& robot,
-                                       double camera_rate_hz)
-    : prismatic_(robot.prismatic_joint_names),
+                                       double camera_rate_hz, bool camera_test)
+    : camera_test_(camera_test),
+      prismatic_(robot.prismatic_joint_names),
       joint_delta_rad_(risk.evidence_joint_offset_rad),
       joint_delta_m_(risk.evidence_joint_offset_m),
       joint_large_rad_(risk.evidence_large_joint_offset_rad),
@@ -145,7 +152,7 @@ SequentialEvidence::SequentialEvidence(const RiskSettings& risk, const robot_mod
                     risk.evidence_camera_translation_m, risk.evidence_camera_rotation_rad,
                     risk.evidence_camera_rotation_rad,  risk.evidence_camera_rotation_rad},
       warning_fraction_(risk.evidence_warning_fraction) {
-  clearing_cusum_["camera"] = 0;
+  if (camera_test_) clearing_cusum_["camera"] = 0;
   for (const std::string& joint : robot.movable_joint_names) {
     joint_tests_[joint] = JointTests{};
     clearing_cusum_[joint] = 0;
@@ -409,12 +416,14 @@ EvidenceStep SequentialEvidence::update(const discrepancy_t& f) {
 }
 
 void SequentialEvidence::add_frame(const discrepancy_t& f) {
-  camera_cusum_ = step(camera_cusum_, camera_region_llr(f, camera_delta_).llr - memory_decay_, h_);
-  double& camera_clearing = clearing_cusum_["camera"];
-  camera_clearing =
-      clearing_step(camera_clearing, camera_region_llr(f, camera_delta_, kClearingAlternativeFraction).llr,
-                    clearing_level());
-  if (camera_cusum_ >= h_) camera_clearing = 0;
+  if (camera_test_) {
+    camera_cusum_ = step(camera_cusum_, camera_region_llr(f, camera_delta_).llr - memory_decay_, h_);
+    double& camera_clearing = clearing_cusum_["camera"];
+    camera_clearing =
+        clearing_step(camera_clearing, camera_region_llr(f, camera_delta_, kClearingAlternativeFraction).llr,
+                      clearing_level());
+    if (camera_cusum_ >= h_) camera_clearing = 0;
+  }
   for (int i = 0; i < f.num_joints; ++i) {
     const auto it = joint_tests_.find(f.joint_name[i]);
     if (it == joint_tests_.end()) continue;  // not a moving joint of the robot: not a hypothesis
@@ -466,7 +475,8 @@ std::string SequentialEvidence::clearing_summary(const std::string& hypothesis) 
 }
 
 SequentialEvidence::NamedCusum SequentialEvidence::largest_cusum() const {
-  NamedCusum largest{"camera", camera_cusum_};
+  // (Without the camera's test, a joint's among zeros.)
+  NamedCusum largest{camera_test_ ? "camera" : "", camera_test_ ? camera_cusum_ : -1.0};
   for (const auto& [joint, tests] : joint_tests_) {
     if (tests.largest() > largest.value) largest = NamedCusum{joint, tests.largest()};
   }
@@ -541,7 +551,7 @@ FrameFinding SequentialEvidence::joint_stop_finding(const discrepancy_t& f, cons
 
 FrameFinding SequentialEvidence::warning_finding(const discrepancy_t& f, const NamedCusum& largest) const {
   const auto at = std::find(f.joint_name.begin(), f.joint_name.end(), largest.name);
-  if (largest.name == "camera" && largest.value == camera_cusum_) return camera_finding(f);
+  if (camera_test_ && largest.name == "camera" && largest.value == camera_cusum_) return camera_finding(f);
   if (at != f.joint_name.end()) return joint_finding(f, static_cast<int>(at - f.joint_name.begin()));
   FrameFinding finding;
   finding.cause = risk_t::CAUSE_JOINT_ERROR;

@@ -136,6 +136,7 @@ RiskSettings read_risk_settings(YamlMap map) {
   r.required_heartbeats = map.strings("required_heartbeats");
   r.continue_after_named_camera_release =
       map.choice("camera_loss", {"stop", "continue_after_named_reset"}) == "continue_after_named_reset";
+  r.unseen_arm_max_fraction = map.number("unseen_arm_max_fraction", 0, 1);
   read_sensor(map.map("sensor"), &r);
   read_joint_error(map.map("joint_error"), &r);
   read_calibration_error(map.map("calibration_error"), &r);

@@ -70,6 +70,7 @@ TEST(Config, EmbeddedDefaultLoads) {
   EXPECT_TRUE(config.risk.estimate_enabled);
   EXPECT_EQ(config.risk.estimate_wait_us, 0);
   EXPECT_TRUE(config.risk.plan_enabled);
+  EXPECT_EQ(config.risk.unseen_arm_max_fraction, 0.5);
   EXPECT_TRUE(config.joints_sim.publish_plan);
   EXPECT_TRUE(config.renderer.prediction_enabled);
   EXPECT_EQ(config.renderer.camera_pose_max_extrapolation_us, 40000);
@@ -191,6 +192,14 @@ INSTANTIATE_TEST_SUITE_P(
                   "    faults: [{kind: pan_tilt_offset, start_s: 1, duration_s: 1, pan_offset_deg: 3, "
                   "tilt_offset_deg: 0}]\n",
                   {"camera.sim.faults", "only with camera.sim.pan_tilt"}},
+        BadConfig{"unseen-arm-fraction-above-1",
+                  "  unseen_arm_max_fraction: 0.5\n",
+                  "  unseen_arm_max_fraction: 1.5\n",
+                  {"risk.unseen_arm_max_fraction", "expected a number in", "1.5"}},
+        BadConfig{"unseen-arm-fraction-missing",
+                  "  unseen_arm_max_fraction: 0.5\n",
+                  "",
+                  {"risk", "unseen_arm_max_fraction"}},
         BadConfig{"intrusion-distance-below-iso-13855",
                   "    intrusion_distance_m: 0.2\n",
                   "    intrusion_distance_m: 0.1\n",

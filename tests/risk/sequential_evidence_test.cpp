@@ -318,6 +318,68 @@ TEST(EvidenceTests, AMarginalFaultCrossesAfterSeveralFramesAsDerived) {
   EXPECT_LE(mean, 2.0 * derived);
 }
 
+// Two cameras that each see a5 as well (I = 1000 per frame) and a 3 degree
+// offset of it: the joints' tests pooled over both cameras' frames (60
+// frames a second) cross sooner than the first of the cameras' own tests
+// (in about half the time one camera's need), as derived: h / (E[ratio] - decay) frames at the pooled rate,
+// with E[ratio] the per-frame log-likelihood ratio's mean under the fault.
+TEST(EvidenceTests, PooledOverTwoCamerasAFaultBothSeeCrossesSoonerThanEitherCamerasOwnTests) {
+  const double delta = 3 * kDeg;
+  const risk::RiskSettings each = risk::several_cameras_evidence_settings(sim_config().risk, 2);
+  EXPECT_EQ(each.evidence_false_stop_period_h, 3 * sim_config().risk.evidence_false_stop_period_h);
+  ScoreSource mast(11);
+  ScoreSource side(12);
+  constexpr int kTrials = 40;
+  double own_s = 0;
+  double pooled_s = 0;
+  double pooled_h = 0;
+  double pooled_decay = 0;
+  for (int trial = 0; trial < kTrials; ++trial) {
+    SequentialEvidence mast_tests(each, friend_arm(), kRateHz);
+    SequentialEvidence side_tests(each, friend_arm(), kRateHz);
+    SequentialEvidence pooled(each, friend_arm(), 2 * kRateHz, /*camera_test=*/false);
+    pooled_h = pooled.threshold();
+    pooled_decay = pooled.memory_decay();
+    EXPECT_EQ(pooled.hypotheses(), 14);
+    EXPECT_NEAR(pooled_h, risk::cusum_threshold(14, 2 * kRateHz, each.evidence_false_stop_period_h), 1e-12);
+    int own_frames = -1;
+    int pooled_frames = -1;
+    for (int k = 0; k < 2000 && (own_frames < 0 || pooled_frames < 0); ++k) {
+      // One frame of each camera per camera period, the pooled tests
+      // taking both.
+      const discrepancy_t m = mast.frame(k, {{"a5", delta}});
+      const discrepancy_t d = side.frame(k, {{"a5", delta}});
+      const bool own = mast_tests.update(m).crossed | side_tests.update(d).crossed;
+      const bool pooled_crossed = pooled.update(m).crossed | pooled.update(d).crossed;
+      if (own && own_frames < 0) own_frames = k + 1;
+      if (pooled_crossed && pooled_frames < 0) pooled_frames = k + 1;
+    }
+    ASSERT_GT(own_frames, 0);
+    ASSERT_GT(pooled_frames, 0);
+    own_s += own_frames / kRateHz;
+    pooled_s += pooled_frames / kRateHz;
+  }
+  own_s /= kTrials;
+  pooled_s /= kTrials;
+  // E[ratio]: the test at joint_offset (3 degrees) under the fault, by
+  // Monte Carlo.
+  const double information = kJointInformation.at("a5");
+  std::mt19937_64 random(3);
+  std::normal_distribution<double> normal;
+  double mean_ratio = 0;
+  constexpr int kDraws = 200000;
+  for (int n = 0; n < kDraws; ++n) {
+    const double score = information * delta + std::sqrt(information) * normal(random);
+    mean_ratio += risk::joint_llr(score, information, delta) / kDraws;
+  }
+  const double derived_s = pooled_h / (mean_ratio - pooled_decay) / (2 * kRateHz);
+  std::cout << "a5 off by 3 deg seen by two cameras: the first camera's own test crossed after " << own_s
+            << " s, the pooled tests after " << pooled_s << " s (derived " << derived_s << " s)\n";
+  EXPECT_LT(pooled_s, 0.7 * own_s);
+  EXPECT_GE(pooled_s, 0.7 * derived_s);
+  EXPECT_LE(pooled_s, 1.5 * derived_s);
+}
+
 // Two joints' tests crossed: the suspect is the one whose one-parameter
 // naming fit explains this frame's residual best (the largest s^2 / I).
 TEST(EvidenceTests, TheSuspectIsTheJointWhoseNamingFitExplainsMost) {
@@ -707,6 +769,56 @@ TEST(RiskMonitorEvidence, AGrossFaultStopsOnItsFirstFrameAndTheSuspectStaysLatch
         << r.detail;
   }
   EXPECT_NE(r.detail.find("this frame: joint a2"), std::string::npos) << r.detail;
+}
+
+// Two cameras' monitors sharing the pooled tests: a fault both see stops
+// the arm on the pooled evidence (said in the detail), and neither
+// monitor's diagnosis closes while the pooled tests still hold it.
+TEST(RiskMonitorEvidence, APooledCrossingStopsAndHoldsTheDiagnosisUntilThePooledTestsClear) {
+  const risk::RiskSettings each = risk::several_cameras_evidence_settings(sim_config().risk, 2);
+  SequentialEvidence pooled(each, friend_arm(), 2 * kRateHz, /*camera_test=*/false);
+  risk::RiskMonitor mast(each, sim_config().channels, friend_arm(), kRateHz, kStart);
+  risk::RiskMonitor side(each, sim_config().channels, friend_arm(), kRateHz, kStart);
+  mast.set_pooled_evidence(&pooled);
+  side.set_pooled_evidence(&pooled);
+  ScoreSource mast_scores(21);
+  ScoreSource side_scores(22);
+  int64_t mast_now = kStart;
+  int64_t side_now = kStart;
+  int64_t seq = 100;
+  risk_t stop;
+  const risk::RiskMonitor* stopped = nullptr;  // the monitor whose frame crossed
+  for (; seq < 1100 && stopped == nullptr; ++seq) {
+    for (risk::RiskMonitor* m : {&mast, &side}) {
+      const risk_t r = m == &mast ? judge(m, mast_scores.frame(seq, {{"a5", 3 * kDeg}}), &mast_now)
+                                  : judge(m, side_scores.frame(seq, {{"a5", 3 * kDeg}}), &side_now);
+      if (r.level == risk_t::DANGEROUS && stopped == nullptr) {
+        stop = r;
+        stopped = m;
+      }
+    }
+  }
+  ASSERT_EQ(stop.level, risk_t::DANGEROUS);
+  EXPECT_EQ(stop.cause, risk_t::CAUSE_JOINT_ERROR);
+  EXPECT_EQ(stop.suspect, "a5");
+  EXPECT_NE(stop.detail.find("pooled over the cameras: joint a5"), std::string::npos) << stop.detail;
+  EXPECT_GE(pooled.joint_cusum("a5"), pooled.threshold());
+  // The fault gone: the diagnosis of the monitor that stopped stays open
+  // until the pooled test of a5 has shown it gone too (its own tests
+  // never crossed).
+  int clean_frames = 0;
+  for (; seq < 3000 && stopped->diagnosis_open(); ++seq) {
+    judge(&mast, mast_scores.frame(seq), &mast_now);
+    judge(&side, side_scores.frame(seq), &side_now);
+    if (!pooled.cleared("a5")) {
+      EXPECT_TRUE(stopped->diagnosis_open());
+    }
+    ++clean_frames;
+  }
+  EXPECT_FALSE(stopped->diagnosis_open());
+  EXPECT_TRUE(pooled.cleared("a5"));
+  std::cout << "pooled a5 diagnosis closed after " << clean_frames
+            << " frames of each camera without the fault\n";
 }
 
 TEST(RiskMonitorEvidence, TheDiagnosisClosesOnlyAfterClearFramesWithoutAnyFinding) {

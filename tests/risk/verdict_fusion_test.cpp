@@ -173,5 +173,34 @@ TEST(ArmCoverage, ALinkIsUnseenOnlyWhenNoCountedCameraSeesIt) {
   EXPECT_EQ(unseen_links_text({}, 3), "");
 }
 
+// More than risk.unseen_arm_max_fraction of the links seen by no camera:
+// the verdict is DANGEROUS and says which; at the limit, or a verdict
+// DANGEROUS already, unchanged.
+TEST(ArmCoverage, MoreOfTheArmUnseenThanTheLimitStopsIt) {
+  risk_t safe{};
+  safe.level = risk_t::SAFE;
+  safe.detail = "tof-side: frame matches";
+  risk_t r = safe;
+  EXPECT_FALSE(limit_unseen_arm({"link6", "link7"}, 4, 0.5, &r));
+  EXPECT_EQ(r.level, risk_t::SAFE);
+  EXPECT_TRUE(limit_unseen_arm({"link5", "link6", "link7"}, 4, 0.5, &r));
+  EXPECT_EQ(r.level, risk_t::DANGEROUS);
+  EXPECT_EQ(r.cause, risk_t::CAUSE_UNCLASSIFIED);
+  EXPECT_EQ(r.suspect, "risk.unseen_arm_max_fraction");
+  EXPECT_DOUBLE_EQ(r.score, 0.75);
+  EXPECT_DOUBLE_EQ(r.threshold, 0.5);
+  EXPECT_EQ(
+      r.detail,
+      "arm not seen (fraction of robot links): link5, link6, link7, 3 of 4 robot links seen by no camera, "
+      "limit 50 %; tof-side: frame matches");
+  risk_t dangerous = safe;
+  dangerous.level = risk_t::DANGEROUS;
+  dangerous.cause = risk_t::CAUSE_JOINT_ERROR;
+  EXPECT_FALSE(limit_unseen_arm({"link5", "link6", "link7"}, 4, 0.5, &dangerous));
+  EXPECT_EQ(dangerous.cause, risk_t::CAUSE_JOINT_ERROR);
+  r = safe;
+  EXPECT_FALSE(limit_unseen_arm({}, 0, 0.5, &r)) << "no link counted yet";
+}
+
 }  // namespace
 }  // namespace tofguard::risk

@@ -80,6 +80,28 @@ class TwoCameras : public ::testing::Test {
     }
   }
 
+  // An encoder offset of `degrees` on `joint` (tofguard-sim-fault) while the
+  // arm moves: the time from the tool's start to the stop (ms; -1: none
+  // within 3 s), printed with `what` and the stop's verdict.
+  double joint_fault_stop_ms(const std::string& joint, double degrees, const std::string& what) {
+    const int64_t fault_us = monotonic_us();
+    std::string out;
+    EXPECT_EQ(run_command("two-cameras-joint-fault",
+                          {bin_dir() + "/tofguard-sim-fault", "--config", chain_->config_path(), "--joint",
+                           joint, "--offset-deg", std::to_string(degrees)},
+                          &out),
+              0)
+        << out;
+    if (!chain_->wait([&] { return chain_->first_stop_since(fault_us) >= 0; }, std::chrono::seconds(3)))
+      return -1;
+    const double ms = (chain_->first_stop_since(fault_us) - fault_us) / 1000.0;
+    EXPECT_TRUE(chain_->wait([&] { return chain_->last_risk().level == risk_t::DANGEROUS; },
+                             std::chrono::seconds(1)));
+    std::cout << what << ": " << joint << " off by " << degrees << " deg stopped " << ms
+              << " ms after tofguard-sim-fault started: " << chain_->describe_last_risk() << std::endl;
+    return ms;
+  }
+
   void on_discrepancy(const lcm::ReceiveBuffer*, const std::string&, const discrepancy_t* d) {
     if (!d->usable) return;
     most_occluded_ = std::max(most_occluded_, d->num_occluded);
@@ -332,13 +354,32 @@ TEST_F(TwoCameras, AnObjectHidingTheArmFromOneCameraDoesNotStopItWhereTheOtherSe
   EXPECT_GT(frames_with_witness_, 20 * frames_without_witness_);
 }
 
+// A joint fault on the links the object before the side camera hides from
+// it: the mast camera finds it, named, as it does alone (below).
+TEST_F(TwoCameras, AJointFaultHiddenFromOneCameraIsFoundByTheOther) {
+  start_chain("two-cameras-hidden-fault", two_camera_config("two-cameras-hidden-fault"));
+  chain_->bring_to_motion("start of the test");
+  if (HasFatalFailure()) return;
+  box_before("tof-side");
+  EXPECT_TRUE(chain_->wait([&] { return most_seen_by_witnesses_ > 100; }, std::chrono::seconds(3)))
+      << "the object never hid the arm from the side camera";
+  const double ms = joint_fault_stop_ms("a4", 5, "hidden from the side camera");
+  ASSERT_GE(ms, 0) << "no stop; last risk " << chain_->describe_last_risk();
+  EXPECT_EQ(chain_->last_risk().cause, risk_t::CAUSE_JOINT_ERROR) << chain_->describe_last_risk();
+  EXPECT_EQ(chain_->last_risk().suspect, "a4") << chain_->describe_last_risk();
+}
+
 // The same measurement with the mast camera alone (config/sim.yaml), for
-// the comparison in docs/benchmarks.md, "Two cameras".
+// the comparison in docs/benchmarks.md, "Two cameras"; then the same joint
+// fault, seen by the mast camera alone.
 TEST_F(TwoCameras, TheMastCameraAloneMeasuredTheSameWay) {
   start_chain("one-camera", sim_config_variant("one-camera"));
   chain_->bring_to_motion("start of the test");
   if (HasFatalFailure()) return;
   measure_nominal(10);
+  const double ms = joint_fault_stop_ms("a4", 5, "the mast camera alone");
+  ASSERT_GE(ms, 0) << "no stop; last risk " << chain_->describe_last_risk();
+  EXPECT_EQ(chain_->last_risk().suspect, "a4") << chain_->describe_last_risk();
 }
 
 // The side camera alone (side_camera_alone_config) and the same object

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "tofguard/discrepancy_t.hpp"
+#include "tofguard/risk_t.hpp"
 
 namespace tofguard::risk {
 
@@ -39,6 +40,15 @@ class ArmCoverage {
   std::vector<std::vector<std::string>> seen_;
   std::vector<bool> framed_;
 };
+
+// The arm no camera sees beyond `max_fraction` of the robot links counted
+// (risk.unseen_arm_max_fraction): a DANGEROUS finding's verdict fields
+// (cause UNCLASSIFIED, suspect "risk.unseen_arm_max_fraction", score the
+// fraction unseen, threshold the limit, the detail naming the links) put
+// on `verdict` unless it is DANGEROUS already; nothing at or below the
+// limit. True when it raised the verdict.
+bool limit_unseen_arm(const std::vector<std::string>& unseen, size_t robot_links, double max_fraction,
+                      risk_t* verdict);
 
 // " [seen by no camera: link6, gripper (2 of 9 robot links)]", or "" when
 // `unseen` is empty.

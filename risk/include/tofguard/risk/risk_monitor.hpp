@@ -110,6 +110,13 @@ class RiskMonitor {
   std::vector<risk_t> release_due(int64_t now_us);
   size_t waiting_frames() const { return gate_.waiting_frames(); }
   const SequentialEvidence& evidence() const { return evidence_; }
+  // Several cameras: the joints' tests pooled over every camera's frames
+  // (docs/safety-chain.md, "Several cameras: joint evidence summed"),
+  // shared by every camera's monitor and outliving them; null: none. Each
+  // frame this monitor judges goes into it as into its own tests; when it
+  // crosses, this frame's verdict is the stop, and a diagnosis stays open
+  // until the pooled tests are quiet and cleared too.
+  void set_pooled_evidence(SequentialEvidence* pooled) { pooled_ = pooled; }
   bool diagnosis_open() const { return decision_.diagnosis_open(); }
 
   using EstimateStats = EstimateGate::Stats;
@@ -130,6 +137,12 @@ class RiskMonitor {
   ClassifiedFrame classify(const discrepancy_t& frame) const;
   // The verdicts of frames the gate released, in order.
   std::vector<risk_t> judge(std::vector<ClassifiedFrame> released, int64_t now_us);
+  // A frame's evidence into the sequential tests (own and pooled): a
+  // crossing replaces `finding`, a warning a finding of nothing.
+  EvidenceStep weigh_evidence(const discrepancy_t& frame, FrameFinding* finding);
+  // The sequential tests a diagnosis of `latched` may close on: quiet, and
+  // `latched`'s fault shown gone (own tests and pooled).
+  bool evidence_clean(const std::string& latched) const;
 
   const RiskSettings settings_;
   ClassifierContext classifier_context_;  // channel names; arm_moving set per frame
@@ -139,6 +152,7 @@ class RiskMonitor {
   PlanMonitor plan_;
   EstimateGate gate_;
   SequentialEvidence evidence_;
+  SequentialEvidence* pooled_ = nullptr;
   DecisionRule decision_;
   // T_r of the protective fields, s (chain_response_time_s).
   double response_time_s_ = 0;

@@ -128,6 +128,15 @@ constexpr double kEvidenceMemoryS = 60.0;
 // h = ln(hypotheses * rate_hz * 3600 * false_stop_period_h).
 double cusum_threshold(int hypotheses, double rate_hz, double false_stop_period_h);
 
+// Several cameras (docs/safety-chain.md, "Several cameras: joint evidence
+// summed"): each camera's own tests and the joints' tests pooled over
+// every camera's frames are `cameras` + 1 families of tests, each held to
+// one false stop in (`cameras` + 1) * evidence_false_stop_period_h hours,
+// so that the deployment keeps one in evidence_false_stop_period_h. The
+// settings each family's tests are made with: `risk` as it is for one
+// camera.
+RiskSettings several_cameras_evidence_settings(const RiskSettings& risk, size_t cameras);
+
 // Whether `frame` carries the naming search (discrepancy_t.joint_search_*,
 // one entry per joint).
 bool searched(const discrepancy_t& frame);
@@ -164,9 +173,11 @@ class SequentialEvidence {
  public:
   // The hypotheses: the camera and each of `robot`'s moving joints (their
   // offsets in radians, prismatic joints in metres). `camera_rate_hz`:
-  // camera.rate_hz (> 0).
-  SequentialEvidence(const RiskSettings& risk, const robot_model::KinematicTree& robot,
-                     double camera_rate_hz);
+  // camera.rate_hz (> 0), the rate frames come at. `camera_test` false:
+  // the joints' tests alone (the tests pooled over several cameras' frames,
+  // whose poses are tested each on its own: pooled_evidence_settings).
+  SequentialEvidence(const RiskSettings& risk, const robot_model::KinematicTree& robot, double camera_rate_hz,
+                     bool camera_test = true);
 
   // The next frame in frame order. A frame without evidence changes
   // nothing (updated false; quiet tells the CUSUMs' state).
@@ -181,7 +192,7 @@ class SequentialEvidence {
   double clearing_level() const { return h_; }
   // The stop tests the threshold's union bound counts: the camera's and
   // each joint's two (at joint_offset and at large_joint_offset).
-  int hypotheses() const { return 2 * static_cast<int>(joint_tests_.size()) + 1; }
+  int hypotheses() const { return 2 * static_cast<int>(joint_tests_.size()) + (camera_test_ ? 1 : 0); }
   // What every stop test's per-frame ratio is lowered by, nats:
   // h / (camera rate * kEvidenceMemoryS).
   double memory_decay() const { return memory_decay_; }
@@ -277,6 +288,7 @@ class SequentialEvidence {
   FrameFinding drift_finding(const DistanceDrift& drift) const;
   FrameFinding joint_finding(const discrepancy_t& frame, int index) const;
 
+  bool camera_test_;
   std::set<std::string> prismatic_;
   double joint_delta_rad_;
   double joint_delta_m_;

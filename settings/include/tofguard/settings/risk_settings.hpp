@@ -50,6 +50,11 @@ struct RiskSettings {
   // every verdict saying which camera is left out, until it is back
   // (risk/verdict_fusion.hpp).
   bool continue_after_named_camera_release = false;
+  // unseen_arm_max_fraction (with several cameras): a frame verdict whose
+  // robot links seen by no camera (risk/arm_coverage.hpp) are more than
+  // this fraction of the links counted is DANGEROUS (unclassified, suspect
+  // risk.unseen_arm_max_fraction), 0..1.
+  double unseen_arm_max_fraction = 0;
   // debounce_frames: a model mismatch (joint, calibration, object,
   // unclassified) is WARNING until it has held for this many consecutive
   // frames, then DANGEROUS.
