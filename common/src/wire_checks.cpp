@@ -401,6 +401,15 @@ std::string check_region_sightings(const discrepancy_t& d) {
   if (!(d.num_robot_hidden_by_user >= 0 && d.num_robot_hidden_by_user <= d.num_pixels)) {
     return expected("num_robot_hidden_by_user", "0..num_pixels", d.num_robot_hidden_by_user);
   }
+  if (!(d.registration_points >= 0 && d.registration_points <= d.num_pixels)) {
+    return expected("registration_points", "0..num_pixels", d.registration_points);
+  }
+  if (!(d.registration_mismatch_fraction >= 0 && d.registration_mismatch_fraction <= 1)) {
+    return expected("registration_mismatch_fraction", "a fraction 0..1", d.registration_mismatch_fraction);
+  }
+  if (!std::isfinite(d.registration_median_mm)) {
+    return expected("registration_median_mm", "a finite number (mm)", d.registration_median_mm);
+  }
   if (!(d.num_robot_hidden_by_objects >= 0 && d.num_robot_hidden_by_objects <= d.num_pixels)) {
     return expected("num_robot_hidden_by_objects", "0..num_pixels", d.num_robot_hidden_by_objects);
   }

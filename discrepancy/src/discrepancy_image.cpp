@@ -924,6 +924,13 @@ DiscrepancyFrame compare_frames(const depth_image_t& camera, const depth_image_t
     unexplained_surfaces(camera, labels, frame, classes, occupant, options, footprint, {rendered, witnesses},
                          &s);
     if (s.field_available) reach = joint_reach_m(labels);
+    if (!witnesses.empty() && labels.optical_pose_given) {
+      const Registration r = registration(camera, labels, frame.pixel_class.ptr<uint8_t>(),
+                                          world_from_optical(labels), witnesses, options.tolerance);
+      s.registration_points = r.points;
+      s.registration_median_mm = static_cast<float>(r.median_mm);
+      s.registration_mismatch_fraction = static_cast<float>(r.mismatch_fraction);
+    }
   });
   // Stage 7, evidence (evidence.hpp).
   compute_evidence(camera_for_arm, rendered, labels, silhouette, options.silhouette_jump_mm,

@@ -114,4 +114,50 @@ double hidden_distance_m(const Eigen::Vector3d& surface_m, const Eigen::Vector3d
   return std::max(0.0, nearest_m - approach_m);
 }
 
+Registration registration(const depth_image_t& camera, const link_labels_t& labels,
+                          const uint8_t* pixel_class, const Eigen::Isometry3d& world_from_optical,
+                          const std::vector<WitnessView>& witnesses, const Tolerance& tolerance) {
+  constexpr int kStride = 4;
+  constexpr uint8_t kMatch = 0;  // discrepancy_t::PIXEL_MATCH
+  std::vector<double> differences_mm;
+  int32_t mismatching = 0;
+  for (const WitnessView& w : witnesses) {
+    const Eigen::Isometry3d witness_from_camera = w.optical_from_world * world_from_optical;
+    const depth_image_t& d = w.depth;
+    for (int v = 0; v < camera.height; v += kStride) {
+      for (int u = 0; u < camera.width; u += kStride) {
+        const int i = v * camera.width + u;
+        const int16_t label = labels.label[static_cast<size_t>(i)];
+        if (pixel_class[i] != kMatch || label < link_labels_t::ENVIRONMENT_FIRST ||
+            label >= link_labels_t::OCCUPANT_FIRST || camera.depth_mm[static_cast<size_t>(i)] <= 0)
+          continue;
+        const double z_m = 1e-3 * camera.depth_mm[static_cast<size_t>(i)];
+        const Eigen::Vector3d p =
+            witness_from_camera *
+            Eigen::Vector3d((u - camera.cx) * z_m / camera.fx, (v - camera.cy) * z_m / camera.fy, z_m);
+        if (!(p.z() > 0)) continue;
+        const long wu = std::lround(d.fx * p.x() / p.z() + d.cx);
+        const long wv = std::lround(d.fy * p.y() / p.z() + d.cy);
+        if (wu < 0 || wv < 0 || wu >= d.width || wv >= d.height) continue;
+        const int16_t seen_mm = d.depth_mm[static_cast<size_t>(wv * d.width + wu)];
+        if (seen_mm <= 0) continue;
+        const double point_mm = 1000.0 * p.z();
+        const double allowed_mm = tolerance.at(point_mm);
+        const double difference_mm = seen_mm - point_mm;
+        if (std::abs(difference_mm) > 3 * allowed_mm) continue;
+        differences_mm.push_back(difference_mm);
+        if (std::abs(difference_mm) > allowed_mm) ++mismatching;
+      }
+    }
+  }
+  Registration r;
+  r.points = static_cast<int32_t>(differences_mm.size());
+  if (r.points == 0) return r;
+  const auto middle = differences_mm.begin() + static_cast<std::ptrdiff_t>(differences_mm.size() / 2);
+  std::nth_element(differences_mm.begin(), middle, differences_mm.end());
+  r.median_mm = *middle;
+  r.mismatch_fraction = static_cast<double>(mismatching) / r.points;
+  return r;
+}
+
 }  // namespace tofguard::discrepancy

@@ -179,6 +179,28 @@ FrameFinding calibration_error(const FrameEvidence& e) {
           fixed(f.robot_median_dis_mm, 0) + " mm");
 }
 
+// CALIBRATION_ERROR, several cameras: this camera's matched static surfaces,
+// seen by the other cameras, mostly lie off their surfaces by more than
+// the tolerance a match gets (discrepancy_t.registration_*): the cameras
+// disagree with each other where their views overlap, so one of them
+// moved or its distances drifted (each camera's own pose test names
+// which, where it can). With at least kMinRegistrationPoints points: a
+// point beyond the tolerance (4 sigma + the model's allowance) by chance
+// has probability < 1e-4, so half of 100 never do by chance.
+constexpr int32_t kMinRegistrationPoints = 100;
+
+FrameFinding cameras_disagree(const FrameEvidence& e) {
+  const discrepancy_t& f = e.frame;
+  if (f.registration_points < kMinRegistrationPoints || !(f.registration_mismatch_fraction > 0.5)) return {};
+  return finding(
+      risk_t::CAUSE_CALIBRATION_ERROR, e.context.depth_channel, f.registration_mismatch_fraction, 0.5,
+      "the cameras disagree where their views overlap (fraction of shared static points beyond the "
+      "tolerance): " +
+          fixed(100.0 * f.registration_mismatch_fraction, 0) + " % of " +
+          std::to_string(f.registration_points) + " points, the other cameras' depths " +
+          fixed(f.registration_median_mm, 0) + " mm off (median): this camera or another moved");
+}
+
 // JOINT_ERROR: the arm is missing where the model has it, on links that all
 // hang below one moving joint; the proximal links match. A missing link the
 // URDF does not know is UNCLASSIFIED (never judged safe).
@@ -346,6 +368,7 @@ const std::vector<FrameRule>& frame_rules() {
       {"uncalibrated camera", uncalibrated_camera},
       {"frozen image", frozen_image},
       {"calibration error", calibration_error},
+      {"cameras disagree", cameras_disagree},
       {"joint error: links missing", joint_error_missing_links},
       {"joint error: links beside unexplained surfaces", joint_error_beside_unexplained_surfaces},
       {"unknown object", unknown_object},

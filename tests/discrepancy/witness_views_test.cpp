@@ -167,5 +167,43 @@ TEST(WitnessSaw, NotOutsideItsImageNorBehindItButThroughAPixelWithoutAReturn) {
   EXPECT_TRUE(witness_saw(w, kArmCentre, t));
 }
 
+// Two cameras side by side 0.3 m apart, both looking along +z at a wall
+// 2 m away (an environment link, every pixel matched): they agree; the
+// witness's pose 10 cm off along its axis, and every shared point
+// disagrees by 100 mm, beyond the tolerance (39 mm at 2 m).
+TEST(Registration, CamerasAgreeOnTheWallTheyShareUnlessOneMoved) {
+  depth_image_t wall;
+  wall.width = 64;
+  wall.height = 48;
+  wall.fx = wall.fy = 60;
+  wall.cx = 31.5;
+  wall.cy = 23.5;
+  wall.depth_mm.assign(64 * 48, 2000);
+  link_labels_t labels{};
+  labels.label.assign(64 * 48, link_labels_t::ENVIRONMENT_FIRST);
+  const std::vector<uint8_t> matched(64 * 48, 0);
+  WitnessView w;
+  w.camera_id = "b";
+  w.depth = wall;
+  Eigen::Isometry3d world_from_witness = Eigen::Isometry3d::Identity();
+  world_from_witness.translation() = Eigen::Vector3d(0.3, 0, 0);
+  w.optical_from_world = world_from_witness.inverse();
+  Registration r =
+      registration(wall, labels, matched.data(), Eigen::Isometry3d::Identity(), {w}, tolerance());
+  EXPECT_GT(r.points, 100);
+  EXPECT_EQ(r.mismatch_fraction, 0.0);
+  EXPECT_NEAR(r.median_mm, 0.0, 1.0);
+  world_from_witness.translation() = Eigen::Vector3d(0.3, 0, -0.1);
+  w.optical_from_world = world_from_witness.inverse();
+  r = registration(wall, labels, matched.data(), Eigen::Isometry3d::Identity(), {w}, tolerance());
+  EXPECT_GT(r.points, 100);
+  EXPECT_EQ(r.mismatch_fraction, 1.0);
+  EXPECT_NEAR(r.median_mm, -100.0, 1.0);
+  // The robot's or the user's pixels, or pixels not matched, take no part.
+  labels.label.assign(64 * 48, link_labels_t::ROBOT_FIRST);
+  EXPECT_EQ(
+      registration(wall, labels, matched.data(), Eigen::Isometry3d::Identity(), {w}, tolerance()).points, 0);
+}
+
 }  // namespace
 }  // namespace tofguard::discrepancy

@@ -195,10 +195,10 @@ TEST(FrameClassifier, RulesAreEvaluatedInTheDocumentedOrder) {
   std::vector<std::string> names;
   for (const risk::FrameRule& rule : risk::frame_rules()) names.push_back(rule.name);
   EXPECT_EQ(names,
-            (std::vector<std::string>{"unusable frame", "invalid pixels", "uncalibrated camera",
-                                      "frozen image", "calibration error", "joint error: links missing",
-                                      "joint error: links beside unexplained surfaces", "unknown object",
-                                      "unexplained blob"}));
+            (std::vector<std::string>{
+                "unusable frame", "invalid pixels", "uncalibrated camera", "frozen image",
+                "calibration error", "cameras disagree", "joint error: links missing",
+                "joint error: links beside unexplained surfaces", "unknown object", "unexplained blob"}));
   // An object near the arm that also makes a large blob is an unknown
   // object, not unclassified: the earlier rule wins.
   discrepancy_t d = summary_of(default_arm());
@@ -209,6 +209,26 @@ TEST(FrameClassifier, RulesAreEvaluatedInTheDocumentedOrder) {
   d.largest_blob_area_m2 = 0.5f;
   place_unexplained_surface(&d, 0.1, 0.001);  // below risk.unknown_object_min_area_m2 = 0.0015
   EXPECT_EQ(classify(d).cause, risk_t::CAUSE_UNCLASSIFIED);
+}
+
+// Several cameras: most of this frame's shared static points off the other
+// camera's surfaces (discrepancy_t.registration_*) is a calibration error;
+// too few points, or a minority off, says nothing.
+TEST(FrameClassifier, CamerasThatDisagreeWhereTheirViewsOverlapAreACalibrationError) {
+  discrepancy_t d = summary_of(default_arm());
+  d.registration_points = 400;
+  d.registration_median_mm = 3;
+  d.registration_mismatch_fraction = 0.1f;
+  EXPECT_EQ(classify(d).cause, risk_t::CAUSE_NONE);
+  d.registration_median_mm = -52;
+  d.registration_mismatch_fraction = 0.8f;
+  const risk::FrameFinding f = classify(d);
+  EXPECT_EQ(f.cause, risk_t::CAUSE_CALIBRATION_ERROR);
+  EXPECT_EQ(f.suspect, "TOF_DEPTH");
+  EXPECT_NE(f.detail.find("the cameras disagree where their views overlap"), std::string::npos) << f.detail;
+  EXPECT_NE(f.detail.find("80 % of 400 points"), std::string::npos) << f.detail;
+  d.registration_points = 99;
+  EXPECT_EQ(classify(d).cause, risk_t::CAUSE_NONE) << "too few points to say";
 }
 
 TEST(FrameClassifier, NoiseOnlyFramesAreSafe) {

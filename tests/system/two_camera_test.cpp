@@ -32,8 +32,9 @@ class TwoCameras : public ::testing::Test {
     chain_->on_frame_verdict = [this](const risk_t& r) { on_frame_verdict(r); };
     chain_->safety().subscribe(chain_->config().channels.risk, &TwoCameras::on_risk, this);
     for (const deployment::CameraSection& camera : chain_->config().cameras) {
-      const std::string channel = deployment::select_camera(chain_->config(), camera.id).channels.depth;
-      chain_->images().subscribe(channel, &TwoCameras::on_depth, this);
+      const deployment::Config its = deployment::select_camera(chain_->config(), camera.id);
+      chain_->images().subscribe(its.channels.depth, &TwoCameras::on_depth, this);
+      chain_->safety().subscribe(its.channels.discrepancy, &TwoCameras::on_registration, this);
     }
     chain_->on_pump = [this] {
       while (chain_->images().handleTimeout(0) > 0) {
@@ -100,6 +101,19 @@ class TwoCameras : public ::testing::Test {
     std::cout << what << ": " << joint << " off by " << degrees << " deg stopped " << ms
               << " ms after tofguard-sim-fault started: " << chain_->describe_last_risk() << std::endl;
     return ms;
+  }
+
+  // The cameras' registration to each other (discrepancy_t.registration_*)
+  // while measuring.
+  void on_registration(const lcm::ReceiveBuffer*, const std::string&, const discrepancy_t* d) {
+    if (!measuring_ || !d->usable || d->registration_points == 0) return;
+    Registration& r = registration_[d->camera_id];
+    ++r.frames;
+    r.fewest_points =
+        r.frames == 1 ? d->registration_points : std::min(r.fewest_points, d->registration_points);
+    r.most_mismatching = std::max(r.most_mismatching, static_cast<double>(d->registration_mismatch_fraction));
+    r.largest_median_mm =
+        std::max(r.largest_median_mm, std::abs(static_cast<double>(d->registration_median_mm)));
   }
 
   void on_discrepancy(const lcm::ReceiveBuffer*, const std::string&, const discrepancy_t* d) {
@@ -187,6 +201,7 @@ class TwoCameras : public ::testing::Test {
     verdict_received_utime_.clear();
     verdicts_by_camera_.clear();
     unseen_link_verdicts_.clear();
+    registration_.clear();
     const int stops_before = chain_->stops_seen();
     measuring_ = true;
     recording_arrivals_ = true;
@@ -200,6 +215,12 @@ class TwoCameras : public ::testing::Test {
     measuring_ = false;
     EXPECT_EQ(chain_->stops_seen(), stops_before) << chain_->last_status().reason;
     for (const deployment::CameraSection& camera : chain_->config().cameras) report_latency(camera, seconds);
+    for (const auto& [camera, r] : registration_) {
+      std::cout << camera << ": registration with the other camera on " << r.frames << " frames: at least "
+                << r.fewest_points << " shared static points, at most " << 100 * r.most_mismatching
+                << " % beyond the tolerance, |median| at most " << r.largest_median_mm << " mm" << std::endl;
+      EXPECT_LE(r.most_mismatching, 0.5) << camera;
+    }
     for (const auto& [text, count] : unseen_link_verdicts_)
       std::cout << count << " verdicts:" << text << std::endl;
   }
@@ -227,7 +248,15 @@ class TwoCameras : public ::testing::Test {
     EXPECT_EQ(unanswered, "") << camera.id;
   }
 
+  struct Registration {
+    int frames = 0;
+    int32_t fewest_points = 0;
+    double most_mismatching = 0;
+    double largest_median_mm = 0;
+  };
+
   std::unique_ptr<LiveChain> chain_;
+  std::map<std::string, Registration> registration_;  // by camera id
   std::map<std::string, int64_t> verdicts_by_camera_;
   std::string last_verdict_detail_;
   std::map<std::string, int64_t> unseen_link_verdicts_;  // by the verdicts' "seen by no camera" text

@@ -102,4 +102,19 @@ double hidden_distance_m(const Eigen::Vector3d& surface_m, const Eigen::Vector3d
                          const std::vector<WitnessView>& witnesses, const ArmDistance& arm,
                          const Tolerance& tolerance, const HiddenVolumeOptions& options, double up_to_m);
 
+// The cameras' registration to each other (discrepancy_t.registration_*):
+// the judged frame's pixels of class MATCH on an environment link
+// (`pixel_class`, `labels`), every 4th in u and v, at their depth in
+// `camera` (optical frame placed by `world_from_optical`), compared with
+// each witness's depth where it sees a surface within 3 tolerances of the
+// point (farther off: another surface, hidden or beside an edge).
+struct Registration {
+  int32_t points = 0;
+  double median_mm = 0;          // signed: witness depth - the point's depth
+  double mismatch_fraction = 0;  // of the points, |difference| beyond the tolerance
+};
+Registration registration(const depth_image_t& camera, const link_labels_t& labels,
+                          const uint8_t* pixel_class, const Eigen::Isometry3d& world_from_optical,
+                          const std::vector<WitnessView>& witnesses, const Tolerance& tolerance);
+
 }  // namespace tofguard::discrepancy
