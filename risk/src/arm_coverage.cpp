@@ -13,7 +13,7 @@ void ArmCoverage::on_frame(size_t camera, const discrepancy_t& frame) {
   std::vector<std::string> seen;
   const int robot_links =
       std::min({frame.num_robot_links, frame.num_links, static_cast<int>(frame.link_name.size()),
-                static_cast<int>(frame.link_compared.size()), static_cast<int>(frame.link_nearer.size())});
+                static_cast<int>(frame.link_compared.size())});
   const bool has_invalid = static_cast<int>(frame.link_invalid.size()) >= robot_links;
   for (int i = 0; i < robot_links; ++i) {
     const std::string& name = frame.link_name[i];
@@ -23,7 +23,7 @@ void ArmCoverage::on_frame(size_t camera, const discrepancy_t& frame) {
     if (rendered && std::find(link_names_.begin(), link_names_.end(), name) == link_names_.end()) {
       link_names_.push_back(name);
     }
-    if (frame.link_compared[i] - frame.link_nearer[i] >= min_link_pixels_) seen.push_back(name);
+    if (frame.link_compared[i] >= min_link_pixels_) seen.push_back(name);
   }
   seen_[camera] = std::move(seen);
   framed_[camera] = true;

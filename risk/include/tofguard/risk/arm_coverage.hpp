@@ -2,10 +2,13 @@
 // Which of the arm's links no camera sees (docs/safety-chain.md, "Several
 // cameras"): a link is seen by a camera when its latest usable frame
 // compares at least risk.joint_error.min_link_pixels of the link's pixels
-// without a nearer surface before them (link_compared - link_nearer: the
-// pixels where the camera sees the link itself, not something in front of
-// it). Pure logic over discrepancy_t; tofguard-risk says the links seen by
-// no camera in its verdicts.
+// (link_compared). With several cameras a link pixel hidden by the user or
+// by a surface beyond discrepancy.near_arm_m of the arm is taken as one
+// without a return (num_robot_hidden_by_user, _by_objects), so it is not
+// compared: what is compared shows the link or what lies within
+// centimetres of it (a moved link, an object against it), which that
+// camera judges. Pure logic over discrepancy_t; tofguard-risk says the
+// links seen by no camera in its verdicts.
 #include <cstddef>
 #include <string>
 #include <vector>
