@@ -349,8 +349,12 @@ TEST(EvidenceTests, PooledOverTwoCamerasAFaultBothSeeCrossesSoonerThanEitherCame
       // taking both.
       const discrepancy_t m = mast.frame(k, {{"a5", delta}});
       const discrepancy_t d = side.frame(k, {{"a5", delta}});
-      const bool own = mast_tests.update(m).crossed | side_tests.update(d).crossed;
-      const bool pooled_crossed = pooled.update(m).crossed | pooled.update(d).crossed;
+      const bool mast_crossed = mast_tests.update(m).crossed;
+      const bool side_crossed = side_tests.update(d).crossed;
+      const bool own = mast_crossed || side_crossed;
+      const bool pooled_after_mast = pooled.update(m).crossed;
+      const bool pooled_after_side = pooled.update(d).crossed;
+      const bool pooled_crossed = pooled_after_mast || pooled_after_side;
       if (own && own_frames < 0) own_frames = k + 1;
       if (pooled_crossed && pooled_frames < 0) pooled_frames = k + 1;
     }
