@@ -22,8 +22,6 @@ HiddenVolumeOptions hidden_volume_options(double detection_capability_m, double 
   options.step_m = detection_capability_m / 4;
   options.layer_m = detection_capability_m / 2;
   options.approach_speed_m_s = approach_speed_m_s;
-  if (getenv("HV_LAYER")) options.layer_m = atof(getenv("HV_LAYER"));
-  if (getenv("HV_APPROACH")) options.approach_speed_m_s = atof(getenv("HV_APPROACH"));
   return options;
 }
 
