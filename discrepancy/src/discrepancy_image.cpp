@@ -511,14 +511,6 @@ int surface_depth_mm(const int16_t* tof, const uint8_t* unexplained, int i, int 
   return placed == std::numeric_limits<int>::max() ? d : placed;
 }
 
-// The point pixel i of `camera` sees at Z = `z_m` along the optical axis:
-// the camera's optical frame (x right, y down, z forward), metres.
-Eigen::Vector3d optical_point_m(const depth_image_t& camera, int i, double z_m) {
-  const int width = camera.width;
-  return Eigen::Vector3d((i % width - camera.cx) * z_m / camera.fx, (i / width - camera.cy) * z_m / camera.fy,
-                         z_m);
-}
-
 // The user's seen surfaces per body region: the pixel classes' counts,
 // the unexplained surfaces found within an envelope, and each region's
 // smallest seen distance to the arm's cover (-1: none seen, or no cover).
@@ -552,16 +544,6 @@ class UserSightings {
   std::vector<float> separation_m_;
 };
 
-// Stage 6, unexplained nearer surfaces and the protective fields: every
-// occluded or unexpected-surface pixel (after the opening, on surfaces:
-// opened_on_surfaces)
-// back-projected at the camera's depth (a mixed pixel at its unexplained
-// neighbour's, surface_depth_mm), and its distance to the arm: 0 for
-// an occluded pixel (it hides part of the arm, and what cannot be seen is
-// occupied), else the distance to the arm's cover (arm_distance.hpp; 0 for
-// every pixel when the labels carry no cover). Fills
-// near_arm_* (within near_arm_m) and the cumulative areas by distance
-// (field_*).
 // The volume behind the occluded pixels (hidden_distance_m), examined on
 // every second pixel in u and v: the pixel at even u and v of each 2 x 2
 // block stands for the block's others where it is occluded itself. Their
@@ -576,7 +558,7 @@ class HiddenVolumeGrid {
         hidden_m_(static_cast<size_t>(width) * height, std::numeric_limits<double>::quiet_NaN()) {}
 
   // Pixel i's hidden distance: its block's anchor's where that one has
-  // one, else `compute()`'s.
+  // one, else `compute()`'s (kept when pixel i is the anchor).
   template <typename Compute>
   double at(int i, const Compute& compute) {
     const int u = i % width_;
@@ -584,7 +566,7 @@ class HiddenVolumeGrid {
     const auto anchor = static_cast<size_t>((v & ~1) * width_ + (u & ~1));
     if (!std::isnan(hidden_m_[anchor])) return hidden_m_[anchor];
     const double h = compute();
-    hidden_m_[static_cast<size_t>(i)] = h;
+    if (anchor == static_cast<size_t>(i)) hidden_m_[anchor] = h;
     return h;
   }
 
@@ -600,6 +582,17 @@ struct LookThrough {
   const std::vector<WitnessView>& witnesses;
 };
 
+// Stage 6, unexplained nearer surfaces and the protective fields: every
+// occluded or unexpected-surface pixel (after the opening, on surfaces:
+// opened_on_surfaces)
+// back-projected at the camera's depth (a mixed pixel at its unexplained
+// neighbour's, surface_depth_mm), and its distance to the arm: 0 for
+// an occluded pixel (it hides part of the arm, and what cannot be seen is
+// occupied; with other cameras' frames, `look`, the distance of what may
+// lie behind it: hidden_distance_m), else the distance to the arm's cover (arm_distance.hpp; 0 for
+// every pixel when the labels carry no cover). Fills
+// near_arm_* (within near_arm_m) and the cumulative areas by distance
+// (field_*).
 void unexplained_surfaces(const depth_image_t& camera, const link_labels_t& labels,
                           const DiscrepancyFrame& frame, const PixelClasses& classes,
                           const OccupantShapes& occupant, const DiscrepancyOptions& options,
@@ -700,9 +693,10 @@ std::optional<depth_image_t> arm_hidden(const depth_image_t& camera, const depth
                                         int32_t* by_objects) {
   *by_user = 0;
   *by_objects = 0;
-  const ArmDistance arm(labels);
-  far_objects = far_objects && !arm.empty();
+  far_objects = far_objects && labels.num_arm_spheres > 0;
   if (occupant.empty() && !far_objects) return std::nullopt;
+  // (The cover is searched only for far objects: not built otherwise.)
+  const std::optional<ArmDistance> arm = far_objects ? std::optional<ArmDistance>(labels) : std::nullopt;
   std::optional<depth_image_t> out;
   const int width = camera.width;
   const int num_pixels = width * camera.height;
@@ -715,7 +709,7 @@ std::optional<depth_image_t> arm_hidden(const depth_image_t& camera, const depth
     const Eigen::Vector3d point = optical_point_m(camera, i, metres_from_mm(t));
     if (!occupant.empty() && occupant.region_holding(point) >= 0) {
       ++*by_user;
-    } else if (far_objects && arm.distance_m(point, 2 * options.near_arm_m) > options.near_arm_m) {
+    } else if (arm && arm->distance_m(point, 2 * options.near_arm_m) > options.near_arm_m) {
       ++*by_objects;
     } else {
       continue;
@@ -985,6 +979,12 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
   depth_image_t corrected = camera;
   apply_camera_profile(*options.camera_profile, &corrected, &labels);
   return compare_frames(corrected, rendered, labels, options, workers, witnesses);
+}
+
+Eigen::Vector3d optical_point_m(const depth_image_t& camera, int i, double z_m) {
+  const int width = camera.width;
+  return Eigen::Vector3d((i % width - camera.cx) * z_m / camera.fx, (i / width - camera.cy) * z_m / camera.fy,
+                         z_m);
 }
 
 int64_t depth_hash(const std::vector<int16_t>& depth_mm) {

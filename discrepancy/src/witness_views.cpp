@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <optional>
 
 #include "tofguard/discrepancy/discrepancy_image.hpp"
 
@@ -27,14 +28,23 @@ HiddenVolumeOptions hidden_volume_options(double detection_capability_m, double 
 
 namespace {
 
-// witness_saw for a point already in `w`'s optical frame (m).
-bool witness_saw_optical(const WitnessView& w, const Eigen::Vector3d& p, const Tolerance& tolerance) {
-  if (!(p.z() > 0)) return false;
+// The depth (mm; <= 0: no return) `w` measured at the pixel a point of
+// its optical frame (m) projects to; nullopt at or behind its optical
+// plane or outside its image.
+std::optional<int16_t> witness_depth_mm(const WitnessView& w, const Eigen::Vector3d& p) {
+  if (!(p.z() > 0)) return std::nullopt;
   const depth_image_t& d = w.depth;
   const long u = std::lround(d.fx * p.x() / p.z() + d.cx);
   const long v = std::lround(d.fy * p.y() / p.z() + d.cy);
-  if (u < 0 || v < 0 || u >= d.width || v >= d.height) return false;
-  const int16_t seen_mm = d.depth_mm[static_cast<size_t>(v * d.width + u)];
+  if (u < 0 || v < 0 || u >= d.width || v >= d.height) return std::nullopt;
+  return d.depth_mm[static_cast<size_t>(v * d.width + u)];
+}
+
+// witness_saw for a point already in `w`'s optical frame (m).
+bool witness_saw_optical(const WitnessView& w, const Eigen::Vector3d& p, const Tolerance& tolerance) {
+  const std::optional<int16_t> depth_mm = witness_depth_mm(w, p);
+  if (!depth_mm) return false;
+  const int16_t seen_mm = *depth_mm;
   // No return: nothing along the ray that returned enough light to be
   // measured, whatever lies there is as unseen as it would be to the
   // judged camera's own rules (a pixel without a return shows no object).
@@ -121,7 +131,6 @@ Registration registration(const depth_image_t& camera, const link_labels_t& labe
   int32_t mismatching = 0;
   for (const WitnessView& w : witnesses) {
     const Eigen::Isometry3d witness_from_camera = w.optical_from_world * world_from_optical;
-    const depth_image_t& d = w.depth;
     for (int v = 0; v < camera.height; v += kStride) {
       for (int u = 0; u < camera.width; u += kStride) {
         const int i = v * camera.width + u;
@@ -129,19 +138,13 @@ Registration registration(const depth_image_t& camera, const link_labels_t& labe
         if (pixel_class[i] != kMatch || label < link_labels_t::ENVIRONMENT_FIRST ||
             label >= link_labels_t::OCCUPANT_FIRST || camera.depth_mm[static_cast<size_t>(i)] <= 0)
           continue;
-        const double z_m = 1e-3 * camera.depth_mm[static_cast<size_t>(i)];
         const Eigen::Vector3d p =
-            witness_from_camera *
-            Eigen::Vector3d((u - camera.cx) * z_m / camera.fx, (v - camera.cy) * z_m / camera.fy, z_m);
-        if (!(p.z() > 0)) continue;
-        const long wu = std::lround(d.fx * p.x() / p.z() + d.cx);
-        const long wv = std::lround(d.fy * p.y() / p.z() + d.cy);
-        if (wu < 0 || wv < 0 || wu >= d.width || wv >= d.height) continue;
-        const int16_t seen_mm = d.depth_mm[static_cast<size_t>(wv * d.width + wu)];
-        if (seen_mm <= 0) continue;
+            witness_from_camera * optical_point_m(camera, i, 1e-3 * camera.depth_mm[static_cast<size_t>(i)]);
+        const std::optional<int16_t> seen_mm = witness_depth_mm(w, p);
+        if (!seen_mm || *seen_mm <= 0) continue;
         const double point_mm = 1000.0 * p.z();
         const double allowed_mm = tolerance.at(point_mm);
-        const double difference_mm = seen_mm - point_mm;
+        const double difference_mm = *seen_mm - point_mm;
         if (std::abs(difference_mm) > 3 * allowed_mm) continue;
         differences_mm.push_back(difference_mm);
         if (std::abs(difference_mm) > allowed_mm) ++mismatching;

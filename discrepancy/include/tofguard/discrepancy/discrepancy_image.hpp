@@ -119,6 +119,11 @@ std::vector<uint8_t> silhouette_mask(const depth_image_t& rendered, double silho
 // caller's).
 discrepancy_t unusable_summary(const depth_image_t& camera, int8_t kind, const std::string& reason);
 
+// The point pixel i (row-major) of `camera` sees at Z = `z_m` along the
+// optical axis: the camera's optical frame (x right, y down, z forward),
+// metres.
+Eigen::Vector3d optical_point_m(const depth_image_t& camera, int i, double z_m);
+
 // FNV-1a 64-bit hash of a depth array's bytes (little-endian int16).
 int64_t depth_hash(const std::vector<int16_t>& depth_mm);
 
