@@ -124,10 +124,16 @@ void erase_config_section(std::string* text, const std::string& key) {
 std::string sim_config_variant(const std::string& name,
                                const std::vector<std::pair<std::string, std::string>>& replacements,
                                const std::string& appended) {
-  std::string text = read_file(source_dir() + "/config/sim.yaml");
+  return config_variant(source_dir() + "/config/sim.yaml", name, replacements, appended);
+}
+
+std::string config_variant(const std::string& base_path, const std::string& name,
+                           const std::vector<std::pair<std::string, std::string>>& replacements,
+                           const std::string& appended) {
+  std::string text = read_file(base_path);
   for (const auto& [from, to] : replacements) {
     const auto at = text.find(from);
-    if (at == std::string::npos) throw std::runtime_error("sim.yaml no longer contains: " + from);
+    if (at == std::string::npos) throw std::runtime_error(base_path + " no longer contains: " + from);
     text.replace(at, from.size(), to);
   }
   const std::string models = source_dir() + "/config/models/";
@@ -136,11 +142,11 @@ std::string sim_config_variant(const std::string& name,
     if (p > 0 && text[p - 1] == '/') continue;
     text.replace(p, 7, models);
   }
-  // The embedded default's camera profile, by absolute path.
+  // The camera profiles (discrepancy's, or each of a cameras list's), by
+  // absolute path.
   const std::string profile_key = "\n  camera_profile: ";
-  if (const auto at = text.find(profile_key);
-      at != std::string::npos && text[at + profile_key.size()] != '/') {
-    text.insert(at + profile_key.size(), source_dir() + "/config/");
+  for (auto at = text.find(profile_key); at != std::string::npos; at = text.find(profile_key, at + 1)) {
+    if (text[at + profile_key.size()] != '/') text.insert(at + profile_key.size(), source_dir() + "/config/");
   }
   // The embedded default's key (made by scripts/build), by absolute path.
   const std::string key_line = "key_file: auth.key";

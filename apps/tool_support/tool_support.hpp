@@ -71,6 +71,11 @@ void erase_config_section(std::string* text, const std::string& key);
 std::string sim_config_variant(const std::string& name,
                                const std::vector<std::pair<std::string, std::string>>& replacements = {},
                                const std::string& appended = "");
+// As sim_config_variant, on another config of config/ (`base_path`, e.g.
+// config/sim-two-cameras.yaml).
+std::string config_variant(const std::string& base_path, const std::string& name,
+                           const std::vector<std::pair<std::string, std::string>>& replacements = {},
+                           const std::string& appended = "");
 
 // The whole line of a config's `text` that starts with `prefix` (after a
 // newline), with its newline; the mapping's continuation lines too when it

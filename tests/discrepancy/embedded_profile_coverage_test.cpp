@@ -1,13 +1,14 @@
 // The embedded default's camera profile (config/sim.yaml's
-// discrepancy.camera_profile, learned on a 12 s recording) covers the
-// distances its arm reaches over the whole simulated motion, not only the
-// recording's: compute_discrepancy refuses a frame whose arm lies beyond the
-// profile's range (add_profile_coverage, kMaxShareOutsideProfile), so a gap
-// would stop scripts/demo as "camera needs recommissioning" once the arm
-// got there. The motion's joints have periods of 4-11 s; an hour of it at
-// 0.5 s steps (7200 poses, each rendered as tofguard-renderer renders it
-// from the configured camera pose) covers every joint's range many times;
-// the assistive task (joints_sim.task) is covered the same way.
+// discrepancy.camera_profile) and each camera's of the two-camera scene
+// (config/sim-two-cameras.yaml) cover the distances their arm reaches over
+// the whole simulated motion, not only their recordings': compute_discrepancy
+// refuses a frame whose arm lies beyond the profile's range
+// (add_profile_coverage, kMaxShareOutsideProfile), so a gap would stop
+// scripts/demo as "camera needs recommissioning" once the arm got there. The
+// motion's joints have periods of 4-11 s; an hour of it at 0.5 s steps
+// (7200 poses, each rendered as tofguard-renderer renders it from the
+// configured camera pose) covers every joint's range many times; the
+// assistive task (joints_sim.task) is covered the same way.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -87,44 +88,59 @@ class CoverageScan {
   test::SimulatedFrames frames_;
 };
 
-deployment::Config embedded_config() {
-  deployment::Config config = deployment::load_config(test::source_dir() + "/config/sim.yaml", nullptr);
-  EXPECT_TRUE(config.discrepancy.camera_profile) << "config/sim.yaml names no camera profile";
-  return config;
+// config/sim.yaml's camera, then each camera of config/sim-two-cameras.yaml
+// as its own processes see the config (deployment::select_camera).
+std::vector<deployment::Config> embedded_cameras() {
+  std::vector<deployment::Config> configs = {
+      deployment::load_config(test::source_dir() + "/config/sim.yaml", nullptr)};
+  const deployment::Config two =
+      deployment::load_config(test::source_dir() + "/config/sim-two-cameras.yaml", nullptr);
+  for (const deployment::CameraSection& camera : two.cameras) {
+    configs.push_back(deployment::select_camera(two, camera.id));
+  }
+  for (const deployment::Config& config : configs) {
+    EXPECT_TRUE(config.discrepancy.camera_profile)
+        << config.file << ": " << config.camera.id << " has no profile";
+  }
+  return configs;
 }
 
 TEST(EmbeddedProfile, CoversTheDistancesTheArmReachesOverItsWholeMotion) {
-  const deployment::Config config = embedded_config();
-  ASSERT_TRUE(config.discrepancy.camera_profile);
-  CoverageScan scan(config);
-  for (double t_s = 0; t_s < kMotionS; t_s += kStepS) {
-    robot_model::JointPositions q;
-    for (const sim::JointMotion& m : config.joints_sim.motion) q[m.joint] = test::joint_position(m, t_s);
-    scan.add(q, t_s);
-    if (HasFatalFailure()) return;
+  for (const deployment::Config& config : embedded_cameras()) {
+    SCOPED_TRACE(config.file + ", camera " + config.camera.id);
+    ASSERT_TRUE(config.discrepancy.camera_profile);
+    CoverageScan scan(config);
+    for (double t_s = 0; t_s < kMotionS; t_s += kStepS) {
+      robot_model::JointPositions q;
+      for (const sim::JointMotion& m : config.joints_sim.motion) q[m.joint] = test::joint_position(m, t_s);
+      scan.add(q, t_s);
+      if (HasFatalFailure()) return;
+    }
+    scan.expect_covered(std::to_string(kMotionS) + " s of the periodic motion, camera " + config.camera.id);
   }
-  scan.expect_covered(std::to_string(kMotionS) + " s of the periodic motion");
 }
 
 // The assistive task (tofguard-joints-sim --task, scripts/demo) too: two
 // cycles at 0.1 s steps of motion time.
 TEST(EmbeddedProfile, CoversTheDistancesTheArmReachesOverItsTask) {
-  const deployment::Config config = embedded_config();
-  ASSERT_TRUE(config.discrepancy.camera_profile);
-  const std::vector<std::string> joints =
-      robot_model::load_kinematic_tree(config.robot.urdf_path).actuated_joint_names;
-  sim::SimulatedArm arm(config.joints_sim, joints, "config/sim.yaml", /*task=*/true);
-  CoverageScan scan(config);
-  constexpr double kTaskStepS = 0.1;
-  for (double t_s = 0; t_s < 2 * arm.task_cycle_s(); t_s += kTaskStepS) {
-    robot_model::JointPositions q;
-    const sim::ArmState& state = arm.true_state();
-    for (size_t i = 0; i < state.name.size(); ++i) q[state.name[i]] = state.position[i];
-    scan.add(q, t_s);
-    if (HasFatalFailure()) return;
-    arm.step(kTaskStepS, true);
+  for (const deployment::Config& config : embedded_cameras()) {
+    SCOPED_TRACE(config.file + ", camera " + config.camera.id);
+    ASSERT_TRUE(config.discrepancy.camera_profile);
+    const std::vector<std::string> joints =
+        robot_model::load_kinematic_tree(config.robot.urdf_path).actuated_joint_names;
+    sim::SimulatedArm arm(config.joints_sim, joints, config.file, /*task=*/true);
+    CoverageScan scan(config);
+    constexpr double kTaskStepS = 0.1;
+    for (double t_s = 0; t_s < 2 * arm.task_cycle_s(); t_s += kTaskStepS) {
+      robot_model::JointPositions q;
+      const sim::ArmState& state = arm.true_state();
+      for (size_t i = 0; i < state.name.size(); ++i) q[state.name[i]] = state.position[i];
+      scan.add(q, t_s);
+      if (HasFatalFailure()) return;
+      arm.step(kTaskStepS, true);
+    }
+    scan.expect_covered("two cycles of the task, camera " + config.camera.id);
   }
-  scan.expect_covered("two cycles of the task");
 }
 
 }  // namespace
