@@ -74,6 +74,22 @@ const std::string& replay_config_path() {
   return path;
 }
 
+// The same for the two-camera scene (config/sim-two-cameras.yaml), whose
+// recordings show the user seated: its occupant stays.
+const std::string& two_camera_replay_config_path() {
+  static const std::string path = [] {
+    const std::string p = output_dir() + "/replay-two-cameras.yaml";
+    std::string out, err;
+    const int code = run_command("replay-write-two-camera-config",
+                                 {"/bin/bash", source_dir() + "/scripts/record-scenario", "--write-config", p,
+                                  "--replay", "--config", source_dir() + "/config/sim-two-cameras.yaml"},
+                                 &out, &err);
+    if (code != 0) throw std::runtime_error("record-scenario --write-config failed: " + out + err);
+    return p;
+  }();
+  return path;
+}
+
 std::string data_log(const std::string& name) {
   return std::string(TOFGUARD_REPLAY_DATA_DIR) + "/" + name + ".lcmlog";
 }
@@ -108,9 +124,55 @@ void expect_same_verdicts(const InputLog& input, const ReplayOutput& first, cons
   EXPECT_EQ(differences, 0);
 }
 
-// Replays `name` twice; checks both runs with `check` and that they give the
-// same verdict sequence.
-void replay_twice(const std::string& name, const std::function<void(const InputLog&, const Replay&)>& check) {
+// With several cameras the published verdict is the worst of every
+// camera's latest (VerdictFusion), so which frame's seq it carries, and
+// whether a frame captured as a fault begins is answered before or after
+// the other camera's, follows the cameras' arrival order (so does the
+// start, before each camera has a frame judged). What must be the same on
+// both replays once motion is allowed: the first DANGEROUS frame verdict's
+// cause, suspect and camera (its seq within one frame), and the verdicts'
+// counts by (level, cause, suspect) within one per camera.
+void expect_same_verdicts_of_every_camera(const InputLog& input, const ReplayOutput& first,
+                                          const ReplayOutput& second) {
+  auto first_dangerous = [](const ReplayOutput& out) -> const Verdict* {
+    for (const Verdict& v : out.verdicts) {
+      if (v.level == risk_t::DANGEROUS && v.received_us > out.first_allowed_us()) return &v;
+    }
+    return nullptr;
+  };
+  auto what = [](const Verdict& v) {
+    return risk_cause_name(v.cause) + " '" + v.suspect + "' " + v.detail.substr(0, v.detail.find(": "));
+  };
+  const Verdict* a = first_dangerous(first);
+  const Verdict* b = first_dangerous(second);
+  ASSERT_EQ(a == nullptr, b == nullptr) << "one replay judged a frame DANGEROUS, the other none";
+  if (a) {
+    EXPECT_EQ(what(*a), what(*b)) << a->detail << "\n" << b->detail;
+    EXPECT_LE(std::abs(a->seq - b->seq), 1) << a->key() << " | " << b->key();
+  }
+  auto counts = [](const ReplayOutput& out) {
+    std::map<std::string, int> n;
+    for (const Verdict& v : out.verdicts) {
+      if (v.received_us <= out.first_allowed_us()) continue;
+      ++n[risk_level_name(v.level) + " " + risk_cause_name(v.cause) + " '" + v.suspect + "'"];
+    }
+    return n;
+  };
+  std::map<std::string, int> in_first = counts(first), in_second = counts(second);
+  const int cameras = static_cast<int>(input.frames_of_camera.size());
+  for (const auto* m : {&in_first, &in_second}) {
+    for (const auto& [key, n] : *m) {
+      EXPECT_LE(std::abs(in_first[key] - in_second[key]), cameras)
+          << key << ": " << in_first[key] << " verdicts in the 1st replay, " << in_second[key]
+          << " in the 2nd";
+    }
+  }
+}
+
+// Replays `name` twice on `config_path`; checks both runs with `check` and
+// that they give the same verdict sequence.
+void replay_twice(const std::string& name, const std::function<void(const InputLog&, const Replay&)>& check,
+                  const std::string& config_path = replay_config_path()) {
   const std::string log = data_log(name);
   ASSERT_TRUE(std::filesystem::exists(log))
       << log << " missing (built from tests/data/" << name << ".lcmlog.xz)";
@@ -120,16 +182,24 @@ void replay_twice(const std::string& name, const std::function<void(const InputL
   std::vector<ReplayOutput> outputs;
   for (int run = 0; run < 2; ++run) {
     SCOPED_TRACE(name + " replay " + std::to_string(run + 1));
-    const Replay replay(log, "replay-" + name + "-" + std::to_string(run + 1), replay_config_path());
+    const Replay replay(log, "replay-" + name + "-" + std::to_string(run + 1), config_path);
     const ReplayOutput& out = replay.output();
-    expect_every_frame_judged_once(input, out);
+    if (replay.config().cameras.size() > 1) {
+      expect_every_camera_frame_judged_once(input, out);
+    } else {
+      expect_every_frame_judged_once(input, out);
+    }
     check(input, replay);
     outputs.push_back(out);
     if (::testing::Test::HasFailure()) {
       std::cout << "verdicts:\n" << describe(out) << replay.stderr_of_all() << std::flush;
     }
   }
-  expect_same_verdicts(input, outputs[0], outputs[1]);
+  if (input.frames_of_camera.size() > 1) {
+    expect_same_verdicts_of_every_camera(input, outputs[0], outputs[1]);
+  } else {
+    expect_same_verdicts(input, outputs[0], outputs[1]);
+  }
 }
 
 int64_t frame_period_us(const deployment::Config& config) {
@@ -142,15 +212,20 @@ int64_t frame_period_us(const deployment::Config& config) {
 // The first affected frame: the first captured after the fault, or with
 // `first_repeat` the first that repeats its predecessor's depth (a frozen
 // camera repeats the last image captured before the fault).
+// With several cameras `camera_id` names the camera the fault is in (its
+// frames are the affected ones), and the stop must name it.
 void expect_fault_stop(const InputLog& input, const Replay& replay, int8_t cause, const std::string& suspect,
-                       int frames_to_dangerous, bool first_repeat = false) {
+                       int frames_to_dangerous, bool first_repeat = false,
+                       const std::string& camera_id = "") {
   const ReplayOutput& out = replay.output();
   ASSERT_GT(input.fault_utime, 0) << "no fault marker in the log";
+  ASSERT_TRUE(camera_id.empty() || out.frames_of_camera.count(camera_id)) << "no frames of " << camera_id;
+  const std::vector<Frame>& frames = camera_id.empty() ? out.frames : out.frames_of_camera.at(camera_id);
   const Frame* affected = nullptr;
-  for (size_t i = 1; i < out.frames.size() && !affected; ++i) {
-    if (first_repeat ? out.frames[i].depth_hash == out.frames[i - 1].depth_hash
-                     : out.frames[i].utime >= input.fault_utime) {
-      affected = &out.frames[i];
+  for (size_t i = 1; i < frames.size() && !affected; ++i) {
+    if (first_repeat ? frames[i].depth_hash == frames[i - 1].depth_hash
+                     : frames[i].utime >= input.fault_utime) {
+      affected = &frames[i];
     }
   }
   ASSERT_NE(affected, nullptr) << "no frame captured after the fault";
@@ -171,6 +246,10 @@ void expect_fault_stop(const InputLog& input, const Replay& replay, int8_t cause
   EXPECT_EQ(risk_cause_name(dangerous->cause), risk_cause_name(cause)) << dangerous->detail;
   if (!suspect.empty()) {
     EXPECT_EQ(dangerous->suspect, suspect) << dangerous->detail;
+  }
+  if (!camera_id.empty()) {
+    EXPECT_EQ(dangerous->detail.rfind(camera_id + ": ", 0), 0u) << "not named: " << dangerous->detail;
+    EXPECT_NE(stop->reason.find(camera_id + ": "), std::string::npos) << stop->reason;
   }
 }
 
@@ -257,6 +336,51 @@ TEST(Replay, CameraStallStopsWithSensorFaultWithinTheDepthDeadline) {
     ASSERT_NE(dangerous, nullptr);
     EXPECT_EQ(dangerous->suspect, "TOF_DEPTH") << dangerous->detail;
   });
+}
+
+// The two-camera scene (config/sim-two-cameras.yaml, the user seated):
+// each camera's frames judged once, and the arm allowed to move until the
+// log ends.
+TEST(Replay, TwoCamerasNominalLogNeverStopsTheArm) {
+  replay_twice(
+      "two-cameras-nominal",
+      [](const InputLog& input, const Replay& replay) {
+        const ReplayOutput& out = replay.output();
+        const int64_t allowed_us = out.first_allowed_us();
+        ASSERT_TRUE(out.reset_accepted && allowed_us > 0) << "motion never allowed (no accepted reset)";
+        const Status* stop = out.first_stop();
+        if (stop) {
+          EXPECT_GT(stop->received_us, out.last_input_us) << "stopped during the log: " << stop->reason;
+        }
+        for (const Verdict& v : out.verdicts) {
+          if (v.received_us >= allowed_us && v.received_us <= out.last_input_us) {
+            EXPECT_NE(v.level, risk_t::DANGEROUS) << v.key() << " | " << v.detail;
+          }
+        }
+        for (const Verdict& v : out.timeouts) {
+          if (v.received_us >= allowed_us && v.received_us <= out.last_input_us) {
+            ADD_FAILURE() << "timeout while the log plays: " << v.key() << " | " << v.detail;
+          }
+        }
+        for (const auto& [camera_id, seqs] : out.discrepancy_seqs_of_camera) {
+          std::cout << camera_id << ": " << seqs.size() << " frames judged of "
+                    << input.frames_of_camera.at(camera_id).size() << " in the log" << std::endl;
+        }
+      },
+      two_camera_replay_config_path());
+}
+
+// The side camera knocked 5 cm along its pose frame's x: a calibration
+// error, named by that camera's id, within the stop budget of its first
+// frame after the knock.
+TEST(Replay, TwoCamerasSideCameraKnockedStopsNamingIt) {
+  replay_twice(
+      "two-cameras-side-camera-pose",
+      [](const InputLog& input, const Replay& replay) {
+        expect_fault_stop(input, replay, risk_t::CAUSE_CALIBRATION_ERROR, "",
+                          replay.config().risk.debounce_frames - 1, false, "tof-side");
+      },
+      two_camera_replay_config_path());
 }
 
 }  // namespace

@@ -30,9 +30,11 @@
 #include <string_view>
 #include <vector>
 
+#include "tofguard/common/process.hpp"
 #include "tofguard/common/risk_names.hpp"
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/depth_image_t.hpp"
+#include "tofguard/discrepancy_t.hpp"
 #include "tofguard/heartbeat_t.hpp"
 #include "tofguard/risk_t.hpp"
 #include "tofguard/safety_status_t.hpp"
@@ -113,19 +115,35 @@ struct Status {
 // What a log under tests/data holds.
 struct InputLog {
   std::vector<Frame> frames;  // TOF_DEPTH (received_us: the recording's)
+  // Every camera's frames (TOF_DEPTH and, with several cameras,
+  // TOF_DEPTH/<id>), by the camera id they carry.
+  std::map<std::string, std::vector<Frame>> frames_of_camera;
   int64_t first_event_us = 0;
   // The fault's injection time (SIM_JOINT_FAULT / SIM_CAMERA_FAULT utime);
   // -1 for the nominal log.
   int64_t fault_utime = -1;
   // The frames captured after the lead-in: those the tests judge.
-  std::set<int64_t> judged_seqs() const {
+  std::set<int64_t> judged_seqs() const { return judged_seqs_of(frames); }
+  std::set<int64_t> judged_seqs(const std::string& camera_id) const {
+    const auto it = frames_of_camera.find(camera_id);
+    return it == frames_of_camera.end() ? std::set<int64_t>{} : judged_seqs_of(it->second);
+  }
+
+ private:
+  std::set<int64_t> judged_seqs_of(const std::vector<Frame>& camera_frames) const {
     std::set<int64_t> seqs;
-    for (const Frame& f : frames) {
+    for (const Frame& f : camera_frames) {
       if (f.received_us >= first_event_us + kLeadInUs) seqs.insert(f.seq);
     }
     return seqs;
   }
 };
+
+// A channel of any camera: `base` (the first camera's, e.g. TOF_DEPTH) or
+// `base`/<id> (another camera's).
+inline bool is_camera_channel(const std::string& channel, const std::string& base) {
+  return channel == base || channel.rfind(base + "/", 0) == 0;
+}
 
 inline InputLog read_input_log(const std::string& path) {
   InputLog log;
@@ -136,11 +154,14 @@ inline InputLog read_input_log(const std::string& path) {
   while (const lcm::LogEvent* e = file.readNextEvent()) {
     if (first) log.first_event_us = e->timestamp;
     first = false;
-    if (e->channel == defaults.depth) {
-      if (auto d = decode<depth_image_t>(*e)) log.frames.push_back(frame_of(*d, e->timestamp));
+    if (is_camera_channel(e->channel, defaults.depth)) {
+      if (auto d = decode<depth_image_t>(*e)) {
+        if (e->channel == defaults.depth) log.frames.push_back(frame_of(*d, e->timestamp));
+        log.frames_of_camera[d->camera_id].push_back(frame_of(*d, e->timestamp));
+      }
     } else if (e->channel == defaults.sim_joint_fault) {
       if (auto f = decode<sim_joint_fault_t>(*e)) log.fault_utime = f->utime;
-    } else if (e->channel == defaults.sim_camera_fault) {
+    } else if (is_camera_channel(e->channel, defaults.sim_camera_fault)) {
       if (auto f = decode<sim_camera_fault_t>(*e)) log.fault_utime = f->utime;
     }
   }
@@ -149,7 +170,11 @@ inline InputLog read_input_log(const std::string& path) {
 
 // What the replay's lcm-logger recorded.
 struct ReplayOutput {
-  std::vector<Frame> frames;      // TOF_DEPTH as replayed
+  std::vector<Frame> frames;  // TOF_DEPTH as replayed
+  // Every camera's frames as replayed, and the seqs of its discrepancies
+  // (SAFETY_DISCREPANCY, SAFETY_DISCREPANCY/<id>), by camera id.
+  std::map<std::string, std::vector<Frame>> frames_of_camera;
+  std::map<std::string, std::vector<int64_t>> discrepancy_seqs_of_camera;
   std::vector<Verdict> verdicts;  // SAFETY_RISK for camera frames
   std::vector<Verdict> timeouts;  // SAFETY_RISK with seq -1
   std::vector<Status> statuses;   // SAFETY_STATUS
@@ -198,10 +223,15 @@ inline ReplayOutput read_output_log(const std::string& path, const deployment::C
   lcm::LogFile file(path, "r");
   EXPECT_TRUE(file.good()) << path;
   while (const lcm::LogEvent* e = file.readNextEvent()) {
-    if (e->channel == config.channels.depth) {
-      if (auto d = decode<depth_image_t>(*e)) out.frames.push_back(frame_of(*d, e->timestamp));
+    if (is_camera_channel(e->channel, config.channels.depth)) {
+      if (auto d = decode<depth_image_t>(*e)) {
+        if (e->channel == config.channels.depth) out.frames.push_back(frame_of(*d, e->timestamp));
+        out.frames_of_camera[d->camera_id].push_back(frame_of(*d, e->timestamp));
+      }
       if (out.first_input_us == 0) out.first_input_us = e->timestamp;
       out.last_input_us = e->timestamp;
+    } else if (is_camera_channel(e->channel, config.channels.discrepancy)) {
+      if (auto d = decode<discrepancy_t>(*e)) out.discrepancy_seqs_of_camera[d->camera_id].push_back(d->seq);
     } else if (e->channel == config.channels.joint_state) {
       if (out.first_input_us == 0) out.first_input_us = e->timestamp;
       out.last_input_us = e->timestamp;
@@ -236,16 +266,13 @@ class Replay {
     logger_ = std::make_unique<Subprocess>(
         run_name + "-lcm-logger",
         std::vector<std::string>{in_path("lcm-logger"), "-q", "-f", "--flush-interval=20", "-c",
-                                 "(SAFETY_.*|TOF_DEPTH|JOINT_STATE|CAMERA_POSE)",
+                                 "(SAFETY_.*|TOF_DEPTH|JOINT_STATE|CAMERA_POSE)(/.*)?",
                                  "--lcm-url=" + config_.lcm.url, output_log_});
-    for (const std::string& name : kChain) {
-      chain_.push_back(std::make_unique<Subprocess>(
-          run_name + "-" + name, std::vector<std::string>{bin_dir() + "/" + name, "--config", config_path_}));
-    }
+    start_chain(run_name);
     // Ready: every process beats, and the logger writes (the heartbeats).
     const bool ready = wait_until(
         [&] {
-          return heartbeats_.size() == kChain.size() && std::filesystem::exists(output_log_) &&
+          return heartbeats_.size() == chain_.size() && std::filesystem::exists(output_log_) &&
                  std::filesystem::file_size(output_log_) > 0;
         },
         std::chrono::seconds(20), [&] { lcm_.handleTimeout(5); });
@@ -268,7 +295,7 @@ class Replay {
     // have arrived here, i.e. at least 100 ms later.
     const int beats_at_last_verdict = heartbeats_seen_;
     wait_until(
-        [&] { return heartbeats_seen_ >= beats_at_last_verdict + 3 * static_cast<int>(kChain.size()); },
+        [&] { return heartbeats_seen_ >= beats_at_last_verdict + 3 * static_cast<int>(chain_.size()); },
         std::chrono::seconds(2), [&] { pump(); });
     logger_->signal(SIGINT);
     EXPECT_EQ(logger_->wait(std::chrono::seconds(5)), 0) << logger_->stderr_text();
@@ -287,6 +314,25 @@ class Replay {
   }
 
  private:
+  // kChain's processes; with several cameras a process of one camera
+  // (per_camera_process_names) once per camera, with --camera ID.
+  void start_chain(const std::string& run_name) {
+    const std::vector<std::string>& per_camera = per_camera_process_names();
+    for (const std::string& name : kChain) {
+      const std::vector<std::string> argv = {bin_dir() + "/" + name, "--config", config_path_};
+      const bool of_a_camera = std::find(per_camera.begin(), per_camera.end(), name) != per_camera.end();
+      if (!of_a_camera || config_.cameras.size() < 2) {
+        chain_.push_back(std::make_unique<Subprocess>(run_name + "-" + name, argv));
+        continue;
+      }
+      for (const deployment::CameraSection& camera : config_.cameras) {
+        std::vector<std::string> with_camera = argv;
+        with_camera.insert(with_camera.end(), {"--camera", camera.id});
+        chain_.push_back(std::make_unique<Subprocess>(run_name + "-" + name + "-" + camera.id, with_camera));
+      }
+    }
+  }
+
   void pump() {
     lcm_.handleTimeout(2);
     if (reset_ && !reset_->running()) {
@@ -342,6 +388,40 @@ inline void expect_every_frame_judged_once(const InputLog& input, const ReplayOu
   }
   EXPECT_EQ(not_replayed, "") << "frames of the log that never arrived (a machine too busy for real time?)";
   EXPECT_EQ(not_judged_once, "") << "frames without exactly one verdict (seq (verdicts))";
+}
+
+// With several cameras: every judged frame of each camera was replayed and
+// got exactly one discrepancy of that camera (one failure each, naming the
+// camera and the frames), and every discrepancy one verdict: a frame
+// verdict, except while a camera has had no frame judged yet and the worst
+// camera's latest verdict is its timeout (seq -1; VerdictFusion), at most
+// once per camera at the start.
+inline void expect_every_camera_frame_judged_once(const InputLog& input, const ReplayOutput& out) {
+  size_t discrepancies = 0;
+  for (const auto& [camera_id, frames] : input.frames_of_camera) {
+    std::set<int64_t> replayed;
+    if (out.frames_of_camera.count(camera_id)) {
+      for (const Frame& f : out.frames_of_camera.at(camera_id)) replayed.insert(f.seq);
+    }
+    std::map<int64_t, int> judged;
+    if (out.discrepancy_seqs_of_camera.count(camera_id)) {
+      for (int64_t seq : out.discrepancy_seqs_of_camera.at(camera_id)) ++judged[seq];
+      discrepancies += out.discrepancy_seqs_of_camera.at(camera_id).size();
+    }
+    std::string not_replayed, not_judged_once;
+    for (int64_t seq : input.judged_seqs(camera_id)) {
+      if (!replayed.count(seq)) not_replayed += " " + std::to_string(seq);
+      if (judged[seq] != 1)
+        not_judged_once += " " + std::to_string(seq) + " (" + std::to_string(judged[seq]) + ")";
+    }
+    EXPECT_EQ(not_replayed, "") << camera_id << ": frames of the log that never arrived";
+    EXPECT_EQ(not_judged_once, "") << camera_id
+                                   << ": frames without exactly one discrepancy (seq (discrepancies))";
+  }
+  EXPECT_GE(input.frames_of_camera.size(), 2u);
+  EXPECT_LE(out.verdicts.size(), discrepancies) << "more frame verdicts than discrepancies";
+  EXPECT_GE(out.verdicts.size() + input.frames_of_camera.size(), discrepancies)
+      << "discrepancies without their frame verdict";
 }
 
 inline std::string describe(const ReplayOutput& out) {
