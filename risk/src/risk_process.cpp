@@ -18,9 +18,7 @@
 #include "tofguard/common/lcm_node.hpp"
 #include "tofguard/common/wire_checks.hpp"
 #include "tofguard/reset_reply_t.hpp"
-#include "tofguard/risk/arm_coverage.hpp"
-#include "tofguard/risk/risk_monitor.hpp"
-#include "tofguard/risk/verdict_fusion.hpp"
+#include "tofguard/risk/cameras_judgement.hpp"
 
 namespace tofguard::risk {
 
@@ -36,47 +34,6 @@ ProcessInfo process_info() {
 namespace {
 
 // One camera's judgement: its monitor, fed from its own channels.
-struct CameraJudge {
-  RiskCamera camera;
-  std::unique_ptr<RiskMonitor> monitor;
-};
-
-std::vector<CameraJudge> camera_judges(const RiskProcessSettings& settings,
-                                       const robot_model::KinematicTree& robot) {
-  std::vector<CameraJudge> judges;
-  for (const RiskCamera& camera : settings.cameras) {
-    RiskSettings risk = several_cameras_evidence_settings(settings.risk, settings.cameras.size());
-    risk.required_heartbeats = camera.required_heartbeats;
-    CameraJudge judge{
-        camera, std::make_unique<RiskMonitor>(risk, camera.channels, robot, camera.rate_hz, monotonic_us())};
-    if (settings.occupant) judge.monitor->set_occupant(*settings.occupant);
-    judges.push_back(std::move(judge));
-  }
-  return judges;
-}
-
-// Several cameras: the joints' tests pooled over every camera's frames, at
-// the cameras' summed frame rate (none with one camera).
-std::unique_ptr<SequentialEvidence> pooled_evidence(const RiskProcessSettings& settings,
-                                                    const robot_model::KinematicTree& robot) {
-  if (settings.cameras.size() < 2) return nullptr;
-  double rate_hz = 0;
-  for (const RiskCamera& camera : settings.cameras) rate_hz += camera.rate_hz;
-  return std::make_unique<SequentialEvidence>(
-      several_cameras_evidence_settings(settings.risk, settings.cameras.size()), robot, rate_hz,
-      /*camera_test=*/false);
-}
-
-VerdictFusion verdict_fusion(const std::vector<CameraJudge>& judges, const RiskSettings& risk) {
-  std::vector<std::string> ids;
-  std::vector<std::string> depth_channels;
-  for (const CameraJudge& judge : judges) {
-    ids.push_back(judge.camera.id);
-    depth_channels.push_back(judge.camera.channels.depth);
-  }
-  return VerdictFusion(ids, depth_channels, risk.continue_after_named_camera_release);
-}
-
 // The wiring of one process: every camera's inputs to its monitor, the
 // shared inputs to all, the fused verdicts and the speed limits out.
 class RiskProcess {
@@ -84,10 +41,7 @@ class RiskProcess {
   explicit RiskProcess(const RiskProcessSettings& settings)
       : settings_(settings),
         robot_(robot_model::load_kinematic_tree(settings.robot_urdf_path)),
-        pooled_(pooled_evidence(settings, robot_)),
-        judges_(camera_judges(settings, robot_)),
-        fusion_(verdict_fusion(judges_, settings.risk)),
-        coverage_(judges_.size(), settings.risk.min_link_pixels),
+        judgement_(settings.risk, settings.cameras, robot_, settings.occupant, monotonic_us()),
         node_(settings.lcm, settings.channels, process_info().name) {
     // With a key, each verdict goes out signed first (the copy a keyed
     // tofguard-intervene acts on), then plain (for people, logs and tools).
@@ -95,8 +49,7 @@ class RiskProcess {
       signer_.emplace(settings.auth.key, wall_utime());
       verifier_.emplace(settings.auth.key, settings.auth.max_age_us);
     }
-    for (CameraJudge& judge : judges_) judge.monitor->set_pooled_evidence(pooled_.get());
-    for (size_t camera = 0; camera < judges_.size(); ++camera) subscribe_camera(camera);
+    for (size_t camera = 0; camera < judgement_.cameras(); ++camera) subscribe_camera(camera);
     subscribe_shared();
     subscribe_camera_release();
     node_.add_timer(settings.risk.check_period_us, [this] { check_due_and_deadlines(); });
@@ -106,25 +59,22 @@ class RiskProcess {
   void run() { node_.run(); }
 
  private:
+  // A verdict of camera `camera`'s monitor, as the judgement publishes it.
   void publish(size_t camera, const risk_t& verdict) {
-    std::optional<risk_t> fused = fusion_.fuse(camera, verdict);
-    if (!fused) return;
-    risk_t& r = *fused;
-    if (judges_.size() > 1 && r.seq >= 0) {
-      const std::vector<std::string> unseen = unseen_links();
-      limit_unseen_arm(unseen, coverage_.robot_links(), settings_.risk.unseen_arm_max_fraction, &r);
-      r.detail += unseen_links_text(unseen, coverage_.robot_links());
-    }
+    if (const std::optional<risk_t> r = judgement_.published(camera, verdict)) send(camera, *r);
+  }
+
+  void send(size_t camera, const risk_t& r) {
     auth::publish_signed(node_.safety(), signer_ ? &*signer_ : nullptr, settings_.channels.risk,
                          settings_.channels.risk_auth, r, wall_utime());
     node_.counters().frames_out++;
     if (r.seq >= 0) node_.heartbeat().set_last_frame_utime(r.utime);
     if (r.level == risk_t::DANGEROUS) ++dangerous_;
-    const RiskMonitor::EstimateStats& e = judges_[camera].monitor->estimate_stats();
+    const RiskMonitor::EstimateStats& e = judgement_.monitor(camera).estimate_stats();
     node_.heartbeat().set_status(
         "last verdict: level " + std::to_string(r.level) + " cause " + std::to_string(r.cause) + " (" +
         r.detail + "); " + std::to_string(dangerous_) + " dangerous so far; estimates of " +
-        judges_[camera].camera.id + ": " + std::to_string(e.received) + " received, " +
+        judgement_.camera(camera).id + ": " + std::to_string(e.received) + " received, " +
         std::to_string(e.used) + " used, " + std::to_string(e.explained_nothing) + " explained nothing, " +
         std::to_string(e.missing) + " missing, " + std::to_string(e.late) + " late");
   }
@@ -139,19 +89,11 @@ class RiskProcess {
                          settings_.channels.speed_limit_auth, limit, wall_utime());
   }
 
-  // The robot links no camera still judging sees (arm_coverage.hpp).
-  std::vector<std::string> unseen_links() const {
-    std::vector<bool> counted(judges_.size());
-    for (size_t c = 0; c < judges_.size(); ++c) counted[c] = !fusion_.released(c);
-    return coverage_.unseen_links(counted);
-  }
-
   void on_frame(size_t camera, const discrepancy_t& d) {
-    coverage_.on_frame(camera, d);
-    RiskMonitor& monitor = *judges_[camera].monitor;
-    const std::string& channel = judges_[camera].camera.channels.discrepancy;
+    RiskMonitor& monitor = judgement_.monitor(camera);
+    const std::string& channel = judgement_.camera(camera).channels.discrepancy;
     const int64_t refused_before = monitor.refused_frames();
-    publish_all(camera, monitor.on_frame(d, monotonic_us()));
+    for (const risk_t& r : judgement_.on_frame(camera, d, monotonic_us())) send(camera, r);
     if (monitor.refused_frames() != refused_before) {
       // A duplicate or out-of-order frame: no verdict (RiskMonitor::on_frame).
       node_.counters().frames_dropped++;
@@ -162,8 +104,8 @@ class RiskProcess {
   }
 
   void subscribe_camera(size_t camera) {
-    RiskMonitor& monitor = *judges_[camera].monitor;
-    const RiskCamera& c = judges_[camera].camera;
+    RiskMonitor& monitor = judgement_.monitor(camera);
+    const RiskCamera& c = judgement_.camera(camera);
     node_.subscribe<discrepancy_t>(
         node_.safety(), c.channels.discrepancy,
         [this, camera](const discrepancy_t& d) { on_frame(camera, d); },
@@ -197,11 +139,11 @@ class RiskProcess {
   }
 
   void subscribe_shared() {
-    RiskMonitor& first = *judges_.front().monitor;
+    RiskMonitor& first = judgement_.monitor(0);
     node_.subscribe<planned_trajectory_t>(
         node_.safety(), settings_.channels.planned_trajectory,
         [this](const planned_trajectory_t& p) {
-          for (CameraJudge& judge : judges_) judge.monitor->on_plan(p);
+          for (size_t c = 0; c < judgement_.cameras(); ++c) judgement_.monitor(c).on_plan(p);
         },
         [&first](const planned_trajectory_t& p) {
           std::string problem = check_planned_trajectory(p);
@@ -218,7 +160,8 @@ class RiskProcess {
     node_.subscribe<heartbeat_t>(
         node_.safety(), settings_.channels.heartbeat,
         [this](const heartbeat_t& hb) {
-          for (CameraJudge& judge : judges_) judge.monitor->on_heartbeat(hb, monotonic_us());
+          for (size_t c = 0; c < judgement_.cameras(); ++c)
+            judgement_.monitor(c).on_heartbeat(hb, monotonic_us());
         },
         check_heartbeat);
   }
@@ -227,8 +170,8 @@ class RiskProcess {
   // once) when the first refuses it, as all have seen the same stream.
   void on_joint_state(const joint_state_t& s) {
     std::string refused;
-    for (CameraJudge& judge : judges_) {
-      const std::string why = judge.monitor->on_joint_state(s, monotonic_us());
+    for (size_t c = 0; c < judgement_.cameras(); ++c) {
+      const std::string why = judgement_.monitor(c).on_joint_state(s, monotonic_us());
       if (refused.empty()) refused = why;
     }
     if (!refused.empty()) {
@@ -239,16 +182,16 @@ class RiskProcess {
   }
 
   void check_due_and_deadlines() {
-    for (size_t camera = 0; camera < judges_.size(); ++camera) {
-      RiskMonitor& monitor = *judges_[camera].monitor;
+    for (size_t camera = 0; camera < judgement_.cameras(); ++camera) {
+      RiskMonitor& monitor = judgement_.monitor(camera);
       publish_all(camera, monitor.release_due(monotonic_us()));
       if (const auto timeout = monitor.check_deadlines(monotonic_us())) {
         publish(camera, *timeout);
         // A released camera's silence is known and said in every verdict:
         // the others' limits stand.
-        if (fusion_.released(camera)) continue;
+        if (judgement_.fusion().released(camera)) continue;
         publish_limit(
-            stand_still_limit(settings_.risk, timeout->utime, judges_[camera].camera.id, timeout->detail));
+            stand_still_limit(settings_.risk, timeout->utime, judgement_.camera(camera).id, timeout->detail));
       }
     }
   }
@@ -259,13 +202,14 @@ class RiskProcess {
     reset_reply_t reply;
     reply.utime = wall_utime();
     reply.request_id = request.request_id;
-    const size_t camera = fusion_.index_of(request.camera_id);
+    VerdictFusion& fusion = judgement_.fusion();
+    const size_t camera = fusion.index_of(request.camera_id);
     if (request.who.empty() || request.why.empty()) {
       reply.reason = "refused: a release needs who and why";
-    } else if (camera == fusion_.cameras()) {
+    } else if (camera == fusion.cameras()) {
       reply.reason = "refused: no camera '" + request.camera_id + "' in this deployment";
     } else {
-      reply.reason = fusion_.release(camera, request.who, request.why);
+      reply.reason = fusion.release(camera, request.who, request.why);
     }
     reply.accepted = reply.reason.empty();
     if (reply.accepted) reply.reason = "released: " + request.camera_id + " is left out until it is back";
@@ -315,11 +259,7 @@ class RiskProcess {
 
   const RiskProcessSettings& settings_;
   const robot_model::KinematicTree robot_;
-  // Declared before the monitors that point at it.
-  std::unique_ptr<SequentialEvidence> pooled_;
-  std::vector<CameraJudge> judges_;
-  VerdictFusion fusion_;
-  ArmCoverage coverage_;
+  CamerasJudgement judgement_;
   LcmNode node_;
   std::optional<auth::MessageSigner> signer_;
   std::optional<auth::MessageVerifier> verifier_;
