@@ -18,11 +18,14 @@
 #include "plot_panel.hpp"
 #include "report_format.hpp"
 #include "simulated_frames.hpp"
+#include "tofguard/common/camera_profile.hpp"
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/common/risk_names.hpp"
 #include "tofguard/discrepancy/discrepancy_image.hpp"
+#include "tofguard/discrepancy/witness_views.hpp"
 #include "tofguard/renderer/rendered_kinematics.hpp"
 #include "tofguard/renderer/renderer_service.hpp"
+#include "tofguard/risk/cameras_judgement.hpp"
 #include "tofguard/risk/protective_field.hpp"
 #include "tofguard/risk/risk_monitor.hpp"
 #include "tofguard/risk/sequential_evidence.hpp"
@@ -141,6 +144,15 @@ CampaignArm default_campaign_arm() {
   return arm;
 }
 
+CampaignArm two_camera_campaign_arm() {
+  CampaignArm arm{"default arm, two cameras (config/sim-two-cameras.yaml)",
+                  deployment::load_config(config_variant(source_dir() + "/config/sim-two-cameras.yaml",
+                                                         "judge-campaign-two-cameras"),
+                                          nullptr)};
+  judge_frames_only(&arm.config);
+  return arm;
+}
+
 CampaignArm generic_campaign_arm(const std::string& name, const std::string& urdf,
                                  const std::vector<std::string>& package_paths, const std::string& scene_dir,
                                  const Eigen::Vector3d& eye_m, const Eigen::Vector3d& target_m) {
@@ -196,6 +208,7 @@ std::optional<CampaignArm> kinova_gen3_campaign_arm(const std::string& shared_di
 CampaignArm with_camera_rate(const CampaignArm& arm, double rate_hz) {
   CampaignArm rated = arm;
   rated.config.camera.rate_hz = rate_hz;
+  for (deployment::CameraSection& camera : rated.config.cameras) camera.rate_hz = rate_hz;
   rated.name = arm.name + ", " + fixed_text(rate_hz, 0) + " Hz";
   return rated;
 }
@@ -203,9 +216,12 @@ CampaignArm with_camera_rate(const CampaignArm& arm, double rate_hz) {
 CampaignArm with_camera_turned(const CampaignArm& arm, double turn_deg) {
   CampaignArm turned = arm;
   const Eigen::Isometry3d turn(Eigen::AngleAxisd(turn_deg * kDegToRad, Eigen::Vector3d::UnitZ()));
-  const Eigen::Isometry3d pose = turn * arm.config.camera.pose.frame_from_optical();
-  turned.config.camera.pose = CameraPose(arm.config.camera.pose.frame_id, pose.translation(),
-                                         UnitQuaternion(Eigen::Quaterniond(pose.linear())));
+  auto turned_pose = [&turn](const CameraPose& given) {
+    const Eigen::Isometry3d pose = turn * given.frame_from_optical();
+    return CameraPose(given.frame_id, pose.translation(), UnitQuaternion(Eigen::Quaterniond(pose.linear())));
+  };
+  turned.config.camera.pose = turned_pose(arm.config.camera.pose);
+  for (deployment::CameraSection& camera : turned.config.cameras) camera.pose = turned_pose(camera.pose);
   turned.name = arm.name + ", camera turned " + fixed_text(turn_deg, 0) + " deg";
   return turned;
 }
@@ -489,12 +505,27 @@ ObjectPath place_object(const CampaignFault& fault, const robot_model::PlacedArm
   return path;
 }
 
+// The discrepancy's options as tofguard-discrepancy derives them; with
+// several cameras it looks through the others' frames.
+discrepancy::DiscrepancyOptions campaign_discrepancy_options(const deployment::Config& config,
+                                                             bool several_cameras) {
+  discrepancy::DiscrepancyOptions options = discrepancy::discrepancy_options(config.discrepancy);
+  if (several_cameras) {
+    options.hidden_volume = discrepancy::hidden_volume_options(
+        std::sqrt(config.risk.unknown_object_min_area_m2), config.risk.field_approach_speed_m_s);
+    options.other_cameras = true;
+  }
+  return options;
+}
+
 // What every run of an arm's campaign shares: the true scene, the model as
 // tofguard-renderer loads it (the config's geometry, padding and mesh
 // simplification), and the tree tofguard-risk loads.
 struct CampaignWorld {
-  explicit CampaignWorld(const CampaignArm& arm)
-      : config(arm.config),
+  // `camera_config`: the deployment as one camera's processes see it
+  // (deployment::select_camera with several cameras); must outlive this.
+  CampaignWorld(const deployment::Config& camera_config, bool several_cameras)
+      : config(camera_config),
         truth(config),
         model_scene(robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths,
                                             renderer::scene_options(config.renderer, config.robot))),
@@ -502,7 +533,7 @@ struct CampaignWorld {
         arm_cover(robot_model::cover_arm_with_spheres(model_scene, config.renderer.arm_cover_cell_m)),
         truth_cover(robot_model::cover_arm_with_spheres(model_scene, 0.01)),
         robot_tree(robot_model::load_kinematic_tree(config.robot.urdf_path)),
-        options(discrepancy::discrepancy_options(config.discrepancy)),
+        options(campaign_discrepancy_options(config, several_cameras)),
         intrinsics(config.camera.intrinsics),
         period_s(1.0 / config.camera.rate_hz),
         period_us(static_cast<int64_t>(std::llround(period_s * 1e6))),
@@ -528,18 +559,38 @@ struct CampaignWorld {
   const risk::SequentialEvidence evidence;
 };
 
+// The cameras as tofguard-risk judges them (no heartbeats: the campaign
+// judges frames only).
+std::vector<risk::RiskCamera> risk_cameras(const std::vector<CampaignWorld*>& worlds) {
+  std::vector<risk::RiskCamera> cameras;
+  for (const CampaignWorld* w : worlds) {
+    cameras.push_back({w->config.camera.id, w->config.camera.rate_hz, w->config.channels, {}});
+  }
+  return cameras;
+}
+
 // One run of the campaign: its frames through the discrepancy and the risk
-// monitor, and what they decided.
+// judgement (each camera's frame through its own discrepancy, the other
+// cameras' frames its witnesses; one judgement of all), and what they
+// decided.
 class CampaignRunJudge {
  public:
-  CampaignRunJudge(CampaignWorld* world, const CampaignRun& run)
-      : w_(*world),
-        config_(world->config),
+  CampaignRunJudge(const std::vector<CampaignWorld*>& worlds, const CampaignRun& run)
+      : worlds_(worlds),
+        w_(*worlds.front()),
+        config_(w_.config),
         run_(run),
-        monitor_(config_.risk, config_.channels, w_.robot_tree, config_.camera.rate_hz, 0),
+        fault_camera_(run.fault.camera),
+        judgement_(config_.risk, risk_cameras(worlds), w_.robot_tree, std::nullopt, 0),
+        repeats_(worlds.size()),
+        last_depth_m_(worlds.size()),
         kind_(run.fault.kind),
         stall_(kind_ == Kind::kCameraStall || kind_ == Kind::kJointStall),
         object_fault_(kind_ == Kind::kObject) {
+    if (fault_camera_ >= worlds.size()) {
+      throw std::invalid_argument("campaign fault " + run.fault.label + ": no camera " +
+                                  std::to_string(fault_camera_));
+    }
     result_.label = run.fault.label;
     result_.group = run.fault.group;
     result_.magnitude = run.fault.magnitude;
@@ -561,22 +612,39 @@ class CampaignRunJudge {
     const bool faulty = kind_ != Kind::kNone && k >= run_.onset_frame;
     robot_model::JointPositions true_joints;
     const joint_state_t state = reported_state(k, t_s, faulty, &true_joints);
-    const Eigen::Isometry3d true_pose =
-        faulty && kind_ == Kind::kCameraPose ? w_.reported_pose * run_.fault.camera_error : w_.reported_pose;
     objects_.clear();
-    if (faulty && object_fault_) move_object(k, true_joints, true_pose);
+    if (faulty && object_fault_) move_object(k, true_joints, true_pose(0, faulty));
     if (stall_ && faulty && !result_.stopped) check_deadlines(k, now_us);
-    if (kind_ == Kind::kCameraStall && faulty) {
-      monitor_.on_joint_state(state, now_us);  // the joints go on
-      return;
+    // Each camera's frame k (none from a stalled camera's).
+    std::vector<std::optional<depth_image_t>> frames(worlds_.size());
+    for (size_t c = 0; c < worlds_.size(); ++c) {
+      if (kind_ == Kind::kCameraStall && faulty && c == fault_camera_) continue;
+      frames[c] = capture(c, k, faulty, state, true_joints, true_pose(c, faulty));
     }
-    const depth_image_t camera = capture(k, faulty, state, true_joints, true_pose);
-    discrepancy::DiscrepancyFrame frame = discrepancy_of(k, camera, state, true_joints, true_pose);
-    if (k < run_.onset_frame || kind_ == Kind::kNone) add_nominal_scores(frame.summary);
-    if (faulty && kind_ == Kind::kJointOffset) add_fault_search_gain(frame.summary);
-    monitor_.on_depth(now_us);
-    if (!(kind_ == Kind::kJointStall && faulty)) monitor_.on_joint_state(state, now_us);
-    for (const risk_t& verdict : monitor_.on_frame(frame.summary, now_us)) judge_verdict(verdict);
+    std::vector<Rendered> rendered(worlds_.size());
+    for (size_t c = 0; c < worlds_.size(); ++c) {
+      if (frames[c]) rendered[c] = render(c, k, *frames[c], state);
+    }
+    for (size_t c = 0; c < worlds_.size(); ++c) {
+      if (frames[c]) judgement_.monitor(c).on_depth(now_us);
+      if (!(kind_ == Kind::kJointStall && faulty)) judgement_.monitor(c).on_joint_state(state, now_us);
+    }
+    for (size_t c = 0; c < worlds_.size(); ++c) {
+      if (!frames[c]) continue;
+      discrepancy::DiscrepancyFrame frame = discrepancy_of(
+          c, k, *frames[c], rendered[c], witnesses(c, frames, rendered), true_joints, true_pose(c, faulty));
+      if (c == 0 && (k < run_.onset_frame || kind_ == Kind::kNone)) add_nominal_scores(frame.summary);
+      if (c == 0 && faulty && kind_ == Kind::kJointOffset) add_fault_search_gain(frame.summary);
+      for (const risk_t& verdict : judgement_.on_frame(c, frame.summary, now_us)) judge_verdict(verdict, k);
+    }
+    every_camera_judged_ = true;
+  }
+
+  // Where camera `c` really is: the reported pose, or the camera fault's.
+  Eigen::Isometry3d true_pose(size_t c, bool faulty) const {
+    const Eigen::Isometry3d& reported = worlds_[c]->reported_pose;
+    return faulty && kind_ == Kind::kCameraPose && c == fault_camera_ ? reported * run_.fault.camera_error
+                                                                      : reported;
   }
 
   // The joint state frame k reports (a joint offset fault's joint off by
@@ -640,52 +708,92 @@ class CampaignRunJudge {
   void check_deadlines(int k, int64_t now_us) {
     const int64_t due_us = (run_.onset_frame + 1) * w_.period_us;
     for (int64_t t_us = now_us - w_.period_us + 1000; t_us <= now_us; t_us += 1000) {
-      const std::optional<risk_t> timeout = monitor_.check_deadlines(t_us);
-      if (!timeout) continue;
-      record_stop(*timeout, k - run_.onset_frame + 1, 1e-6 * static_cast<double>(t_us - due_us), 0);
-      break;
+      for (size_t c = 0; c < worlds_.size(); ++c) {
+        const std::optional<risk_t> timeout = judgement_.monitor(c).check_deadlines(t_us);
+        if (!timeout) continue;
+        const std::optional<risk_t> published = judgement_.published(c, *timeout);
+        if (!published || published->level != risk_t::DANGEROUS) continue;
+        record_stop(*published, k - run_.onset_frame + 1, 1e-6 * static_cast<double>(t_us - due_us), 0);
+        return;
+      }
     }
   }
 
-  // The camera's frame k (a frozen camera repeats its last image).
-  depth_image_t capture(int k, bool faulty, const joint_state_t& state,
+  // Camera `c`'s frame k (a frozen camera repeats its last image).
+  depth_image_t capture(size_t c, int k, bool faulty, const joint_state_t& state,
                         const robot_model::JointPositions& true_joints, const Eigen::Isometry3d& true_pose) {
+    CampaignWorld& w = *worlds_[c];
+    const bool frozen = kind_ == Kind::kFrozenImage && c == fault_camera_;
     std::vector<float> depth_m =
-        kind_ == Kind::kFrozenImage && faulty && !last_depth_m_.empty()
-            ? last_depth_m_
-            : w_.truth.capture(true_joints, true_pose, w_.intrinsics,
-                               run_.noise_seed * 100000 + static_cast<uint64_t>(k), objects_);
-    if (kind_ == Kind::kFrozenImage) last_depth_m_ = depth_m;
-    return make_depth_image(config_.camera.id, w_.intrinsics, state.utime, k, /*calibrated=*/true, depth_m);
+        frozen && faulty && !last_depth_m_[c].empty()
+            ? last_depth_m_[c]
+            : w.truth.capture(true_joints, true_pose, w.intrinsics,
+                              (run_.noise_seed + 7919 * c) * 100000 + static_cast<uint64_t>(k), objects_);
+    if (frozen) last_depth_m_[c] = depth_m;
+    return make_depth_image(w.config.camera.id, w.intrinsics, state.utime, k, /*calibrated=*/true, depth_m);
   }
 
-  // The model rendered at the reported joints and pose, and the frame's
-  // discrepancy as tofguard-discrepancy computes it.
-  discrepancy::DiscrepancyFrame discrepancy_of(int k, const depth_image_t& camera, const joint_state_t& state,
-                                               const robot_model::JointPositions& true_joints,
-                                               const Eigen::Isometry3d& true_pose) {
+  // The model rendered at the reported joints and camera `c`'s reported
+  // pose, and its labels and kinematics as tofguard-renderer publishes
+  // them (with several cameras, where the camera was).
+  struct Rendered {
+    renderer::RenderResult result;
+    depth_image_t depth;
+    link_labels_t labels;
+  };
+  Rendered render(size_t c, int k, const depth_image_t& camera, const joint_state_t& state) {
+    CampaignWorld& w = *worlds_[c];
     robot_model::JointPositions reported_joints;
     for (int i = 0; i < state.num_joints; ++i) reported_joints[state.name[i]] = state.position[i];
-    const robot_model::LinkPoses poses = robot_model::forward_kinematics(w_.model_scene, reported_joints);
+    const robot_model::LinkPoses poses = robot_model::forward_kinematics(w.model_scene, reported_joints);
     if (!poses.usable) throw std::runtime_error(poses.unusable_reason);
-    const renderer::RenderResult rendered_result = w_.model.render_at(poses, w_.reported_pose, w_.intrinsics);
-    if (!rendered_result.usable) throw std::runtime_error(rendered_result.unusable_reason);
-    const depth_image_t rendered = make_depth_image(config_.camera.id, w_.intrinsics, state.utime, k,
-                                                    /*calibrated=*/true, rendered_result.depth_m);
-    // Labels and kinematics as tofguard-renderer publishes them.
-    const link_labels_t labels =
-        renderer::make_rendered_link_labels(camera, rendered_result, w_.model_scene, w_.arm_cover);
+    Rendered r;
+    r.result = w.model.render_at(poses, w.reported_pose, w.intrinsics);
+    if (!r.result.usable) throw std::runtime_error(r.result.unusable_reason);
+    r.depth = make_depth_image(w.config.camera.id, w.intrinsics, state.utime, k, /*calibrated=*/true,
+                               r.result.depth_m);
+    r.labels = renderer::make_rendered_link_labels(camera, r.result, w.model_scene, w.arm_cover);
+    if (worlds_.size() > 1) renderer::set_rendered_optical_pose(w.reported_pose, &r.labels);
+    return r;
+  }
 
-    if (k == run_.onset_frame && kind_ != Kind::kNone) {
-      result_.changed_pixels =
-          changed_pixels(w_.model, w_.model_scene, true_joints, true_pose, rendered_result.depth_m,
-                         w_.intrinsics, w_.options.tolerance.noise);
+  // The other cameras' frames of this time for camera `c`'s discrepancy,
+  // each corrected by its own profile (discrepancy/witness_frames.cpp).
+  std::vector<discrepancy::WitnessView> witnesses(size_t c,
+                                                  const std::vector<std::optional<depth_image_t>>& frames,
+                                                  const std::vector<Rendered>& rendered) const {
+    std::vector<discrepancy::WitnessView> views;
+    for (size_t other = 0; other < worlds_.size(); ++other) {
+      if (other == c || !frames[other]) continue;
+      discrepancy::WitnessView view;
+      view.camera_id = worlds_[other]->config.camera.id;
+      view.depth = *frames[other];
+      if (const auto& profile = worlds_[other]->config.discrepancy.camera_profile) {
+        apply_camera_profile(*profile, &view.depth, &rendered[other].labels);
+      }
+      view.optical_from_world = worlds_[other]->reported_pose.inverse();
+      views.push_back(std::move(view));
     }
-    discrepancy::DiscrepancyFrame frame =
-        discrepancy::compute_discrepancy(camera, rendered, labels, w_.options);
+    return views;
+  }
+
+  // Camera `c`'s frame's discrepancy as tofguard-discrepancy computes it.
+  discrepancy::DiscrepancyFrame discrepancy_of(size_t c, int k, const depth_image_t& camera,
+                                               const Rendered& rendered,
+                                               const std::vector<discrepancy::WitnessView>& witnesses,
+                                               const robot_model::JointPositions& true_joints,
+                                               const Eigen::Isometry3d& true_pose) {
+    CampaignWorld& w = *worlds_[c];
+    if (c == 0 && k == run_.onset_frame && kind_ != Kind::kNone) {
+      result_.changed_pixels =
+          changed_pixels(w.model, w.model_scene, true_joints, true_pose, rendered.result.depth_m,
+                         w.intrinsics, w.options.tolerance.noise);
+    }
+    discrepancy::DiscrepancyFrame frame = discrepancy::compute_discrepancy(
+        camera, rendered.depth, rendered.labels, w.options, nullptr, witnesses);
     // As tofguard-discrepancy counts a camera repeating its image.
     frame.summary.depth_hash = discrepancy::depth_hash(camera.depth_mm);
-    frame.summary.repeat_count = repeats_.update(frame.summary.depth_hash);
+    frame.summary.repeat_count = repeats_[c].update(frame.summary.depth_hash);
     return frame;
   }
 
@@ -754,28 +862,35 @@ class CampaignRunJudge {
       result_.fault_search_gain.push_back(d.joint_search_gain[at - d.joint_name.begin()]);
   }
 
-  void judge_verdict(const risk_t& verdict) {
+  // A verdict published at frame k (with several cameras it carries the
+  // worst camera's latest seq, which may be its timeout's -1).
+  void judge_verdict(const risk_t& verdict, int k) {
+    // With several cameras the first frame's verdicts, before every camera
+    // has had one judged, are DANGEROUS (VerdictFusion: no frame of that
+    // camera judged yet); the chain allows motion only after a reset,
+    // accepted only while the verdict is SAFE.
+    if (!every_camera_judged_) return;
     ++result_.frames_judged;
     // An object outside the protective field must never stop the arm:
     // its stops count as false stops, unless the arm's speed had grown
     // the field over it then (an UNKNOWN_OBJECT stop whose S reaches the
     // object's true distance, within the 3 cm the true distance's cover
     // may err).
-    const bool inside_s_then =
-        object_fault_ && verdict.seq >= run_.onset_frame && verdict.level == risk_t::DANGEROUS &&
-        verdict.cause == risk_t::CAUSE_UNKNOWN_OBJECT && object_distance_m_ <= verdict.threshold + 0.03;
+    const bool inside_s_then = object_fault_ && k >= run_.onset_frame && verdict.level == risk_t::DANGEROUS &&
+                               verdict.cause == risk_t::CAUSE_UNKNOWN_OBJECT &&
+                               object_distance_m_ <= verdict.threshold + 0.03;
     const bool after_onset =
-        verdict.seq >= run_.onset_frame && kind_ != Kind::kNone &&
+        k >= run_.onset_frame && kind_ != Kind::kNone &&
         (!object_fault_ || run_.fault.object_in_field || inside_s_then || result_.stopped);
-    if (verdict.seq >= run_.onset_frame && verdict.level == risk_t::WARNING) ++result_.warnings_after_onset;
+    if (k >= run_.onset_frame && verdict.level == risk_t::WARNING) ++result_.warnings_after_onset;
     if (verdict.level == risk_t::DANGEROUS && !after_onset && !result_.false_stop) {
       result_.false_stop = true;
-      result_.false_stop_detail = "seq " + std::to_string(verdict.seq) + ": " + verdict.detail;
+      result_.false_stop_detail = "frame " + std::to_string(k) + ": " + verdict.detail;
     }
     if (!after_onset) return;
     if (!result_.stopped) {
       if (verdict.level != risk_t::DANGEROUS) return;
-      const int frames = static_cast<int>(verdict.seq) - run_.onset_frame + 1;
+      const int frames = k - run_.onset_frame + 1;
       record_stop(verdict, frames, frames * w_.period_s, object_distance_m_);
       return;
     }
@@ -814,25 +929,29 @@ class CampaignRunJudge {
       // A sensor fault naming the stream that froze or stopped (a stalled
       // camera starves the discrepancy stream too: either is right).
       result_.right_cause = result_.stopped && result_.cause == risk_t::CAUSE_SENSOR_FAULT;
-      const bool names_stream = kind_ == Kind::kJointStall
-                                    ? result_.suspect == config_.channels.joint_state
-                                    : result_.suspect == config_.channels.depth ||
-                                          (stall_ && result_.suspect == config_.channels.discrepancy);
+      const ChannelNames& faulty = worlds_[fault_camera_]->config.channels;
+      const bool names_stream =
+          kind_ == Kind::kJointStall
+              ? result_.suspect == config_.channels.joint_state
+              : result_.suspect == faulty.depth || (stall_ && result_.suspect == faulty.discrepancy);
       result_.right_suspect = result_.right_cause && names_stream;
     }
     result_.expected_stop = kind_ != Kind::kNone && !(object_fault_ && !run_.fault.object_in_field);
   }
 
-  CampaignWorld& w_;
-  const deployment::Config& config_;
+  const std::vector<CampaignWorld*> worlds_;
+  CampaignWorld& w_;                  // the first camera's
+  const deployment::Config& config_;  // as the first camera's processes see it
   const CampaignRun& run_;
-  risk::RiskMonitor monitor_;
+  const size_t fault_camera_;
+  risk::CamerasJudgement judgement_;
+  std::vector<discrepancy::RepeatCounter> repeats_;
+  std::vector<std::vector<float>> last_depth_m_;  // the image a frozen camera repeats
   CampaignResult result_;
   const Kind kind_;
   const bool stall_;
   const bool object_fault_;
-  discrepancy::RepeatCounter repeats_;
-  std::vector<float> last_depth_m_;  // the image a frozen camera repeats
+  bool every_camera_judged_ = worlds_.size() == 1;
   std::map<std::string, double> previous_t_;
   ObjectPath object_path_;
   std::vector<renderer::ExtraObject> objects_;
@@ -842,9 +961,23 @@ class CampaignRunJudge {
 }  // namespace
 
 std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vector<CampaignRun>& runs) {
-  CampaignWorld world(arm);
+  // Each camera's deployment as its processes see it.
+  std::vector<deployment::Config> camera_configs;
+  if (arm.config.cameras.size() < 2) {
+    camera_configs.push_back(arm.config);
+  } else {
+    for (const deployment::CameraSection& camera : arm.config.cameras) {
+      camera_configs.push_back(deployment::select_camera(arm.config, camera.id));
+    }
+  }
+  std::vector<std::unique_ptr<CampaignWorld>> worlds;
+  std::vector<CampaignWorld*> world_pointers;
+  for (const deployment::Config& config : camera_configs) {
+    worlds.push_back(std::make_unique<CampaignWorld>(config, camera_configs.size() > 1));
+    world_pointers.push_back(worlds.back().get());
+  }
   std::vector<CampaignResult> results;
-  for (const CampaignRun& run : runs) results.push_back(CampaignRunJudge(&world, run).judge());
+  for (const CampaignRun& run : runs) results.push_back(CampaignRunJudge(world_pointers, run).judge());
   return results;
 }
 

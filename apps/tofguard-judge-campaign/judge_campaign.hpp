@@ -39,6 +39,11 @@ struct CampaignArm {
 
 // The default arm: config/sim.yaml (its motion and camera) as it is.
 CampaignArm default_campaign_arm();
+// The two-camera scene: config/sim-two-cameras.yaml as it is, both its
+// simulated cameras imperfect as real ones and commissioned. Each camera's
+// frame is judged by its own discrepancy (the other's frame its witness)
+// and one judgement of both, as tofguard-risk judges them.
+CampaignArm two_camera_campaign_arm();
 // `urdf` with package paths, in the generic scene written under
 // `scene_dir`; the camera at `eye_m` looking at `target_m` (world, m).
 CampaignArm generic_campaign_arm(const std::string& name, const std::string& urdf,
@@ -51,11 +56,13 @@ std::optional<CampaignArm> kinova_gen3_campaign_arm(const std::string& shared_di
                                                     const std::string& scene_dir);
 
 // `arm` watched by a camera at `rate_hz` (camera.rate_hz: the evidence
-// tests' threshold and the protective field's response time follow it).
+// tests' threshold and the protective field's response time follow it;
+// every camera's, with several).
 CampaignArm with_camera_rate(const CampaignArm& arm, double rate_hz);
 // `arm` watched from a second placement: its camera pose turned by
 // `turn_deg` about the world's vertical (z) axis through the robot's root
-// (the world origin), so the camera sees the arm from another side.
+// (the world origin), so the camera sees the arm from another side (every
+// camera, with several).
 CampaignArm with_camera_turned(const CampaignArm& arm, double turn_deg);
 
 // A fault from frame `onset_frame` on (none: kind kNone).
@@ -67,6 +74,10 @@ struct CampaignFault {
   // the ones still arriving).
   enum class Kind { kNone, kJointOffset, kCameraPose, kObject, kFrozenImage, kCameraStall, kJointStall };
   Kind kind = Kind::kNone;
+  // With several cameras: the camera (index in config.cameras) that a
+  // camera fault (pose, frozen image, stall) is in; objects and joint
+  // faults are seen by every camera.
+  size_t camera = 0;
   // The fault's kind and size for the report and the plots (e.g. "joint
   // offset", 5 (deg); "camera translation", 2 (cm)); size 0: no size.
   std::string group;

@@ -11,7 +11,7 @@
 //                           [--rates-hz 25,30] [--turns-deg 0,40] [--shared DIR]
 //                           [--tsv FILE] [--plots DIR] [--plots-from FILE]
 //                           [--imperfect-cameras N] [--camera-seeds 2,4]
-//                           [--commission-s SECONDS]
+//                           [--commission-s SECONDS] [--fault-camera ID]
 //
 // --camera-cm / --camera-deg: the camera moved along / turned about each
 // axis of its optical frame by each magnitude (fault_runs).
@@ -34,6 +34,8 @@
 // three times that (default 40 s and 120 s: a
 // 12 s recording kept the Kinova Gen3 farther from camera 5 than its motion
 // later goes, and commissioning refuses such a profile).
+// --fault-camera: with several cameras (--arms two-cameras), the camera
+// faults (pose, frozen image, stall) in camera ID (default: the first).
 // --tsv: every run, a line each (campaign_tsv); --plots: detection rate and
 // latency against magnitude per fault kind (plot_campaign), of this
 // campaign's runs or, with --plots-from FILE, of the runs in FILE (a TSV
@@ -41,6 +43,7 @@
 //
 // Prints a markdown table per arm, rate and placement (and every run that
 // missed a target).
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
@@ -64,7 +67,7 @@ int usage(const std::string& why) {
          "[--camera-cm 2,3] [--camera-deg 1] [--streams RUNS] [--nominal-s SECONDS] [--passers-s SECONDS] "
          "[--no-faults] [--objects-cm 5,10,20,40,80] [--beyond-cm 10] [--rates-hz 25,30] "
          "[--turns-deg 0,40] [--shared DIR] [--tsv FILE] [--plots DIR] [--plots-from FILE] "
-         "[--imperfect-cameras N] [--camera-seeds 2,4] [--commission-s SECONDS]\n";
+         "[--imperfect-cameras N] [--camera-seeds 2,4] [--commission-s SECONDS] [--fault-camera ID]\n";
   return 2;
 }
 
@@ -80,6 +83,7 @@ struct Options {
   double beyond_m = 0.1;
   std::vector<double> rates_hz;
   std::vector<double> turns_deg = {0};
+  std::string fault_camera;  // "": the first
   std::string tsv_path;
   std::string plots_dir;
   std::string plots_from;
@@ -136,6 +140,8 @@ bool set_option(const std::string& option, const std::string& value, Options* o)
     }
   } else if (option == "--commission-s") {
     o->commission_s = number_list(value).at(0);
+  } else if (option == "--fault-camera") {
+    o->fault_camera = value;
   } else if (option == "--tsv") {
     o->tsv_path = value;
   } else if (option == "--plots") {
@@ -211,6 +217,14 @@ std::vector<tofguard::test::CampaignRun> runs_for(const tofguard::test::Campaign
   if (o.nominal_s > 0) append(nominal_runs(o.nominal_s, 60, arm.config.camera.rate_hz, 7));
   if (o.passers_s > 0) append(passer_runs(arm, o.passers_s, 9000));
   if (!o.objects_m.empty()) append(object_runs(arm, o.objects_m, o.beyond_m));
+  if (!o.fault_camera.empty()) {
+    const auto& cameras = arm.config.cameras;
+    const auto at = std::find_if(cameras.begin(), cameras.end(),
+                                 [&](const auto& camera) { return camera.id == o.fault_camera; });
+    if (at == cameras.end())
+      throw std::runtime_error("--fault-camera: " + arm.name + " has no camera '" + o.fault_camera + "'");
+    for (CampaignRun& run : runs) run.fault.camera = static_cast<size_t>(at - cameras.begin());
+  }
   return runs;
 }
 
@@ -236,12 +250,14 @@ int run_campaigns(const Options& o) {
       std::optional<CampaignArm> base;
       if (name == "default") {
         base = default_campaign_arm();
+      } else if (name == "two-cameras") {
+        base = two_camera_campaign_arm();
       } else if (name == "iiwa14") {
         base = iiwa14_campaign_arm(o.shared, scene_dir);
       } else if (name == "kinova") {
         base = kinova_gen3_campaign_arm(o.shared, scene_dir);
       } else {
-        return usage("--arms: expected default, iiwa14 or kinova, got '" + name + "'");
+        return usage("--arms: expected default, two-cameras, iiwa14 or kinova, got '" + name + "'");
       }
       if (!base) {
         std::cout << name << ": skipped, its URDF is not under " << o.shared << "/robots\n";

@@ -243,5 +243,69 @@ TEST(JudgeCampaign, KinovaGen3) {
   expect_targets(*arm);
 }
 
+// The two-camera scene (config/sim-two-cameras.yaml: both cameras
+// imperfect and commissioned; each frame judged by its own camera's
+// discrepancy, the other camera's frame its witness, and one judgement of
+// both, as tofguard-risk judges them): the objects' targets; every joint 5
+// degrees off stopped and named at the stop (a joint whose offset changes
+// (almost) no pixel excepted, as above); each camera moved 2 cm or turned 1
+// degree, frozen or stalled: stopped and named by its id. What may differ
+// from one camera: after the stop the published verdict is the worst
+// camera's, whose diagnosis may name another joint (docs/detection.md,
+// "Two cameras").
+TEST(JudgeCampaign, TwoCameras) {
+  const CampaignArm arm = two_camera_campaign_arm();
+  ASSERT_EQ(arm.config.cameras.size(), 2u);
+  expect_object_targets(arm);
+  std::vector<CampaignRun> runs;
+  int joint_runs = 0;
+  for (CampaignRun run : short_runs(arm)) {
+    if (run.fault.kind == CampaignFault::Kind::kJointOffset) {
+      ++joint_runs;
+      runs.push_back(run);
+      continue;
+    }
+    for (size_t camera : {0u, 1u}) {
+      run.fault.camera = camera;
+      runs.push_back(run);
+    }
+  }
+  for (CampaignRun run : stream_fault_runs(1)) {
+    if (run.fault.kind == CampaignFault::Kind::kJointStall) continue;
+    run.fault.camera = 1;
+    runs.push_back(run);
+  }
+  const std::vector<CampaignResult> results = run_campaign(arm, runs);
+  std::cout << campaign_report(arm.name, results, 1.0 / arm.config.camera.rate_hz);
+  int observable_joint_faults = 0, right_suspects = 0, camera_faults = 0;
+  for (size_t i = 0; i < results.size(); ++i) {
+    const CampaignResult& r = results[i];
+    const std::string& camera_id = arm.config.cameras[runs[i].fault.camera].id;
+    SCOPED_TRACE(r.label +
+                 (runs[i].fault.kind == CampaignFault::Kind::kJointOffset ? "" : " in " + camera_id));
+    EXPECT_FALSE(r.false_stop) << r.false_stop_detail;
+    if (runs[i].fault.kind == CampaignFault::Kind::kJointOffset) {
+      if (r.changed_pixels < 5) continue;
+      ++observable_joint_faults;
+      right_suspects += r.right_suspect ? 1 : 0;
+      continue;
+    }
+    ++camera_faults;
+    ASSERT_TRUE(r.stopped);
+    EXPECT_TRUE(r.right_cause) << r.detail;
+    EXPECT_TRUE(r.right_suspect) << r.suspect << ": " << r.detail;
+    EXPECT_EQ(r.detail.rfind(camera_id + ": ", 0), 0u) << "not named: " << r.detail;
+    EXPECT_EQ(r.safe_after_stop, 0);
+    if (runs[i].fault.kind == CampaignFault::Kind::kCameraPose) {
+      EXPECT_LE(r.stop_frames, 2) << r.detail;
+    }
+  }
+  EXPECT_EQ(joint_runs, 7);
+  EXPECT_GE(observable_joint_faults, 6);
+  // Every observable fault but one stopped and named at the stop.
+  EXPECT_GE(right_suspects, observable_joint_faults - 1);
+  EXPECT_EQ(camera_faults, 2 * 3 + 2);
+}
+
 }  // namespace
 }  // namespace tofguard::test
