@@ -153,6 +153,39 @@ CampaignArm two_camera_campaign_arm() {
   return arm;
 }
 
+CampaignArm camera_alone(const CampaignArm& arm, const std::string& camera_id) {
+  CampaignArm alone{arm.name + ", " + camera_id + " alone", deployment::select_camera(arm.config, camera_id)};
+  deployment::CameraSection lone = alone.config.camera;
+  lone.name_suffix = "";
+  alone.config.cameras = {lone};
+  alone.config.camera = lone;
+  alone.config.channels = camera_channel_names(arm.config.channels, "");
+  return alone;
+}
+
+Eigen::Vector3d occluder_before(const CampaignArm& arm, const std::string& camera_id, double distance_m) {
+  const deployment::Config camera =
+      arm.config.cameras.size() > 1 ? deployment::select_camera(arm.config, camera_id) : arm.config;
+  if (camera.camera.id != camera_id)
+    throw std::invalid_argument(arm.name + ": no camera '" + camera_id + "'");
+  return camera.camera.pose.frame_from_optical() * Eigen::Vector3d(0, 0, distance_m);
+}
+
+CampaignArm with_second_camera(const CampaignArm& arm, double turn_deg) {
+  if (arm.config.cameras.size() != 1)
+    throw std::invalid_argument(arm.name + ": a second camera needs one first");
+  CampaignArm two = arm;
+  deployment::CameraSection second = with_camera_turned(arm, turn_deg).config.camera;
+  second.id = arm.config.camera.id + "-2";
+  second.name_suffix = "/" + second.id;
+  second.profile = arm.config.camera.profile;
+  // (A lone camera's settings are config.camera's; generic_campaign_arm
+  // places that one.)
+  two.config.cameras = {arm.config.camera, second};
+  two.name = arm.name + ", a second camera turned " + fixed_text(turn_deg, 0) + " deg";
+  return two;
+}
+
 CampaignArm generic_campaign_arm(const std::string& name, const std::string& urdf,
                                  const std::vector<std::string>& package_paths, const std::string& scene_dir,
                                  const Eigen::Vector3d& eye_m, const Eigen::Vector3d& target_m) {
@@ -614,6 +647,7 @@ class CampaignRunJudge {
     const joint_state_t state = reported_state(k, t_s, faulty, &true_joints);
     objects_.clear();
     if (faulty && object_fault_) move_object(k, true_joints, true_pose(0, faulty));
+    if (run_.occluder_size_m > 0) objects_.push_back(occluder());
     if (stall_ && faulty && !result_.stopped) check_deadlines(k, now_us);
     // Each camera's frame k (none from a stalled camera's).
     std::vector<std::optional<depth_image_t>> frames(worlds_.size());
@@ -638,6 +672,15 @@ class CampaignRunJudge {
       for (const risk_t& verdict : judgement_.on_frame(c, frame.summary, now_us)) judge_verdict(verdict, k);
     }
     every_camera_judged_ = true;
+  }
+
+  // CampaignRun's occluder, in the world.
+  renderer::ExtraObject occluder() const {
+    renderer::ExtraObject box;
+    box.kind = renderer::ExtraObject::Kind::kBox;
+    box.size_m = Eigen::Vector3d::Constant(run_.occluder_size_m);
+    box.world_from_object.translation() = run_.occluder_centre_m;
+    return box;
   }
 
   // Where camera `c` really is: the reported pose, or the camera fault's.

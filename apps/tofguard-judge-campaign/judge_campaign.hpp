@@ -44,6 +44,13 @@ CampaignArm default_campaign_arm();
 // frame is judged by its own discrepancy (the other's frame its witness)
 // and one judgement of both, as tofguard-risk judges them.
 CampaignArm two_camera_campaign_arm();
+// Camera `camera_id` of a deployment of several cameras as a deployment of
+// its own (its lone camera, its profile, one camera's thresholds).
+CampaignArm camera_alone(const CampaignArm& arm, const std::string& camera_id);
+// `arm` (one camera) watched by a second camera as well: its own, turned by
+// `turn_deg` about the world's vertical through the robot's root, with the
+// same sensor, judged together as config/sim-two-cameras.yaml's cameras are.
+CampaignArm with_second_camera(const CampaignArm& arm, double turn_deg);
 // `urdf` with package paths, in the generic scene written under
 // `scene_dir`; the camera at `eye_m` looking at `target_m` (world, m).
 CampaignArm generic_campaign_arm(const std::string& name, const std::string& urdf,
@@ -115,7 +122,16 @@ struct CampaignRun {
   // Motion time of frame 0, seconds (varies the pose between runs).
   double start_s = 0;
   uint64_t noise_seed = 0;
+  // Besides the fault, from frame 0 on: a still cube of edge
+  // occluder_size_m (0: none) centred at occluder_centre_m (world, m), e.g.
+  // before a camera (occluder_before), hiding part of its view of the arm
+  // (a harmless object between that camera and the arm).
+  double occluder_size_m = 0;
+  Eigen::Vector3d occluder_centre_m = Eigen::Vector3d::Zero();
 };
+
+// The point `distance_m` along camera `camera_id`'s optical axis (world, m).
+Eigen::Vector3d occluder_before(const CampaignArm& arm, const std::string& camera_id, double distance_m);
 
 // What happened in one run.
 struct CampaignResult {

@@ -12,6 +12,8 @@
 //                           [--tsv FILE] [--plots DIR] [--plots-from FILE]
 //                           [--imperfect-cameras N] [--camera-seeds 2,4]
 //                           [--commission-s SECONDS] [--fault-camera ID]
+//                           [--occluder-before ID] [--occluder-cm CM] [--camera-alone ID]
+//                           [--second-camera-deg DEG]
 //
 // --camera-cm / --camera-deg: the camera moved along / turned about each
 // axis of its optical frame by each magnitude (fault_runs).
@@ -36,6 +38,14 @@
 // later goes, and commissioning refuses such a profile).
 // --fault-camera: with several cameras (--arms two-cameras), the camera
 // faults (pose, frozen image, stall) in camera ID (default: the first).
+// --occluder-before: in every run, from its first frame, a still cube of
+// --occluder-cm (default 6) edge 0.2 m before camera ID on its optical axis
+// (a harmless object hiding part of that camera's view of the arm).
+// --camera-alone: a deployment of several cameras judged as one of camera
+// ID alone (the matched comparison: the same runs, poses and noise).
+// --second-camera-deg: each arm of one camera watched by a second one as
+// well, its camera turned by DEG about the vertical through the robot's
+// root (its id the first's with "-2").
 // --tsv: every run, a line each (campaign_tsv); --plots: detection rate and
 // latency against magnitude per fault kind (plot_campaign), of this
 // campaign's runs or, with --plots-from FILE, of the runs in FILE (a TSV
@@ -67,7 +77,9 @@ int usage(const std::string& why) {
          "[--camera-cm 2,3] [--camera-deg 1] [--streams RUNS] [--nominal-s SECONDS] [--passers-s SECONDS] "
          "[--no-faults] [--objects-cm 5,10,20,40,80] [--beyond-cm 10] [--rates-hz 25,30] "
          "[--turns-deg 0,40] [--shared DIR] [--tsv FILE] [--plots DIR] [--plots-from FILE] "
-         "[--imperfect-cameras N] [--camera-seeds 2,4] [--commission-s SECONDS] [--fault-camera ID]\n";
+         "[--imperfect-cameras N] [--camera-seeds 2,4] [--commission-s SECONDS] [--fault-camera ID] "
+         "[--occluder-before ID] [--occluder-cm CM] "
+         "[--camera-alone ID] [--second-camera-deg DEG]\n";
   return 2;
 }
 
@@ -83,7 +95,11 @@ struct Options {
   double beyond_m = 0.1;
   std::vector<double> rates_hz;
   std::vector<double> turns_deg = {0};
-  std::string fault_camera;  // "": the first
+  std::string fault_camera;     // "": the first
+  std::string occluder_camera;  // "": no occluder
+  double occluder_m = 0.06;
+  std::string camera_alone;  // "": every camera
+  std::optional<double> second_camera_deg;
   std::string tsv_path;
   std::string plots_dir;
   std::string plots_from;
@@ -142,6 +158,14 @@ bool set_option(const std::string& option, const std::string& value, Options* o)
     o->commission_s = number_list(value).at(0);
   } else if (option == "--fault-camera") {
     o->fault_camera = value;
+  } else if (option == "--occluder-before") {
+    o->occluder_camera = value;
+  } else if (option == "--occluder-cm") {
+    o->occluder_m = std::stod(value) / 100;
+  } else if (option == "--camera-alone") {
+    o->camera_alone = value;
+  } else if (option == "--second-camera-deg") {
+    o->second_camera_deg = std::stod(value);
   } else if (option == "--tsv") {
     o->tsv_path = value;
   } else if (option == "--plots") {
@@ -205,6 +229,16 @@ std::vector<tofguard::test::CampaignArm> variants_of(const tofguard::test::Campa
   return variants;
 }
 
+// The index of camera `id` in `arm`'s cameras (for `option`'s error).
+size_t camera_index(const tofguard::test::CampaignArm& arm, const std::string& id,
+                    const std::string& option) {
+  const auto& cameras = arm.config.cameras;
+  const auto at =
+      std::find_if(cameras.begin(), cameras.end(), [&](const auto& camera) { return camera.id == id; });
+  if (at == cameras.end()) throw std::runtime_error(option + ": " + arm.name + " has no camera '" + id + "'");
+  return static_cast<size_t>(at - cameras.begin());
+}
+
 // The runs the options ask for on `arm`.
 std::vector<tofguard::test::CampaignRun> runs_for(const tofguard::test::CampaignArm& arm, const Options& o) {
   using namespace tofguard::test;
@@ -218,20 +252,36 @@ std::vector<tofguard::test::CampaignRun> runs_for(const tofguard::test::Campaign
   if (o.passers_s > 0) append(passer_runs(arm, o.passers_s, 9000));
   if (!o.objects_m.empty()) append(object_runs(arm, o.objects_m, o.beyond_m));
   if (!o.fault_camera.empty()) {
-    const auto& cameras = arm.config.cameras;
-    const auto at = std::find_if(cameras.begin(), cameras.end(),
-                                 [&](const auto& camera) { return camera.id == o.fault_camera; });
-    if (at == cameras.end())
-      throw std::runtime_error("--fault-camera: " + arm.name + " has no camera '" + o.fault_camera + "'");
-    for (CampaignRun& run : runs) run.fault.camera = static_cast<size_t>(at - cameras.begin());
+    const size_t camera = camera_index(arm, o.fault_camera, "--fault-camera");
+    for (CampaignRun& run : runs) run.fault.camera = camera;
+  }
+  return runs;
+}
+
+// The runs the options ask for on `arm`, with the occluder before camera
+// --occluder-before of `scene` (the arm before --camera-alone took its
+// other cameras away).
+std::vector<tofguard::test::CampaignRun> runs_for(const tofguard::test::CampaignArm& arm,
+                                                  const tofguard::test::CampaignArm& scene,
+                                                  const Options& o) {
+  using namespace tofguard::test;
+  std::vector<CampaignRun> runs = runs_for(arm, o);
+  if (!o.occluder_camera.empty()) {
+    camera_index(scene, o.occluder_camera, "--occluder-before");
+    for (CampaignRun& run : runs) {
+      run.occluder_size_m = o.occluder_m;
+      run.occluder_centre_m = occluder_before(scene, o.occluder_camera, 0.2);
+    }
   }
   return runs;
 }
 
 // Runs `arm`'s campaign, prints its report(s) and adds its runs to *tsv.
-void run_arm(const tofguard::test::CampaignArm& arm, const Options& o, std::string* tsv) {
+// `scene`: the arm before --camera-alone (the occluder's camera is in it).
+void run_arm(const tofguard::test::CampaignArm& arm, const tofguard::test::CampaignArm& scene,
+             const Options& o, std::string* tsv) {
   using namespace tofguard::test;
-  const std::vector<CampaignResult> results = run_campaign(arm, runs_for(arm, o));
+  const std::vector<CampaignResult> results = run_campaign(arm, runs_for(arm, scene, o));
   std::cout << campaign_report(arm.name, results, 1.0 / arm.config.camera.rate_hz) << "\n";
   if (!o.objects_m.empty() || o.passers_s > 0)
     std::cout << object_report(arm.name, results, arm.config) << "\n";
@@ -263,9 +313,10 @@ int run_campaigns(const Options& o) {
         std::cout << name << ": skipped, its URDF is not under " << o.shared << "/robots\n";
         continue;
       }
+      if (o.second_camera_deg) base = with_second_camera(*base, *o.second_camera_deg);
       for (const CampaignArm& arm : variants_of(*base, o)) {
         if (o.camera_seeds.empty()) {
-          run_arm(arm, o, &tsv);
+          run_arm(o.camera_alone.empty() ? arm : camera_alone(arm, o.camera_alone), arm, o, &tsv);
           continue;
         }
         for (int seed : o.camera_seeds) {
@@ -277,7 +328,7 @@ int run_campaigns(const Options& o) {
             continue;
           }
           std::cout << camera.summary << "\n";
-          run_arm(camera.arm, o, &tsv);
+          run_arm(camera.arm, camera.arm, o, &tsv);
         }
       }
     }

@@ -12,6 +12,7 @@ VerdictFusion::VerdictFusion(std::vector<std::string> camera_ids, std::vector<st
       depth_channels_(std::move(depth_channels)),
       releases_allowed_(releases_allowed),
       latest_(camera_ids_.size()),
+      dangerous_since_(camera_ids_.size(), 0),
       released_(camera_ids_.size()) {}
 
 size_t VerdictFusion::index_of(const std::string& id) const {
@@ -34,11 +35,18 @@ risk_t VerdictFusion::no_verdict_yet(size_t camera, const risk_t& verdict) const
 
 risk_t VerdictFusion::worst_counted(size_t camera, const risk_t& verdict) const {
   std::optional<risk_t> worst;
+  size_t worst_camera = camera;
   if (!released_[camera]) worst = verdict;
   for (size_t other = 0; other < latest_.size(); ++other) {
     if (other == camera || released_[other]) continue;
     const risk_t candidate = latest_[other] ? *latest_[other] : no_verdict_yet(other, verdict);
-    if (!worst || candidate.level > worst->level) worst = candidate;
+    const bool found_first = worst && latest_[other] && candidate.level == risk_t::DANGEROUS &&
+                             worst->level == risk_t::DANGEROUS &&
+                             dangerous_since_[other] < dangerous_since_[worst_camera];
+    if (!worst || candidate.level > worst->level || found_first) {
+      worst = candidate;
+      worst_camera = other;
+    }
   }
   // release() never leaves every camera released.
   return *worst;
@@ -48,6 +56,11 @@ std::optional<risk_t> VerdictFusion::fuse(size_t camera, risk_t verdict) {
   if (camera_ids_.size() == 1) return verdict;
   verdict.detail = camera_ids_[camera] + ": " + verdict.detail;
   latest_[camera] = verdict;
+  if (verdict.level != risk_t::DANGEROUS) {
+    dangerous_since_[camera] = 0;
+  } else if (dangerous_since_[camera] == 0) {
+    dangerous_since_[camera] = ++dangerous_runs_;
+  }
   // Back: a released camera that judges a frame SAFE counts again.
   if (released_[camera] && verdict.seq >= 0 && verdict.level == risk_t::SAFE) released_[camera].reset();
   if (released_[camera]) return std::nullopt;

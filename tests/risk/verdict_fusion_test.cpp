@@ -74,6 +74,37 @@ TEST(VerdictFusion, OneCamerasStopHoldsWhateverTheOtherSees) {
   EXPECT_EQ(cleared.detail, "tof-mast: ok");
 }
 
+// Both cameras DANGEROUS: the first finding is published while it holds
+// (a knocked camera, then a joint test the other camera's frames push
+// over, is published as the knock), whichever camera's frame comes; once
+// it clears, the other's.
+TEST(VerdictFusion, AmongStoppedCamerasTheFirstFindingIsPublished) {
+  VerdictFusion fusion = two_cameras();
+  fusion.fuse(0, verdict(1, risk_t::SAFE));
+  fusion.fuse(1, verdict(1, risk_t::SAFE));
+  fusion.fuse(1, verdict(2, risk_t::DANGEROUS, risk_t::CAUSE_CALIBRATION_ERROR, "camera moved"));
+  const risk_t later = *fusion.fuse(0, verdict(2, risk_t::DANGEROUS, risk_t::CAUSE_JOINT_ERROR, "joint a5"));
+  EXPECT_EQ(later.cause, risk_t::CAUSE_CALIBRATION_ERROR);
+  EXPECT_EQ(later.detail, "tof-side: camera moved");
+  for (int64_t seq = 3; seq < 6; ++seq) {
+    EXPECT_EQ(fusion.fuse(0, verdict(seq, risk_t::DANGEROUS, risk_t::CAUSE_JOINT_ERROR, "joint a5"))->detail,
+              "tof-side: camera moved");
+    EXPECT_EQ(
+        fusion.fuse(1, verdict(seq, risk_t::DANGEROUS, risk_t::CAUSE_CALIBRATION_ERROR, "camera moved"))
+            ->detail,
+        "tof-side: camera moved");
+  }
+  // The side camera's finding clears: the mast camera's is the worst.
+  const risk_t cleared = *fusion.fuse(1, verdict(6, risk_t::SAFE));
+  EXPECT_EQ(cleared.cause, risk_t::CAUSE_JOINT_ERROR);
+  EXPECT_EQ(cleared.detail, "tof-mast: joint a5");
+  // Equal warnings: the newest.
+  VerdictFusion warnings = two_cameras();
+  warnings.fuse(0, verdict(1, risk_t::WARNING, risk_t::CAUSE_NONE, "near"));
+  EXPECT_EQ(warnings.fuse(1, verdict(1, risk_t::WARNING, risk_t::CAUSE_NONE, "nearer"))->detail,
+            "tof-side: nearer");
+}
+
 TEST(VerdictFusion, AStalledCamerasTimeoutHoldsUntilItsNextVerdict) {
   VerdictFusion fusion = two_cameras();
   fusion.fuse(0, verdict(1, risk_t::SAFE));

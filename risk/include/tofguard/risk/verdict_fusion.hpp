@@ -40,8 +40,11 @@ class VerdictFusion {
 
   // Camera `camera`'s verdict `verdict`: the verdict to publish. With
   // several cameras its detail begins with the camera's id ("tof-side: ").
-  // The worst level of the cameras not released wins; among equals, the
-  // newest. A released camera's SAFE frame verdict brings it back; its
+  // The worst level of the cameras not released wins; among cameras equally
+  // DANGEROUS, the one that has been so longest (the first finding stands
+  // while it holds: a camera knocked, then the joint tests that its
+  // frames push over, are published as the knock); among other equals,
+  // the newest. A released camera's SAFE frame verdict brings it back; its
   // other verdicts publish nothing (nullopt): the cameras that judge say
   // what there is to say.
   std::optional<risk_t> fuse(size_t camera, risk_t verdict);
@@ -70,6 +73,10 @@ class VerdictFusion {
   std::vector<std::string> depth_channels_;
   bool releases_allowed_;
   std::vector<std::optional<risk_t>> latest_;
+  // Per camera, the order in which its latest run of DANGEROUS verdicts
+  // began (1, 2, ...; 0 while its latest verdict is not DANGEROUS).
+  std::vector<uint64_t> dangerous_since_;
+  uint64_t dangerous_runs_ = 0;
   std::vector<std::optional<Release>> released_;
 };
 
