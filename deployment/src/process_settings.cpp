@@ -73,6 +73,7 @@ estimator::EstimatorProcessSettings estimator_process_settings(const Config& con
   s.estimator = config.estimator;
   s.occupant = config.occupant;
   if (config.cameras.size() > 1) s.hidden_nearer_than_m = config.discrepancy.near_arm_m;
+  s.several_cameras = config.cameras.size() > 1;
   return s;
 }
 

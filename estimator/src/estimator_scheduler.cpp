@@ -79,6 +79,9 @@ void EstimatorScheduler::on_discrepancy(const discrepancy_t& d) {
 void EstimatorScheduler::on_risk(const risk_t& r) {
   // Timeouts (seq -1) are about no frame; faults are not the model's.
   if (r.seq < 0 || r.level < risk_t::WARNING || !is_model_mismatch(r.cause)) return;
+  // Another camera's verdict (several cameras): not about this camera's
+  // frame of that seq.
+  if (settings_.several_cameras && r.detail.rfind(settings_.camera.id + ": ", 0) != 0) return;
   // A verdict on a frame kept with another utime is not about that frame
   // (a camera restarted its seqs).
   const auto f = frames_.find(r.seq);

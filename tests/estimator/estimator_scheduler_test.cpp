@@ -164,6 +164,31 @@ risk_t verdict(int64_t seq, int8_t level, int8_t cause) {
   return r;
 }
 
+// With several cameras the published verdict is the worst camera's (its
+// detail prefixed with its id): only this camera's verdicts trigger an
+// estimate of this camera's frame of that seq.
+TEST_F(SchedulerTest, WithSeveralCamerasOnlyThisCamerasVerdictTriggersAnEstimate) {
+  EstimatorProcessSettings several = config_;
+  several.several_cameras = true;
+  EstimatorScheduler scheduler(several, scene_);
+  feed_joint_states(&scheduler, /*a4_turning=*/true);
+  for (int seq = 1; seq <= 3; ++seq) {
+    ASSERT_TRUE(scheduler.on_depth(frame(seq)));
+    scheduler.on_discrepancy(discrepancy(seq, false));
+  }
+  risk_t other = verdict(3, risk_t::DANGEROUS, risk_t::CAUSE_JOINT_ERROR);
+  other.detail = "tof-side: joint a4 reads other than seen";
+  scheduler.on_risk(other);
+  EXPECT_TRUE(scheduler.take_ready().empty()) << "another camera's verdict triggered an estimate";
+  risk_t own = other;
+  own.detail = several.camera.id + ": joint a4 reads other than seen";
+  scheduler.on_risk(own);
+  const std::vector<ScheduledWork> ready = scheduler.take_ready();
+  ASSERT_EQ(ready.size(), 1u);
+  ASSERT_TRUE(ready[0].job.has_value());
+  EXPECT_EQ(ready[0].job->context.seq, 3);
+}
+
 TEST_F(SchedulerTest, ARiskVerdictOfAModelMismatchTriggersAnEstimate) {
   for (int seq = 1; seq <= 3; ++seq) {
     ASSERT_TRUE(scheduler_.on_depth(frame(seq)));

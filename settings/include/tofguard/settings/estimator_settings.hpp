@@ -80,6 +80,10 @@ struct EstimatorProcessSettings {
   // measured depth is nearer by more than this takes no part
   // (EstimatorOptions::hidden_nearer_than_m); 0 with one camera.
   double hidden_nearer_than_m = 0;
+  // With several cameras tofguard-risk publishes the worst camera's
+  // verdict, its detail prefixed with that camera's id ("tof-side: "): only
+  // a verdict of this camera's is about this camera's frame of that seq.
+  bool several_cameras = false;
 };
 
 }  // namespace tofguard::settings
