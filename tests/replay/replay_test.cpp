@@ -253,26 +253,34 @@ void expect_fault_stop(const InputLog& input, const Replay& replay, int8_t cause
   }
 }
 
+// A nominal log: motion allowed after the start-up reset and never
+// withdrawn, and no timeout verdict, while the log plays (the chain stops
+// the arm when the log ends: every input goes stale). Returns when motion
+// was allowed (-1: never, a failure).
+int64_t expect_motion_held_while_the_log_plays(const ReplayOutput& out) {
+  const int64_t allowed_us = out.first_allowed_us();
+  EXPECT_TRUE(out.reset_accepted && allowed_us > 0) << "motion never allowed (no accepted reset)";
+  if (!out.reset_accepted || allowed_us <= 0) return -1;
+  if (const Status* stop = out.first_stop()) {
+    EXPECT_GT(stop->received_us, out.last_input_us) << "stopped during the log: " << stop->reason;
+  }
+  for (const Verdict& v : out.timeouts) {
+    if (v.received_us >= allowed_us && v.received_us <= out.last_input_us) {
+      ADD_FAILURE() << "timeout while the log plays: " << v.key() << " | " << v.detail;
+    }
+  }
+  return allowed_us;
+}
+
 TEST(Replay, NominalLogNeverStopsTheArm) {
   replay_twice("nominal", [](const InputLog& input, const Replay& replay) {
     const ReplayOutput& out = replay.output();
-    const int64_t allowed_us = out.first_allowed_us();
-    ASSERT_TRUE(out.reset_accepted && allowed_us > 0) << "motion never allowed (no accepted reset)";
-    const Status* stop = out.first_stop();
-    // The chain stops the arm when the log ends (every input goes stale):
-    // only stops while the log still plays count.
-    if (stop) {
-      EXPECT_GT(stop->received_us, out.last_input_us) << "stopped during the log: " << stop->reason;
-    }
+    const int64_t allowed_us = expect_motion_held_while_the_log_plays(out);
+    if (allowed_us < 0) return;
     const std::set<int64_t> judged = input.judged_seqs();
     for (const Verdict& v : out.verdicts) {
       if (judged.count(v.seq)) {
         EXPECT_NE(v.level, risk_t::DANGEROUS) << v.key() << " | " << v.detail;
-      }
-    }
-    for (const Verdict& v : out.timeouts) {
-      if (v.received_us >= allowed_us && v.received_us <= out.last_input_us) {
-        ADD_FAILURE() << "timeout while the log plays: " << v.key() << " | " << v.detail;
       }
     }
     std::cout << "nominal: motion allowed " << (allowed_us - out.first_input_us) / 1000
@@ -346,20 +354,11 @@ TEST(Replay, TwoCamerasNominalLogNeverStopsTheArm) {
       "two-cameras-nominal",
       [](const InputLog& input, const Replay& replay) {
         const ReplayOutput& out = replay.output();
-        const int64_t allowed_us = out.first_allowed_us();
-        ASSERT_TRUE(out.reset_accepted && allowed_us > 0) << "motion never allowed (no accepted reset)";
-        const Status* stop = out.first_stop();
-        if (stop) {
-          EXPECT_GT(stop->received_us, out.last_input_us) << "stopped during the log: " << stop->reason;
-        }
+        const int64_t allowed_us = expect_motion_held_while_the_log_plays(out);
+        if (allowed_us < 0) return;
         for (const Verdict& v : out.verdicts) {
           if (v.received_us >= allowed_us && v.received_us <= out.last_input_us) {
             EXPECT_NE(v.level, risk_t::DANGEROUS) << v.key() << " | " << v.detail;
-          }
-        }
-        for (const Verdict& v : out.timeouts) {
-          if (v.received_us >= allowed_us && v.received_us <= out.last_input_us) {
-            ADD_FAILURE() << "timeout while the log plays: " << v.key() << " | " << v.detail;
           }
         }
         for (const auto& [camera_id, seqs] : out.discrepancy_seqs_of_camera) {
