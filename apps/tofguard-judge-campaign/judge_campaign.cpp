@@ -145,10 +145,11 @@ CampaignArm default_campaign_arm() {
 }
 
 CampaignArm two_camera_campaign_arm() {
-  CampaignArm arm{"default arm, two cameras (config/sim-two-cameras.yaml)",
-                  deployment::load_config(config_variant(source_dir() + "/config/sim-two-cameras.yaml",
-                                                         "judge-campaign-two-cameras-" + std::to_string(::getpid())),
-                                          nullptr)};
+  CampaignArm arm{
+      "default arm, two cameras (config/sim-two-cameras.yaml)",
+      deployment::load_config(config_variant(source_dir() + "/config/sim-two-cameras.yaml",
+                                             "judge-campaign-two-cameras-" + std::to_string(::getpid())),
+                              nullptr)};
   judge_frames_only(&arm.config);
   return arm;
 }
