@@ -21,8 +21,10 @@
 #include "tofguard/common/camera_profile.hpp"
 #include "tofguard/common/depth_frame.hpp"
 #include "tofguard/common/risk_names.hpp"
+#include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/discrepancy/discrepancy_image.hpp"
-#include "tofguard/discrepancy/witness_views.hpp"
+#include "tofguard/discrepancy/discrepancy_process.hpp"
+#include "tofguard/discrepancy/witness_frames.hpp"
 #include "tofguard/renderer/rendered_kinematics.hpp"
 #include "tofguard/renderer/renderer_service.hpp"
 #include "tofguard/risk/cameras_judgement.hpp"
@@ -160,7 +162,7 @@ CampaignArm camera_alone(const CampaignArm& arm, const std::string& camera_id) {
   lone.name_suffix = "";
   alone.config.cameras = {lone};
   alone.config.camera = lone;
-  alone.config.channels = camera_channel_names(arm.config.channels, "");
+  alone.config.channels = arm.config.channels;  // the first camera's names
   return alone;
 }
 
@@ -539,26 +541,13 @@ ObjectPath place_object(const CampaignFault& fault, const robot_model::PlacedArm
   return path;
 }
 
-// The discrepancy's options as tofguard-discrepancy derives them; with
-// several cameras it looks through the others' frames.
-discrepancy::DiscrepancyOptions campaign_discrepancy_options(const deployment::Config& config,
-                                                             bool several_cameras) {
-  discrepancy::DiscrepancyOptions options = discrepancy::discrepancy_options(config.discrepancy);
-  if (several_cameras) {
-    options.hidden_volume = discrepancy::hidden_volume_options(
-        std::sqrt(config.risk.unknown_object_min_area_m2), config.risk.field_approach_speed_m_s);
-    options.other_cameras = true;
-  }
-  return options;
-}
-
 // What every run of an arm's campaign shares: the true scene, the model as
 // tofguard-renderer loads it (the config's geometry, padding and mesh
 // simplification), and the tree tofguard-risk loads.
 struct CampaignWorld {
   // `camera_config`: the deployment as one camera's processes see it
   // (deployment::select_camera with several cameras); must outlive this.
-  CampaignWorld(const deployment::Config& camera_config, bool several_cameras)
+  explicit CampaignWorld(const deployment::Config& camera_config)
       : config(camera_config),
         truth(config),
         model_scene(robot_model::load_scene(config.robot.urdf_path, config.environment.urdf_paths,
@@ -567,7 +556,9 @@ struct CampaignWorld {
         arm_cover(robot_model::cover_arm_with_spheres(model_scene, config.renderer.arm_cover_cell_m)),
         truth_cover(robot_model::cover_arm_with_spheres(model_scene, 0.01)),
         robot_tree(robot_model::load_kinematic_tree(config.robot.urdf_path)),
-        options(campaign_discrepancy_options(config, several_cameras)),
+        // As tofguard-discrepancy derives them (with several cameras it
+        // looks through the others' frames).
+        options(discrepancy::process_discrepancy_options(deployment::discrepancy_process_settings(config))),
         intrinsics(config.camera.intrinsics),
         period_s(1.0 / config.camera.rate_hz),
         period_us(static_cast<int64_t>(std::llround(period_s * 1e6))),
@@ -621,6 +612,13 @@ class CampaignRunJudge {
         kind_(run.fault.kind),
         stall_(kind_ == Kind::kCameraStall || kind_ == Kind::kJointStall),
         object_fault_(kind_ == Kind::kObject) {
+    for (const CampaignWorld* w : worlds) {
+      std::vector<settings::WitnessCameraSettings> witnesses =
+          deployment::discrepancy_process_settings(w->config).witnesses;
+      witness_ids_.emplace_back();
+      for (const auto& witness : witnesses) witness_ids_.back().push_back(witness.id);
+      witness_frames_.emplace_back(std::move(witnesses));
+    }
     if (fault_camera_ >= worlds.size()) {
       throw std::invalid_argument("campaign fault " + run.fault.label + ": no camera " +
                                   std::to_string(fault_camera_));
@@ -658,7 +656,9 @@ class CampaignRunJudge {
     }
     std::vector<Rendered> rendered(worlds_.size());
     for (size_t c = 0; c < worlds_.size(); ++c) {
-      if (frames[c]) rendered[c] = render(c, k, *frames[c], state);
+      if (!frames[c]) continue;
+      rendered[c] = render(c, k, *frames[c], state);
+      show_to_witnesses(c, *frames[c], rendered[c].labels);
     }
     for (size_t c = 0; c < worlds_.size(); ++c) {
       if (frames[c]) judgement_.monitor(c).on_depth(now_us);
@@ -666,8 +666,9 @@ class CampaignRunJudge {
     }
     for (size_t c = 0; c < worlds_.size(); ++c) {
       if (!frames[c]) continue;
-      discrepancy::DiscrepancyFrame frame = discrepancy_of(
-          c, k, *frames[c], rendered[c], witnesses(c, frames, rendered), true_joints, true_pose(c, faulty));
+      discrepancy::DiscrepancyFrame frame =
+          discrepancy_of(c, k, *frames[c], rendered[c], witness_frames_[c].views_at(frames[c]->utime),
+                         true_joints, true_pose(c, faulty));
       if (c == 0 && (k < run_.onset_frame || kind_ == Kind::kNone)) add_nominal_scores(frame.summary);
       if (c == 0 && faulty && kind_ == Kind::kJointOffset) add_fault_search_gain(frame.summary);
       for (const risk_t& verdict : judgement_.on_frame(c, frame.summary, now_us)) judge_verdict(verdict, k);
@@ -801,24 +802,20 @@ class CampaignRunJudge {
     return r;
   }
 
-  // The other cameras' frames of this time for camera `c`'s discrepancy,
-  // each corrected by its own profile (discrepancy/witness_frames.cpp).
-  std::vector<discrepancy::WitnessView> witnesses(size_t c,
-                                                  const std::vector<std::optional<depth_image_t>>& frames,
-                                                  const std::vector<Rendered>& rendered) const {
-    std::vector<discrepancy::WitnessView> views;
-    for (size_t other = 0; other < worlds_.size(); ++other) {
-      if (other == c || !frames[other]) continue;
-      discrepancy::WitnessView view;
-      view.camera_id = worlds_[other]->config.camera.id;
-      view.depth = *frames[other];
-      if (const auto& profile = worlds_[other]->config.discrepancy.camera_profile) {
-        apply_camera_profile(*profile, &view.depth, &rendered[other].labels);
+  // Camera `c`'s frame and labels to every other camera's witnesses, as
+  // its tofguard-discrepancy takes them in (paired by seq, corrected by
+  // camera c's profile).
+  void show_to_witnesses(size_t c, const depth_image_t& frame, const link_labels_t& labels) {
+    for (size_t judged = 0; judged < worlds_.size(); ++judged) {
+      const std::vector<std::string>& ids = witness_ids_[judged];
+      const auto at = std::find(ids.begin(), ids.end(), worlds_[c]->config.camera.id);
+      if (at == ids.end()) continue;
+      const auto index = static_cast<size_t>(at - ids.begin());
+      witness_frames_[judged].add_depth(index, frame);
+      if (const std::string why = witness_frames_[judged].add_labels(index, labels); !why.empty()) {
+        throw std::runtime_error("campaign: " + *at + "'s frame cannot be looked through: " + why);
       }
-      view.optical_from_world = worlds_[other]->reported_pose.inverse();
-      views.push_back(std::move(view));
     }
-    return views;
   }
 
   // Camera `c`'s frame's discrepancy as tofguard-discrepancy computes it.
@@ -991,6 +988,10 @@ class CampaignRunJudge {
   risk::CamerasJudgement judgement_;
   std::vector<discrepancy::RepeatCounter> repeats_;
   std::vector<std::vector<float>> last_depth_m_;  // the image a frozen camera repeats
+  // Per camera, its tofguard-discrepancy's witnesses: the other cameras'
+  // frames (witness_frames.hpp), and their ids in that order.
+  std::vector<discrepancy::WitnessFrames> witness_frames_;
+  std::vector<std::vector<std::string>> witness_ids_;
   CampaignResult result_;
   const Kind kind_;
   const bool stall_;
@@ -1017,7 +1018,7 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
   std::vector<std::unique_ptr<CampaignWorld>> worlds;
   std::vector<CampaignWorld*> world_pointers;
   for (const deployment::Config& config : camera_configs) {
-    worlds.push_back(std::make_unique<CampaignWorld>(config, camera_configs.size() > 1));
+    worlds.push_back(std::make_unique<CampaignWorld>(config));
     world_pointers.push_back(worlds.back().get());
   }
   std::vector<CampaignResult> results;

@@ -47,14 +47,19 @@ void subscribe_witnesses(LcmNode& node, const DiscrepancyProcessSettings& settin
 
 }  // namespace
 
+DiscrepancyOptions process_discrepancy_options(const DiscrepancyProcessSettings& settings) {
+  DiscrepancyOptions options = discrepancy_options(settings.discrepancy);
+  options.hidden_volume = hidden_volume_options(settings.detection_capability_m, settings.approach_speed_m_s);
+  options.other_cameras = !settings.witnesses.empty();
+  return options;
+}
+
 int run_discrepancy(const DiscrepancyProcessSettings& settings) {
   if (!keep_heap_resident())
     std::fprintf(stderr, "tofguard-discrepancy: warning: mallopt refused keep_heap_resident's settings\n");
   LcmNode node(settings.lcm, settings.channels, process_info().name);
   const DiscrepancySettings& dc = settings.discrepancy;
-  DiscrepancyOptions options = discrepancy_options(dc);
-  options.hidden_volume = hidden_volume_options(settings.detection_capability_m, settings.approach_speed_m_s);
-  options.other_cameras = !settings.witnesses.empty();
+  const DiscrepancyOptions options = process_discrepancy_options(settings);
   WitnessFrames witnesses(settings.witnesses);
   FramePairer pairer(dc.pair_timeout_us, dc.max_pending_frames);
   RepeatCounter repeats;
