@@ -170,7 +170,7 @@ Eigen::Vector3d occluder_before(const CampaignArm& arm, const std::string& camer
   const deployment::Config camera =
       arm.config.cameras.size() > 1 ? deployment::select_camera(arm.config, camera_id) : arm.config;
   if (camera.camera.id != camera_id)
-    throw std::invalid_argument(arm.name + ": no camera '" + camera_id + "'");
+    throw std::invalid_argument(arm.name + ": no camera '" + camera_id + "' to put an occluder before");
   return camera.camera.pose.frame_from_optical() * Eigen::Vector3d(0, 0, distance_m);
 }
 

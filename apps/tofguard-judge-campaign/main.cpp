@@ -267,10 +267,10 @@ std::vector<tofguard::test::CampaignRun> runs_for(const tofguard::test::Campaign
   using namespace tofguard::test;
   std::vector<CampaignRun> runs = runs_for(arm, o);
   if (!o.occluder_camera.empty()) {
-    camera_index(scene, o.occluder_camera, "--occluder-before");
+    const Eigen::Vector3d centre_m = occluder_before(scene, o.occluder_camera, 0.2);
     for (CampaignRun& run : runs) {
       run.occluder_size_m = o.occluder_m;
-      run.occluder_centre_m = occluder_before(scene, o.occluder_camera, 0.2);
+      run.occluder_centre_m = centre_m;
     }
   }
   return runs;
