@@ -556,6 +556,9 @@ struct CampaignWorld {
         arm_cover(robot_model::cover_arm_with_spheres(model_scene, config.renderer.arm_cover_cell_m)),
         truth_cover(robot_model::cover_arm_with_spheres(model_scene, 0.01)),
         robot_tree(robot_model::load_kinematic_tree(config.robot.urdf_path)),
+        // As tofguard-risk reads them.
+        robot_link_areas(risk::read_robot_link_areas(config.robot.urdf_path, config.robot.package_paths,
+                                                     config.renderer.geometry)),
         // As tofguard-discrepancy derives them (with several cameras it
         // looks through the others' frames).
         options(discrepancy::process_discrepancy_options(deployment::discrepancy_process_settings(config))),
@@ -574,6 +577,7 @@ struct CampaignWorld {
   // of the surface) than the renderer's.
   const robot_model::ArmSpheres truth_cover;
   const robot_model::KinematicTree robot_tree;
+  const std::vector<risk::LinkArea> robot_link_areas;
   const discrepancy::DiscrepancyOptions options;
   const Intrinsics intrinsics;
   const double period_s;
@@ -606,7 +610,7 @@ class CampaignRunJudge {
         config_(w_.config),
         run_(run),
         fault_camera_(run.fault.camera),
-        judgement_(config_.risk, risk_cameras(worlds), w_.robot_tree, std::nullopt, 0),
+        judgement_(config_.risk, risk_cameras(worlds), w_.robot_tree, w_.robot_link_areas, std::nullopt, 0),
         repeats_(worlds.size()),
         last_depth_m_(worlds.size()),
         kind_(run.fault.kind),

@@ -42,6 +42,8 @@ risk::RiskProcessSettings risk_process_settings(const Config& config) {
   s.channels = config.channels;
   s.occupant = config.occupant;
   s.robot_urdf_path = config.robot.urdf_path;
+  s.robot_package_paths = config.robot.package_paths;
+  s.rendered_geometry = config.renderer.geometry;
   for (const CameraSection& camera : config.cameras) {
     risk::RiskCamera c;
     c.id = camera.id;

@@ -2,11 +2,48 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace tofguard::risk {
+namespace {
 
-ArmCoverage::ArmCoverage(size_t cameras, int min_link_pixels)
-    : min_link_pixels_(min_link_pixels), seen_(cameras), framed_(cameras, false) {}
+std::string joined(const std::vector<std::string>& names) {
+  std::string text;
+  for (const std::string& name : names) text += (text.empty() ? "" : ", ") + name;
+  return text;
+}
+
+std::string percent(double fraction) {
+  return std::to_string(static_cast<int>(std::lround(100 * fraction))) + " %";
+}
+
+}  // namespace
+
+std::vector<LinkArea> read_robot_link_areas(const std::string& urdf_path,
+                                            const std::vector<std::string>& package_paths,
+                                            const std::string& geometry) {
+  robot_model::SceneOptions options;
+  options.geometry = robot_model::parse_geometry_source(geometry);
+  options.package_paths = package_paths;
+  const robot_model::SceneModel scene = robot_model::load_scene(urdf_path, {}, options);
+  const std::vector<double> area_m2 = robot_model::robot_link_areas_m2(scene);
+  std::vector<LinkArea> links;
+  for (size_t i = 0; i < area_m2.size(); ++i) links.push_back({scene.links[i].name, area_m2[i]});
+  return links;
+}
+
+ArmCoverage::ArmCoverage(size_t cameras, int min_link_pixels, const std::vector<LinkArea>& robot_link_areas)
+    : min_link_pixels_(min_link_pixels), seen_(cameras), framed_(cameras, false) {
+  for (const LinkArea& link : robot_link_areas) {
+    if (!std::isfinite(link.area_m2) || link.area_m2 < 0) {
+      throw std::invalid_argument("ArmCoverage: robot link '" + link.name + "' has area " +
+                                  std::to_string(link.area_m2) + " m^2, expected a finite area >= 0");
+    }
+    if (link.area_m2 == 0) continue;
+    links_.push_back(link);
+    total_area_m2_ += link.area_m2;
+  }
+}
 
 void ArmCoverage::on_frame(size_t camera, const discrepancy_t& frame) {
   if (!frame.usable) return;
@@ -14,16 +51,8 @@ void ArmCoverage::on_frame(size_t camera, const discrepancy_t& frame) {
   const int robot_links =
       std::min({frame.num_robot_links, frame.num_links, static_cast<int>(frame.link_name.size()),
                 static_cast<int>(frame.link_compared.size())});
-  const bool has_invalid = static_cast<int>(frame.link_invalid.size()) >= robot_links;
   for (int i = 0; i < robot_links; ++i) {
-    const std::string& name = frame.link_name[i];
-    // Part of the arm's surface once a camera has rendered it (a link
-    // without geometry, such as a root frame, never is).
-    const bool rendered = frame.link_compared[i] + (has_invalid ? frame.link_invalid[i] : 0) > 0;
-    if (rendered && std::find(link_names_.begin(), link_names_.end(), name) == link_names_.end()) {
-      link_names_.push_back(name);
-    }
-    if (frame.link_compared[i] >= min_link_pixels_) seen.push_back(name);
+    if (frame.link_compared[i] >= min_link_pixels_) seen.push_back(frame.link_name[i]);
   }
   seen_[camera] = std::move(seen);
   framed_[camera] = true;
@@ -34,41 +63,44 @@ std::vector<std::string> ArmCoverage::unseen_links(const std::vector<bool>& coun
     if (counted[c] && !framed_[c]) return {};
   }
   std::vector<std::string> unseen;
-  for (const std::string& link : link_names_) {
+  for (const LinkArea& link : links_) {
     bool seen = false;
     for (size_t c = 0; c < seen_.size() && !seen; ++c) {
-      seen = counted[c] && std::find(seen_[c].begin(), seen_[c].end(), link) != seen_[c].end();
+      seen = counted[c] && std::find(seen_[c].begin(), seen_[c].end(), link.name) != seen_[c].end();
     }
-    if (!seen) unseen.push_back(link);
+    if (!seen) unseen.push_back(link.name);
   }
   return unseen;
 }
 
-bool limit_unseen_arm(const std::vector<std::string>& unseen, size_t robot_links, double max_fraction,
+double ArmCoverage::area_fraction(const std::vector<std::string>& links) const {
+  if (total_area_m2_ <= 0) return 0;
+  double area_m2 = 0;
+  for (const LinkArea& link : links_) {
+    if (std::find(links.begin(), links.end(), link.name) != links.end()) area_m2 += link.area_m2;
+  }
+  return area_m2 / total_area_m2_;
+}
+
+bool limit_unseen_arm(const std::vector<std::string>& unseen, double unseen_fraction, double max_fraction,
                       risk_t* verdict) {
-  if (robot_links == 0 || verdict->level == risk_t::DANGEROUS) return false;
-  const double fraction = static_cast<double>(unseen.size()) / static_cast<double>(robot_links);
-  if (!(fraction > max_fraction)) return false;
-  std::string names;
-  for (const std::string& link : unseen) names += (names.empty() ? "" : ", ") + link;
+  if (unseen.empty() || verdict->level == risk_t::DANGEROUS) return false;
+  if (!(unseen_fraction > max_fraction)) return false;
   verdict->level = risk_t::DANGEROUS;
   verdict->cause = risk_t::CAUSE_UNCLASSIFIED;
   verdict->suspect = "risk.unseen_arm_max_fraction";
-  verdict->score = fraction;
+  verdict->score = unseen_fraction;
   verdict->threshold = max_fraction;
-  verdict->detail =
-      "arm not seen (fraction of robot links): " + names + ", " + std::to_string(unseen.size()) + " of " +
-      std::to_string(robot_links) + " robot links seen by no camera, limit " +
-      std::to_string(static_cast<int>(std::lround(100 * max_fraction))) + " %; " + verdict->detail;
+  verdict->detail = "arm not seen (fraction of the arm's surface): " + joined(unseen) + ", " +
+                    percent(unseen_fraction) + " of the arm's surface seen by no camera, limit " +
+                    percent(max_fraction) + "; " + verdict->detail;
   return true;
 }
 
-std::string unseen_links_text(const std::vector<std::string>& unseen, size_t robot_links) {
+std::string unseen_links_text(const std::vector<std::string>& unseen, double unseen_fraction) {
   if (unseen.empty()) return "";
-  std::string names;
-  for (const std::string& link : unseen) names += (names.empty() ? "" : ", ") + link;
-  return " [seen by no camera: " + names + " (" + std::to_string(unseen.size()) + " of " +
-         std::to_string(robot_links) + " robot links)]";
+  return " [seen by no camera: " + joined(unseen) + " (" + percent(unseen_fraction) +
+         " of the arm's surface)]";
 }
 
 }  // namespace tofguard::risk

@@ -31,13 +31,19 @@ VerdictFusion verdict_fusion(const std::vector<RiskCamera>& cameras, const RiskS
 
 CamerasJudgement::CamerasJudgement(const RiskSettings& risk, const std::vector<RiskCamera>& cameras,
                                    const robot_model::KinematicTree& robot,
+                                   const std::vector<LinkArea>& robot_link_areas,
                                    const std::optional<OccupantSettings>& occupant, int64_t now_us)
     : unseen_arm_max_fraction_(risk.unseen_arm_max_fraction),
       cameras_(cameras),
       pooled_(pooled_evidence(risk, cameras, robot)),
       fusion_(verdict_fusion(cameras, risk)),
-      coverage_(cameras.size(), risk.min_link_pixels) {
+      coverage_(cameras.size(), risk.min_link_pixels, robot_link_areas) {
   if (cameras.empty()) throw std::invalid_argument("CamerasJudgement: no camera to judge");
+  if (cameras.size() > 1 && !(coverage_.total_area_m2() > 0)) {
+    throw std::invalid_argument(
+        "CamerasJudgement: no robot link with a surface area, so the arm no camera sees cannot be measured "
+        "(risk.unseen_arm_max_fraction)");
+  }
   for (const RiskCamera& camera : cameras_) {
     RiskSettings settings = several_cameras_evidence_settings(risk, cameras_.size());
     settings.required_heartbeats = camera.required_heartbeats;
@@ -57,8 +63,9 @@ std::optional<risk_t> CamerasJudgement::published(size_t c, const risk_t& verdic
   std::optional<risk_t> fused = fusion_.fuse(c, verdict);
   if (!fused || cameras_.size() < 2 || fused->seq < 0) return fused;
   const std::vector<std::string> unseen = unseen_links();
-  limit_unseen_arm(unseen, coverage_.robot_links(), unseen_arm_max_fraction_, &*fused);
-  fused->detail += unseen_links_text(unseen, coverage_.robot_links());
+  const double unseen_fraction = coverage_.area_fraction(unseen);
+  limit_unseen_arm(unseen, unseen_fraction, unseen_arm_max_fraction_, &*fused);
+  fused->detail += unseen_links_text(unseen, unseen_fraction);
   return fused;
 }
 

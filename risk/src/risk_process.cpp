@@ -33,6 +33,14 @@ ProcessInfo process_info() {
 
 namespace {
 
+// Each robot link's surface area, read from the URDF's meshes, with
+// several cameras (the unseen arm's share); none with one.
+std::vector<LinkArea> arm_link_areas(const RiskProcessSettings& settings) {
+  if (settings.cameras.size() < 2) return {};
+  return read_robot_link_areas(settings.robot_urdf_path, settings.robot_package_paths,
+                               settings.rendered_geometry);
+}
+
 // One camera's judgement: its monitor, fed from its own channels.
 // The wiring of one process: every camera's inputs to its monitor, the
 // shared inputs to all, the fused verdicts and the speed limits out.
@@ -41,7 +49,8 @@ class RiskProcess {
   explicit RiskProcess(const RiskProcessSettings& settings)
       : settings_(settings),
         robot_(robot_model::load_kinematic_tree(settings.robot_urdf_path)),
-        judgement_(settings.risk, settings.cameras, robot_, settings.occupant, monotonic_us()),
+        judgement_(settings.risk, settings.cameras, robot_, arm_link_areas(settings), settings.occupant,
+                   monotonic_us()),
         node_(settings.lcm, settings.channels, process_info().name) {
     // With a key, each verdict goes out signed first (the copy a keyed
     // tofguard-intervene acts on), then plain (for people, logs and tools).

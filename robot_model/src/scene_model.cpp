@@ -289,6 +289,24 @@ size_t SceneModel::num_source_triangles() const {
   return total;
 }
 
+std::vector<double> robot_link_areas_m2(const SceneModel& scene) {
+  std::vector<double> area_m2(static_cast<size_t>(scene.num_robot_links), 0.0);
+  for (const Shape& shape : scene.shapes) {
+    if (shape.link_index < 0 || shape.link_index >= scene.num_robot_links) continue;
+    const TriangleMesh& mesh = scene.meshes[shape.mesh_index];
+    const Eigen::Vector3d scale = shape.scale;
+    double sum_m2 = 0;
+    for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+      const Eigen::Vector3d a = mesh.vertices[mesh.indices[t]].cast<double>().cwiseProduct(scale);
+      const Eigen::Vector3d b = mesh.vertices[mesh.indices[t + 1]].cast<double>().cwiseProduct(scale);
+      const Eigen::Vector3d c = mesh.vertices[mesh.indices[t + 2]].cast<double>().cwiseProduct(scale);
+      sum_m2 += 0.5 * (b - a).cross(c - a).norm();
+    }
+    area_m2[static_cast<size_t>(shape.link_index)] += sum_m2;
+  }
+  return area_m2;
+}
+
 SceneModel load_scene(const std::string& robot_urdf, const std::vector<std::string>& environment_urdfs,
                       const SceneOptions& options) {
   SceneBuilder builder(options);  // checks the options before any file is read

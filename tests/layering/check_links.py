@@ -38,7 +38,9 @@ RENDERER = ["tofguard_renderer", "tofguard_scene_model", "tofguard_robot_model",
 PROGRAM_CLOSURES = {
     "tofguard-intervene": DEPLOYMENT + ["tofguard_intervene"],
     "tofguard-reset": DEPLOYMENT + ["tofguard_intervene"],
-    "tofguard-risk": DEPLOYMENT + ["tofguard_risk", "tofguard_robot_model"],
+    # With several cameras tofguard-risk reads the arm's meshes once, for
+    # each link's surface area (the arm no camera sees).
+    "tofguard-risk": DEPLOYMENT + ["tofguard_risk", "tofguard_robot_model", "tofguard_scene_model"],
     "tofguard-discrepancy": DEPLOYMENT + ["tofguard_discrepancy"],
     "tofguard-renderer": DEPLOYMENT + RENDERER,
     "tofguard-estimator": DEPLOYMENT + RENDERER + ["tofguard_estimator"],
@@ -52,7 +54,8 @@ PROGRAM_CLOSURES = {
     "tofguard-spy": DEPLOYMENT + ["tofguard_spy"],
     # The viewer colours I_dis as tofguard-discrepancy does and draws the
     # protective field as the risk rules size it.
-    "tofguard-view": DEPLOYMENT + ["tofguard_view", "tofguard_discrepancy", "tofguard_risk", "tofguard_robot_model"],
+    "tofguard-view": DEPLOYMENT + ["tofguard_view", "tofguard_discrepancy", "tofguard_risk", "tofguard_robot_model",
+                                   "tofguard_scene_model"],
     "tofguard-tune": DEPLOYMENT + RENDERER + ["tofguard_tune", "tofguard_discrepancy", "tofguard_risk"],
     "tofguard-keygen": ["tofguard_auth", "tofguard_common", "tofguard_lcmtypes"],
     "tofguard-calibrate-depth": ["tofguard_calibration_tool", "tofguard_camera", "tofguard_camera_settings",

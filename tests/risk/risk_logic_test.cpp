@@ -14,6 +14,8 @@
 #include "tofguard/deployment/config.hpp"
 #include "tofguard/deployment/process_settings.hpp"
 #include "tofguard/discrepancy/discrepancy_image.hpp"
+#include "tofguard/risk/arm_coverage.hpp"
+#include "tofguard/risk/cameras_judgement.hpp"
 #include "tofguard/risk/frame_classifier.hpp"
 #include "tofguard/risk/protective_field.hpp"
 #include "tofguard/risk/risk_monitor.hpp"
@@ -70,6 +72,33 @@ using risk::RiskMonitor;
 const deployment::Config& sim_config() {
   static const deployment::Config config = deployment::load_config(ideal_camera_config(), nullptr);
   return config;
+}
+
+// With several cameras the judgement weighs the links no camera sees by
+// their surface, read from the arm's meshes as the renderer draws them:
+// every link of the default arm with geometry has one, and without the
+// arm's surface two cameras are refused rather than judged with no limit
+// on the arm unseen.
+TEST(CamerasJudgement, SeveralCamerasNeedTheArmsSurface) {
+  const deployment::Config& config = sim_config();
+  const std::vector<risk::LinkArea> areas = risk::read_robot_link_areas(
+      config.robot.urdf_path, config.robot.package_paths, config.renderer.geometry);
+  const robot_model::KinematicTree robot = robot_model::load_kinematic_tree(config.robot.urdf_path);
+  ASSERT_EQ(areas.size(), static_cast<size_t>(robot.num_robot_links));
+  for (int i = 0; i < robot.num_robot_links; ++i) {
+    EXPECT_EQ(areas[i].name, robot.links[i].name);
+    EXPECT_EQ(areas[i].area_m2 > 0, !robot.links[i].visuals.empty()) << areas[i].name;
+  }
+  std::vector<risk::RiskCamera> two = {{"tof-mast", 30, config.channels, {}},
+                                       {"tof-side", 30, config.channels, {}}};
+  two[1].channels.depth += "/tof-side";
+  EXPECT_NO_THROW(risk::CamerasJudgement(config.risk, two, robot, areas, std::nullopt, 0));
+  try {
+    risk::CamerasJudgement judgement(config.risk, two, robot, {{"world", 0.0}}, std::nullopt, 0);
+    ADD_FAILURE() << "judged two cameras without the arm's surface";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("no robot link with a surface area"), std::string::npos) << e.what();
+  }
 }
 
 // The deadline tests below count on one deadline for the camera and the

@@ -178,62 +178,85 @@ discrepancy_t frame_seeing(const std::vector<int>& compared, const std::vector<i
   return f;
 }
 
+// The arm's links and their surface areas (m^2): link1 half the arm,
+// link2 a quarter, the gripper and link3 an eighth each; the root frame
+// has no surface.
+const std::vector<LinkArea> kLinkAreas = {
+    {"world", 0.0}, {"link1", 0.2}, {"link2", 0.1}, {"gripper", 0.05}, {"link3", 0.05}};
+
 // The links no camera sees: a link is seen by a camera whose latest frame
 // compares at least min_link_pixels of it (pixels hidden by the user or a
 // far object are not compared: the discrepancy takes them as without a
-// return).
+// return). A link in no camera's view (link3, not in the frames) is unseen.
 TEST(ArmCoverage, ALinkIsUnseenOnlyWhenNoCountedCameraSeesIt) {
-  ArmCoverage coverage(2, /*min_link_pixels=*/30);
+  ArmCoverage coverage(2, /*min_link_pixels=*/30, kLinkAreas);
+  EXPECT_DOUBLE_EQ(coverage.total_area_m2(), 0.4);
   EXPECT_TRUE(coverage.unseen_links({true, true}).empty()) << "no frame yet: nothing to say";
   // The mast camera sees link1 only: the user's arm hides most of link2
   // (20 compared) and the gripper is out of its view.
   coverage.on_frame(0, frame_seeing({100, 20, 0}, {0, 0, 0}));
   EXPECT_TRUE(coverage.unseen_links({true, true}).empty()) << "the side camera has had no frame";
-  EXPECT_EQ(coverage.unseen_links({true, false}), (std::vector<std::string>{"link2", "gripper"}));
+  EXPECT_EQ(coverage.unseen_links({true, false}), (std::vector<std::string>{"link2", "gripper", "link3"}));
+  EXPECT_DOUBLE_EQ(coverage.area_fraction(coverage.unseen_links({true, false})), 0.5);
   // The side camera sees link2 and the gripper (5 of its pixels nearer: a
   // moved link or something against it, judged by that camera).
   coverage.on_frame(1, frame_seeing({0, 60, 35}, {0, 0, 5}));
-  EXPECT_EQ(coverage.unseen_links({true, true}), (std::vector<std::string>{}));
+  EXPECT_EQ(coverage.unseen_links({true, true}), (std::vector<std::string>{"link3"}));
   // Its next frame sees the gripper with only 29 px: unseen by both.
   coverage.on_frame(1, frame_seeing({0, 60, 29}, {0, 0, 5}));
-  EXPECT_EQ(coverage.unseen_links({true, true}), (std::vector<std::string>{"gripper"}));
-  EXPECT_EQ(unseen_links_text(coverage.unseen_links({true, true}), coverage.robot_links()),
-            " [seen by no camera: gripper (1 of 3 robot links)]");
+  const std::vector<std::string> unseen = coverage.unseen_links({true, true});
+  EXPECT_EQ(unseen, (std::vector<std::string>{"gripper", "link3"}));
+  EXPECT_DOUBLE_EQ(coverage.area_fraction(unseen), 0.25);
+  EXPECT_EQ(unseen_links_text(unseen, coverage.area_fraction(unseen)),
+            " [seen by no camera: gripper, link3 (25 % of the arm's surface)]");
   // An unusable frame says nothing about the links.
   discrepancy_t unusable = frame_seeing({0, 0, 0}, {0, 0, 0});
   unusable.usable = false;
   coverage.on_frame(1, unusable);
-  EXPECT_EQ(coverage.unseen_links({true, true}), (std::vector<std::string>{"gripper"}));
-  EXPECT_EQ(unseen_links_text({}, 3), "");
+  EXPECT_EQ(coverage.unseen_links({true, true}), (std::vector<std::string>{"gripper", "link3"}));
+  EXPECT_EQ(unseen_links_text({}, 0), "");
 }
 
-// More than risk.unseen_arm_max_fraction of the links seen by no camera:
-// the verdict is DANGEROUS and says which; at the limit, or a verdict
-// DANGEROUS already, unchanged.
+// An area that is not a surface is a fault in the model, not a link to
+// leave out.
+TEST(ArmCoverage, ANegativeOrUndefinedAreaIsRefused) {
+  EXPECT_THROW(ArmCoverage(2, 30, {{"link1", -0.1}}), std::invalid_argument);
+  EXPECT_THROW(ArmCoverage(2, 30, {{"link1", std::nan("")}}), std::invalid_argument);
+}
+
+// More than risk.unseen_arm_max_fraction of the arm's surface seen by no
+// camera: the verdict is DANGEROUS and says which links and what share;
+// at the limit, or a verdict DANGEROUS already, unchanged. The share is
+// of area, not of links: link1 alone (half the arm) is at the limit, link1
+// with the gripper beyond it, three small links far below it.
 TEST(ArmCoverage, MoreOfTheArmUnseenThanTheLimitStopsIt) {
+  const ArmCoverage coverage(2, 30, kLinkAreas);
   risk_t safe{};
   safe.level = risk_t::SAFE;
   safe.detail = "tof-side: frame matches";
   risk_t r = safe;
-  EXPECT_FALSE(limit_unseen_arm({"link6", "link7"}, 4, 0.5, &r));
+  const std::vector<std::string> small = {"link2", "gripper", "link3"};
+  EXPECT_FALSE(limit_unseen_arm(small, coverage.area_fraction(small), 0.5, &r));
+  EXPECT_FALSE(limit_unseen_arm({"link1"}, coverage.area_fraction({"link1"}), 0.5, &r));
   EXPECT_EQ(r.level, risk_t::SAFE);
-  EXPECT_TRUE(limit_unseen_arm({"link5", "link6", "link7"}, 4, 0.5, &r));
+  const std::vector<std::string> large = {"link1", "gripper"};
+  EXPECT_TRUE(limit_unseen_arm(large, coverage.area_fraction(large), 0.5, &r));
   EXPECT_EQ(r.level, risk_t::DANGEROUS);
   EXPECT_EQ(r.cause, risk_t::CAUSE_UNCLASSIFIED);
   EXPECT_EQ(r.suspect, "risk.unseen_arm_max_fraction");
-  EXPECT_DOUBLE_EQ(r.score, 0.75);
+  EXPECT_DOUBLE_EQ(r.score, 0.625);
   EXPECT_DOUBLE_EQ(r.threshold, 0.5);
   EXPECT_EQ(
       r.detail,
-      "arm not seen (fraction of robot links): link5, link6, link7, 3 of 4 robot links seen by no camera, "
-      "limit 50 %; tof-side: frame matches");
+      "arm not seen (fraction of the arm's surface): link1, gripper, 63 % of the arm's surface seen by no "
+      "camera, limit 50 %; tof-side: frame matches");
   risk_t dangerous = safe;
   dangerous.level = risk_t::DANGEROUS;
   dangerous.cause = risk_t::CAUSE_JOINT_ERROR;
-  EXPECT_FALSE(limit_unseen_arm({"link5", "link6", "link7"}, 4, 0.5, &dangerous));
+  EXPECT_FALSE(limit_unseen_arm(large, coverage.area_fraction(large), 0.5, &dangerous));
   EXPECT_EQ(dangerous.cause, risk_t::CAUSE_JOINT_ERROR);
   r = safe;
-  EXPECT_FALSE(limit_unseen_arm({}, 0, 0.5, &r)) << "no link counted yet";
+  EXPECT_FALSE(limit_unseen_arm({}, 0, 0.5, &r)) << "nothing unseen";
 }
 
 }  // namespace

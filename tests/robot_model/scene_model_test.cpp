@@ -124,6 +124,15 @@ TEST(SceneModel, TessellatedBoxAsStlAndObjRendersLikeThePrimitiveBox) {
       {}, {});
   EXPECT_EQ(stl.meshes.back().num_triangles(), 6u * 4 * 4 * 2);
   EXPECT_EQ(obj_scaled.meshes.back().num_triangles(), 6u * 3 * 3 * 2);
+  // The box's surface, 2 (0.3*0.2 + 0.3*0.25 + 0.2*0.25) = 0.37 m^2, from
+  // each (the scaled unit primitive, the mesh in metres, the unit mesh
+  // scaled per axis); the root frame has none.
+  for (const robot_model::SceneModel* scene : {&primitive, &stl, &obj_scaled}) {
+    const std::vector<double> area_m2 = robot_model::robot_link_areas_m2(*scene);
+    ASSERT_EQ(area_m2.size(), 2u);
+    EXPECT_EQ(area_m2[0], 0.0);
+    EXPECT_NEAR(area_m2[1], 0.37, 1e-6);
+  }
 
   const RenderResult a = render_world_view(primitive);
   const RenderResult b = render_world_view(stl);

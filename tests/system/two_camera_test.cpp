@@ -388,7 +388,7 @@ TEST_F(TwoCameras, AnObjectHidingTheArmFromOneCameraDoesNotStopItWhereTheOtherSe
 // A joint fault on the links the object before the side camera hides from
 // it: the arm stops, either named by the mast camera's joint tests (a4),
 // or, at poses where the mast camera sees too little of the links the
-// fault moves, because more than half the arm is then seen by no camera
+// fault moves, because more than half the arm's surface is then seen by no camera
 // (risk.unseen_arm_max_fraction, the faulted joint's links among them).
 TEST_F(TwoCameras, AJointFaultHiddenFromOneCameraIsFoundByTheOther) {
   start_chain("two-cameras-hidden-fault", two_camera_config("two-cameras-hidden-fault"));

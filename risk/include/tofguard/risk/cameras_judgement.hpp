@@ -31,9 +31,12 @@ class CamerasJudgement {
  public:
   // `robot` must outlive the judgement. Each camera's monitor holds the
   // evidence thresholds for N cameras (several_cameras_evidence_settings).
+  // `robot_link_areas` (arm_coverage.hpp) weigh the links no camera sees;
+  // with several cameras they must give the arm a surface
+  // (std::invalid_argument otherwise), with one they are not used.
   CamerasJudgement(const RiskSettings& risk, const std::vector<RiskCamera>& cameras,
-                   const robot_model::KinematicTree& robot, const std::optional<OccupantSettings>& occupant,
-                   int64_t now_us);
+                   const robot_model::KinematicTree& robot, const std::vector<LinkArea>& robot_link_areas,
+                   const std::optional<OccupantSettings>& occupant, int64_t now_us);
 
   size_t cameras() const { return cameras_.size(); }
   const RiskCamera& camera(size_t c) const { return cameras_[c]; }

@@ -101,6 +101,13 @@ struct SceneModel : KinematicTree {
   size_t num_source_triangles() const;
 };
 
+// Each robot link's surface area, m^2, as the scene draws it: the summed
+// area of its shapes' triangles (a shape's scale applied per axis, a mesh
+// counted once per shape that uses it, padding included). Indexed as
+// KinematicTree::links, robot links only (num_robot_links entries); 0 for
+// a link without geometry, such as a root frame.
+std::vector<double> robot_link_areas_m2(const SceneModel& scene);
+
 // Loads the robot and the environments. Mesh URIs: package://NAME/rest
 // through options.package_paths, file:///abs, absolute paths, and paths
 // relative to the URDF's folder. Meshes are read with assimp (STL, OBJ, DAE,

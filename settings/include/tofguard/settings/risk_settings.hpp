@@ -192,6 +192,12 @@ struct RiskProcessSettings {
   ChannelNames channels;
   // robot.urdf: the arm's kinematic tree (which joint moves which link).
   std::string robot_urdf_path;
+  // With several cameras, each robot link's surface area for the unseen
+  // arm's share (risk/arm_coverage.hpp) is read from the URDF's meshes:
+  // robot.package_paths to find them, renderer.geometry ("visual" or
+  // "collision") for the geometry the cameras' frames are compared with.
+  std::vector<std::string> robot_package_paths;
+  std::string rendered_geometry;
   // Every camera, in config order; each is judged on its own and the
   // verdicts are fused (risk/verdict_fusion.hpp).
   std::vector<RiskCamera> cameras;
