@@ -129,6 +129,11 @@ int64_t get_int64_be(const uint8_t* at) {
 constexpr size_t kHashUtimeSeqBytes = 24;
 constexpr size_t kSeqOffset = 16;
 constexpr size_t kUtimeOffset = 8;
+// With several cameras camera c's k-th frame carries seq
+// c * kCameraSeqStride + k: each stage's message (TOF_RENDERED,
+// SAFETY_DISCREPANCY, the verdict on SAFETY_RISK) then says whose frame it
+// is by its seq alone. Camera 0's seqs are those of one camera.
+constexpr int64_t kCameraSeqStride = 1'000'000'000;
 
 // When each stage's message of a frame arrived (monotonic us, 0: not yet).
 struct FrameArrivals {
@@ -195,10 +200,14 @@ class TwoUrlThread {
 // (auth::publish_signed).
 class ArrivalRecorder {
  public:
-  explicit ArrivalRecorder(const deployment::Config& config)
+  // `cameras`: each camera's channels (TOF_RENDERED and
+  // SAFETY_DISCREPANCY of its own); the verdicts are on config's.
+  ArrivalRecorder(const deployment::Config& config, const std::vector<ChannelNames>& cameras)
       : risk_channel_(config.channels.risk), lcm_(config.lcm.url, config.lcm.image_url) {
-    lcm_.images().subscribe(config.channels.rendered, &ArrivalRecorder::on_rendered, this);
-    lcm_.safety().subscribe(config.channels.discrepancy, &ArrivalRecorder::on_discrepancy, this);
+    for (const ChannelNames& camera : cameras) {
+      lcm_.images().subscribe(camera.rendered, &ArrivalRecorder::on_rendered, this);
+      lcm_.safety().subscribe(camera.discrepancy, &ArrivalRecorder::on_discrepancy, this);
+    }
     lcm_.safety().subscribe(config.channels.risk, &ArrivalRecorder::on_risk, this);
     lcm_.safety().subscribe(config.channels.risk_auth, &ArrivalRecorder::on_signed_risk, this);
     lcm_.safety().subscribe(config.channels.heartbeat, &ArrivalRecorder::on_heartbeat, this);
@@ -238,9 +247,11 @@ class ArrivalRecorder {
     }
     return true;
   }
+  // Forgets every camera's frames before its `seq`-th.
   void forget_before(int64_t seq) {
     std::lock_guard<std::mutex> lock(mutex_);
-    for (auto it = frames_.begin(); it != frames_.end();) it = it->first < seq ? frames_.erase(it) : ++it;
+    for (auto it = frames_.begin(); it != frames_.end();)
+      it = it->first % kCameraSeqStride < seq ? frames_.erase(it) : ++it;
   }
   // tofguard-renderer's prediction counts as of the frame captured at
   // `frame_utime`: from its newest heartbeat once one says it has handled
@@ -506,51 +517,55 @@ struct ArmPath {
   }
 };
 
+// One camera of the bench's deployment: the deployment as its processes
+// see it, the frames it sends (prepared per step), and the seqs they carry.
+struct BenchCamera {
+  deployment::Config config;  // deployment::select_camera's with several cameras
+  std::unique_ptr<SimulatedFrames> frames;
+  std::vector<std::vector<uint8_t>> encoded;
+  int64_t seq_base = 0;  // c * kCameraSeqStride for camera c
+  // Its processes' names in BenchChain's table end with it: "" with one
+  // camera, "/<camera id>" with several.
+  std::string process_suffix;
+};
+
 // One arm at one camera size: its config, the chain running on it, the
-// bench's publisher and receiver, and the simulated camera that prepares
+// bench's publisher and receiver, and the simulated cameras that prepare
 // the frames.
 class BenchChain {
  public:
   BenchChain(const std::string& arm_name, const CampaignArm& arm, const Intrinsics& intrinsics,
              double config_rate_hz, const BenchOptions& options, std::ostream& log)
       : arm_name_(arm_name), arm_(arm), intrinsics_(intrinsics), options_(options), log_(log) {
-    arm_.config.camera.intrinsics = intrinsics;
-    arm_.config.camera.rate_hz = config_rate_hz;
-    frames_ = std::make_unique<SimulatedFrames>(arm_.config);
-    // The campaign's generic scenes place the camera in "world", which the
-    // campaign resolves itself; tofguard-renderer needs a link of the model:
-    // the robot's root link is the world frame (docs/architecture.md).
-    const robot_model::SceneModel& scene = frames_->scene();
-    const CameraPose& pose = arm_.config.camera.pose;
-    if (std::none_of(scene.links.begin(), scene.links.end(),
-                     [&](const robot_model::Link& l) { return l.name == pose.frame_id; })) {
-      arm_.config.camera.pose =
-          CameraPose(scene.links.front().name, pose.translation_m, UnitQuaternion(pose.rotation));
-    }
     const std::string name = "bench-" + arm_name + "-" + size_text(intrinsics.width, intrinsics.height);
-    config_path_ = write_bench_config(arm_, intrinsics, name, options_.joint_prediction);
-    config_ = deployment::load_config(config_path_, nullptr);
+    const std::string scene_config = bench_scene_config(arm_name);
+    if (scene_config.empty()) {
+      add_campaign_arm_camera(name, config_rate_hz);
+    } else {
+      add_scene_cameras(scene_config, name, config_rate_hz);
+    }
     // What tofguard-renderer draws (its geometry, padding and mesh
     // simplification), not the simulated camera's exact scene.
     scene_ = robot_model::load_scene(config_.robot.urdf_path, config_.environment.urdf_paths,
                                      renderer::scene_options(config_.renderer, config_.robot));
     triangles_ = scene_.num_triangles();
-    for (const std::string& joint : frames_->scene().actuated_joint_names) joint_names_.push_back(joint);
-    recorder_ = std::make_unique<ArrivalRecorder>(config_);
+    for (const std::string& joint : cameras_.front().frames->scene().actuated_joint_names)
+      joint_names_.push_back(joint);
+    std::vector<ChannelNames> channels;
+    for (const BenchCamera& camera : cameras_) channels.push_back(camera.config.channels);
+    recorder_ = std::make_unique<ArrivalRecorder>(config_, channels);
     safety_ = std::make_unique<lcm::LCM>(config_.lcm.url);
     images_ = std::make_unique<lcm::LCM>(config_.lcm.image_url);
     if (!safety_->good() || !images_->good()) throw std::runtime_error("cannot open LCM for publishing");
-    for (const std::string& p : kChainProcesses) {
-      processes_[p] = std::make_unique<Subprocess>(
-          name + "-" + p, std::vector<std::string>{bin_dir() + "/" + p, "--config", config_path_});
-    }
+    start_processes(name);
   }
 
   size_t triangles() const { return triangles_; }
+  size_t cameras() const { return cameras_.size(); }
 
   // Runs `rate_hz` for `seconds` (after a warm-up on the first call) and
-  // measures it.
-  BenchStep run_step(double rate_hz, double seconds) {
+  // measures it: a step per camera.
+  std::vector<BenchStep> run_step(double rate_hz, double seconds) {
     if (!recorder_) throw std::logic_error("run_step after measure_floors stopped the chain");
     const int64_t frames = std::max<int64_t>(1, std::llround(rate_hz * seconds));
     const ArmPath path = prepare(rate_hz, static_cast<int>(std::min<int64_t>(frames, kMaxPreparedFrames)));
@@ -558,15 +573,9 @@ class BenchChain {
     {
       const int64_t lead_in_first = next_seq_;
       publish(path, 0, kLeadInFrames);
-      recorder_->wait_for_verdicts(lead_in_first, next_seq_ - 1, last_send_us_ + options_.result_timeout_us);
+      wait_for_verdicts(lead_in_first, next_seq_ - 1);
       recorder_->forget_before(next_seq_);
     }
-    BenchStep step;
-    step.arm = arm_name_;
-    step.width = intrinsics_.width;
-    step.height = intrinsics_.height;
-    step.triangles = triangles();
-    step.rate_hz = rate_hz;
     std::map<std::string, ProcSample> cpu_before;
     for (const auto& [name, p] : processes_) cpu_before[name] = sample_proc(p->pid());
     cpu_before[kBenchProcess] = sample_proc(getpid());
@@ -579,20 +588,57 @@ class BenchChain {
     publish(path, kLeadInFrames, frames);
     const int64_t sent_us = monotonic_us();
     const int64_t last_seq = next_seq_ - 1;
-    recorder_->wait_for_verdicts(first_seq, last_seq, last_send_us_ + options_.result_timeout_us);
+    wait_for_verdicts(first_seq, last_seq);
     const int64_t end_us = monotonic_us();
+    std::map<std::string, double> cpu_percent;
     for (const auto& [name, p] : processes_) {
       const ProcSample after = sample_proc(p->pid());
       if (!after.alive) throw std::runtime_error(name + " died during the step\n" + stderr_of_all());
-      step.cpu_percent[name] = 100.0 * (after.cpu_s - cpu_before[name].cpu_s) / ((end_us - start_us) * 1e-6);
+      cpu_percent[name] = 100.0 * (after.cpu_s - cpu_before[name].cpu_s) / ((end_us - start_us) * 1e-6);
     }
-    step.cpu_percent[kBenchProcess] = 100.0 *
-                                      (sample_proc(getpid()).cpu_s - cpu_before[kBenchProcess].cpu_s) /
-                                      ((end_us - start_us) * 1e-6);
-    step.frames_sent = static_cast<int>(frames);
-    step.sent_rate_hz = frames > 1 ? (frames - 1) / ((sent_us - start_us) * 1e-6) : rate_hz;
+    cpu_percent[kBenchProcess] = 100.0 * (sample_proc(getpid()).cpu_s - cpu_before[kBenchProcess].cpu_s) /
+                                 ((end_us - start_us) * 1e-6);
+    std::vector<BenchStep> steps;
+    for (const BenchCamera& camera : cameras_) {
+      BenchStep step = camera_step(camera, first_seq, last_seq, cpu_percent);
+      step.rate_hz = rate_hz;
+      step.frames_sent = static_cast<int>(frames);
+      step.sent_rate_hz = frames > 1 ? (frames - 1) / ((sent_us - start_us) * 1e-6) : rate_hz;
+      steps.push_back(std::move(step));
+    }
+    if (prediction_before) {
+      const auto after = recorder_->renderer_prediction(last_utime_, monotonic_us() + 1000000);
+      if (after) {
+        BenchStep& step = steps.front();
+        step.prediction_hits = static_cast<int>(after->hits - prediction_before->hits);
+        step.prediction_misses = static_cast<int>(after->misses - prediction_before->misses);
+        step.frames_without_prediction = static_cast<int>(after->without - prediction_before->without);
+      }
+    }
+    recorder_->forget_before(next_seq_);
+    return steps;
+  }
+
+  // One camera's frames [first_seq, last_seq] of a step (their seqs
+  // camera.seq_base on): what arrived of each and when; its processes'
+  // CPU from `cpu_percent` (by the chain's names), with the shared ones'.
+  BenchStep camera_step(const BenchCamera& camera, int64_t first_seq, int64_t last_seq,
+                        const std::map<std::string, double>& cpu_percent) {
+    BenchStep step;
+    step.arm = cameras_.size() > 1 ? arm_name_ + " " + camera.config.camera.id : arm_name_;
+    step.width = intrinsics_.width;
+    step.height = intrinsics_.height;
+    step.triangles = triangles();
+    for (const auto& [name, percent] : cpu_percent) {
+      const size_t slash = name.find('/');
+      if (slash == std::string::npos) {
+        step.cpu_percent[name] = percent;  // a shared process, or the one camera's
+      } else if (name.substr(slash) == camera.process_suffix) {
+        step.cpu_percent[name.substr(0, slash)] = percent;
+      }
+    }
     std::vector<double> render_ms, discrepancy_ms, compute_ms, risk_ms, end_to_end_ms;
-    for (int64_t seq = first_seq; seq <= last_seq; ++seq) {
+    for (int64_t seq = camera.seq_base + first_seq; seq <= camera.seq_base + last_seq; ++seq) {
       const FrameArrivals a = recorder_->arrivals(seq);
       BenchStep::Frame frame;
       frame.seq = seq;
@@ -614,20 +660,11 @@ class BenchChain {
       if (a.risk_us && a.level == risk_t::SAFE) ++step.frames_safe;
       if (a.risk_us == 0 || a.risk_us - a.sent_us > options_.result_timeout_us) ++step.frames_dropped;
     }
-    if (prediction_before) {
-      const auto after = recorder_->renderer_prediction(last_utime_, monotonic_us() + 1000000);
-      if (after) {
-        step.prediction_hits = static_cast<int>(after->hits - prediction_before->hits);
-        step.prediction_misses = static_cast<int>(after->misses - prediction_before->misses);
-        step.frames_without_prediction = static_cast<int>(after->without - prediction_before->without);
-      }
-    }
     step.render = summarise(render_ms);
     step.discrepancy = summarise(discrepancy_ms);
     step.discrepancy_compute = summarise(compute_ms);
     step.risk = summarise(risk_ms);
     step.end_to_end = summarise(end_to_end_ms);
-    recorder_->forget_before(next_seq_);
     return step;
   }
 
@@ -641,7 +678,8 @@ class BenchChain {
     f.height = intrinsics_.height;
     f.rate_hz = rate_hz;
     f.listeners = options_.floor_listeners;
-    f.image_hop.bytes = encoded_.empty() ? 0 : encoded_.front().size();
+    const std::vector<std::vector<uint8_t>>& encoded = cameras_.front().encoded;
+    f.image_hop.bytes = encoded.empty() ? 0 : encoded.front().size();
     f.discrepancy_hop.bytes = recorder_->largest_message(ArrivalRecorder::Stage::kDiscrepancy);
     f.risk_hop.bytes = recorder_->largest_message(ArrivalRecorder::Stage::kRisk);
     const size_t rendered_bytes = recorder_->largest_message(ArrivalRecorder::Stage::kRendered);
@@ -670,9 +708,97 @@ class BenchChain {
   }
 
  private:
+  // A campaign arm (config/sim.yaml with its robot, scene and camera, the
+  // ideal camera: write_bench_config) at the bench's size and rate: one
+  // camera, its frames from the campaign arm's camera.
+  void add_campaign_arm_camera(const std::string& name, double config_rate_hz) {
+    arm_.config.camera.intrinsics = intrinsics_;
+    arm_.config.camera.rate_hz = config_rate_hz;
+    auto frames = std::make_unique<SimulatedFrames>(arm_.config);
+    // The campaign's generic scenes place the camera in "world", which the
+    // campaign resolves itself; tofguard-renderer needs a link of the model:
+    // the robot's root link is the world frame (docs/architecture.md).
+    const robot_model::SceneModel& scene = frames->scene();
+    const CameraPose& pose = arm_.config.camera.pose;
+    if (std::none_of(scene.links.begin(), scene.links.end(),
+                     [&](const robot_model::Link& l) { return l.name == pose.frame_id; })) {
+      arm_.config.camera.pose =
+          CameraPose(scene.links.front().name, pose.translation_m, UnitQuaternion(pose.rotation));
+    }
+    config_path_ = write_bench_config(arm_, intrinsics_, name, options_.joint_prediction);
+    config_ = deployment::load_config(config_path_, nullptr);
+    BenchCamera camera;
+    camera.config = config_;
+    camera.config.camera.pose = arm_.config.camera.pose;
+    camera.frames = std::move(frames);
+    cameras_.push_back(std::move(camera));
+  }
+
+  // A deployment of config/ as it is (write_scene_bench_config): each of its
+  // cameras imperfect and commissioned, at its own size and rate, its
+  // frames from its own simulated camera.
+  void add_scene_cameras(const std::string& scene_config, const std::string& name, double config_rate_hz) {
+    config_path_ = write_scene_bench_config(scene_config, name, options_.joint_prediction);
+    config_ = deployment::load_config(config_path_, nullptr);
+    arm_.config = config_;  // the arm's motion
+    for (size_t c = 0; c < config_.cameras.size(); ++c) {
+      BenchCamera camera;
+      const bool several = config_.cameras.size() > 1;
+      camera.config = several ? deployment::select_camera(config_, config_.cameras[c].id) : config_;
+      const Intrinsics& own = camera.config.camera.intrinsics;
+      if (own.width != intrinsics_.width || own.height != intrinsics_.height ||
+          camera.config.camera.rate_hz != config_rate_hz) {
+        throw std::invalid_argument(
+            "--arms " + arm_name_ + ": " + scene_config +
+            " runs as it is, at its cameras' own size and rate: " + camera.config.camera.id + " is " +
+            size_text(own.width, own.height) + " at " + number_text(camera.config.camera.rate_hz) +
+            " Hz, asked " + size_text(intrinsics_.width, intrinsics_.height) + " at " +
+            number_text(config_rate_hz) + " Hz");
+      }
+      camera.frames = std::make_unique<SimulatedFrames>(camera.config);
+      camera.seq_base = static_cast<int64_t>(c) * kCameraSeqStride;
+      camera.process_suffix = several ? "/" + camera.config.camera.id : "";
+      cameras_.push_back(std::move(camera));
+    }
+  }
+
+  // The judge first, so that it listens before its inputs speak (as
+  // LiveChain starts it); with several cameras each camera's renderer and
+  // discrepancy process with --camera, as the deployment's launch: section
+  // starts them.
+  void start_processes(const std::string& name) {
+    for (const std::string& p : kChainProcesses) {
+      const bool per_camera = p == "tofguard-renderer" || p == "tofguard-discrepancy";
+      if (!per_camera || cameras_.size() == 1) {
+        processes_[p] = std::make_unique<Subprocess>(
+            name + "-" + p, std::vector<std::string>{bin_dir() + "/" + p, "--config", config_path_});
+        continue;
+      }
+      for (const BenchCamera& camera : cameras_) {
+        const std::string& id = camera.config.camera.id;
+        processes_[p + camera.process_suffix] = std::make_unique<Subprocess>(
+            name + "-" + p + "-" + id,
+            std::vector<std::string>{bin_dir() + "/" + p, "--config", config_path_, "--camera", id});
+      }
+    }
+  }
+
+  // Every camera's frames [first_seq, last_seq] have their verdicts, or
+  // result_timeout_us has passed since the last was sent.
+  bool wait_for_verdicts(int64_t first_seq, int64_t last_seq) {
+    bool all = true;
+    for (const BenchCamera& camera : cameras_) {
+      all = recorder_->wait_for_verdicts(camera.seq_base + first_seq, camera.seq_base + last_seq,
+                                         last_send_us_ + options_.result_timeout_us) &&
+            all;
+    }
+    return all;
+  }
+
   // Renders the step's frames before it starts, so that the publisher only
-  // publishes: the simulated ToF camera's pipeline (scene at the arm's pose,
-  // noise, mixed and invalid pixels, distance calibration), encoded once.
+  // publishes: each simulated ToF camera's pipeline (scene at the arm's
+  // pose, noise, mixed and invalid pixels, distance calibration), encoded
+  // once.
   ArmPath prepare(double rate_hz, int count) {
     ArmPath path;
     path.rate_hz = rate_hz;
@@ -680,18 +806,21 @@ class BenchChain {
     path.start_s = motion_start_s_;
     // The next step starts elsewhere on the arm's path.
     motion_start_s_ += 1.7;
-    encoded_.clear();
-    const Eigen::Isometry3d world_from_optical = arm_.config.camera.pose.frame_from_optical();
     last_path_ = path;
-    for (int i = 0; i < count; ++i) {
-      const std::vector<float> depth_m = frames_->capture(joints_at(path.start_s + i / rate_hz),
-                                                          world_from_optical, intrinsics_, ++noise_index_);
-      const depth_image_t image =
-          make_depth_image(config_.camera.id, intrinsics_, 0, 0, /*calibrated=*/true, depth_m);
-      std::vector<uint8_t> bytes(static_cast<size_t>(image.getEncodedSize()));
-      if (image.encode(bytes.data(), 0, static_cast<int>(bytes.size())) < 0)
-        throw std::runtime_error("cannot encode a depth frame");
-      encoded_.push_back(std::move(bytes));
+    for (BenchCamera& camera : cameras_) {
+      camera.encoded.clear();
+      const Eigen::Isometry3d world_from_optical = camera.config.camera.pose.frame_from_optical();
+      const Intrinsics& intrinsics = camera.config.camera.intrinsics;
+      for (int i = 0; i < count; ++i) {
+        const std::vector<float> depth_m = camera.frames->capture(
+            joints_at(path.start_s + i / rate_hz), world_from_optical, intrinsics, ++noise_index_);
+        const depth_image_t image =
+            make_depth_image(camera.config.camera.id, intrinsics, 0, 0, /*calibrated=*/true, depth_m);
+        std::vector<uint8_t> bytes(static_cast<size_t>(image.getEncodedSize()));
+        if (image.encode(bytes.data(), 0, static_cast<int>(bytes.size())) < 0)
+          throw std::runtime_error("cannot encode a depth frame");
+        camera.encoded.push_back(std::move(bytes));
+      }
     }
     return path;
   }
@@ -763,11 +892,15 @@ class BenchChain {
       const joint_state_t s = joint_state(path, (first_k * period_us + frame_us) * 1e-6, utime);
       safety_->publish(config_.channels.joint_state, &s);
       at(frame_us);
-      std::vector<uint8_t>& bytes = encoded_[static_cast<size_t>(path.index(first_k + k))];
-      put_int64_be(bytes.data() + kUtimeOffset, utime);
-      put_int64_be(bytes.data() + kSeqOffset, next_seq_);
-      recorder_->sent(next_seq_, monotonic_us());
-      images_->publish(config_.channels.depth, bytes.data(), static_cast<unsigned int>(bytes.size()));
+      // Every camera's frame of this instant, one after the other (cameras
+      // that run free may expose at the same time).
+      for (BenchCamera& camera : cameras_) {
+        std::vector<uint8_t>& bytes = camera.encoded[static_cast<size_t>(path.index(first_k + k))];
+        put_int64_be(bytes.data() + kUtimeOffset, utime);
+        put_int64_be(bytes.data() + kSeqOffset, camera.seq_base + next_seq_);
+        recorder_->sent(camera.seq_base + next_seq_, monotonic_us());
+        images_->publish(camera.config.channels.depth, bytes.data(), static_cast<unsigned int>(bytes.size()));
+      }
       last_send_us_ = monotonic_us();
       last_utime_ = utime;
       ++next_seq_;
@@ -825,7 +958,8 @@ class BenchChain {
   }
 
   void measure_compute_floors(BenchFloors* f) {
-    if (encoded_.empty()) return;
+    const std::vector<std::vector<uint8_t>>& encoded = cameras_.front().encoded;
+    if (encoded.empty()) return;
     renderer::DepthRenderer renderer(scene_, config_.renderer.near_m, config_.renderer.far_m);
     const CameraPose& pose = config_.camera.pose;
     const auto joints = [&](int i) {
@@ -859,7 +993,7 @@ class BenchChain {
     // (docs/benchmarks.md, "The hot paths").
     uint64_t digest = 0xcbf29ce484222325ULL;
     for (int i = 0; i < n; ++i) {
-      const std::vector<uint8_t>& bytes = encoded_[static_cast<size_t>(last_path_.index(i))];
+      const std::vector<uint8_t>& bytes = encoded[static_cast<size_t>(last_path_.index(i))];
       depth_image_t camera;
       if (camera.decode(bytes.data(), 0, static_cast<int>(bytes.size())) < 0)
         throw std::runtime_error("floors: cannot decode a prepared frame");
@@ -961,7 +1095,8 @@ class BenchChain {
   std::ostream& log_;
   std::string config_path_;
   deployment::Config config_;
-  std::unique_ptr<SimulatedFrames> frames_;
+  // Camera 0 is config_'s first camera (its channels config_.channels).
+  std::vector<BenchCamera> cameras_;
   std::vector<std::string> joint_names_;
   size_t triangles_ = 0;
   // What tofguard-renderer loads (the floors render it).
@@ -972,7 +1107,6 @@ class BenchChain {
   std::unique_ptr<lcm::LCM> safety_;
   std::unique_ptr<lcm::LCM> images_;
   std::map<std::string, std::unique_ptr<Subprocess>> processes_;
-  std::vector<std::vector<uint8_t>> encoded_;
   int64_t next_seq_ = 1;
   int64_t last_send_us_ = 0;
   int64_t last_utime_ = 0;
@@ -1024,12 +1158,31 @@ std::string not_sustained_because(const BenchStep& step) {
 
 }  // namespace
 
+std::string bench_scene_config(const std::string& arm_name) {
+  if (arm_name == "sim") return "config/sim.yaml";
+  if (arm_name == "two-cameras") return "config/sim-two-cameras.yaml";
+  return "";
+}
+
+std::string write_scene_bench_config(const std::string& scene_config, const std::string& name,
+                                     bool joint_prediction) {
+  const std::vector<std::pair<std::string, std::string>> bench = {
+      {"required_heartbeats: [tofguard-camera, tofguard-renderer, tofguard-discrepancy]",
+       "required_heartbeats: [tofguard-renderer, tofguard-discrepancy]"},
+      {"estimate:\n    enabled: true", "estimate:\n    enabled: false"},
+      {"from_joint_states: true", joint_prediction ? "from_joint_states: true" : "from_joint_states: false"}};
+  return config_variant(source_dir() + "/" + scene_config, name, bench, "occupant: ~\n");
+}
+
 std::optional<CampaignArm> bench_arm(const std::string& name, const std::string& shared_dir,
                                      const std::string& scene_dir) {
   if (name == "default") return default_campaign_arm();
+  // (The chain runs the config file; the arm gives the size asked of it.)
+  if (!bench_scene_config(name).empty()) return default_campaign_arm();
   if (name == "iiwa14") return iiwa14_campaign_arm(shared_dir, scene_dir);
   if (name == "kinova") return kinova_gen3_campaign_arm(shared_dir, scene_dir);
-  throw std::invalid_argument("--arms: expected default, iiwa14 or kinova, got '" + name + "'");
+  throw std::invalid_argument("--arms: expected default, iiwa14, kinova, sim or two-cameras, got '" + name +
+                              "'");
 }
 
 std::string write_bench_config(const CampaignArm& arm, const Intrinsics& intrinsics, const std::string& name,
@@ -1104,13 +1257,18 @@ BenchReport run_bench(const BenchOptions& options, std::ostream& log) {
       const auto floor_hops = [](double rate_hz, double seconds) {
         return static_cast<int>(std::clamp<int64_t>(std::llround(rate_hz * seconds), 30, 300));
       };
+      // The floors are one camera's stages alone.
+      const bool floors = options.floors && chain.cameras() == 1;
+      if (options.floors && !floors) log << "  floors: not measured with several cameras" << std::endl;
       if (!options.ramp) {
-        report.steps.push_back(chain.run_step(options.rate_hz, options.seconds));
-        if (options.floors)
+        for (BenchStep& step : chain.run_step(options.rate_hz, options.seconds))
+          report.steps.push_back(std::move(step));
+        if (floors)
           report.floors.push_back(
               chain.measure_floors(options.rate_hz, floor_hops(options.rate_hz, options.seconds)));
         continue;
       }
+      if (chain.cameras() > 1) throw std::invalid_argument("--ramp: with one camera only, not " + arm_name);
       BenchRamp ramp;
       ramp.arm = arm_name;
       ramp.width = width;
@@ -1119,7 +1277,7 @@ BenchReport run_bench(const BenchOptions& options, std::ostream& log) {
       // Whether `rate` is sustained; if not, why (stopped_because).
       const auto sustains = [&](double rate) {
         log << "  " << fixed_text(rate, 0) << " Hz for " << options.ramp_step_s << " s" << std::endl;
-        ramp.steps.push_back(chain.run_step(rate, options.ramp_step_s));
+        ramp.steps.push_back(chain.run_step(rate, options.ramp_step_s).front());
         const std::string why = not_sustained_because(ramp.steps.back());
         if (why.empty()) return true;
         ramp.stopped_because = fixed_text(rate, 0) + " Hz: " + why;
@@ -1148,7 +1306,7 @@ BenchReport run_bench(const BenchOptions& options, std::ostream& log) {
       if (ramp.stopped_because.empty())
         ramp.stopped_because = "none up to " + fixed_text(options.ramp_max_hz, 0) + " Hz (the ramp's end)";
       report.ramps.push_back(std::move(ramp));
-      if (options.floors)
+      if (floors)
         report.floors.push_back(chain.measure_floors(options.ramp_start_hz,
                                                      floor_hops(options.ramp_start_hz, options.ramp_step_s)));
     }

@@ -225,7 +225,7 @@ double risk_stage_floor_ms(const BenchFloors& floors);
 struct BenchReport {
   std::string machine;               // nproc, CPU model, load
   std::string date;                  // UTC
-  std::vector<BenchStep> steps;      // without --ramp: one per arm and size
+  std::vector<BenchStep> steps;      // without --ramp: one per arm, size and camera
   std::vector<BenchRamp> ramps;      // with --ramp
   std::vector<BenchFloors> floors;   // one per arm and size (unless --no-floors)
   std::vector<std::string> skipped;  // arms skipped, with why
@@ -233,10 +233,28 @@ struct BenchReport {
 };
 
 // The campaign arm `name` (default, iiwa14, kinova; judge_campaign.hpp's
-// scenes), nothing when its URDF is not under `shared_dir`. Throws
-// std::invalid_argument for another name.
+// scenes), nothing when its URDF is not under `shared_dir`; for a
+// deployment of config/ (bench_scene_config) the default arm, whose size
+// it must be run at. Throws std::invalid_argument for another name.
 std::optional<CampaignArm> bench_arm(const std::string& name, const std::string& shared_dir,
                                      const std::string& scene_dir);
+
+// The deployments the bench runs as they are, their cameras imperfect and
+// commissioned (each with its own profile), at their cameras' own size and
+// rate: "sim" config/sim.yaml, "two-cameras" config/sim-two-cameras.yaml
+// (each camera's renderer and discrepancy process started with --camera,
+// both cameras' frames sent at the same instant, camera c's seqs from
+// c * 10^9 on, a step per camera). The file under the source tree, or ""
+// for a campaign arm.
+std::string bench_scene_config(const std::string& arm_name);
+
+// `scene_config` (bench_scene_config's) as the bench's chain runs it: no
+// tofguard-camera heartbeat required (the bench publishes the frames), no
+// estimate, no occupant (the simulated frames show no user), written to
+// output_dir()/<name>.yaml; returns the path. joint_prediction as
+// write_bench_config's.
+std::string write_scene_bench_config(const std::string& scene_config, const std::string& name,
+                                     bool joint_prediction = true);
 
 // config/sim.yaml for `arm` at `intrinsics` (its robot, environment,
 // camera pose and rate), as the bench's chain runs it, written to

@@ -3,10 +3,16 @@
 // frames dropped and CPU per process, per arm and camera size, at one rate or
 // ramping. Run it through scripts/bench (a private network namespace).
 //
-//   tofguard-bench [--arms default,iiwa14,kinova] [--resolutions 176x144,320x240,640x480]
+//   tofguard-bench [--arms default,iiwa14,kinova,sim,two-cameras] [--resolutions 176x144,320x240,640x480]
 //                  [--rate-hz 30] [--seconds 10] [--ramp] [--ramp-step-s 3] [--ramp-max-hz 1920]
 //                  [--shared DIR] [--markdown FILE] [--plot FILE.png] [--frames FILE.csv] [--no-floors]
 //                  [--floor-listeners N] [--plan] [--no-joint-prediction]
+//
+// --arms: the campaign's arms (default, iiwa14, kinova: the ideal camera
+// at each size asked), or a deployment of config/ as it is, at its cameras'
+// 176x144 and 30 Hz: sim (config/sim.yaml, its camera commissioned),
+// two-cameras (config/sim-two-cameras.yaml: both cameras' frames at each
+// instant, a row per camera; no floors, no --ramp).
 //
 // Each step's measured frames come after 20 at its rate that are not
 // measured (the chain's steady state at that rate; chain_bench.cpp,
@@ -54,12 +60,12 @@
 namespace {
 
 int usage(const std::string& why) {
-  std::cerr
-      << "tofguard-bench: " << why
-      << "\nusage: tofguard-bench [--arms default,iiwa14,kinova] [--resolutions 176x144,320x240,640x480] "
-         "[--rate-hz 30] [--seconds 10] [--ramp] [--ramp-step-s 3] [--ramp-max-hz 1920] [--shared DIR] "
-         "[--markdown FILE] [--plot FILE.png] [--frames FILE.csv] [--no-floors] [--floor-listeners N] "
-         "[--plan] [--no-joint-prediction]\n";
+  std::cerr << "tofguard-bench: " << why
+            << "\nusage: tofguard-bench [--arms default,iiwa14,kinova,sim,two-cameras] [--resolutions "
+               "176x144,320x240,640x480] "
+               "[--rate-hz 30] [--seconds 10] [--ramp] [--ramp-step-s 3] [--ramp-max-hz 1920] [--shared DIR] "
+               "[--markdown FILE] [--plot FILE.png] [--frames FILE.csv] [--no-floors] [--floor-listeners N] "
+               "[--plan] [--no-joint-prediction]\n";
   return 2;
 }
 

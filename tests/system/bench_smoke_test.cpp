@@ -1,5 +1,6 @@
 // tofguard-bench's logic, short (apps/tofguard-bench/chain_bench.hpp): the
-// default arm at 176x144 and 10 Hz for 3 s through the real observer chain.
+// default arm at 176x144 and 10 Hz for 3 s through the real observer chain,
+// and the two-camera scene (config/sim-two-cameras.yaml) for 2 s at 30 Hz.
 // Asserts that every frame went through every stage, none was dropped, and
 // the report has its rows, the floors' included (renders, compute_discrepancy
 // calls and LCM hops counted); never a wall-clock latency (the machine may
@@ -146,6 +147,54 @@ TEST(BenchSmoke, WithThePlanFramesAreRenderedAhead) {
   EXPECT_NE(markdown.find("tofguard-renderer rendered " + std::to_string(step.prediction_hits) + " of 30"),
             std::string::npos)
       << markdown;
+}
+
+// The two-camera deployment as it is (config/sim-two-cameras.yaml, both
+// cameras commissioned), both cameras' frames sent at each instant: each
+// camera's frames go through its own renderer and discrepancy process to a
+// verdict of their own (by seq), a row per camera; no floors (one camera's
+// stages alone).
+TEST(BenchSmoke, TwoCamerasEachFrameGetsItsOwnVerdict) {
+  BenchOptions options = smoke_options();
+  options.arms = {"two-cameras"};
+  options.rate_hz = 30;  // the cameras' own rate
+  options.seconds = 2;
+  const BenchReport report = run_bench(options, std::cerr);
+  ASSERT_EQ(report.steps.size(), 2u);
+  EXPECT_TRUE(report.floors.empty());
+  const std::string ids[2] = {"tof-mast", "tof-side"};
+  for (size_t c = 0; c < 2; ++c) {
+    const BenchStep& step = report.steps[c];
+    EXPECT_EQ(step.arm, "two-cameras " + ids[c]);
+    EXPECT_EQ(step.frames_sent, 60);
+    EXPECT_EQ(step.frames_rendered, step.frames_sent) << step.arm;
+    EXPECT_EQ(step.frames_judged, step.frames_sent) << step.arm;
+    EXPECT_EQ(step.frames_verdict, step.frames_sent) << step.arm;
+    EXPECT_EQ(step.frames_dropped, 0) << step.arm;
+    EXPECT_EQ(step.end_to_end.count, step.frames_sent) << step.arm;
+    EXPECT_GE(step.frames_safe, step.frames_sent * 9 / 10) << step.arm;
+    for (const char* p : {"tofguard-renderer", "tofguard-discrepancy", "tofguard-risk", "tofguard-intervene"})
+      EXPECT_EQ(step.cpu_percent.count(p), 1u) << step.arm << ": " << p;
+  }
+  const std::string markdown = bench_markdown(report);
+  std::cout << markdown;
+  EXPECT_NE(markdown.find("| two-cameras tof-side | "), std::string::npos) << markdown;
+}
+
+// A deployment of config/ runs at its cameras' own size and rate: another
+// is refused before any process starts, naming the camera and both.
+TEST(BenchSmoke, ADeploymentAtAnotherSizeIsRefused) {
+  BenchOptions options = smoke_options();
+  options.arms = {"two-cameras"};
+  options.resolutions = {{320, 240}};
+  try {
+    run_bench(options, std::cerr);
+    ADD_FAILURE() << "ran config/sim-two-cameras.yaml at 320x240";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("tof-mast is 176x144 at 30 Hz, asked 320x240 at 10 Hz"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace
