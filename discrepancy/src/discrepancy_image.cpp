@@ -982,9 +982,7 @@ DiscrepancyFrame compute_discrepancy(const depth_image_t& camera, const depth_im
 }
 
 Eigen::Vector3d optical_point_m(const depth_image_t& camera, int i, double z_m) {
-  const int width = camera.width;
-  return Eigen::Vector3d((i % width - camera.cx) * z_m / camera.fx, (i / width - camera.cy) * z_m / camera.fy,
-                         z_m);
+  return tofguard::optical_point_m(camera, i % camera.width, i / camera.width, z_m);
 }
 
 int64_t depth_hash(const std::vector<int16_t>& depth_mm) {

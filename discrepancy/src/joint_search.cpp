@@ -1,4 +1,5 @@
 #include "tofguard/discrepancy/joint_search.hpp"
+#include "tofguard/common/camera_geometry.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -277,9 +278,7 @@ SearchPoint search_point(const depth_image_t& rendered, int u, int v, const Dept
                          double model_var) {
   const double z = rendered.depth_mm[static_cast<size_t>(v) * rendered.width + u];
   const double sigma_d = noise.sigma_mm(z);
-  return SearchPoint{
-      Eigen::Vector3d((u - rendered.cx) * z / rendered.fx, (v - rendered.cy) * z / rendered.fy, z),
-      1.0 / std::sqrt(sigma_d * sigma_d + model_var)};
+  return SearchPoint{optical_point_m(rendered, u, v, z), 1.0 / std::sqrt(sigma_d * sigma_d + model_var)};
 }
 
 using PointsOfLink = std::vector<std::vector<SearchPoint>>;

@@ -1,4 +1,5 @@
 #include "tofguard/estimator/motion_estimator.hpp"
+#include "tofguard/common/camera_geometry.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -324,8 +325,7 @@ struct MotionEstimator::RenderedView {
 
   // The optical-frame point (m) of pixel (u, v) at depth z (m).
   Eigen::Vector3d back_project(int u, int v, double z) const {
-    const Intrinsics& in = frame.intrinsics;
-    return Eigen::Vector3d((u - in.cx) * z / in.fx, (v - in.cy) * z / in.fy, z);
+    return optical_point_m(frame.intrinsics, u, v, z);
   }
 };
 
@@ -427,7 +427,7 @@ void MotionEstimator::add_depth_term(const RenderedView& view, const std::vector
   // shifts a small object's surface along the rays by about the same
   // amount, which would otherwise turn the distal joints.
   const bool robot = is_robot_label(labels[i]);
-  const Eigen::Vector3d ray((u - in.cx) / in.fx, (v - in.cy) / in.fy, 1.0);
+  const Eigen::Vector3d ray = optical_point_m(in, u, v, 1.0);
   const Eigen::Vector3d d =
       view.back_project(u, v, z_measured) + (robot ? view.state.robot_depth_offset_m : 0.0) * ray;
   const double residual = normal.dot(m - d);

@@ -1,4 +1,5 @@
 #include "tofguard/sim/tof_error_model.hpp"
+#include "tofguard/common/camera_geometry.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,11 +13,6 @@
 
 namespace tofguard::sim {
 namespace {
-
-// The point seen at pixel (u, v) with depth z, in the optical frame.
-Eigen::Vector3d back_project(const Intrinsics& in, int u, int v, double z) {
-  return Eigen::Vector3d((u - in.cx) / in.fx * z, (v - in.cy) / in.fy * z, z);
-}
 
 // What the true image shows per pixel (row-major): the seen point in the
 // optical frame, its radial distance (0: nothing seen) and the surface's
@@ -45,7 +41,7 @@ SurfaceGeometry surface_geometry(const std::vector<float>& z_true, const Intrins
       const double z = at(u, v);
       if (!(z > 0)) continue;
       const size_t i = static_cast<size_t>(v) * w + u;
-      const Eigen::Vector3d p = back_project(intrinsics, u, v, z);
+      const Eigen::Vector3d p = optical_point_m(intrinsics, u, v, z);
       g.point_m[i] = p;
       g.r_m[i] = p.norm();
       // Surface tangents from the neighbours on the same surface (central
@@ -55,8 +51,8 @@ SurfaceGeometry surface_geometry(const std::vector<float>& z_true, const Intrins
         const bool before = u0 >= 0 && v0 >= 0 && same_surface(z, at(u0, v0));
         const bool after = u1 < w && v1 < h && same_surface(z, at(u1, v1));
         if (!before && !after) return false;
-        const Eigen::Vector3d a = before ? back_project(intrinsics, u0, v0, at(u0, v0)) : p;
-        const Eigen::Vector3d b = after ? back_project(intrinsics, u1, v1, at(u1, v1)) : p;
+        const Eigen::Vector3d a = before ? optical_point_m(intrinsics, u0, v0, at(u0, v0)) : p;
+        const Eigen::Vector3d b = after ? optical_point_m(intrinsics, u1, v1, at(u1, v1)) : p;
         *t = b - a;
         return true;
       };

@@ -1,4 +1,5 @@
 #include "tofguard/view/view_compose.hpp"
+#include "tofguard/common/camera_geometry.hpp"
 
 #include <lcm/lcm-cpp.hpp>
 
@@ -67,8 +68,7 @@ cv::Mat1b field_classes(const depth_image_t& camera, const link_labels_t& labels
     const int16_t d = camera.depth_mm[i];
     if (d <= 0) continue;
     const double z = d * 1e-3;
-    const Eigen::Vector3d point((i % camera.width - camera.cx) * z / camera.fx,
-                                (i / camera.width - camera.cy) * z / camera.fy, z);
+    const Eigen::Vector3d point = optical_point_m(camera, i % camera.width, i / camera.width, z);
     const double distance = arm.distance_m(point, warning_m + 0.01);
     classes(i / camera.width, i % camera.width) = distance <= protective_m ? 2
                                                   : distance <= warning_m  ? 1

@@ -77,6 +77,17 @@ struct Intrinsics {
   size_t pixel_count() const { return static_cast<size_t>(width) * static_cast<size_t>(height); }
 };
 
+// The point that pixel (u, v) of a pinhole camera `k` sees at depth z_m,
+// in the camera's optical frame (x right, y down, z along the optical axis;
+// metres): ((u - cx) z / fx, (v - cy) z / fy, z). z_m is the Z
+// coordinate, not the distance along the ray. `k` is anything with fx, fy,
+// cx, cy in pixels (Intrinsics, a depth_image_t's header), unchecked: the
+// back-projection every component does per pixel, in one place.
+template <class Pinhole>
+Eigen::Vector3d optical_point_m(const Pinhole& k, double u, double v, double z_m) {
+  return Eigen::Vector3d((u - k.cx) * z_m / k.fx, (v - k.cy) * z_m / k.fy, z_m);
+}
+
 // A rotation as a quaternion of norm 1, stored normalised.
 // Invariant: finite components; the norm it was made from was within a
 // tolerance of 1 (a quaternion far from unit is refused, never normalised:
