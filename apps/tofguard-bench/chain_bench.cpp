@@ -248,6 +248,23 @@ class ArrivalRecorder {
     return true;
   }
   // Forgets every camera's frames before its `seq`-th.
+  // Waits until one frame of `seqs` has its SAFETY_RISK, or until
+  // `deadline_us` (monotonic). Returns whether one came.
+  bool wait_for_any_verdict(const std::vector<int64_t>& seqs, int64_t deadline_us) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    const auto one_judged = [&] {
+      return std::any_of(seqs.begin(), seqs.end(), [&](int64_t seq) {
+        const auto it = frames_.find(seq);
+        return it != frames_.end() && it->second.risk_us != 0;
+      });
+    };
+    while (!one_judged()) {
+      const int64_t left_us = deadline_us - monotonic_us();
+      if (left_us <= 0) return false;
+      verdict_.wait_for(lock, std::chrono::microseconds(std::min<int64_t>(left_us, 20000)));
+    }
+    return true;
+  }
   void forget_before(int64_t seq) {
     std::lock_guard<std::mutex> lock(mutex_);
     for (auto it = frames_.begin(); it != frames_.end();)
@@ -523,6 +540,10 @@ struct BenchCamera {
   deployment::Config config;  // deployment::select_camera's with several cameras
   std::unique_ptr<SimulatedFrames> frames;
   std::vector<std::vector<uint8_t>> encoded;
+  // Exposing after camera 0 (BenchOptions::camera_offset_ms): each frame
+  // made with the arm as far back along the path (played backwards); empty
+  // otherwise.
+  std::vector<std::vector<uint8_t>> encoded_behind;
   int64_t seq_base = 0;  // c * kCameraSeqStride for camera c
   // Its processes' names in BenchChain's table end with it: "" with one
   // camera, "/<camera id>" with several.
@@ -551,6 +572,7 @@ class BenchChain {
     triangles_ = scene_.num_triangles();
     for (const std::string& joint : cameras_.front().frames->scene().actuated_joint_names)
       joint_names_.push_back(joint);
+    check_camera_offset(std::llround(1e6 / config_rate_hz));
     std::vector<ChannelNames> channels;
     for (const BenchCamera& camera : cameras_) channels.push_back(camera.config.channels);
     recorder_ = std::make_unique<ArrivalRecorder>(config_, channels);
@@ -582,7 +604,7 @@ class BenchChain {
     // (Before the step: the renderer's counts up to the last frame sent
     // before it, the lead-in's; its heartbeats come at 20 Hz.)
     const std::optional<renderer::RendererService::PredictionStats> prediction_before =
-        recorder_->renderer_prediction(last_utime_, monotonic_us() + 1000000);
+        recorder_->renderer_prediction(last_first_camera_utime_, monotonic_us() + 1000000);
     const int64_t start_us = monotonic_us();
     const int64_t first_seq = next_seq_;
     publish(path, kLeadInFrames, frames);
@@ -607,7 +629,7 @@ class BenchChain {
       steps.push_back(std::move(step));
     }
     if (prediction_before) {
-      const auto after = recorder_->renderer_prediction(last_utime_, monotonic_us() + 1000000);
+      const auto after = recorder_->renderer_prediction(last_first_camera_utime_, monotonic_us() + 1000000);
       if (after) {
         BenchStep& step = steps.front();
         step.prediction_hits = static_cast<int>(after->hits - prediction_before->hits);
@@ -798,7 +820,9 @@ class BenchChain {
   // Renders the step's frames before it starts, so that the publisher only
   // publishes: each simulated ToF camera's pipeline (scene at the arm's
   // pose, noise, mixed and invalid pixels, distance calibration), encoded
-  // once.
+  // once. A camera exposing camera_offset_us() after camera 0 gets each
+  // frame twice: the arm that much further along the path, and that much
+  // back (the path played backwards).
   ArmPath prepare(double rate_hz, int count) {
     ArmPath path;
     path.rate_hz = rate_hz;
@@ -807,22 +831,66 @@ class BenchChain {
     // The next step starts elsewhere on the arm's path.
     motion_start_s_ += 1.7;
     last_path_ = path;
-    for (BenchCamera& camera : cameras_) {
-      camera.encoded.clear();
-      const Eigen::Isometry3d world_from_optical = camera.config.camera.pose.frame_from_optical();
-      const Intrinsics& intrinsics = camera.config.camera.intrinsics;
-      for (int i = 0; i < count; ++i) {
-        const std::vector<float> depth_m = camera.frames->capture(
-            joints_at(path.start_s + i / rate_hz), world_from_optical, intrinsics, ++noise_index_);
-        const depth_image_t image =
-            make_depth_image(camera.config.camera.id, intrinsics, 0, 0, /*calibrated=*/true, depth_m);
-        std::vector<uint8_t> bytes(static_cast<size_t>(image.getEncodedSize()));
-        if (image.encode(bytes.data(), 0, static_cast<int>(bytes.size())) < 0)
-          throw std::runtime_error("cannot encode a depth frame");
-        camera.encoded.push_back(std::move(bytes));
-      }
+    for (size_t c = 0; c < cameras_.size(); ++c) {
+      BenchCamera& camera = cameras_[c];
+      const double offset_s = camera_offset_us(c) * 1e-6;
+      camera.encoded = prepare_frames(camera, path, offset_s);
+      camera.encoded_behind.clear();
+      if (offset_s > 0) camera.encoded_behind = prepare_frames(camera, path, -offset_s);
     }
     return path;
+  }
+
+  std::vector<std::vector<uint8_t>> prepare_frames(BenchCamera& camera, const ArmPath& path,
+                                                   double offset_s) {
+    std::vector<std::vector<uint8_t>> encoded;
+    const Eigen::Isometry3d world_from_optical = camera.config.camera.pose.frame_from_optical();
+    const Intrinsics& intrinsics = camera.config.camera.intrinsics;
+    for (int i = 0; i < path.prepared; ++i) {
+      const std::vector<float> depth_m =
+          camera.frames->capture(joints_at(path.start_s + i / path.rate_hz + offset_s), world_from_optical,
+                                 intrinsics, ++noise_index_);
+      const depth_image_t image =
+          make_depth_image(camera.config.camera.id, intrinsics, 0, 0, /*calibrated=*/true, depth_m);
+      std::vector<uint8_t> bytes(static_cast<size_t>(image.getEncodedSize()));
+      if (image.encode(bytes.data(), 0, static_cast<int>(bytes.size())) < 0)
+        throw std::runtime_error("cannot encode a depth frame");
+      encoded.push_back(std::move(bytes));
+    }
+    return encoded;
+  }
+
+  // Every camera exposes within the frame period less 2 ms (its joint
+  // state 1 ms before, the next slot's after); throws
+  // std::invalid_argument otherwise.
+  void check_camera_offset(int64_t period_us) const {
+    if (static_cast<int64_t>(cameras_.size() - 1) * camera_offset_us(1) > period_us - 2000)
+      throw std::invalid_argument("--camera-offset-ms " + number_text(options_.camera_offset_ms) + ": " +
+                                  std::to_string(cameras_.size()) + " cameras must expose within the " +
+                                  number_text(period_us * 1e-3) + " ms period less 2 ms");
+  }
+
+  // When camera c exposes after camera 0, microseconds.
+  int64_t camera_offset_us(size_t c) const {
+    return static_cast<int64_t>(c) * std::llround(options_.camera_offset_ms * 1000);
+  }
+
+  // Camera c's prepared frame for path index `index` exposed at `t_s` on the
+  // path (the arm at path.at(t_s)): the one made at that motion time.
+  std::vector<uint8_t>& frame_at(size_t c, const ArmPath& path, int index, double t_s) {
+    BenchCamera& camera = cameras_[c];
+    if (camera.encoded_behind.empty()) return camera.encoded[static_cast<size_t>(index)];
+    // (The slots are whole microseconds apart, the prepared frames 1 /
+    // rate_hz: the two drift apart by under a microsecond a frame.)
+    const double motion_s = path.at(t_s).first;
+    const double ahead_s = path.start_s + index / path.rate_hz + camera_offset_us(c) * 1e-6;
+    const double behind_s = path.start_s + index / path.rate_hz - camera_offset_us(c) * 1e-6;
+    const double off_ahead_s = std::abs(motion_s - ahead_s), off_behind_s = std::abs(motion_s - behind_s);
+    if (std::min(off_ahead_s, off_behind_s) < 1e-3)
+      return off_ahead_s <= off_behind_s ? camera.encoded[static_cast<size_t>(index)]
+                                         : camera.encoded_behind[static_cast<size_t>(index)];
+    throw std::logic_error("no prepared frame of " + camera.config.camera.id + " at motion time " +
+                           std::to_string(motion_s) + " s (index " + std::to_string(index) + ")");
   }
 
   robot_model::JointPositions joints_at(double motion_s) const {
@@ -853,58 +921,98 @@ class BenchChain {
     return s;
   }
 
-  // Publishes `frames` frames at path.rate_hz on the monotonic clock: before
-  // frame k the joint states since the last frame (every 10 ms) and, 1 ms
-  // before the frame, one at the frame's own utime, so that the renderer
-  // interpolates, never extrapolates (docs/renderer.md). `first_k`: the first frame's index on
-  // the path (the warm-up goes on along it one frame per call).
+  // One thing publish() sends, at_us after its start: a joint state (at
+  // utime_us), the plan's chunk from slot k, or camera `camera`'s frame of
+  // slot k (captured at utime_us).
+  struct Send {
+    enum class Kind { kJointState, kPlan, kFrame };
+    Kind kind = Kind::kJointState;
+    int64_t at_us = 0;
+    int64_t utime_us = 0;
+    int64_t k = 0;
+    size_t camera = 0;
+  };
+
+  // What publish() sends, in time order: before slot k the joint states
+  // since the last slot (every 10 ms) and, 1 ms before each camera's
+  // exposure, one at the exposure's own utime, so that the renderer
+  // interpolates, never extrapolates (docs/renderer.md). JOINT_STATE
+  // (safety URL) and TOF_DEPTH (image URL) arrive on separate sockets, and
+  // a frame that came first would be rendered at joints extrapolated from
+  // the states before it. In the warm-up (one frame a call, no states in
+  // between, the path a period ahead per frame whatever the clock) that
+  // extrapolation was off by degrees: an encoder error the risk's
+  // sequential test then carried into the measured step's first frames
+  // (270-290 SAFE of 300 in some runs). A 10 ms state within that last
+  // millisecond before an exposure is left out: the states' utimes rise.
+  std::vector<Send> schedule(int64_t period_us, int64_t frames) const {
+    check_camera_offset(period_us);
+    std::vector<int64_t> exposures_us;
+    for (int64_t k = 0; k < frames; ++k)
+      for (size_t c = 0; c < cameras_.size(); ++c)
+        exposures_us.push_back(k * period_us + camera_offset_us(c));
+    const auto just_before_an_exposure = [&](int64_t j) {
+      return std::any_of(exposures_us.begin(), exposures_us.end(),
+                         [j](int64_t e) { return e - 1000 <= j && j <= e; });
+    };
+    std::vector<Send> sends;
+    for (int64_t k = 0; k < frames; ++k) {
+      const int64_t slot_us = k * period_us;
+      for (int64_t j = slot_us - period_us + kJointStatePeriodUs; k > 0 && j < slot_us - 1000;
+           j += kJointStatePeriodUs) {
+        if (!just_before_an_exposure(j)) sends.push_back({Send::Kind::kJointState, j, j, k, 0});
+      }
+      if (options_.plan && k % kPlanChunkFrames == 0)
+        sends.push_back({Send::Kind::kPlan, slot_us - 1000, 0, k, 0});
+      for (size_t c = 0; c < cameras_.size(); ++c) {
+        const int64_t exposure_us = slot_us + camera_offset_us(c);
+        // (Cameras exposing at the same instant share its state.)
+        if (c == 0 || camera_offset_us(c) != camera_offset_us(c - 1))
+          sends.push_back({Send::Kind::kJointState, exposure_us - 1000, exposure_us, k, c});
+        sends.push_back({Send::Kind::kFrame, exposure_us, exposure_us, k, c});
+      }
+    }
+    std::stable_sort(sends.begin(), sends.end(),
+                     [](const Send& a, const Send& b) { return a.at_us < b.at_us; });
+    return sends;
+  }
+
+  // Publishes `frames` frames of every camera at path.rate_hz on the
+  // monotonic clock, with the joint states around them (schedule()).
+  // `first_k`: the first frame's index on the path (the warm-up goes on
+  // along it one frame per call).
   void publish(const ArmPath& path, int64_t first_k, int64_t frames) {
     const int64_t period_us = std::llround(1e6 / path.rate_hz);
+    const std::vector<Send> sends = schedule(period_us, frames);
     const int64_t start_mono_us = monotonic_us() + 2000;
     // utimes continue the wall clock (capture time = the time it is sent),
     // and always rise across steps.
     const int64_t start_utime = std::max(wall_utime(), last_utime_ + 1000) + 2000;
-    const auto at = [&](int64_t offset_us) {
+    const int64_t first_seq = next_seq_;
+    for (const Send& send : sends) {
       std::this_thread::sleep_until(
-          std::chrono::steady_clock::time_point(std::chrono::microseconds(start_mono_us + offset_us)));
-    };
-    for (int64_t k = 0; k < frames; ++k) {
-      const int64_t frame_us = k * period_us;
-      if (k > 0) {
-        for (int64_t j = frame_us - period_us + kJointStatePeriodUs; j < frame_us - 1000;
-             j += kJointStatePeriodUs) {
-          at(j);
-          const joint_state_t s = joint_state(path, (first_k * period_us + j) * 1e-6, start_utime + j);
-          safety_->publish(config_.channels.joint_state, &s);
-        }
-      }
-      // The frame's own joint state 1 ms before the frame: JOINT_STATE
-      // (safety URL) and TOF_DEPTH (image URL) arrive on separate sockets,
-      // and a frame that came first would be rendered at joints
-      // extrapolated from the states before it. In the warm-up (one frame a
-      // call, no states in between, the path a period ahead per frame
-      // whatever the clock) that extrapolation was off by degrees: an
-      // encoder error the risk's sequential test then carried into the
-      // measured step's first frames (270-290 SAFE of 300 in some runs).
-      at(frame_us - 1000);
-      if (options_.plan && k % kPlanChunkFrames == 0) publish_plan(path, first_k, k, frames, start_utime);
-      const int64_t utime = start_utime + frame_us;
-      const joint_state_t s = joint_state(path, (first_k * period_us + frame_us) * 1e-6, utime);
-      safety_->publish(config_.channels.joint_state, &s);
-      at(frame_us);
-      // Every camera's frame of this instant, one after the other (cameras
-      // that run free may expose at the same time).
-      for (BenchCamera& camera : cameras_) {
-        std::vector<uint8_t>& bytes = camera.encoded[static_cast<size_t>(path.index(first_k + k))];
+          std::chrono::steady_clock::time_point(std::chrono::microseconds(start_mono_us + send.at_us)));
+      const int64_t utime = start_utime + send.utime_us;
+      const double t_s = (first_k * period_us + send.utime_us) * 1e-6;  // on the path
+      if (send.kind == Send::Kind::kPlan) {
+        publish_plan(path, first_k, send.k, frames, start_utime);
+      } else if (send.kind == Send::Kind::kJointState) {
+        const joint_state_t state = joint_state(path, t_s, utime);
+        safety_->publish(config_.channels.joint_state, &state);
+      } else {
+        const BenchCamera& camera = cameras_[send.camera];
+        std::vector<uint8_t>& bytes = frame_at(send.camera, path, path.index(first_k + send.k), t_s);
+        const int64_t seq = camera.seq_base + first_seq + send.k;
         put_int64_be(bytes.data() + kUtimeOffset, utime);
-        put_int64_be(bytes.data() + kSeqOffset, camera.seq_base + next_seq_);
-        recorder_->sent(camera.seq_base + next_seq_, monotonic_us());
+        put_int64_be(bytes.data() + kSeqOffset, seq);
+        recorder_->sent(seq, monotonic_us());
         images_->publish(camera.config.channels.depth, bytes.data(), static_cast<unsigned int>(bytes.size()));
+        last_send_us_ = monotonic_us();
+        last_utime_ = std::max(last_utime_, utime);
+        if (send.camera == 0) last_first_camera_utime_ = utime;
       }
-      last_send_us_ = monotonic_us();
-      last_utime_ = utime;
-      ++next_seq_;
     }
+    next_seq_ = first_seq + frames;
   }
 
   // The plan's chunk from frame k of a publish() call on: a point at each
@@ -947,8 +1055,13 @@ class BenchChain {
         if (!p->running()) throw std::runtime_error(name + " exited at start\n" + stderr_of_all());
       }
       publish(path, next_seq_ - first_seq, 1);
-      const int64_t seq = next_seq_ - 1;
-      in_a_row = recorder_->wait_for_verdicts(seq, seq, monotonic_us() + options_.result_timeout_us)
+      // With several cameras, while the verdict is not SAFE (the start's
+      // deadlines) tofguard-risk publishes the camera longest DANGEROUS,
+      // with that camera's seq: a verdict for any camera's frame of the
+      // slot shows the chain through.
+      std::vector<int64_t> seqs;
+      for (const BenchCamera& camera : cameras_) seqs.push_back(camera.seq_base + next_seq_ - 1);
+      in_a_row = recorder_->wait_for_any_verdict(seqs, monotonic_us() + options_.result_timeout_us)
                      ? in_a_row + 1
                      : 0;
     }
@@ -1109,7 +1222,8 @@ class BenchChain {
   std::map<std::string, std::unique_ptr<Subprocess>> processes_;
   int64_t next_seq_ = 1;
   int64_t last_send_us_ = 0;
-  int64_t last_utime_ = 0;
+  int64_t last_utime_ = 0;               // the newest frame's utime sent (any camera's)
+  int64_t last_first_camera_utime_ = 0;  // camera 0's newest frame (its renderer's heartbeats say it)
   uint64_t noise_index_ = 0;
   double motion_start_s_ = 0;
   bool warm_ = false;

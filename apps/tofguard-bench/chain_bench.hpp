@@ -10,8 +10,8 @@
 // arrived; from that the latency of each stage, frames dropped, CPU per
 // process (/proc) and, ramping the rate, the highest rate sustained.
 //
-// Beside each arm and size, the floors the stages are held against (issue
-// 17: each stage within 2x of its floor), measured by the bench itself after
+// Beside each arm and size, the floors the stages are held against (the
+// target: each stage within 2x of its floor), measured by the bench itself after
 // the chain's processes are stopped: the renderer's scene rendered in this
 // process along the same joint path at the same intrinsics, compute_discrepancy
 // on the prepared frames, and one LCM hop of each stage's message size on a
@@ -38,6 +38,14 @@ struct BenchOptions {
   std::vector<std::pair<int, int>> resolutions = {{176, 144}};
   double rate_hz = 30;
   double seconds = 10;
+  // With several cameras (--arms two-cameras), camera c exposes
+  // c * camera_offset_ms after camera 0 (cameras triggered in turn, as
+  // time-multiplexed ToF cameras are); each camera's frames then show the
+  // arm at their own instant, carry it as utime, and its joint state comes
+  // 1 ms before each as before camera 0's. 0: every camera at the same
+  // instant, one frame right after the other. At most the frame period
+  // less 2 ms over the cameras.
+  double camera_offset_ms = 0;
   // Ramp: rates ramp_start_hz, twice that, ... up to ramp_max_hz, each for
   // ramp_step_s, stopping at the first rate with a dropped frame, a stage's
   // p99 above the frame period, or a publisher that could not keep the rate;

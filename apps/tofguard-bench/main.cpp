@@ -6,13 +6,15 @@
 //   tofguard-bench [--arms default,iiwa14,kinova,sim,two-cameras] [--resolutions 176x144,320x240,640x480]
 //                  [--rate-hz 30] [--seconds 10] [--ramp] [--ramp-step-s 3] [--ramp-max-hz 1920]
 //                  [--shared DIR] [--markdown FILE] [--plot FILE.png] [--frames FILE.csv] [--no-floors]
-//                  [--floor-listeners N] [--plan] [--no-joint-prediction]
+//                  [--floor-listeners N] [--plan] [--no-joint-prediction] [--camera-offset-ms MS]
 //
 // --arms: the campaign's arms (default, iiwa14, kinova: the ideal camera
 // at each size asked), or a deployment of config/ as it is, at its cameras'
 // 176x144 and 30 Hz: sim (config/sim.yaml, its camera commissioned),
 // two-cameras (config/sim-two-cameras.yaml: both cameras' frames at each
-// instant, a row per camera; no floors, no --ramp).
+// instant, a row per camera; no floors, no --ramp). --camera-offset-ms MS:
+// camera c exposes c * MS after camera 0 (cameras triggered in turn), each
+// frame showing the arm at its own instant (BenchOptions::camera_offset_ms).
 //
 // Each step's measured frames come after 20 at its rate that are not
 // measured (the chain's steady state at that rate; chain_bench.cpp,
@@ -65,7 +67,7 @@ int usage(const std::string& why) {
                "176x144,320x240,640x480] "
                "[--rate-hz 30] [--seconds 10] [--ramp] [--ramp-step-s 3] [--ramp-max-hz 1920] [--shared DIR] "
                "[--markdown FILE] [--plot FILE.png] [--frames FILE.csv] [--no-floors] [--floor-listeners N] "
-               "[--plan] [--no-joint-prediction]\n";
+               "[--plan] [--no-joint-prediction] [--camera-offset-ms MS]\n";
   return 2;
 }
 
@@ -127,6 +129,10 @@ int main(int argc, char** argv) {
         plot_path = value;
       } else if (option == "--frames") {
         frames_path = value;
+      } else if (option == "--camera-offset-ms") {
+        options.camera_offset_ms = std::stod(value);
+        if (!(options.camera_offset_ms >= 0))
+          return usage("--camera-offset-ms: expected 0 or more, got " + value);
       } else if (option == "--floor-listeners") {
         options.floor_listeners = std::stoi(value);
         if (options.floor_listeners < 0 || options.floor_listeners > 16)

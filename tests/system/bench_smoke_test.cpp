@@ -150,15 +150,17 @@ TEST(BenchSmoke, WithThePlanFramesAreRenderedAhead) {
 }
 
 // The two-camera deployment as it is (config/sim-two-cameras.yaml, both
-// cameras commissioned), both cameras' frames sent at each instant: each
-// camera's frames go through its own renderer and discrepancy process to a
-// verdict of their own (by seq), a row per camera; no floors (one camera's
-// stages alone).
+// cameras commissioned), the side camera exposing half a period after the
+// mast camera (its frames made at their own instant of the arm's path):
+// each camera's frames go through its own renderer and discrepancy process
+// to a verdict of their own (by seq), SAFE, a row per camera; no floors
+// (one camera's stages alone).
 TEST(BenchSmoke, TwoCamerasEachFrameGetsItsOwnVerdict) {
   BenchOptions options = smoke_options();
   options.arms = {"two-cameras"};
   options.rate_hz = 30;  // the cameras' own rate
   options.seconds = 2;
+  options.camera_offset_ms = 16.7;
   const BenchReport report = run_bench(options, std::cerr);
   ASSERT_EQ(report.steps.size(), 2u);
   EXPECT_TRUE(report.floors.empty());
@@ -181,9 +183,10 @@ TEST(BenchSmoke, TwoCamerasEachFrameGetsItsOwnVerdict) {
   EXPECT_NE(markdown.find("| two-cameras tof-side | "), std::string::npos) << markdown;
 }
 
-// A deployment of config/ runs at its cameras' own size and rate: another
-// is refused before any process starts, naming the camera and both.
-TEST(BenchSmoke, ADeploymentAtAnotherSizeIsRefused) {
+// A deployment of config/ runs at its cameras' own size and rate, and its
+// cameras expose within a frame period: anything else is refused before
+// any process starts, saying what was asked and what it must be.
+TEST(BenchSmoke, ADeploymentAtAnotherSizeOrOffsetIsRefused) {
   BenchOptions options = smoke_options();
   options.arms = {"two-cameras"};
   options.resolutions = {{320, 240}};
@@ -192,6 +195,19 @@ TEST(BenchSmoke, ADeploymentAtAnotherSizeIsRefused) {
     ADD_FAILURE() << "ran config/sim-two-cameras.yaml at 320x240";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("tof-mast is 176x144 at 30 Hz, asked 320x240 at 10 Hz"),
+              std::string::npos)
+        << e.what();
+  }
+  options = smoke_options();
+  options.arms = {"two-cameras"};
+  options.rate_hz = 30;
+  options.camera_offset_ms = 32;
+  try {
+    run_bench(options, std::cerr);
+    ADD_FAILURE() << "ran two cameras 32 ms apart at 30 Hz";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find(
+                  "--camera-offset-ms 32: 2 cameras must expose within the 33.333 ms period"),
               std::string::npos)
         << e.what();
   }
