@@ -59,7 +59,11 @@ void LcmNode::join(lcm::LCM& lcm) {
 LcmNode::~LcmNode() = default;
 
 void LcmNode::add_timer(int64_t period_us, std::function<void()> tick) {
-  timers_.push_back(Timer{period_us, monotonic_us() + period_us, std::move(tick)});
+  add_timer(period_us, monotonic_us() + period_us, std::move(tick));
+}
+
+void LcmNode::add_timer(int64_t period_us, int64_t first_due_us, std::function<void()> tick) {
+  timers_.push_back(Timer{period_us, first_due_us, std::move(tick)});
 }
 
 bool LcmNode::spin_once(int max_wait_ms) {

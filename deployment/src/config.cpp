@@ -39,7 +39,15 @@ CameraSection read_camera_section(YamlMap& camera, bool profile_key) {
     c.depth_calibration = camera::read_depth_calibration_settings(camera.map("depth_calibration"));
   }
   if (c.source == "uvc" || camera.optional("uvc")) c.uvc = camera::read_uvc_settings(camera.map("uvc"));
-  if (c.source == "sim" || camera.optional("sim")) c.sim = sim::read_sim_camera_settings(camera.map("sim"));
+  if (c.source == "sim" || camera.optional("sim")) {
+    c.sim = sim::read_sim_camera_settings(camera.map("sim"));
+    if (c.sim.exposure_offset_ms >= 1000 / c.rate_hz) {
+      camera.map("sim").fail(
+          "exposure_offset_ms",
+          "less than the frame period, " + std::to_string(1000 / c.rate_hz) + " ms at rate_hz",
+          std::to_string(c.sim.exposure_offset_ms));
+    }
+  }
   if (profile_key && camera.optional("camera_profile")) {
     c.profile =
         std::make_shared<const CameraProfile>(read_camera_profile(camera.existing_path("camera_profile")));

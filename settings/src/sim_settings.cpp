@@ -78,6 +78,7 @@ SimUserSettings read_sim_user(YamlMap map) {
 SimCameraSettings read_sim_camera_settings(YamlMap map) {
   SimCameraSettings c;
   c.seed = static_cast<uint64_t>(map.integer("seed", 0, INT64_MAX));
+  if (map.optional("exposure_offset_ms")) c.exposure_offset_ms = map.number("exposure_offset_ms", 0, 1000);
   c.systematic_error_m = map.numbers("systematic_error_m", -1);
   if (c.systematic_error_m.empty() || c.systematic_error_m.size() > 10) {
     map.fail("systematic_error_m", "1 to 10 polynomial coefficients (ascending powers, metres)",

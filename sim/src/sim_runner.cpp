@@ -136,14 +136,18 @@ int run_sim_camera(const SimCameraProcessSettings& settings) {
       },
       check_sim_camera_fault);
 
-  // Frame slots on the monotonic clock; the capture time is one period
-  // before publication (exposure and read-out of a real camera), so that
-  // the true joint states around it have arrived.
+  // Frame slots on the monotonic clock, camera.sim.exposure_offset_ms after
+  // each whole period of it (cameras on one computer expose in turn); the
+  // capture time is one period before publication (exposure and read-out
+  // of a real camera), so that the true joint states around it have
+  // arrived.
   const int64_t period_us = static_cast<int64_t>(std::llround(1e6 / camera_config.rate_hz));
-  const int64_t start_us = monotonic_us();
+  const int64_t offset_us = std::llround(settings.sim.exposure_offset_ms * 1000);
+  const int64_t first_slot_us = (monotonic_us() / period_us + 1) * period_us + offset_us;
+  const int64_t start_us = first_slot_us - period_us;
   int64_t last_slot = 0;
   node.heartbeat().set_status("starting: waiting for true joint states");
-  node.add_timer(period_us, [&] {
+  node.add_timer(period_us, first_slot_us, [&] {
     const int64_t slot = (monotonic_us() - start_us + period_us / 2) / period_us;
     if (slot <= last_slot) return;
     if (slot > last_slot + 1) {

@@ -192,6 +192,10 @@ INSTANTIATE_TEST_SUITE_P(
                   "    faults: [{kind: pan_tilt_offset, start_s: 1, duration_s: 1, pan_offset_deg: 3, "
                   "tilt_offset_deg: 0}]\n",
                   {"camera.sim.faults", "only with camera.sim.pan_tilt"}},
+        BadConfig{"exposure-offset-beyond-the-period",
+                  "    seed: 1\n",
+                  "    seed: 1\n    exposure_offset_ms: 40\n",
+                  {"camera.sim.exposure_offset_ms", "less than the frame period, 33.3", "40"}},
         BadConfig{"unseen-arm-fraction-above-1",
                   "  unseen_arm_max_fraction: 0.5\n",
                   "  unseen_arm_max_fraction: 1.5\n",

@@ -67,6 +67,9 @@ class LcmNode {
   // Calls `tick` every `period_us` microseconds of the monotonic clock
   // (first call one period from now).
   void add_timer(int64_t period_us, std::function<void()> tick);
+  // The same, the first call at `first_due_us` (monotonic), so that the
+  // calls keep that phase.
+  void add_timer(int64_t period_us, int64_t first_due_us, std::function<void()> tick);
 
   // Handles every message and due timer within `max_wait_ms`; returns false
   // once a stop was requested.

@@ -216,6 +216,13 @@ struct SimUserSettings {
 
 struct SimCameraSettings {
   uint64_t seed = 0;
+  // exposure_offset_ms (optional, 0..the frame period; absent: 0): the
+  // camera exposes this long after each whole frame period of the
+  // computer's monotonic clock, so that cameras simulated on one computer
+  // expose in turn, as time-multiplexed ToF cameras are triggered so that
+  // none sees another's light (docs/camera.md, "The second camera"). Every
+  // camera with the same offset exposes at the same instant.
+  double exposure_offset_ms = 0;
   // systematic_error_m: systematic error e(r) = sum_i systematic_error_m[i]
   // * r^i, metres; the camera measures r + e(r).
   std::vector<double> systematic_error_m;
