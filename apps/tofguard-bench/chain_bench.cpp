@@ -247,7 +247,6 @@ class ArrivalRecorder {
     }
     return true;
   }
-  // Forgets every camera's frames before its `seq`-th.
   // Waits until one frame of `seqs` has its SAFETY_RISK, or until
   // `deadline_us` (monotonic). Returns whether one came.
   bool wait_for_any_verdict(const std::vector<int64_t>& seqs, int64_t deadline_us) {
@@ -265,6 +264,7 @@ class ArrivalRecorder {
     }
     return true;
   }
+  // Forgets every camera's frames before its `seq`-th.
   void forget_before(int64_t seq) {
     std::lock_guard<std::mutex> lock(mutex_);
     for (auto it = frames_.begin(); it != frames_.end();)

@@ -65,6 +65,11 @@ std::optional<risk_t> VerdictFusion::fuse(size_t camera, risk_t verdict) {
   if (released_[camera] && verdict.seq >= 0 && verdict.level == risk_t::SAFE) released_[camera].reset();
   if (released_[camera]) return std::nullopt;
   risk_t published = worst_counted(camera, verdict);
+  // A verdict about no frame (a deadline's, seq -1) that publishes another
+  // camera's worse frame verdict publishes it as about no frame: that
+  // frame's verdict went out when it was judged, and a second one with its
+  // seq would be taken for another frame judged.
+  if (verdict.seq < 0) published.seq = -1;
   for (size_t c = 0; c < released_.size(); ++c) {
     if (!released_[c]) continue;
     published.detail += " [" + camera_ids_[c] + " left out: released by " + released_[c]->who + ": " +

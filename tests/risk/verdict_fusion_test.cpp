@@ -119,6 +119,24 @@ TEST(VerdictFusion, AStalledCamerasTimeoutHoldsUntilItsNextVerdict) {
   EXPECT_EQ(out.detail, "tof-side: TOF_DEPTH/tof-side stale");
 }
 
+// A verdict about no frame (seq -1) while another camera's latest frame
+// verdict is worse publishes that verdict, but as about no frame: its
+// frame's verdict went out once already, and a second with its seq would
+// count as another frame judged (a replay's frames and verdicts).
+TEST(VerdictFusion, AVerdictAboutNoFramePublishesNoFramesVerdictAgain) {
+  VerdictFusion fusion = two_cameras();
+  const risk_t unusable =
+      *fusion.fuse(0, verdict(6, risk_t::WARNING, risk_t::CAUSE_SENSOR_FAULT, "unusable"));
+  EXPECT_EQ(unusable.seq, 6);
+  EXPECT_EQ(fusion.fuse(1, verdict(6, risk_t::SAFE))->seq, 6);  // the mast camera's WARNING, as it was
+  const risk_t out = *fusion.fuse(1, verdict(-1, risk_t::SAFE, risk_t::CAUSE_NONE, "inputs fresh"));
+  EXPECT_EQ(out.level, risk_t::WARNING);
+  EXPECT_EQ(out.detail, "tof-mast: unusable");
+  EXPECT_EQ(out.seq, -1);
+  // A frame verdict still publishes the winner's seq.
+  EXPECT_EQ(fusion.fuse(1, verdict(7, risk_t::SAFE))->seq, 6);
+}
+
 // risk.camera_loss continue_after_named_reset: a lost camera released by
 // name is left out, said in every verdict, until it judges SAFE again.
 TEST(VerdictFusion, AReleasedLostCameraIsLeftOutAndSaidUntilItIsBack) {

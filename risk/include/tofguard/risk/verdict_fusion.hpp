@@ -44,9 +44,12 @@ class VerdictFusion {
   // DANGEROUS, the one that has been so longest (the first finding stands
   // while it holds: a camera knocked, then the joint tests that its
   // frames push over, are published as the knock); among other equals,
-  // the newest. A released camera's SAFE frame verdict brings it back; its
-  // other verdicts publish nothing (nullopt): the cameras that judge say
-  // what there is to say.
+  // the newest. The verdict published carries the seq of the verdict that
+  // won, except that a verdict about no frame (seq -1, a deadline's)
+  // publishes with seq -1 whichever wins: each frame verdict goes out once.
+  // A released camera's SAFE frame verdict brings it back; its other
+  // verdicts publish nothing (nullopt): the cameras that judge say what
+  // there is to say.
   std::optional<risk_t> fuse(size_t camera, risk_t verdict);
 
   // An operator's release of lost camera `camera`: "" when accepted (or
