@@ -545,9 +545,6 @@ struct BenchCamera {
   // otherwise.
   std::vector<std::vector<uint8_t>> encoded_behind;
   int64_t seq_base = 0;  // c * kCameraSeqStride for camera c
-  // Its processes' names in BenchChain's table end with it: "" with one
-  // camera, "/<camera id>" with several.
-  std::string process_suffix;
 };
 
 // One arm at one camera size: its config, the chain running on it, the
@@ -655,7 +652,7 @@ class BenchChain {
       const size_t slash = name.find('/');
       if (slash == std::string::npos) {
         step.cpu_percent[name] = percent;  // a shared process, or the one camera's
-      } else if (name.substr(slash) == camera.process_suffix) {
+      } else if (name.substr(slash + 1) == camera.config.camera.id) {  // "<process>/<camera id>"
         step.cpu_percent[name.substr(0, slash)] = percent;
       }
     }
@@ -779,7 +776,6 @@ class BenchChain {
       }
       camera.frames = std::make_unique<SimulatedFrames>(camera.config);
       camera.seq_base = static_cast<int64_t>(c) * kCameraSeqStride;
-      camera.process_suffix = several ? "/" + camera.config.camera.id : "";
       cameras_.push_back(std::move(camera));
     }
   }
@@ -787,7 +783,7 @@ class BenchChain {
   // The judge first, so that it listens before its inputs speak (as
   // LiveChain starts it); with several cameras each camera's renderer and
   // discrepancy process with --camera, as the deployment's launch: section
-  // starts them.
+  // starts them, named "<process>/<camera id>" in processes_.
   void start_processes(const std::string& name) {
     for (const std::string& p : kChainProcesses) {
       const bool per_camera = p == "tofguard-renderer" || p == "tofguard-discrepancy";
@@ -798,7 +794,7 @@ class BenchChain {
       }
       for (const BenchCamera& camera : cameras_) {
         const std::string& id = camera.config.camera.id;
-        processes_[p + camera.process_suffix] = std::make_unique<Subprocess>(
+        processes_[p + "/" + id] = std::make_unique<Subprocess>(
             name + "-" + p + "-" + id,
             std::vector<std::string>{bin_dir() + "/" + p, "--config", config_path_, "--camera", id});
       }

@@ -556,12 +556,8 @@ struct CampaignWorld {
         arm_cover(robot_model::cover_arm_with_spheres(model_scene, config.renderer.arm_cover_cell_m)),
         truth_cover(robot_model::cover_arm_with_spheres(model_scene, 0.01)),
         robot_tree(robot_model::load_kinematic_tree(config.robot.urdf_path)),
-        // As tofguard-risk reads them.
-        robot_link_areas(risk::read_robot_link_areas(config.robot.urdf_path, config.robot.package_paths,
-                                                     config.renderer.geometry)),
-        // As tofguard-discrepancy derives them (with several cameras it
-        // looks through the others' frames).
-        options(discrepancy::process_discrepancy_options(deployment::discrepancy_process_settings(config))),
+        discrepancy_process(deployment::discrepancy_process_settings(config)),
+        options(discrepancy::process_discrepancy_options(discrepancy_process)),
         intrinsics(config.camera.intrinsics),
         period_s(1.0 / config.camera.rate_hz),
         period_us(static_cast<int64_t>(std::llround(period_s * 1e6))),
@@ -577,7 +573,10 @@ struct CampaignWorld {
   // of the surface) than the renderer's.
   const robot_model::ArmSpheres truth_cover;
   const robot_model::KinematicTree robot_tree;
-  const std::vector<risk::LinkArea> robot_link_areas;
+  // tofguard-discrepancy's settings (its witnesses: the other cameras) and
+  // the options it derives from them (with several cameras it looks
+  // through the others' frames).
+  const settings::DiscrepancyProcessSettings discrepancy_process;
   const discrepancy::DiscrepancyOptions options;
   const Intrinsics intrinsics;
   const double period_s;
@@ -604,25 +603,21 @@ std::vector<risk::RiskCamera> risk_cameras(const std::vector<CampaignWorld*>& wo
 // decided.
 class CampaignRunJudge {
  public:
-  CampaignRunJudge(const std::vector<CampaignWorld*>& worlds, const CampaignRun& run)
+  // `robot_link_areas`: as tofguard-risk reads them (with several cameras).
+  CampaignRunJudge(const std::vector<CampaignWorld*>& worlds,
+                   const std::vector<risk::LinkArea>& robot_link_areas, const CampaignRun& run)
       : worlds_(worlds),
         w_(*worlds.front()),
         config_(w_.config),
         run_(run),
         fault_camera_(run.fault.camera),
-        judgement_(config_.risk, risk_cameras(worlds), w_.robot_tree, w_.robot_link_areas, std::nullopt, 0),
+        judgement_(config_.risk, risk_cameras(worlds), w_.robot_tree, robot_link_areas, std::nullopt, 0),
         repeats_(worlds.size()),
         last_depth_m_(worlds.size()),
         kind_(run.fault.kind),
         stall_(kind_ == Kind::kCameraStall || kind_ == Kind::kJointStall),
         object_fault_(kind_ == Kind::kObject) {
-    for (const CampaignWorld* w : worlds) {
-      std::vector<settings::WitnessCameraSettings> witnesses =
-          deployment::discrepancy_process_settings(w->config).witnesses;
-      witness_ids_.emplace_back();
-      for (const auto& witness : witnesses) witness_ids_.back().push_back(witness.id);
-      witness_frames_.emplace_back(std::move(witnesses));
-    }
+    for (const CampaignWorld* w : worlds) witness_frames_.emplace_back(w->discrepancy_process.witnesses);
     if (fault_camera_ >= worlds.size()) {
       throw std::invalid_argument("campaign fault " + run.fault.label + ": no camera " +
                                   std::to_string(fault_camera_));
@@ -810,14 +805,13 @@ class CampaignRunJudge {
   // its tofguard-discrepancy takes them in (paired by seq, corrected by
   // camera c's profile).
   void show_to_witnesses(size_t c, const depth_image_t& frame, const link_labels_t& labels) {
-    for (size_t judged = 0; judged < worlds_.size(); ++judged) {
-      const std::vector<std::string>& ids = witness_ids_[judged];
-      const auto at = std::find(ids.begin(), ids.end(), worlds_[c]->config.camera.id);
-      if (at == ids.end()) continue;
-      const auto index = static_cast<size_t>(at - ids.begin());
-      witness_frames_[judged].add_depth(index, frame);
-      if (const std::string why = witness_frames_[judged].add_labels(index, labels); !why.empty()) {
-        throw std::runtime_error("campaign: " + *at + "'s frame cannot be looked through: " + why);
+    const std::string& id = worlds_[c]->config.camera.id;
+    for (discrepancy::WitnessFrames& witnesses : witness_frames_) {
+      const size_t index = witnesses.index_of(id);
+      if (index == witnesses.cameras()) continue;  // camera c's own
+      witnesses.add_depth(index, frame);
+      if (const std::string why = witnesses.add_labels(index, labels); !why.empty()) {
+        throw std::runtime_error("campaign: " + id + "'s frame cannot be looked through: " + why);
       }
     }
   }
@@ -993,9 +987,8 @@ class CampaignRunJudge {
   std::vector<discrepancy::RepeatCounter> repeats_;
   std::vector<std::vector<float>> last_depth_m_;  // the image a frozen camera repeats
   // Per camera, its tofguard-discrepancy's witnesses: the other cameras'
-  // frames (witness_frames.hpp), and their ids in that order.
+  // frames (witness_frames.hpp).
   std::vector<discrepancy::WitnessFrames> witness_frames_;
-  std::vector<std::vector<std::string>> witness_ids_;
   CampaignResult result_;
   const Kind kind_;
   const bool stall_;
@@ -1025,8 +1018,16 @@ std::vector<CampaignResult> run_campaign(const CampaignArm& arm, const std::vect
     worlds.push_back(std::make_unique<CampaignWorld>(config));
     world_pointers.push_back(worlds.back().get());
   }
+  // Each robot link's surface area as tofguard-risk reads it, once, with
+  // several cameras (the arm no camera sees); one camera needs none.
+  const std::vector<risk::LinkArea> robot_link_areas =
+      camera_configs.size() < 2
+          ? std::vector<risk::LinkArea>{}
+          : risk::read_robot_link_areas(arm.config.robot.urdf_path, arm.config.robot.package_paths,
+                                        arm.config.renderer.geometry);
   std::vector<CampaignResult> results;
-  for (const CampaignRun& run : runs) results.push_back(CampaignRunJudge(world_pointers, run).judge());
+  for (const CampaignRun& run : runs)
+    results.push_back(CampaignRunJudge(world_pointers, robot_link_areas, run).judge());
   return results;
 }
 

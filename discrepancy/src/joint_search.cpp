@@ -1,5 +1,4 @@
 #include "tofguard/discrepancy/joint_search.hpp"
-#include "tofguard/common/camera_geometry.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -11,6 +10,7 @@
 #include <Eigen/Geometry>
 
 #include "double2.hpp"
+#include "tofguard/common/camera_geometry.hpp"
 #include "tofguard/common/depth_frame.hpp"
 
 namespace tofguard::discrepancy {

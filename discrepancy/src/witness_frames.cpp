@@ -10,6 +10,12 @@ namespace tofguard::discrepancy {
 WitnessFrames::WitnessFrames(std::vector<settings::WitnessCameraSettings> cameras)
     : cameras_(std::move(cameras)), depth_(cameras_.size()), ready_(cameras_.size()) {}
 
+size_t WitnessFrames::index_of(const std::string& id) const {
+  size_t c = 0;
+  while (c < cameras_.size() && cameras_[c].id != id) ++c;
+  return c;
+}
+
 void WitnessFrames::add_depth(size_t camera, const depth_image_t& frame) {
   std::deque<depth_image_t>& kept = depth_[camera];
   kept.push_back(frame);

@@ -1,5 +1,4 @@
 #include "tofguard/estimator/motion_estimator.hpp"
-#include "tofguard/common/camera_geometry.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -11,6 +10,7 @@
 #include <Eigen/Cholesky>
 #include <opencv2/imgproc.hpp>
 
+#include "tofguard/common/camera_geometry.hpp"
 #include "tofguard/common/depth_frame.hpp"
 
 namespace tofguard::estimator {

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "tofguard/robot_model/scene_model.hpp"
+
 namespace tofguard::risk {
 namespace {
 

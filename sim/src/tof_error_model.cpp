@@ -1,5 +1,4 @@
 #include "tofguard/sim/tof_error_model.hpp"
-#include "tofguard/common/camera_geometry.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,6 +8,7 @@
 #include <Eigen/Core>
 
 #include "tofguard/camera/depth_calibration.hpp"
+#include "tofguard/common/camera_geometry.hpp"
 #include "tofguard/sim/deterministic_random.hpp"
 
 namespace tofguard::sim {

@@ -1,5 +1,4 @@
 #include "tofguard/view/view_compose.hpp"
-#include "tofguard/common/camera_geometry.hpp"
 
 #include <lcm/lcm-cpp.hpp>
 
@@ -9,6 +8,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "tofguard/common/camera_geometry.hpp"
 #include "tofguard/common/decode.hpp"
 #include "tofguard/common/risk_names.hpp"
 #include "tofguard/common/wire_checks.hpp"

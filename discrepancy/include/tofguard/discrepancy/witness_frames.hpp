@@ -34,6 +34,9 @@ class WitnessFrames {
   explicit WitnessFrames(std::vector<settings::WitnessCameraSettings> cameras);
 
   size_t cameras() const { return cameras_.size(); }
+  // The index of camera `id` among them, or cameras() when it is none of
+  // them (the judged camera itself).
+  size_t index_of(const std::string& id) const;
   // Camera `camera`'s frame (passed its wire checks, of that camera).
   void add_depth(size_t camera, const depth_image_t& frame);
   // Camera `camera`'s labels. "" when taken (or not needed: unusable, or

@@ -19,7 +19,6 @@
 
 #include "tofguard/discrepancy_t.hpp"
 #include "tofguard/risk_t.hpp"
-#include "tofguard/robot_model/scene_model.hpp"
 
 namespace tofguard::risk {
 
